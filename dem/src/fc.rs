@@ -1,0 +1,1 @@
+//! Standalone frictional-contact problems (fc-problem-v1).
