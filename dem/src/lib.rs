@@ -12,3 +12,4 @@
 
 pub mod fc;
 pub mod local;
+pub mod snapshot;
