@@ -1,0 +1,389 @@
+//! μ(I) and φ(I) fits from steady shear (laws in [`crate::laws::mu_i`]).
+//!
+//! - [`fit_mu_i`]: `μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)`, fitted in the parameters
+//!   `(μ_s, Δμ = μ₂ − μ_s, I₀)` with box bounds `μ_s > 0`, `0 < Δμ ≤ 10`, `I₀ > 0` (so that
+//!   `μ_s < μ₂` holds by construction) and reported as `(μ_s, μ₂, I₀)` (exact linear
+//!   reparametrisation of the covariance). Started from a variable-projection grid over `I₀`
+//!   (the law is linear in `μ_s, Δμ` for fixed `I₀`).
+//! - [`fit_mu_i_linear`]: `μ = μ_s + b I`, for comparison ([`compare_mu_i_forms`] ranks both by
+//!   AIC).
+//! - [`fit_phi_i`]: `φ(I) = φ_max − (φ_max − φ_min) I`, with `0 < φ_min < φ_max ≤ 1`.
+//!
+//! Identifiability: when every `I` is far below `I₀` (`I_max < I₀/10`) the data only see the
+//! initial slope `(μ₂ − μ_s)/I₀` → [`IdentifyError::IRangeBelowI0`]; when every `I` is far above
+//! (`I_min > 10 I₀`) they only see `μ₂` → [`IdentifyError::IRangeAboveI0`].
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{
+    check_finite, check_non_negative_pressure, check_same_len, check_spread, min_max,
+    IdentifyError, Result,
+};
+use crate::fit::{
+    fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel, Observations,
+    ParameterSpec,
+};
+use crate::laws::mu_i::{LinearMuILaw, MuILaw, PhiILaw};
+use crate::report::{FitReport, ModelComparison, ValidityRange};
+
+/// Steady-shear measurements (data): one row per steady state.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct RheologySeries {
+    /// Inertial number `I = γ̇ d/√(P/ρ_s)` (1), strictly positive.
+    pub inertial_number: Vec<f64>,
+    /// Friction coefficient `μ = τ/P` (1), when measured.
+    pub mu: Option<Vec<f64>>,
+    /// Solid fraction `φ` (1), when measured.
+    pub phi: Option<Vec<f64>>,
+    /// Pressure `P` (Pa, compressive positive), optional: checked and reported as validity.
+    pub pressure_pa: Option<Vec<f64>>,
+}
+
+/// Result of [`fit_mu_i`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MuIFit {
+    /// The calibrated law.
+    pub law: MuILaw,
+    /// Parameters `mu_s`, `mu_2`, `I_0`.
+    pub report: FitReport,
+}
+
+/// Result of [`fit_mu_i_linear`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinearMuIFit {
+    /// The calibrated law.
+    pub law: LinearMuILaw,
+    /// Parameters `mu_s`, `b`.
+    pub report: FitReport,
+}
+
+/// Result of [`fit_phi_i`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhiIFit {
+    /// The calibrated law.
+    pub law: PhiILaw,
+    /// Parameters `phi_max`, `phi_min`.
+    pub report: FitReport,
+}
+
+fn checked_i(series: &RheologySeries) -> Result<&[f64]> {
+    let i = &series.inertial_number;
+    check_finite("I", i)?;
+    if let Some(k) = i.iter().position(|v| *v <= 0.0) {
+        return Err(IdentifyError::OutOfDomain {
+            column: "I".into(),
+            index: k,
+            value: i[k],
+            expected: "an inertial number I > 0".into(),
+        });
+    }
+    if let Some(p) = &series.pressure_pa {
+        check_finite("P_Pa", p)?;
+        check_same_len("I", i, "P_Pa", p)?;
+        check_non_negative_pressure("P_Pa", p)?;
+    }
+    Ok(i)
+}
+
+fn checked_column<'a>(
+    series: &'a RheologySeries,
+    name: &str,
+    column: &'a Option<Vec<f64>>,
+) -> Result<&'a [f64]> {
+    let y = column
+        .as_ref()
+        .ok_or_else(|| IdentifyError::NotIdentifiable {
+            reason: format!("the series has no {name} column"),
+        })?;
+    check_finite(name, y)?;
+    check_same_len("I", &series.inertial_number, name, y)?;
+    if let Some(k) = y.iter().position(|v| *v < 0.0) {
+        return Err(IdentifyError::OutOfDomain {
+            column: name.into(),
+            index: k,
+            value: y[k],
+            expected: "a non-negative value".into(),
+        });
+    }
+    Ok(y)
+}
+
+fn validity(series: &RheologySeries) -> Vec<ValidityRange> {
+    let mut v = vec![ValidityRange::of("I", "1", &series.inertial_number)];
+    if let Some(p) = &series.pressure_pa {
+        v.push(ValidityRange::of("P", "Pa", p));
+    }
+    v
+}
+
+struct MuIModel<'a> {
+    i: &'a [f64],
+    i_max: f64,
+}
+
+impl LeastSquaresModel for MuIModel<'_> {
+    fn name(&self) -> String {
+        "mu-i".into()
+    }
+    fn parameters(&self) -> Vec<ParameterSpec> {
+        vec![
+            ParameterSpec::new("mu_s", "1", 0.0, f64::INFINITY),
+            ParameterSpec::new("delta_mu", "1", 0.0, 10.0),
+            ParameterSpec::new("I_0", "1", 0.0, 1e4 * self.i_max),
+        ]
+    }
+    fn predict(&self, t: &[f64]) -> Vec<f64> {
+        let law = MuILaw {
+            mu_s: t[0],
+            mu_2: t[0] + t[1],
+            i0: t[2],
+        };
+        self.i.iter().map(|&i| law.mu(i)).collect()
+    }
+    fn jacobian(&self, t: &[f64]) -> DMatrix<f64> {
+        let law = MuILaw {
+            mu_s: t[0],
+            mu_2: t[0] + t[1],
+            i0: t[2],
+        };
+        let mut j = DMatrix::zeros(self.i.len(), 3);
+        for (k, &i) in self.i.iter().enumerate() {
+            let g = law.gradient_delta_form(i);
+            for c in 0..3 {
+                j[(k, c)] = g[c];
+            }
+        }
+        j
+    }
+}
+
+fn check_i_range(i_min: f64, i_max: f64, i0: f64) -> Result<()> {
+    if i_max < 0.1 * i0 {
+        return Err(IdentifyError::IRangeBelowI0 { i_max, i0 });
+    }
+    if i_min > 10.0 * i0 {
+        return Err(IdentifyError::IRangeAboveI0 { i_min, i0 });
+    }
+    Ok(())
+}
+
+/// Fits `μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)` (see the module documentation).
+///
+/// Errors: too few points (< 5), non-finite values, `I ≤ 0`, negative pressure, zero variance
+/// of `I` or `μ`, [`IdentifyError::IRangeBelowI0`], [`IdentifyError::IRangeAboveI0`],
+/// [`IdentifyError::ParameterAtBound`].
+pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit> {
+    let i = checked_i(series)?;
+    let mu = checked_column(series, "mu", &series.mu)?;
+    if i.len() < crate::fit::min_points(3) {
+        return Err(IdentifyError::TooFewPoints {
+            law: "mu-i".into(),
+            needed: crate::fit::min_points(3),
+            got: i.len(),
+        });
+    }
+    check_spread("I", i)?;
+    check_spread("mu", mu)?;
+    let (i_min, i_max) = min_max(i);
+    let grid = log_grid(1e-2 * i_min, 1e2 * i_max, 121);
+    let (i0, c) = separable_start(&grid, mu, |i0| {
+        DMatrix::from_fn(
+            i.len(),
+            2,
+            |k, j| if j == 0 { 1.0 } else { i[k] / (i[k] + i0) },
+        )
+    })
+    .ok_or_else(|| IdentifyError::NotIdentifiable {
+        reason: "no start value for μ(I)".into(),
+    })?;
+    check_i_range(i_min, i_max, i0)?;
+    let model = MuIModel { i, i_max };
+    let theta0 = [c[0].max(1e-3), c[1].clamp(1e-3, 9.0), i0];
+    let result = fit_least_squares(
+        &model,
+        &Observations::single("mu", mu.to_vec()),
+        &theta0,
+        options,
+        validity(series),
+    );
+    let report = match result {
+        Ok(r) => r,
+        Err(IdentifyError::ParameterAtBound {
+            report,
+            name,
+            value,
+            bound,
+            side,
+        }) => {
+            check_i_range(i_min, i_max, report.parameters[2].value)?;
+            return Err(IdentifyError::ParameterAtBound {
+                name,
+                value,
+                bound,
+                side,
+                report,
+            });
+        }
+        Err(e) => return Err(e),
+    };
+    check_i_range(i_min, i_max, report.parameters[2].value)?;
+    let report = report.reparametrised(&[("mu_s", "1"), ("mu_2", "1"), ("I_0", "1")], |p| {
+        (
+            vec![p[0], p[0] + p[1], p[2]],
+            DMatrix::from_row_slice(3, 3, &[1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0]),
+        )
+    });
+    let law = MuILaw {
+        mu_s: report.parameters[0].value,
+        mu_2: report.parameters[1].value,
+        i0: report.parameters[2].value,
+    };
+    Ok(MuIFit { law, report })
+}
+
+struct LinearModel<'a> {
+    x: &'a [f64],
+    name: &'static str,
+    names: [&'static str; 2],
+    bounds: [(f64, f64); 2],
+    /// `y = a + b x` (false) or `y = a − b x` (true).
+    decreasing: bool,
+}
+
+impl LeastSquaresModel for LinearModel<'_> {
+    fn name(&self) -> String {
+        self.name.into()
+    }
+    fn parameters(&self) -> Vec<ParameterSpec> {
+        vec![
+            ParameterSpec::new(self.names[0], "1", self.bounds[0].0, self.bounds[0].1),
+            ParameterSpec::new(self.names[1], "1", self.bounds[1].0, self.bounds[1].1),
+        ]
+    }
+    fn predict(&self, t: &[f64]) -> Vec<f64> {
+        let s = if self.decreasing { -1.0 } else { 1.0 };
+        self.x.iter().map(|x| t[0] + s * t[1] * x).collect()
+    }
+    fn jacobian(&self, _t: &[f64]) -> DMatrix<f64> {
+        let s = if self.decreasing { -1.0 } else { 1.0 };
+        DMatrix::from_fn(
+            self.x.len(),
+            2,
+            |k, j| if j == 0 { 1.0 } else { s * self.x[k] },
+        )
+    }
+}
+
+fn ols_start(x: &[f64], y: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let mx = x.iter().sum::<f64>() / n;
+    let my = y.iter().sum::<f64>() / n;
+    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let b = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    (my - b * mx, b)
+}
+
+/// Fits the linear form `μ = μ_s + b I` (no bounds). Errors: data checks as [`fit_mu_i`]
+/// (at least 4 points).
+pub fn fit_mu_i_linear(series: &RheologySeries, options: &FitOptions) -> Result<LinearMuIFit> {
+    let i = checked_i(series)?;
+    let mu = checked_column(series, "mu", &series.mu)?;
+    check_spread("I", i)?;
+    let model = LinearModel {
+        x: i,
+        name: "mu-i-linear",
+        names: ["mu_s", "b"],
+        bounds: [(f64::NEG_INFINITY, f64::INFINITY); 2],
+        decreasing: false,
+    };
+    let (a, b) = ols_start(i, mu);
+    let report = fit_least_squares(
+        &model,
+        &Observations::single("mu", mu.to_vec()),
+        &[a, b],
+        options,
+        validity(series),
+    )?;
+    let law = LinearMuILaw {
+        mu_s: report.parameters[0].value,
+        slope: report.parameters[1].value,
+    };
+    Ok(LinearMuIFit { law, report })
+}
+
+/// Fits both μ(I) forms and ranks them by AIC (ΔAIC, Akaike weights). A form that cannot be
+/// fitted is listed in `failed` with its error.
+pub fn compare_mu_i_forms(series: &RheologySeries, options: &FitOptions) -> ModelComparison {
+    let mut aics = Vec::new();
+    let mut failed = Vec::new();
+    match fit_mu_i(series, options) {
+        Ok(f) => aics.push(("mu-i".to_string(), f.report.aic)),
+        Err(e) => failed.push(("mu-i".to_string(), e.to_string())),
+    }
+    match fit_mu_i_linear(series, options) {
+        Ok(f) => aics.push(("mu-i-linear".to_string(), f.report.aic)),
+        Err(e) => failed.push(("mu-i-linear".to_string(), e.to_string())),
+    }
+    ModelComparison::from_aics(&aics, failed)
+}
+
+/// Fits `φ(I) = φ_max − (φ_max − φ_min) I` with `0 < φ_max ≤ 1`, `0 < φ_max − φ_min ≤ 1`;
+/// reported as `(phi_max, phi_min)`. A `φ` that does not decrease with `I` ends at the bound
+/// `φ_max − φ_min = 0` ([`IdentifyError::ParameterAtBound`]).
+pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFit> {
+    let i = checked_i(series)?;
+    let phi = checked_column(series, "phi", &series.phi)?;
+    if let Some(k) = phi.iter().position(|v| *v > 1.0) {
+        return Err(IdentifyError::OutOfDomain {
+            column: "phi".into(),
+            index: k,
+            value: phi[k],
+            expected: "a solid fraction 0 ≤ φ ≤ 1".into(),
+        });
+    }
+    check_spread("I", i)?;
+    let model = LinearModel {
+        x: i,
+        name: "phi-i",
+        names: ["phi_max", "delta_phi"],
+        bounds: [(0.0, 1.0), (0.0, 1.0)],
+        decreasing: true,
+    };
+    let (a, b) = ols_start(i, phi);
+    let report = fit_least_squares(
+        &model,
+        &Observations::single("phi", phi.to_vec()),
+        &[a.clamp(0.01, 0.99), (-b).clamp(1e-3, 0.99)],
+        options,
+        validity(series),
+    )?;
+    let report = report.reparametrised(&[("phi_max", "1"), ("phi_min", "1")], |p| {
+        (
+            vec![p[0], p[0] - p[1]],
+            DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 1.0, -1.0]),
+        )
+    });
+    let law = PhiILaw {
+        phi_max: report.parameters[0].value,
+        phi_min: report.parameters[1].value,
+    };
+    Ok(PhiIFit { law, report })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::finite_difference_jacobian;
+
+    #[test]
+    fn mu_i_jacobian_matches_finite_differences() {
+        let i: Vec<f64> = (1..20).map(|k| 0.01 * k as f64).collect();
+        let m = MuIModel { i: &i, i_max: 0.19 };
+        let t = [0.38, 0.26, 0.279];
+        let a = m.jacobian(&t);
+        let f = finite_difference_jacobian(|p| m.predict(p), &t);
+        assert!((a - f).amax() < 1e-8);
+    }
+}
