@@ -1,0 +1,97 @@
+//! Second-order tensors of the plane as `nalgebra::Matrix2<f64>`, `T[(i, j)] = T_ij`, and the few
+//! operations the homogenisation needs.
+//!
+//! Convention for dyads: `(a ⊗ b)_ij = a_i b_j`, so the Love–Weber term `r ⊗ (x − c)` has the
+//! force in the row index and the lever in the column index.
+
+use nalgebra::{Matrix2, Vector2};
+
+/// A plane second-order tensor (for stresses: Pa, tension positive).
+pub type Tensor2 = Matrix2<f64>;
+
+/// The rotation generator `j = [[0, −1], [1, 0]]`: `j u = e_z × u` (a quarter turn counter-clockwise).
+pub fn rotation_generator() -> Tensor2 {
+    Matrix2::new(0.0, -1.0, 1.0, 0.0)
+}
+
+/// Dyadic product `a ⊗ b`, `(a ⊗ b)_ij = a_i b_j`.
+pub fn outer(a: &Vector2<f64>, b: &Vector2<f64>) -> Tensor2 {
+    a * b.transpose()
+}
+
+/// Symmetric part `(T + Tᵀ)/2`.
+pub fn symmetric_part(t: &Tensor2) -> Tensor2 {
+    (t + t.transpose()) * 0.5
+}
+
+/// Skew part `(T − Tᵀ)/2`.
+pub fn skew_part(t: &Tensor2) -> Tensor2 {
+    (t - t.transpose()) * 0.5
+}
+
+/// Frobenius norm `‖T‖_F = √(T : T)`.
+pub fn frobenius(t: &Tensor2) -> f64 {
+    t.norm()
+}
+
+/// Relative asymmetry `‖skew T‖_F / ‖T‖_F` (0 for the zero tensor).
+pub fn skew_ratio(t: &Tensor2) -> f64 {
+    let n = frobenius(t);
+    if n > 0.0 {
+        frobenius(&skew_part(t)) / n
+    } else {
+        0.0
+    }
+}
+
+/// Deviatoric part in 2D, `T' = T − (tr T / 2) 𝟙`.
+pub fn deviator(t: &Tensor2) -> Tensor2 {
+    t - Matrix2::identity() * (t.trace() * 0.5)
+}
+
+/// Components in the orthonormal frame `(e1, e2)`: `T'_ab = e_a · T e_b`, i.e. `Qᵀ T Q` with
+/// `Q = [e1 e2]` (columns). Used for the slope frame of the rolling disk (e1 down the slope,
+/// e2 the outward normal).
+pub fn in_frame(t: &Tensor2, e1: &Vector2<f64>, e2: &Vector2<f64>) -> Tensor2 {
+    let q = Matrix2::from_columns(&[*e1, *e2]);
+    q.transpose() * t * q
+}
+
+/// Cross product of plane vectors (z component), `a × b = a_x b_y − a_y b_x`.
+pub fn cross(a: &Vector2<f64>, b: &Vector2<f64>) -> f64 {
+    a.x * b.y - a.y * b.x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn j_is_the_quarter_turn() {
+        let u = Vector2::new(0.3, -1.7);
+        let ju = rotation_generator() * u;
+        // e_z × u = (−u_y, u_x)
+        assert!((ju - Vector2::new(1.7, 0.3)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn skew_of_dyad_is_the_torque() {
+        // skew(r ⊗ l)_xy = (r_x l_y − r_y l_x)/2 = −(l × r)/2
+        let r = Vector2::new(2.0, 3.0);
+        let l = Vector2::new(-0.5, 0.25);
+        let s = skew_part(&outer(&r, &l));
+        assert!((s[(0, 1)] + 0.5 * cross(&l, &r)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn frame_change_preserves_invariants() {
+        let t = Matrix2::new(1.0, 2.0, 0.5, -3.0);
+        let a: f64 = 0.7;
+        let e1 = Vector2::new(a.cos(), -a.sin());
+        let e2 = Vector2::new(a.sin(), a.cos());
+        let tf = in_frame(&t, &e1, &e2);
+        assert!((tf.trace() - t.trace()).abs() < 1e-14);
+        assert!((tf.norm() - t.norm()).abs() < 1e-14);
+        assert!((tf[(0, 1)] - e1.dot(&(t * e2))).abs() < 1e-14);
+    }
+}
