@@ -325,19 +325,6 @@ pub(crate) fn check_non_negative_pressure(column: &str, values: &[f64]) -> Resul
     }
 }
 
-/// Checks that every value is strictly positive.
-pub(crate) fn check_positive(column: &str, values: &[f64]) -> Result<()> {
-    match values.iter().position(|v| *v <= 0.0) {
-        Some(index) => Err(IdentifyError::OutOfDomain {
-            column: column.to_string(),
-            index,
-            value: values[index],
-            expected: "a strictly positive value".to_string(),
-        }),
-        None => Ok(()),
-    }
-}
-
 /// Checks a strictly positive, finite set-up constant.
 pub(crate) fn check_setup_positive(field: &str, value: f64) -> Result<()> {
     if !(value.is_finite() && value > 0.0) {

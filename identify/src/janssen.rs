@@ -132,6 +132,8 @@ pub struct JanssenFit {
     pub saturation_length_m: Estimate,
     /// Mobilisation `μ_w / μ_wall` (1).
     pub mobilisation: Estimate,
+    /// Grain–wall friction `μ_wall` the fit was bounded by (1).
+    pub wall_friction: f64,
     /// Depth range used `[z_min, z_max]` (m).
     pub depth_range_m: [f64; 2],
     /// Depths used / depths given.
@@ -544,6 +546,7 @@ fn fit_joint(
         k_mu_w,
         saturation_length_m: lambda,
         mobilisation,
+        wall_friction: mu_wall,
         depth_range_m: [zmin, zmax],
         points_used: sel.z.len(),
         points_total: sel.total,

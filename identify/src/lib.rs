@@ -40,5 +40,5 @@ pub mod wall_law;
 
 pub use error::{IdentifyError, Result};
 pub use fit::{BootstrapOptions, FitOptions};
-// pub use law::CalibratedLaw;
+pub use law::CalibratedLaw;
 pub use report::{Estimate, FitReport, ModelComparison, ValidityRange};

@@ -1,1 +1,364 @@
-//! placeholder
+//! Mohr–Coulomb envelope (friction angle, cohesion) from stress states at yield, posed as a
+//! second-order cone program solved by Clarabel (law in [`crate::laws::mohr_coulomb`]).
+//!
+//! Both input forms reduce to a straight line `y = a x + b` with sign constraints:
+//! - Mohr circles at yield ([`YieldData::Circles`], from 2D tensors or principal stresses):
+//!   `x = p = (σ₁ + σ₃)/2`, `y = q = (σ₁ − σ₃)/2`, tangency `q = p sin φ + c cos φ`, so
+//!   `a = sin φ ∈ [0, 1]`, `b = c cos φ ≥ 0`;
+//! - failure-plane tractions ([`YieldData::FailurePlane`], direct shear):
+//!   `x = σ_n`, `y = |τ|`, `τ = c + σ_n tan φ`, so `a = tan φ ≥ 0`, `b = c ≥ 0`.
+//!
+//! Objective: least squares on `y`, `min ‖y − a x − b 1‖₂` subject to the constraints, written as
+//! the conic program `min t` s.t. `(t, y − a x − b) ∈ SOC`, `b ≥ 0`, `a ≥ 0` (`a ≤ 1`).
+//! Why this norm: with Gaussian scatter of the yield stress it is the maximum-likelihood
+//! estimate; when no constraint is active it equals ordinary least squares, so the OLS
+//! covariance `s² (XᵀX)⁻¹` gives honest intervals; and the cone form lets the solver enforce
+//! `c ≥ 0` exactly (a plain regression returns negative cohesion on cohesionless data).
+//! (An L1 objective would be an LP and more robust to outliers, but has no simple covariance.)
+//! Scatter in `x` is neglected (regression of `y` on `x`).
+//!
+//! Cohesion at zero is an expected outcome for a cohesionless material, not a failure: the fit
+//! then reports `c = 0` with `at_bound = true`, refits `a` through the origin for the
+//! friction angle's interval, and gives for `c` the one-sided interval
+//! `[0, max(0, b_ols + t·se(b_ols))]` from the unconstrained regression. The friction
+//! coefficient ending at `a = 0` (or `sin φ = 1`) is [`IdentifyError::ParameterAtBound`].
+//!
+//! The 2D Drucker–Prager equivalent is [`MohrCoulombLaw::drucker_prager_2d`]
+//! (`α = sin φ`, `k = c cos φ`, exact in 2D).
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{
+    check_finite, check_non_negative_pressure, check_same_len, check_spread, min_max, BoundSide,
+    IdentifyError, Result,
+};
+use crate::laws::mohr_coulomb::{p_q_from_tension_positive, MohrCoulombLaw};
+use crate::report::{
+    correlation_of, matrix_rows, Estimate, FitReport, GroupSummary, ValidityRange,
+};
+use crate::stats;
+
+/// Stress states at yield (data). Compressive-positive magnitudes, Pa.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum YieldData {
+    /// Mohr circles: centre `p = (σ₁ + σ₃)/2` and radius `q = (σ₁ − σ₃)/2`.
+    Circles {
+        /// Mean in-plane stress `p` (Pa).
+        p_pa: Vec<f64>,
+        /// Circle radius `q` (Pa).
+        q_pa: Vec<f64>,
+    },
+    /// Normal and shear traction on the failure plane.
+    FailurePlane {
+        /// Normal stress `σ_n` (Pa).
+        sigma_n_pa: Vec<f64>,
+        /// Shear stress `τ` (Pa); its magnitude is used.
+        tau_pa: Vec<f64>,
+    },
+}
+
+impl YieldData {
+    /// Mohr circles from 2D tension-positive stress tensors `(σ_xx, σ_yy, σ_xy)` (the project's
+    /// convention, e.g. homogenised `Σ`): `p = −(σ_xx + σ_yy)/2`,
+    /// `q = √(((σ_xx − σ_yy)/2)² + σ_xy²)`.
+    pub fn from_tension_positive_tensors(tensors: &[[f64; 3]]) -> Self {
+        let (p_pa, q_pa) = tensors
+            .iter()
+            .map(|t| p_q_from_tension_positive(t[0], t[1], t[2]))
+            .unzip();
+        YieldData::Circles { p_pa, q_pa }
+    }
+
+    /// Mohr circles from compressive-positive principal stresses `σ₁ ≥ σ₃`.
+    pub fn from_principal(sigma_1_pa: &[f64], sigma_3_pa: &[f64]) -> Self {
+        YieldData::Circles {
+            p_pa: sigma_1_pa
+                .iter()
+                .zip(sigma_3_pa)
+                .map(|(a, b)| 0.5 * (a + b))
+                .collect(),
+            q_pa: sigma_1_pa
+                .iter()
+                .zip(sigma_3_pa)
+                .map(|(a, b)| 0.5 * (a - b).abs())
+                .collect(),
+        }
+    }
+}
+
+/// Result of [`fit_mohr_coulomb`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MohrCoulombFit {
+    /// The calibrated law.
+    pub law: MohrCoulombLaw,
+    /// Friction angle `φ` (rad).
+    pub friction_angle: Estimate,
+    /// Friction angle in degrees (same estimate, for reading).
+    pub friction_angle_deg: Estimate,
+    /// Cohesion `c` (Pa); `at_bound = true` when the constraint `c ≥ 0` is active.
+    pub cohesion: Estimate,
+    /// The fit, with parameters `friction_angle` (rad) and `cohesion` (Pa); residuals on `q`
+    /// (circles) or `|τ|` (failure plane).
+    pub report: FitReport,
+}
+
+/// Solves `min ‖y − a x − b‖₂` s.t. `a ≥ 0`, `b ≥ 0`, `a ≤ a_max` (if finite) with Clarabel.
+/// Inputs are scaled by `max |y|` for conditioning. Returns `(a, b)`.
+fn solve_conic(x: &[f64], y: &[f64], a_max: f64) -> Result<(f64, f64)> {
+    let n = x.len();
+    let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+    let xs: Vec<f64> = x.iter().map(|v| v / scale).collect();
+    let ys: Vec<f64> = y.iter().map(|v| v / scale).collect();
+    // Variables (a, b, t). Rows: nonnegative cone [a ≥ 0, b ≥ 0, (a ≤ a_max)], then SOC of
+    // dimension n + 1: (t, y − a x − b).
+    let n_nonneg = if a_max.is_finite() { 3 } else { 2 };
+    let m = n_nonneg + 1 + n;
+    let mut rows_a = Vec::new();
+    let mut vals_a = Vec::new();
+    let mut rows_b = Vec::new();
+    let mut vals_b = Vec::new();
+    let mut rhs = vec![0.0; m];
+    // a ≥ 0: s = a → −a + s = 0.
+    rows_a.push(0);
+    vals_a.push(-1.0);
+    // b ≥ 0.
+    rows_b.push(1);
+    vals_b.push(-1.0);
+    if a_max.is_finite() {
+        rows_a.push(2);
+        vals_a.push(1.0);
+        rhs[2] = a_max;
+    }
+    // SOC head: s₀ = t.
+    let head = n_nonneg;
+    for k in 0..n {
+        let r = head + 1 + k;
+        rows_a.push(r);
+        vals_a.push(xs[k]);
+        rows_b.push(r);
+        vals_b.push(1.0);
+        rhs[r] = ys[k];
+    }
+    let mut colptr = vec![0];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for (rows, vals) in [(rows_a, vals_a), (rows_b, vals_b), (vec![head], vec![-1.0])] {
+        rowval.extend(rows);
+        nzval.extend(vals);
+        colptr.push(rowval.len());
+    }
+    let a_mat = CscMatrix::new(m, 3, colptr, rowval, nzval);
+    let p_mat = CscMatrix::new(3, 3, vec![0, 0, 0, 0], vec![], vec![]);
+    let q = [0.0, 0.0, 1.0];
+    let cones = [
+        SupportedConeT::NonnegativeConeT(n_nonneg),
+        SupportedConeT::SecondOrderConeT(n + 1),
+    ];
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .tol_gap_abs(1e-12)
+        .tol_gap_rel(1e-12)
+        .tol_feas(1e-12)
+        .build()
+        .map_err(|e| IdentifyError::ConicSolver {
+            status: format!("settings: {e}"),
+        })?;
+    let mut solver = DefaultSolver::new(&p_mat, &q, &a_mat, &rhs, &cones, settings).map_err(
+        |e| IdentifyError::ConicSolver {
+            status: format!("{e:?}"),
+        },
+    )?;
+    solver.solve();
+    match solver.solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {}
+        status => {
+            return Err(IdentifyError::ConicSolver {
+                status: format!("{status:?}"),
+            })
+        }
+    }
+    let sol = &solver.solution.x;
+    Ok((sol[0], sol[1] * scale))
+}
+
+/// Ordinary least squares `y = a x + b`: `(a, b, cov, rss)`.
+fn ols(x: &[f64], y: &[f64]) -> (f64, f64, DMatrix<f64>, f64) {
+    let n = x.len();
+    let xm = DMatrix::from_fn(n, 2, |k, j| if j == 0 { x[k] } else { 1.0 });
+    let yv = DVector::from_column_slice(y);
+    let xtx = xm.tr_mul(&xm);
+    let inv = xtx.try_inverse().unwrap_or_else(|| DMatrix::from_element(2, 2, f64::NAN));
+    let beta = &inv * xm.tr_mul(&yv);
+    let rss = (&xm * &beta - &yv).norm_squared();
+    let s2 = rss / (n - 2) as f64;
+    (beta[0], beta[1], inv * s2, rss)
+}
+
+/// Fits the Mohr–Coulomb envelope (see the module documentation).
+///
+/// Errors: [`IdentifyError::TooFewPoints`] (< 4), [`IdentifyError::NonFinite`],
+/// [`IdentifyError::NegativePressure`] (`p` or `σ_n` < 0: tensile states are not handled),
+/// [`IdentifyError::OutOfDomain`] (`q < 0`), [`IdentifyError::ZeroVariance`] (all states at the
+/// same pressure), [`IdentifyError::ParameterAtBound`] (`φ = 0` or `φ = 90°`),
+/// [`IdentifyError::ConicSolver`].
+pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulombFit> {
+    let (x, y, circles, xname, yname) = match data {
+        YieldData::Circles { p_pa, q_pa } => (p_pa.clone(), q_pa.clone(), true, "p_Pa", "q_Pa"),
+        YieldData::FailurePlane { sigma_n_pa, tau_pa } => (
+            sigma_n_pa.clone(),
+            tau_pa.iter().map(|t| t.abs()).collect(),
+            false,
+            "sigma_n_Pa",
+            "tau_Pa",
+        ),
+    };
+    check_finite(xname, &x)?;
+    check_finite(yname, &y)?;
+    check_same_len(xname, &x, yname, &y)?;
+    check_non_negative_pressure(xname, &x)?;
+    if let Some(k) = y.iter().position(|v| *v < 0.0) {
+        return Err(IdentifyError::OutOfDomain {
+            column: yname.into(),
+            index: k,
+            value: y[k],
+            expected: "a Mohr-circle radius q ≥ 0".into(),
+        });
+    }
+    let n = x.len();
+    if n < 4 {
+        return Err(IdentifyError::TooFewPoints {
+            law: "mohr-coulomb".into(),
+            needed: 4,
+            got: n,
+        });
+    }
+    check_spread(xname, &x)?;
+    let a_max = if circles { 1.0 } else { f64::INFINITY };
+    let (a, b) = solve_conic(&x, &y, a_max)?;
+    let (_, y_max) = min_max(&y);
+    let cohesionless = b <= 1e-8 * y_max;
+
+    // Covariance of (a, b) and the degrees of freedom.
+    let (a, b, cov_ab, dof, b_upper) = if cohesionless {
+        let sxx: f64 = x.iter().map(|v| v * v).sum();
+        let a0 = x.iter().zip(&y).map(|(u, v)| u * v).sum::<f64>() / sxx;
+        let a0 = a0.clamp(0.0, a_max);
+        let rss: f64 = x.iter().zip(&y).map(|(u, v)| (v - a0 * u).powi(2)).sum();
+        let dof = n - 1;
+        let var_a = rss / dof as f64 / sxx;
+        let (_, b_ols, cov_ols, _) = ols(&x, &y);
+        let t2 = stats::t_critical(confidence, n - 2);
+        let upper = (b_ols + t2 * cov_ols[(1, 1)].max(0.0).sqrt()).max(0.0);
+        let cov = DMatrix::from_row_slice(2, 2, &[var_a, 0.0, 0.0, 0.0]);
+        (a0, 0.0, cov, dof, Some(upper))
+    } else {
+        let (_, _, cov, _) = ols(&x, &y);
+        (a, b, cov, n - 2, None)
+    };
+    let t = stats::t_critical(confidence, dof);
+
+    // (a, b) → (φ, c) and its Jacobian.
+    let (phi, c, jac) = if circles {
+        let ca = (1.0 - a * a).max(0.0).sqrt();
+        let phi = a.clamp(-1.0, 1.0).asin();
+        let c = if ca > 0.0 { b / ca } else { f64::INFINITY };
+        let jac = DMatrix::from_row_slice(
+            2,
+            2,
+            &[1.0 / ca, 0.0, b * a / (ca * ca * ca), 1.0 / ca],
+        );
+        (phi, c, jac)
+    } else {
+        let jac = DMatrix::from_row_slice(2, 2, &[1.0 / (1.0 + a * a), 0.0, 0.0, 1.0]);
+        (a.atan(), b, jac)
+    };
+    let cov = &jac * cov_ab * jac.transpose();
+    let fitted: Vec<f64> = x.iter().map(|v| a * v + b).collect();
+    let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(o, f)| o - f).collect();
+    let rss: f64 = residuals.iter().map(|r| r * r).sum();
+    let ymean = y.iter().sum::<f64>() / n as f64;
+    let tss: f64 = y.iter().map(|v| (v - ymean).powi(2)).sum();
+    let n_params = if cohesionless { 1 } else { 2 };
+    let friction_angle = Estimate::new("friction_angle", "rad", phi, cov[(0, 0)].sqrt(), t);
+    let mut cohesion = Estimate::new("cohesion", "Pa", c, cov[(1, 1)].max(0.0).sqrt(), t);
+    if let Some(upper) = b_upper {
+        cohesion.at_bound = true;
+        cohesion.ci_low = 0.0;
+        cohesion.ci_high = if circles {
+            upper / phi.cos()
+        } else {
+            upper
+        };
+    }
+    let report = FitReport {
+        model: "mohr-coulomb".into(),
+        confidence,
+        t_critical: t,
+        parameters: vec![friction_angle.clone(), cohesion.clone()],
+        covariance: matrix_rows(&cov),
+        correlation: matrix_rows(&correlation_of(&cov)),
+        observed: y.clone(),
+        fitted,
+        residuals,
+        group_of: vec![0; n],
+        groups: vec![GroupSummary {
+            name: if circles { "q" } else { "tau" }.into(),
+            n,
+            rss,
+            tss,
+            weight: 1.0,
+        }],
+        n,
+        dof,
+        residual_variance: rss / dof as f64,
+        r_squared: 1.0 - rss / tss,
+        aic: stats::aic(&[(n, rss)], n_params),
+        bic: stats::bic(&[(n, rss)], n_params),
+        iterations: 0,
+        validity: vec![
+            ValidityRange::of(if circles { "p" } else { "sigma_n" }, "Pa", &x),
+            ValidityRange::of(if circles { "q" } else { "tau" }, "Pa", &y),
+        ],
+        bootstrap: None,
+    };
+    let a_tol = 1e-9;
+    if a <= a_tol || (circles && a >= 1.0 - a_tol) {
+        let (bound, side) = if a <= a_tol {
+            (0.0, BoundSide::Lower)
+        } else {
+            (std::f64::consts::FRAC_PI_2, BoundSide::Upper)
+        };
+        return Err(IdentifyError::ParameterAtBound {
+            name: "friction_angle".into(),
+            value: phi,
+            bound,
+            side,
+            report: Box::new(report),
+        });
+    }
+    let deg = 180.0 / std::f64::consts::PI;
+    let friction_angle_deg = Estimate {
+        name: "friction_angle_deg".into(),
+        unit: "deg".into(),
+        value: phi * deg,
+        std_error: friction_angle.std_error * deg,
+        ci_low: friction_angle.ci_low * deg,
+        ci_high: friction_angle.ci_high * deg,
+        at_bound: false,
+    };
+    Ok(MohrCoulombFit {
+        law: MohrCoulombLaw {
+            friction_angle_rad: phi,
+            cohesion_pa: c,
+        },
+        friction_angle,
+        friction_angle_deg,
+        cohesion,
+        report,
+    })
+}
