@@ -217,8 +217,8 @@ pub struct PlaneStress {
 
 /// Stress across the horizontal planes `y = levels[k]` by the method of planes (see the module
 /// documentation). `width` is the sample width `W` (m); by default the periodic cell or the
-/// grains' x extent. A branch crosses the plane when one end is below (`y < y₀`) and the other
-/// at or above.
+/// grains' x extent. A branch crosses the plane when one end is at or below (`y ≤ y₀`) and the
+/// other above (`y > y₀`): a plane at the surface of a bottom wall sees the wall's reaction.
 pub fn plane_stress_profile(
     snapshot: &Snapshot,
     levels: &[f64],
@@ -270,9 +270,9 @@ pub fn plane_stress_profile(
             }
             let mut t = Vector2::zeros();
             for &(ya, yb, f) in &branches {
-                if ya < y0 && yb >= y0 {
+                if ya <= y0 && yb > y0 {
                     t += f; // b is above: force of the lower (a) on the upper (b)
-                } else if yb < y0 && ya >= y0 {
+                } else if yb <= y0 && ya > y0 {
                     t -= f;
                 }
             }

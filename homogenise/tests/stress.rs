@@ -25,7 +25,9 @@ fn rolling_disk_is_exact_at_several_times_angles_and_radii() {
                     let b = &r.snap.bodies[1];
                     let acc = r.e1 * (2.0 / 3.0 * 9.81 * phi.sin());
                     assert!((b.acceleration - acc).norm() <= 1e-12 * acc.norm());
-                    assert!((b.angular_acceleration - r.omega_dot).abs() <= 1e-12 * r.omega_dot.abs());
+                    assert!(
+                        (b.angular_acceleration - r.omega_dot).abs() <= 1e-12 * r.omega_dot.abs()
+                    );
                     assert!((r.omega_dot.abs() - acc.norm() / a).abs() <= 1e-12 * acc.norm() / a);
 
                     let g = grain_stresses(&r.snap).unwrap();
@@ -91,15 +93,26 @@ fn consistent_dynamic_states_give_symmetric_stress() {
         assert_eq!(g.len(), 48);
         let mut worst_contact: f64 = 0.0;
         for p in &g {
-            assert!(skew_ratio(&p.total) <= 1e-8, "seed {seed} grain {}: {}", p.body, skew_ratio(&p.total));
+            assert!(
+                skew_ratio(&p.total) <= 1e-8,
+                "seed {seed} grain {}: {}",
+                p.body,
+                skew_ratio(&p.total)
+            );
             worst_contact = worst_contact.max(skew_ratio(&p.contact));
         }
         // the contact part alone is visibly skew in these dynamic states
         assert!(worst_contact > 0.05, "seed {seed}: {worst_contact}");
         for region in [
             Region::Whole,
-            Region::Slice { y_min: 2e-3, y_max: 9e-3 },
-            Region::Rectangle { min: v(1e-3, 1e-3), max: v(1.1e-2, 1.3e-2) },
+            Region::Slice {
+                y_min: 2e-3,
+                y_max: 9e-3,
+            },
+            Region::Rectangle {
+                min: v(1e-3, 1e-3),
+                max: v(1.1e-2, 1.3e-2),
+            },
         ] {
             let m = mean_stress(&snap, &g, &region).unwrap();
             assert!(skew_ratio(&m.total) <= 1e-8);
@@ -116,7 +129,11 @@ fn translation_by_a_kilometre_leaves_the_stress_unchanged() {
         let b = support::random_dynamic(seed, 7, 5, shift);
         let (ga, gb) = (grain_stresses(&a).unwrap(), grain_stresses(&b).unwrap());
         for (p, q) in ga.iter().zip(&gb) {
-            assert!(rel(&q.total, &p.total) < 1e-9, "{}", rel(&q.total, &p.total));
+            assert!(
+                rel(&q.total, &p.total) < 1e-9,
+                "{}",
+                rel(&q.total, &p.total)
+            );
             assert!(rel(&q.contact, &p.contact) < 1e-9);
         }
         // region means, with regions that cut grains (border weights computed at 1e3 m)
@@ -125,16 +142,29 @@ fn translation_by_a_kilometre_leaves_the_stress_unchanged() {
             (Region::Whole, Region::Whole),
             (
                 Region::Rectangle { min, max },
-                Region::Rectangle { min: min + shift, max: max + shift },
+                Region::Rectangle {
+                    min: min + shift,
+                    max: max + shift,
+                },
             ),
             (
-                Region::Slice { y_min: 3.3e-3, y_max: 7.9e-3 },
-                Region::Slice { y_min: 3.3e-3 + shift.y, y_max: 7.9e-3 + shift.y },
+                Region::Slice {
+                    y_min: 3.3e-3,
+                    y_max: 7.9e-3,
+                },
+                Region::Slice {
+                    y_min: 3.3e-3 + shift.y,
+                    y_max: 7.9e-3 + shift.y,
+                },
             ),
         ] {
             let ma = mean_stress(&a, &ga, &ra).unwrap();
             let mb = mean_stress(&b, &gb, &rb).unwrap();
-            assert!(rel(&mb.total, &ma.total) < 1e-9, "{}", rel(&mb.total, &ma.total));
+            assert!(
+                rel(&mb.total, &ma.total) < 1e-9,
+                "{}",
+                rel(&mb.total, &ma.total)
+            );
             assert!((mb.grains - ma.grains).abs() < 1e-9 * ma.grains);
         }
     }
@@ -168,7 +198,9 @@ fn region_means_are_additive_over_a_partition() {
     let g = grain_stresses(&snap).unwrap();
     let whole = mean_stress(&snap, &g, &Region::Whole).unwrap();
     let (y0, y1) = (whole.region.min.y, whole.region.max.y);
-    let edges: Vec<f64> = (0..=7).map(|k| y0 + (y1 - y0) * (k as f64 / 7.0).powf(1.3)).collect();
+    let edges: Vec<f64> = (0..=7)
+        .map(|k| y0 + (y1 - y0) * (k as f64 / 7.0).powf(1.3))
+        .collect();
     let slices = homogenise::stress::slice_stress_profile(&snap, &g, &edges).unwrap();
     let sum: Matrix2<f64> = slices.iter().map(|s| s.total * s.area).sum();
     assert!(rel(&sum, &(whole.total * whole.area)) < 1e-12);
@@ -189,6 +221,9 @@ fn bad_snapshots_are_errors_not_panics() {
     assert!(grain_stresses(&snap).is_err());
     let snap = support::cannonball(0.01, 1000.0);
     let g = grain_stresses(&snap).unwrap();
-    let flat = Region::Rectangle { min: v(0.0, 0.0), max: v(1.0, 0.0) };
+    let flat = Region::Rectangle {
+        min: v(0.0, 0.0),
+        max: v(1.0, 0.0),
+    };
     assert!(mean_stress(&snap, &g, &flat).is_err());
 }

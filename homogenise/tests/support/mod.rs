@@ -208,7 +208,15 @@ pub fn rolling_disk(phi: f64, a: f64, rho: f64, t: f64, mirrored: bool, origin: 
     // reaction (eq. 13): r = m g (−sinφ/3 e1 + cosφ e2)
     let r = (e1 * (-phi.sin() / 3.0) + e2 * phi.cos()) * (m * g);
     let tangent = v(-e2.y, e2.x);
-    b.contact(wall, disk, centre - e2 * a, e2, r.dot(&e2), r.dot(&tangent), 1.0);
+    b.contact(
+        wall,
+        disk,
+        centre - e2 * a,
+        e2,
+        r.dot(&e2),
+        r.dot(&tangent),
+        1.0,
+    );
     let snap = b.finish();
     let (s, c) = (phi.sin(), phi.cos());
     Rolling {
@@ -228,7 +236,15 @@ pub fn rolling_disk(phi: f64, a: f64, rho: f64, t: f64, mirrored: bool, origin: 
 /// `left` (x = 0) and `right` (x = 2r) on a `bottom` wall (y = 0), at rest. Each disk is
 /// pressed by both side walls with `h` (N) and held up by wall friction `t_k` (N) per side
 /// (`t_k` of layer k from the bottom); disk-disk and bottom contacts carry the load above.
-pub fn column(layers: usize, r: f64, rho: f64, thickness: f64, mu: f64, h: f64, t: &[f64]) -> Snapshot {
+pub fn column(
+    layers: usize,
+    r: f64,
+    rho: f64,
+    thickness: f64,
+    mu: f64,
+    h: f64,
+    t: &[f64],
+) -> Snapshot {
     assert_eq!(t.len(), layers);
     let g = 9.81;
     let mut b = Builder::new(v(0.0, -g));
@@ -243,12 +259,21 @@ pub fn column(layers: usize, r: f64, rho: f64, thickness: f64, mu: f64, h: f64, 
     let mut p = vec![0.0; layers + 1];
     for k in (0..layers).rev() {
         p[k] = p[k + 1] + w - 2.0 * t[k];
+        assert!(p[k] >= 0.0, "the walls would hold layer {k} up by tension");
     }
     b.contact(bottom, ids[0], v(r, 0.0), v(0.0, 1.0), p[0], 0.0, mu);
     for k in 0..layers {
         let y = r + 2.0 * r * k as f64;
         if k + 1 < layers {
-            b.contact(ids[k], ids[k + 1], v(r, y + r), v(0.0, 1.0), p[k + 1], 0.0, mu);
+            b.contact(
+                ids[k],
+                ids[k + 1],
+                v(r, y + r),
+                v(0.0, 1.0),
+                p[k + 1],
+                0.0,
+                mu,
+            );
         }
         // left wall: n = +x, t = (0, 1): upward friction is f_t = +t_k
         b.contact(left, ids[k], v(0.0, y), v(1.0, 0.0), h, t[k], mu);
@@ -320,7 +345,10 @@ pub fn random_dynamic(seed: u64, nx: usize, ny: usize, offset: V2) -> Snapshot {
                     continue;
                 }
                 let bb = ids[j2][i2];
-                let (ca, cb) = (b.snap.bodies[a as usize].position, b.snap.bodies[bb as usize].position);
+                let (ca, cb) = (
+                    b.snap.bodies[a as usize].position,
+                    b.snap.bodies[bb as usize].position,
+                );
                 let n = (cb - ca).normalize();
                 let rb = b.snap.bodies[bb as usize].radius;
                 let (f_n, f_t) = force(&mut rng);
@@ -331,14 +359,20 @@ pub fn random_dynamic(seed: u64, nx: usize, ny: usize, offset: V2) -> Snapshot {
     for j in 0..ny {
         for (i, wall, n) in [(0usize, left, v(1.0, 0.0)), (nx - 1, right, v(-1.0, 0.0))] {
             let id = ids[j][i];
-            let (c, r) = (b.snap.bodies[id as usize].position, b.snap.bodies[id as usize].radius);
+            let (c, r) = (
+                b.snap.bodies[id as usize].position,
+                b.snap.bodies[id as usize].radius,
+            );
             let (f_n, f_t) = force(&mut rng);
             b.contact(wall, id, c - n * r, n, f_n, f_t, mu);
         }
     }
     for i in 0..nx {
         let id = ids[0][i];
-        let (c, r) = (b.snap.bodies[id as usize].position, b.snap.bodies[id as usize].radius);
+        let (c, r) = (
+            b.snap.bodies[id as usize].position,
+            b.snap.bodies[id as usize].radius,
+        );
         let (f_n, f_t) = force(&mut rng);
         b.contact(bottom, id, c - v(0.0, r), v(0.0, 1.0), f_n, f_t, mu);
     }
