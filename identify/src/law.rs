@@ -281,8 +281,12 @@ impl CalibratedLaw {
         provenance: Provenance,
     ) -> Self {
         let formula = match fit.form {
-            WallLawForm::Exponential => "mu_eff(V) = mu_inf - (mu_inf - mu_0)*exp(-V/V_star); V = V_s/sqrt(g*d)",
-            WallLawForm::Hyperbolic => "mu_eff(V) = mu_0 + (mu_inf - mu_0)*V/(V + V_star); V = V_s/sqrt(g*d)",
+            WallLawForm::Exponential => {
+                "mu_eff(V) = mu_inf - (mu_inf - mu_0)*exp(-V/V_star); V = V_s/sqrt(g*d)"
+            }
+            WallLawForm::Hyperbolic => {
+                "mu_eff(V) = mu_0 + (mu_inf - mu_0)*V/(V + V_star); V = V_s/sqrt(g*d)"
+            }
             WallLawForm::PowerLaw => "mu_eff(V) = mu_0 + k*V^n; V = V_s/sqrt(g*d)",
         };
         let mut law = Self::build(

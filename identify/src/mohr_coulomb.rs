@@ -168,11 +168,12 @@ fn solve_conic(x: &[f64], y: &[f64], a_max: f64) -> Result<(f64, f64)> {
         .map_err(|e| IdentifyError::ConicSolver {
             status: format!("settings: {e}"),
         })?;
-    let mut solver = DefaultSolver::new(&p_mat, &q, &a_mat, &rhs, &cones, settings).map_err(
-        |e| IdentifyError::ConicSolver {
-            status: format!("{e:?}"),
-        },
-    )?;
+    let mut solver =
+        DefaultSolver::new(&p_mat, &q, &a_mat, &rhs, &cones, settings).map_err(|e| {
+            IdentifyError::ConicSolver {
+                status: format!("{e:?}"),
+            }
+        })?;
     solver.solve();
     match solver.solution.status {
         SolverStatus::Solved | SolverStatus::AlmostSolved => {}
@@ -192,7 +193,9 @@ fn ols(x: &[f64], y: &[f64]) -> (f64, f64, DMatrix<f64>, f64) {
     let xm = DMatrix::from_fn(n, 2, |k, j| if j == 0 { x[k] } else { 1.0 });
     let yv = DVector::from_column_slice(y);
     let xtx = xm.tr_mul(&xm);
-    let inv = xtx.try_inverse().unwrap_or_else(|| DMatrix::from_element(2, 2, f64::NAN));
+    let inv = xtx
+        .try_inverse()
+        .unwrap_or_else(|| DMatrix::from_element(2, 2, f64::NAN));
     let beta = &inv * xm.tr_mul(&yv);
     let rss = (&xm * &beta - &yv).norm_squared();
     let s2 = rss / (n - 2) as f64;
@@ -267,11 +270,7 @@ pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulomb
         let ca = (1.0 - a * a).max(0.0).sqrt();
         let phi = a.clamp(-1.0, 1.0).asin();
         let c = if ca > 0.0 { b / ca } else { f64::INFINITY };
-        let jac = DMatrix::from_row_slice(
-            2,
-            2,
-            &[1.0 / ca, 0.0, b * a / (ca * ca * ca), 1.0 / ca],
-        );
+        let jac = DMatrix::from_row_slice(2, 2, &[1.0 / ca, 0.0, b * a / (ca * ca * ca), 1.0 / ca]);
         (phi, c, jac)
     } else {
         let jac = DMatrix::from_row_slice(2, 2, &[1.0 / (1.0 + a * a), 0.0, 0.0, 1.0]);
@@ -289,11 +288,7 @@ pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulomb
     if let Some(upper) = b_upper {
         cohesion.at_bound = true;
         cohesion.ci_low = 0.0;
-        cohesion.ci_high = if circles {
-            upper / phi.cos()
-        } else {
-            upper
-        };
+        cohesion.ci_high = if circles { upper / phi.cos() } else { upper };
     }
     let report = FitReport {
         model: "mohr-coulomb".into(),

@@ -284,11 +284,7 @@ pub fn fit_wall_law(
             [c[0].clamp(1e-3, 9.0), c[1].clamp(1e-3, 9.0), s]
         }
     };
-    let model = WallModel {
-        v: &v,
-        form,
-        v_max,
-    };
+    let model = WallModel { v: &v, form, v_max };
     let validity = vec![
         ValidityRange {
             variable: "V".into(),
@@ -493,9 +489,8 @@ pub fn fit_boundary_layer(
     check_scale("delta", report.parameters[2].value, y)?;
     let d = profile.grain_diameter_m;
     let thickness_m = report.parameters[2].clone();
-    let thickness_diameters = report.derived("delta_over_d", "1", |p| {
-        (p[2] / d, vec![0.0, 0.0, 1.0 / d])
-    });
+    let thickness_diameters =
+        report.derived("delta_over_d", "1", |p| (p[2] / d, vec![0.0, 0.0, 1.0 / d]));
     let t = report.values();
     Ok(BoundaryLayerFit {
         law: VelocityBoundaryLayer {
