@@ -264,9 +264,16 @@ fn select(profile: &JanssenProfile, options: &JanssenOptions, need_h: bool) -> R
             total: z.len(),
         });
     }
-    if !sel.z.is_empty() {
-        check_spread("z_m", &sel.z)?;
+    // At least (parameters + 2) depths: 4 for (K, μ_w), 3 for K μ_w.
+    let needed = if need_h { 4 } else { 3 };
+    if sel.z.len() < needed {
+        return Err(IdentifyError::TooFewPoints {
+            law: if need_h { "janssen" } else { "janssen-kmu" }.into(),
+            needed,
+            got: sel.z.len(),
+        });
     }
+    check_spread("z_m", &sel.z)?;
     Ok(sel)
 }
 
