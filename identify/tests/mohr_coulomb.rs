@@ -1,0 +1,170 @@
+//! Mohr–Coulomb envelope by conic programming (Clarabel) on synthetic states at yield.
+
+mod common;
+
+use common::gaussian;
+use identify::laws::MohrCoulombLaw;
+use identify::mohr_coulomb::{fit_mohr_coulomb, YieldData};
+use identify::IdentifyError;
+
+/// 40 Mohr circles at yield with p ∈ [1, 20] kPa, q = p sin φ + c cos φ + noise, each turned
+/// into a tension-positive 2D tensor at a different orientation.
+fn tensors(phi_deg: f64, c: f64, seed: u64, noise: f64) -> Vec<[f64; 3]> {
+    let law = MohrCoulombLaw {
+        friction_angle_rad: phi_deg.to_radians(),
+        cohesion_pa: c,
+    };
+    let e = gaussian(seed, 40, noise);
+    (0..40)
+        .map(|k| {
+            let p = 1000.0 + 19000.0 * k as f64 / 39.0;
+            let q = law.yield_q(p) + e[k];
+            let a = 0.37 * k as f64; // principal direction
+            let (s1, s3) = (-(p + q), -(p - q)); // tension positive: compression negative
+            [
+                s1 * a.cos().powi(2) + s3 * a.sin().powi(2),
+                s1 * a.sin().powi(2) + s3 * a.cos().powi(2),
+                (s1 - s3) * a.sin() * a.cos(),
+            ]
+        })
+        .collect()
+}
+
+#[test]
+fn noise_free_states_give_phi_and_c_exactly() {
+    let fit = fit_mohr_coulomb(
+        &YieldData::from_tension_positive_tensors(&tensors(30.0, 500.0, 0, 0.0)),
+        0.95,
+    )
+    .unwrap();
+    assert!((fit.friction_angle_deg.value - 30.0).abs() < 1e-6, "{:?}", fit.friction_angle_deg);
+    assert!((fit.cohesion.value - 500.0).abs() < 1e-3, "{:?}", fit.cohesion);
+    assert!(!fit.cohesion.at_bound);
+}
+
+#[test]
+fn noisy_cohesive_states_recover_phi_and_c() {
+    // Tolerances: φ within 0.5°, c within 150 Pa (noise 50 Pa on q), and within 3 standard errors.
+    let fit = fit_mohr_coulomb(
+        &YieldData::from_tension_positive_tensors(&tensors(30.0, 500.0, 1, 50.0)),
+        0.95,
+    )
+    .unwrap();
+    let phi = &fit.friction_angle_deg;
+    assert!((phi.value - 30.0).abs() < 0.5 && (phi.value - 30.0).abs() < 3.0 * phi.std_error);
+    let c = &fit.cohesion;
+    assert!((c.value - 500.0).abs() < 150.0 && (c.value - 500.0).abs() < 3.0 * c.std_error);
+    assert_eq!(fit.report.parameters[0].unit, "rad");
+    assert_eq!(fit.report.validity[0].variable, "p");
+    // The 2D Drucker–Prager equivalent gives the same yield radius.
+    let dp = fit.law.drucker_prager_2d();
+    assert!((dp.alpha * 5000.0 + dp.k_pa - fit.law.yield_q(5000.0)).abs() < 1e-9);
+}
+
+#[test]
+fn cohesionless_states_give_c_zero_on_its_bound() {
+    for seed in 0..5 {
+        let fit = fit_mohr_coulomb(
+            &YieldData::from_tension_positive_tensors(&tensors(25.0, 0.0, 10 + seed, 50.0)),
+            0.95,
+        )
+        .unwrap();
+        // Either the constraint is active (c = 0 exactly) or c is small, and φ is recovered.
+        assert!(fit.cohesion.value >= 0.0);
+        if fit.cohesion.at_bound {
+            assert_eq!(fit.cohesion.value, 0.0);
+            assert_eq!(fit.cohesion.ci_low, 0.0);
+            assert!(fit.cohesion.ci_high >= 0.0);
+        } else {
+            assert!(fit.cohesion.value < 150.0);
+        }
+        assert!((fit.friction_angle_deg.value - 25.0).abs() < 0.5);
+    }
+    // A draw whose unconstrained intercept is negative: cohesion sits at 0 with the flag.
+    let mut states = tensors(25.0, 0.0, 0, 0.0);
+    // Shift every circle's radius down by 100 Pa (q = p sin φ − 100): OLS would give c < 0.
+    let data = YieldData::from_tension_positive_tensors(&states);
+    let YieldData::Circles { p_pa, q_pa } = data else {
+        unreachable!()
+    };
+    let shifted = YieldData::Circles {
+        p_pa: p_pa.clone(),
+        q_pa: q_pa.iter().map(|q| q - 100.0).collect(),
+    };
+    let fit = fit_mohr_coulomb(&shifted, 0.95).unwrap();
+    assert!(fit.cohesion.at_bound && fit.cohesion.value == 0.0);
+    states.clear();
+}
+
+#[test]
+fn failure_plane_and_principal_forms() {
+    let law = MohrCoulombLaw {
+        friction_angle_rad: 35f64.to_radians(),
+        cohesion_pa: 200.0,
+    };
+    let sigma: Vec<f64> = (1..=10).map(|k| 1000.0 * k as f64).collect();
+    let tau: Vec<f64> = sigma.iter().map(|s| -law.shear_strength(*s)).collect(); // sign ignored
+    let fit = fit_mohr_coulomb(
+        &YieldData::FailurePlane {
+            sigma_n_pa: sigma.clone(),
+            tau_pa: tau,
+        },
+        0.95,
+    )
+    .unwrap();
+    assert!((fit.friction_angle_deg.value - 35.0).abs() < 1e-6);
+    assert!((fit.cohesion.value - 200.0).abs() < 1e-3);
+    // Principal stresses σ₁ = p + q, σ₃ = p − q.
+    let (s1, s3): (Vec<f64>, Vec<f64>) = sigma
+        .iter()
+        .map(|p| (p + law.yield_q(*p), p - law.yield_q(*p)))
+        .unzip();
+    let fit = fit_mohr_coulomb(&YieldData::from_principal(&s1, &s3), 0.95).unwrap();
+    assert!((fit.friction_angle_deg.value - 35.0).abs() < 1e-6);
+    assert!((fit.cohesion.value - 200.0).abs() < 1e-3);
+}
+
+#[test]
+fn degenerate_yield_data() {
+    let bad = YieldData::Circles {
+        p_pa: vec![1000.0, -5.0, 3000.0, 4000.0],
+        q_pa: vec![500.0, 1000.0, 1500.0, 2000.0],
+    };
+    assert!(matches!(
+        fit_mohr_coulomb(&bad, 0.95).unwrap_err(),
+        IdentifyError::NegativePressure { index: 1, .. }
+    ));
+    let few = YieldData::Circles {
+        p_pa: vec![1000.0, 2000.0, 3000.0],
+        q_pa: vec![500.0, 1000.0, 1500.0],
+    };
+    assert!(matches!(
+        fit_mohr_coulomb(&few, 0.95).unwrap_err(),
+        IdentifyError::TooFewPoints { needed: 4, got: 3, .. }
+    ));
+    let same = YieldData::Circles {
+        p_pa: vec![1000.0; 6],
+        q_pa: vec![500.0, 510.0, 490.0, 505.0, 495.0, 500.0],
+    };
+    assert!(matches!(
+        fit_mohr_coulomb(&same, 0.95).unwrap_err(),
+        IdentifyError::ZeroVariance { .. }
+    ));
+    // q decreasing with p: the friction coefficient ends at its bound 0.
+    let weird = YieldData::Circles {
+        p_pa: vec![1000.0, 2000.0, 3000.0, 4000.0, 5000.0],
+        q_pa: vec![900.0, 800.0, 700.0, 600.0, 500.0],
+    };
+    assert!(matches!(
+        fit_mohr_coulomb(&weird, 0.95).unwrap_err(),
+        IdentifyError::ParameterAtBound { .. }
+    ));
+    let nan = YieldData::Circles {
+        p_pa: vec![1000.0, 2000.0, f64::NAN, 4000.0],
+        q_pa: vec![500.0, 1000.0, 1500.0, 2000.0],
+    };
+    assert!(matches!(
+        fit_mohr_coulomb(&nan, 0.95).unwrap_err(),
+        IdentifyError::NonFinite { index: 2, .. }
+    ));
+}
