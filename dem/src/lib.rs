@@ -3,13 +3,34 @@
 //! Rigid disks and walls, Moreau–Jean time stepping, Coulomb friction as one bipotential solved
 //! by nonlinear Gauss–Seidel with the bipotential predictor–corrector per contact.
 //!
-//! Pipeline of one step (see [`world::World::step`]):
-//! detection ([`detection`]) → free velocities → NLGS contact solve ([`solver`], local law in
-//! [`local`]) → θ-method position update.
+//! Data: [`body::Body`] (rigid bodies with per-degree-of-freedom control), [`collider::Collider`]
+//! (disks, lines, segments attached to bodies), [`material::ContactLaws`] (μ, e per material
+//! pair), [`contact::ContactSet`] (the contacts of a step), [`snapshot::Snapshot`] (the state
+//! after a step, for the later stages).
+//!
+//! Algorithms, in the order of one step ([`world::World::step`]):
+//! [`detection`] (cell grid, O(N)) → free velocities → [`solver`] (NLGS, O(1) per contact
+//! update, local law in [`local`]) → θ-method position update.
 //!
 //! The same local law solves standalone frictional-contact problems given by `W`, `q`, `μ`
 //! ([`fc`]).
 
+pub mod body;
+pub mod collider;
+pub mod contact;
+pub mod detection;
+pub mod error;
 pub mod fc;
 pub mod local;
+pub mod material;
 pub mod snapshot;
+pub mod solver;
+pub mod world;
+
+pub use body::{Body, BodyKind, Dof};
+pub use error::DemError;
+pub use local::ContactStatus;
+pub use material::ContactLaws;
+pub use snapshot::Snapshot;
+pub use solver::{SolveReport, SolverParams};
+pub use world::{StepReport, World, WorldParams};

@@ -1,0 +1,152 @@
+//! The contact set of a step: hot rows read by the solver (body indices, frame, lever arms,
+//! Delassus block, impulse) and cold geometry kept for output, both in the same order, sorted by
+//! collider pair so that warm starting is a merge with the previous step.
+
+use serde::{Deserialize, Serialize};
+
+use crate::local::{ContactStatus, Delassus2};
+
+/// What the solver reads and writes for one contact (hot data, 15 words).
+///
+/// Kinematics with `t = (−n_y, n_x)` and lever arms `ρ_a = x − c_a`, `ρ_b = x − c_b`:
+/// ```text
+/// u_n = n·(v_b − v_a) + (ρ_b×n) ω_b − (ρ_a×n) ω_a + shift
+/// u_t = t·(v_b − v_a) + (ρ_b×t) ω_b − (ρ_a×t) ω_a
+/// ```
+/// which is `u = H v + shift`; the impulse `R = r_n n + r_t t` acts on `b` and `−R` on `a`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(C)]
+pub struct ContactRow {
+    /// Body `a` (the wall, or the disk of lower collider index).
+    pub a: u32,
+    /// Body `b`.
+    pub b: u32,
+    /// Unit normal from `a` to `b`.
+    pub n: [f64; 2],
+    /// Lever cross products `[ρ_a×n, ρ_a×t, ρ_b×n, ρ_b×t]` (m).
+    pub k: [f64; 4],
+    /// Local Delassus block `W_αα = H_α M⁻¹ H_αᵀ` (1/kg).
+    pub w: Delassus2,
+    /// Constant shift of the normal velocity (m/s): `max(g,0)/(hθ)` lets an open gap close
+    /// within the step; `e u_n⁻` adds Newton restitution on impacts.
+    pub shift: f64,
+    /// Friction coefficient μ.
+    pub mu: f64,
+    /// Impulse `(r_n, r_t)` (N·s).
+    pub r: [f64; 2],
+}
+
+impl ContactRow {
+    /// Local relative velocity `u = H v + (shift, 0)` from body velocities `[v_x, v_y, ω]`.
+    #[inline(always)]
+    pub fn velocity(&self, va: &[f64; 3], vb: &[f64; 3]) -> [f64; 2] {
+        let [nx, ny] = self.n;
+        let dx = vb[0] - va[0];
+        let dy = vb[1] - va[1];
+        [
+            nx * dx + ny * dy + self.k[2] * vb[2] - self.k[0] * va[2] + self.shift,
+            -ny * dx + nx * dy + self.k[3] * vb[2] - self.k[1] * va[2],
+        ]
+    }
+
+    /// Apply an impulse increment `d = (Δr_n, Δr_t)` to the body velocities:
+    /// `v_b += M_b⁻¹ H_bᵀ d`, `v_a −= M_a⁻¹ H_aᵀ d`.
+    #[inline(always)]
+    pub fn apply(&self, d: [f64; 2], va: &mut [f64; 3], ia: &[f64; 3], vb: &mut [f64; 3], ib: &[f64; 3]) {
+        let [nx, ny] = self.n;
+        let fx = d[0] * nx - d[1] * ny;
+        let fy = d[0] * ny + d[1] * nx;
+        vb[0] += ib[0] * fx;
+        vb[1] += ib[1] * fy;
+        vb[2] += ib[2] * (self.k[2] * d[0] + self.k[3] * d[1]);
+        va[0] -= ia[0] * fx;
+        va[1] -= ia[1] * fy;
+        va[2] -= ia[2] * (self.k[0] * d[0] + self.k[1] * d[1]);
+    }
+
+    /// The local Delassus block from the inverse masses of both bodies.
+    #[inline]
+    pub fn delassus(n: [f64; 2], k: [f64; 4], ia: &[f64; 3], ib: &[f64; 3]) -> Delassus2 {
+        let [nx, ny] = n;
+        let (tx, ty) = (-ny, nx);
+        let lin = |i: &[f64; 3]| {
+            (
+                i[0] * nx * nx + i[1] * ny * ny,
+                i[0] * nx * tx + i[1] * ny * ty,
+                i[0] * tx * tx + i[1] * ty * ty,
+            )
+        };
+        let (an, at_, att) = lin(ia);
+        let (bn, bt, btt) = lin(ib);
+        Delassus2 {
+            nn: an + bn + ia[2] * k[0] * k[0] + ib[2] * k[2] * k[2],
+            nt: at_ + bt + ia[2] * k[0] * k[1] + ib[2] * k[2] * k[3],
+            tt: att + btt + ia[2] * k[1] * k[1] + ib[2] * k[3] * k[3],
+        }
+    }
+}
+
+/// Geometry of one contact kept for output (cold data).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ContactGeometry {
+    /// Collider pair key `(collider_a << 32) | collider_b`; identity across steps.
+    pub key: u64,
+    /// Contact point (m), on the surface of `b`.
+    pub point: [f64; 2],
+    /// Gap at the start of the step (m).
+    pub gap: f64,
+    /// Lever arm `x − c_a` (m).
+    pub lever_a: [f64; 2],
+    /// Lever arm `x − c_b` (m).
+    pub lever_b: [f64; 2],
+    /// Normal restitution coefficient of the pair.
+    pub restitution: f64,
+}
+
+/// All contacts of a step, sorted by `geometry.key`.
+#[derive(Debug, Clone, Default)]
+pub struct ContactSet {
+    /// Solver rows.
+    pub rows: Vec<ContactRow>,
+    /// Output geometry, same order.
+    pub geometry: Vec<ContactGeometry>,
+    /// Local-law outcome after the solve, same order.
+    pub status: Vec<ContactStatus>,
+}
+
+impl ContactSet {
+    /// Number of contacts.
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// True when there is no contact.
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// Remove every contact, keeping the allocations.
+    pub fn clear(&mut self) {
+        self.rows.clear();
+        self.geometry.clear();
+        self.status.clear();
+    }
+
+    /// Warm start: copy the impulses of `previous` onto the contacts with the same key (both sets
+    /// sorted by key; a linear merge), scaled by `scale` (ratio of time steps).
+    pub fn warm_start_from(&mut self, previous: &ContactSet, scale: f64) {
+        let mut j = 0;
+        let pk = &previous.geometry;
+        for (i, g) in self.geometry.iter().enumerate() {
+            while j < pk.len() && pk[j].key < g.key {
+                j += 1;
+            }
+            if j < pk.len() && pk[j].key == g.key {
+                let r = previous.rows[j].r;
+                self.rows[i].r = [r[0] * scale, r[1] * scale];
+            } else {
+                self.rows[i].r = [0.0, 0.0];
+            }
+        }
+    }
+}

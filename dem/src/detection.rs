@@ -1,0 +1,449 @@
+//! Contact detection in O(N): a uniform cell grid over the disks (cell side ≥ the largest
+//! diameter plus the detection gap, periodic along x when asked), each disk tested against the
+//! disks of its 3×3 neighbourhood, and every line or segment tested against every disk.
+//!
+//! A contact is created for every pair whose gap is at most the detection gap `g_d`:
+//! `g = |c_b − c_a| − R_a − R_b` for two disks, `g = (c − p)·n − R` for a line, and the distance
+//! to the closest point minus `R` for a segment. Contacts come out sorted by the collider pair
+//! key `(collider_a << 32) | collider_b` (a is the wall or the disk of lower index), so that the
+//! next step can warm start by a linear merge.
+
+use nalgebra::Vector2;
+
+use crate::body::Body;
+use crate::collider::{rotate, Collider, Shape};
+use crate::contact::{ContactGeometry, ContactRow, ContactSet};
+use crate::error::DemError;
+use crate::local::ContactStatus;
+use crate::material::ContactLaws;
+
+/// Periodic cell along x, `[x_min, x_max)` (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Periodic {
+    /// Lower bound (m).
+    pub x_min: f64,
+    /// Length L (m).
+    pub length: f64,
+}
+
+impl Periodic {
+    /// Wrap `x` into `[x_min, x_min + L)`.
+    #[inline]
+    pub fn wrap(&self, x: f64) -> f64 {
+        let w = self.x_min + (x - self.x_min).rem_euclid(self.length);
+        if w >= self.x_min + self.length {
+            self.x_min
+        } else {
+            w
+        }
+    }
+
+    /// Minimum-image difference along x.
+    #[inline]
+    pub fn min_image(&self, dx: f64) -> f64 {
+        dx - self.length * (dx / self.length).round()
+    }
+}
+
+/// Reusable detection buffers (kept between steps so that detection allocates nothing in the
+/// steady state).
+#[derive(Debug, Default, Clone)]
+pub struct Detector {
+    disk_collider: Vec<u32>,
+    centre: Vec<[f64; 2]>,
+    radius: Vec<f64>,
+    margin: Vec<f64>,
+    cell_of: Vec<u32>,
+    cell_start: Vec<u32>,
+    cell_items: Vec<u32>,
+    neighbours: Vec<(u32, u32)>,
+    fill: Vec<u32>,
+}
+
+/// A line or segment in world coordinates.
+enum WallShape {
+    Line { p: Vector2<f64>, n: Vector2<f64> },
+    Segment { a: Vector2<f64>, b: Vector2<f64> },
+}
+
+impl Detector {
+    /// Detect all contacts that may close during a step of length `dt` and fill `out` (cleared
+    /// first), with geometry, Delassus blocks and friction; impulses are zero.
+    ///
+    /// A pair becomes a contact when its gap is at most `detection_gap + m_a + m_b`, with the
+    /// swept margin of a body `m = dt (|v| + dt |g| + |ω| ρ)` (ρ the distance of the shape from
+    /// the body's centre): a grain moving several detection gaps per step is still caught before
+    /// it overlaps. Pass `dt = 0` for a purely geometric test.
+    #[allow(clippy::too_many_arguments)]
+    pub fn detect(
+        &mut self,
+        bodies: &[Body],
+        inv_mass: &[[f64; 3]],
+        colliders: &[Collider],
+        laws: &ContactLaws,
+        periodic: Option<Periodic>,
+        detection_gap: f64,
+        dt: f64,
+        gravity: f64,
+        out: &mut ContactSet,
+    ) -> Result<(), DemError> {
+        out.clear();
+        self.collect_disks(bodies, colliders, periodic, dt, gravity);
+        let nd = self.centre.len();
+        let mut max_d = 0.0f64;
+        let mut max_m = 0.0f64;
+        for (&r, &m) in self.radius.iter().zip(&self.margin) {
+            max_d = max_d.max(2.0 * r);
+            max_m = max_m.max(m);
+        }
+        let mut cell = max_d + detection_gap.max(0.0) + 2.0 * max_m;
+        if !(cell > 0.0) {
+            cell = 1.0;
+        }
+        // Grid extent.
+        let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for c in &self.centre {
+            xmin = xmin.min(c[0]);
+            xmax = xmax.max(c[0]);
+            ymin = ymin.min(c[1]);
+            ymax = ymax.max(c[1]);
+        }
+        if nd == 0 {
+            (xmin, xmax, ymin, ymax) = (0.0, 1.0, 0.0, 1.0);
+        }
+        // Keep the number of cells O(N) even if one grain flies far away.
+        let cap = 4 * nd + 64;
+        let (ncx, cx_size) = match periodic {
+            Some(p) => {
+                let n = (p.length / cell).floor() as usize;
+                if n < 3 {
+                    return Err(DemError::Parameter {
+                        name: "periodic_x".into(),
+                        reason: format!(
+                            "the periodic length {} m must be at least 3 times the largest \
+                             diameter plus the detection gap ({} m)",
+                            p.length, cell
+                        ),
+                    });
+                }
+                let n = n.min(cap);
+                xmin = p.x_min;
+                (n, p.length / n as f64)
+            }
+            None => {
+                let n = (((xmax - xmin) / cell).floor() as usize + 1).min(cap);
+                (n, ((xmax - xmin) / n as f64).max(cell))
+            }
+        };
+        let ncy0 = ((ymax - ymin) / cell).floor() as usize + 1;
+        let mut cy_size = cell;
+        let mut ncy = ncy0;
+        if ncx * ncy > cap {
+            ncy = (cap / ncx).max(1);
+            cy_size = ((ymax - ymin) / ncy as f64).max(cell) * (1.0 + 1e-12);
+            ncy = ((ymax - ymin) / cy_size).floor() as usize + 1;
+        }
+        let ncells = ncx * ncy;
+        // Counting sort of disks into cells.
+        self.cell_of.clear();
+        self.cell_start.clear();
+        self.cell_start.resize(ncells + 1, 0);
+        for c in &self.centre {
+            let ix = (((c[0] - xmin) / cx_size).floor() as isize).clamp(0, ncx as isize - 1) as usize;
+            let iy = (((c[1] - ymin) / cy_size).floor() as isize).clamp(0, ncy as isize - 1) as usize;
+            let id = (iy * ncx + ix) as u32;
+            self.cell_of.push(id);
+            self.cell_start[id as usize + 1] += 1;
+        }
+        for i in 0..ncells {
+            self.cell_start[i + 1] += self.cell_start[i];
+        }
+        self.cell_items.clear();
+        self.cell_items.resize(nd, 0);
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.cell_start[..ncells]);
+        for (d, &cid) in self.cell_of.iter().enumerate() {
+            self.cell_items[self.fill[cid as usize] as usize] = d as u32;
+            self.fill[cid as usize] += 1;
+        }
+
+        // Ordered outer loop over colliders: disks find higher disks in the grid, walls find
+        // every disk, so keys come out sorted.
+        let mut disk_pos = 0usize;
+        for (ci, col) in colliders.iter().enumerate() {
+            match col.shape {
+                Shape::Disk { .. } => {
+                    let d = disk_pos;
+                    disk_pos += 1;
+                    self.neighbours.clear();
+                    let cid = self.cell_of[d] as usize;
+                    let (ix, iy) = ((cid % ncx) as isize, (cid / ncx) as isize);
+                    for dy in -1isize..=1 {
+                        let jy = iy + dy;
+                        if jy < 0 || jy >= ncy as isize {
+                            continue;
+                        }
+                        for dx in -1isize..=1 {
+                            let mut jx = ix + dx;
+                            if periodic.is_some() {
+                                jx = jx.rem_euclid(ncx as isize);
+                            } else if jx < 0 || jx >= ncx as isize {
+                                continue;
+                            }
+                            let c2 = jy as usize * ncx + jx as usize;
+                            for &e in &self.cell_items
+                                [self.cell_start[c2] as usize..self.cell_start[c2 + 1] as usize]
+                            {
+                                if (e as usize) > d {
+                                    self.neighbours.push((self.disk_collider[e as usize], e));
+                                }
+                            }
+                        }
+                    }
+                    self.neighbours.sort_unstable();
+                    for k in 0..self.neighbours.len() {
+                        let (cj, e) = self.neighbours[k];
+                        self.disk_disk(
+                            bodies, inv_mass, colliders, laws, periodic, detection_gap, ci as u32, d,
+                            cj, e as usize, out,
+                        );
+                    }
+                }
+                Shape::Line { .. } | Shape::Segment { .. } => {
+                    let wb = &bodies[col.body as usize];
+                    let wall_margin = dt * wb.velocity.norm();
+                    let shape = match &col.shape {
+                        Shape::Line { point, normal } => WallShape::Line {
+                            p: wb.position + rotate(*point, wb.angle),
+                            n: rotate(*normal, wb.angle).normalize(),
+                        },
+                        Shape::Segment { a, b } => WallShape::Segment {
+                            a: wb.position + rotate(*a, wb.angle),
+                            b: wb.position + rotate(*b, wb.angle),
+                        },
+                        Shape::Disk { .. } => unreachable!(),
+                    };
+                    for e in 0..nd {
+                        self.wall_disk(
+                            bodies,
+                            inv_mass,
+                            colliders,
+                            laws,
+                            periodic,
+                            detection_gap + wall_margin + self.margin[e],
+                            ci as u32,
+                            &shape,
+                            e,
+                            out,
+                        );
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn collect_disks(
+        &mut self,
+        bodies: &[Body],
+        colliders: &[Collider],
+        periodic: Option<Periodic>,
+        dt: f64,
+        gravity: f64,
+    ) {
+        self.disk_collider.clear();
+        self.centre.clear();
+        self.radius.clear();
+        self.margin.clear();
+        for (ci, col) in colliders.iter().enumerate() {
+            match col.shape {
+                Shape::Disk { radius, offset } => {
+                    let b = &bodies[col.body as usize];
+                    let mut c = b.position + rotate(offset, b.angle);
+                    if let Some(p) = periodic {
+                        c.x = p.wrap(c.x);
+                    }
+                    self.disk_collider.push(ci as u32);
+                    self.centre.push([c.x, c.y]);
+                    self.radius.push(radius);
+                    let g = if b.gravity { gravity } else { 0.0 };
+                    self.margin
+                        .push(dt * (b.velocity.norm() + dt * g + b.omega.abs() * offset.norm()));
+                }
+                _ => {}
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn disk_disk(
+        &self,
+        bodies: &[Body],
+        inv_mass: &[[f64; 3]],
+        colliders: &[Collider],
+        laws: &ContactLaws,
+        periodic: Option<Periodic>,
+        gap_max: f64,
+        ci: u32,
+        di: usize,
+        cj: u32,
+        dj: usize,
+        out: &mut ContactSet,
+    ) {
+        let (ca, cb) = (&colliders[ci as usize], &colliders[cj as usize]);
+        if ca.body == cb.body {
+            return;
+        }
+        let (ba, bb) = (ca.body as usize, cb.body as usize);
+        if bodies[ba].is_kinematic() && bodies[bb].is_kinematic() {
+            return;
+        }
+        let (pa, pb) = (self.centre[di], self.centre[dj]);
+        let mut dx = pb[0] - pa[0];
+        if let Some(p) = periodic {
+            dx = p.min_image(dx);
+        }
+        let dy = pb[1] - pa[1];
+        let (ra, rb) = (self.radius[di], self.radius[dj]);
+        let reach = ra + rb + gap_max + self.margin[di] + self.margin[dj];
+        let d2 = dx * dx + dy * dy;
+        if d2 > reach * reach {
+            return;
+        }
+        let dist = d2.sqrt();
+        if dist <= 0.0 {
+            return;
+        }
+        let n = Vector2::new(dx / dist, dy / dist);
+        let gap = dist - ra - rb;
+        // Contact point on the surface of b; levers from the bodies' centres of mass.
+        let off_a = disk_offset(&bodies[ba], ca);
+        let off_b = disk_offset(&bodies[bb], cb);
+        let lever_b = -n * rb + off_b;
+        let lever_a = Vector2::new(dx, dy) - n * rb + off_a;
+        let point = Vector2::new(pb[0], pb[1]) - n * rb;
+        push_contact(
+            out, inv_mass, laws, ca, cb, ci, cj, ba, bb, n, point, lever_a, lever_b, gap,
+        );
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn wall_disk(
+        &self,
+        bodies: &[Body],
+        inv_mass: &[[f64; 3]],
+        colliders: &[Collider],
+        laws: &ContactLaws,
+        periodic: Option<Periodic>,
+        gap_max: f64,
+        cw: u32,
+        shape: &WallShape,
+        e: usize,
+        out: &mut ContactSet,
+    ) {
+        let cj = self.disk_collider[e];
+        let (ca, cb) = (&colliders[cw as usize], &colliders[cj as usize]);
+        let (ba, bb) = (ca.body as usize, cb.body as usize);
+        if ba == bb || (bodies[ba].is_kinematic() && bodies[bb].is_kinematic()) {
+            return;
+        }
+        let c = Vector2::new(self.centre[e][0], self.centre[e][1]);
+        let r = self.radius[e];
+        let (n, gap) = match *shape {
+            WallShape::Line { p, n } => {
+                let mut d = c - p;
+                if let Some(per) = periodic {
+                    d.x = per.min_image(d.x);
+                }
+                (n, d.dot(&n) - r)
+            }
+            WallShape::Segment { a, b } => {
+                let ab = b - a;
+                let mut ac = c - a;
+                if let Some(per) = periodic {
+                    ac.x = per.min_image(ac.x);
+                }
+                let l2 = ab.norm_squared();
+                let s = if l2 > 0.0 { (ac.dot(&ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+                let d = ac - ab * s;
+                let dist = d.norm();
+                if dist - r > gap_max {
+                    return;
+                }
+                let n = if dist > 0.0 {
+                    d / dist
+                } else {
+                    Vector2::new(-ab.y, ab.x).normalize()
+                };
+                (n, dist - r)
+            }
+        };
+        if gap > gap_max {
+            return;
+        }
+        let point = c - n * r;
+        let off_b = disk_offset(&bodies[bb], cb);
+        let lever_b = -n * r + off_b;
+        let mut lever_a = point - bodies[ba].position;
+        if let Some(per) = periodic {
+            lever_a.x = per.min_image(lever_a.x);
+        }
+        push_contact(
+            out, inv_mass, laws, ca, cb, cw, cj, ba, bb, n, point, lever_a, lever_b, gap,
+        );
+    }
+}
+
+#[inline]
+fn disk_offset(b: &Body, c: &Collider) -> Vector2<f64> {
+    match c.shape {
+        Shape::Disk { offset, .. } => rotate(offset, b.angle),
+        _ => Vector2::zeros(),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn push_contact(
+    out: &mut ContactSet,
+    inv_mass: &[[f64; 3]],
+    laws: &ContactLaws,
+    ca: &Collider,
+    cb: &Collider,
+    ci: u32,
+    cj: u32,
+    ba: usize,
+    bb: usize,
+    n: Vector2<f64>,
+    point: Vector2<f64>,
+    lever_a: Vector2<f64>,
+    lever_b: Vector2<f64>,
+    gap: f64,
+) {
+    let t = Vector2::new(-n.y, n.x);
+    let cross = |r: Vector2<f64>, v: Vector2<f64>| r.x * v.y - r.y * v.x;
+    let k = [cross(lever_a, n), cross(lever_a, t), cross(lever_b, n), cross(lever_b, t)];
+    let nn = [n.x, n.y];
+    let w = ContactRow::delassus(nn, k, &inv_mass[ba], &inv_mass[bb]);
+    out.rows.push(ContactRow {
+        a: ba as u32,
+        b: bb as u32,
+        n: nn,
+        k,
+        w,
+        shift: 0.0,
+        mu: laws.friction(ca.material, cb.material),
+        r: [0.0, 0.0],
+    });
+    out.geometry.push(ContactGeometry {
+        key: ((ci as u64) << 32) | cj as u64,
+        point: [point.x, point.y],
+        gap,
+        lever_a: [lever_a.x, lever_a.y],
+        lever_b: [lever_b.x, lever_b.y],
+        restitution: laws.restitution(ca.material, cb.material),
+    });
+    out.status.push(ContactStatus::Open);
+}

@@ -1,0 +1,600 @@
+//! The world: bodies, colliders, contact laws, and the Moreau–Jean time step.
+//!
+//! One step of length h (θ-method, impulses `R = h r`):
+//!
+//! ```text
+//! 1. detect contacts at q⁻ (gap ≤ detection gap), warm-start impulses by collider pair
+//! 2. v_free = v⁻ + h M⁻¹ f_ext                    (imposed degrees of freedom keep their velocity)
+//! 3. solve  u = H v⁺ + shift,  v⁺ = v_free + M⁻¹ Hᵀ R,  (u, R) extremal pairs of the bipotential
+//!    with shift = max(g⁻, 0)/(hθ) + e·min(u_n⁻, 0)
+//! 4. q⁺ = q⁻ + h [(1 − θ) v⁻ + θ v⁺]
+//! ```
+//!
+//! The shift lets a contact that is still open at the start of the step close during it (it
+//! stops exactly at contact for θ = 1) and adds Newton restitution `u_n⁺ ≥ −e u_n⁻` on impacts;
+//! with `e = 0` (the default) an impact is perfectly inelastic. Overlaps are never pushed apart,
+//! so the scheme injects no energy: with θ = 1 the energy change of a step is
+//! `R·u⁺ − ½ ‖v⁺ − v⁻‖²_M ≤ 0`.
+
+use nalgebra::Vector2;
+use serde::{Deserialize, Serialize};
+
+use crate::body::{Body, Dof};
+use crate::collider::{rotate, Collider, Shape};
+use crate::contact::ContactSet;
+use crate::detection::{Detector, Periodic};
+use crate::error::DemError;
+use crate::material::ContactLaws;
+use crate::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
+use crate::solver::{self, SolveReport, SolverParams};
+
+/// Parameters of the time stepping.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WorldParams {
+    /// Time step h (s).
+    pub dt: f64,
+    /// θ of the θ-method, in [1/2, 1]. The default θ = 1 makes every step dissipative
+    /// (`ΔE = R·u⁺ − ½‖v⁺ − v⁻‖²_M ≤ 0`); θ = 1/2 integrates free flight exactly but a step with
+    /// several contacts can gain a little energy.
+    pub theta: f64,
+    /// Gravity (m/s²).
+    pub gravity: Vector2<f64>,
+    /// Periodic cell along x, `[x_min, x_max)` (m).
+    pub periodic_x: Option<[f64; 2]>,
+    /// Detection gap (m): pairs closer than this become contacts.
+    pub detection_gap: f64,
+    /// Contact solver.
+    pub solver: SolverParams,
+}
+
+impl Default for WorldParams {
+    fn default() -> Self {
+        WorldParams {
+            dt: 1e-3,
+            theta: 1.0,
+            gravity: Vector2::new(0.0, -9.81),
+            periodic_x: None,
+            detection_gap: 1e-4,
+            solver: SolverParams::default(),
+        }
+    }
+}
+
+/// What one step did.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct StepReport {
+    /// Step index after the step.
+    pub step: u64,
+    /// Time after the step (s).
+    pub time: f64,
+    /// Contacts detected.
+    pub contacts: usize,
+    /// Contacts with a non-zero normal impulse.
+    pub active_contacts: usize,
+    /// The contact solve.
+    pub solver: SolveReport,
+    /// Largest overlap (−gap) at the start of the step (m), 0 if none.
+    pub max_penetration: f64,
+}
+
+/// A 2D granular world.
+#[derive(Debug, Clone)]
+pub struct World {
+    /// Time stepping parameters.
+    pub params: WorldParams,
+    /// Bodies (grains and walls).
+    pub bodies: Vec<Body>,
+    /// Shapes attached to bodies.
+    pub colliders: Vec<Collider>,
+    /// Friction and restitution between materials.
+    pub laws: ContactLaws,
+    /// Current time (s).
+    pub time: f64,
+    /// Steps done.
+    pub step_index: u64,
+    contacts: ContactSet,
+    previous: ContactSet,
+    detector: Detector,
+    vel: Vec<[f64; 3]>,
+    inv: Vec<[f64; 3]>,
+    body_force: Vec<[f64; 3]>,
+    order: Vec<u32>,
+    last: StepReport,
+}
+
+impl World {
+    /// An empty world.
+    pub fn new(params: WorldParams, laws: ContactLaws) -> Self {
+        World {
+            params,
+            bodies: Vec::new(),
+            colliders: Vec::new(),
+            laws,
+            time: 0.0,
+            step_index: 0,
+            contacts: ContactSet::default(),
+            previous: ContactSet::default(),
+            detector: Detector::default(),
+            vel: Vec::new(),
+            inv: Vec::new(),
+            body_force: Vec::new(),
+            order: Vec::new(),
+            last: StepReport::default(),
+        }
+    }
+
+    /// Add a free disk grain (thickness 1 m); returns its body index.
+    pub fn add_grain(&mut self, position: Vector2<f64>, radius: f64, density: f64, material: u16) -> u32 {
+        self.add_grain_with_thickness(position, radius, density, 1.0, material)
+    }
+
+    /// Add a free disk grain of given thickness (m); returns its body index.
+    pub fn add_grain_with_thickness(
+        &mut self,
+        position: Vector2<f64>,
+        radius: f64,
+        density: f64,
+        thickness: f64,
+        material: u16,
+    ) -> u32 {
+        let b = self.bodies.len() as u32;
+        self.bodies.push(Body::disk(position, radius, density, thickness));
+        self.colliders.push(Collider {
+            body: b,
+            shape: Shape::Disk {
+                radius,
+                offset: Vector2::zeros(),
+            },
+            material,
+        });
+        b
+    }
+
+    /// Add a fixed (or, by setting its velocity, driven) infinite line wall through `point` with
+    /// unit `normal` pointing to the grains; returns its body index.
+    pub fn add_line_wall(&mut self, name: &str, point: Vector2<f64>, normal: Vector2<f64>, material: u16) -> u32 {
+        let b = self.bodies.len() as u32;
+        self.bodies.push(Body::wall(name, point, Vector2::zeros()));
+        self.colliders.push(Collider {
+            body: b,
+            shape: Shape::Line {
+                point: Vector2::zeros(),
+                normal: normal.normalize(),
+            },
+            material,
+        });
+        b
+    }
+
+    /// Add a fixed segment wall from `a` to `b`; returns its body index (centre at the middle).
+    pub fn add_segment_wall(&mut self, name: &str, a: Vector2<f64>, b: Vector2<f64>, material: u16) -> u32 {
+        let id = self.bodies.len() as u32;
+        let c = (a + b) * 0.5;
+        self.bodies.push(Body::wall(name, c, Vector2::zeros()));
+        self.colliders.push(Collider {
+            body: id,
+            shape: Shape::Segment { a: a - c, b: b - c },
+            material,
+        });
+        id
+    }
+
+    /// Add a rigid clump of glued disks (a rough wall), fixed by default; returns its body index.
+    /// Its centre is the mean of the disk centres. Give it free degrees of freedom, a mass and
+    /// an applied force to control it (e.g. a platen at imposed pressure).
+    pub fn add_clump(&mut self, name: &str, centres: &[Vector2<f64>], radii: &[f64], material: u16) -> u32 {
+        let id = self.bodies.len() as u32;
+        let n = centres.len().max(1) as f64;
+        let c = centres.iter().fold(Vector2::zeros(), |s, x| s + x) / n;
+        self.bodies.push(Body::wall(name, c, Vector2::zeros()));
+        for (x, &r) in centres.iter().zip(radii) {
+            self.colliders.push(Collider {
+                body: id,
+                shape: Shape::Disk {
+                    radius: r,
+                    offset: x - c,
+                },
+                material,
+            });
+        }
+        id
+    }
+
+    /// The periodic cell, if any.
+    pub fn periodic(&self) -> Option<Periodic> {
+        self.params.periodic_x.map(|[a, b]| Periodic {
+            x_min: a,
+            length: b - a,
+        })
+    }
+
+    /// Contacts of the last step.
+    pub fn contacts(&self) -> &ContactSet {
+        &self.contacts
+    }
+
+    /// Report of the last step.
+    pub fn last_report(&self) -> StepReport {
+        self.last
+    }
+
+    /// Total contact force (N) and torque (N·m) received by body `b` during the last step.
+    pub fn contact_force(&self, b: usize) -> (Vector2<f64>, f64) {
+        let f = self.body_force.get(b).copied().unwrap_or([0.0; 3]);
+        (Vector2::new(f[0], f[1]), f[2])
+    }
+
+    /// Kinetic energy of all free degrees of freedom (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.bodies.iter().map(Body::kinetic_energy).sum()
+    }
+
+    /// Gravitational potential energy `−Σ m g·x` over free degrees of freedom (J), relative to
+    /// the origin.
+    pub fn potential_energy(&self) -> f64 {
+        let g = self.params.gravity;
+        self.bodies
+            .iter()
+            .filter(|b| b.gravity)
+            .map(|b| {
+                let mut e = 0.0;
+                if b.dofs[0] == Dof::Free {
+                    e -= b.mass * g.x * b.position.x;
+                }
+                if b.dofs[1] == Dof::Free {
+                    e -= b.mass * g.y * b.position.y;
+                }
+                e
+            })
+            .sum()
+    }
+
+    /// Check every parameter, body, collider and contact law, and that no two grains overlap
+    /// and no grain lies behind a line wall by more than `tolerance` (m).
+    pub fn validate(&mut self, tolerance: f64) -> Result<(), DemError> {
+        let p = &self.params;
+        let perr = |name: &str, reason: String| DemError::Parameter {
+            name: name.into(),
+            reason,
+        };
+        if !(p.dt.is_finite() && p.dt > 0.0) {
+            return Err(perr("dt", format!("must be a positive time step in s, got {}", p.dt)));
+        }
+        if !(0.5..=1.0).contains(&p.theta) {
+            return Err(perr("theta", format!("must lie in [0.5, 1], got {}", p.theta)));
+        }
+        if !(p.gravity.x.is_finite() && p.gravity.y.is_finite()) {
+            return Err(perr("gravity", "must be finite".into()));
+        }
+        if !(p.detection_gap.is_finite() && p.detection_gap >= 0.0) {
+            return Err(perr("detection_gap", format!("must be ≥ 0 m, got {}", p.detection_gap)));
+        }
+        if let Some([a, b]) = p.periodic_x {
+            if !(a.is_finite() && b.is_finite() && b > a) {
+                return Err(perr("periodic_x", format!("needs x_min < x_max, got [{a}, {b}]")));
+            }
+        }
+        if !(p.solver.tolerance.is_finite() && p.solver.tolerance > 0.0) {
+            return Err(perr("solver.tolerance", format!("must be > 0, got {}", p.solver.tolerance)));
+        }
+        if p.solver.max_iterations == 0 {
+            return Err(perr("solver.max_iterations", "must be ≥ 1".into()));
+        }
+        for &mu in self.laws.friction_table() {
+            if !(mu.is_finite() && mu >= 0.0) {
+                return Err(perr("friction", format!("must be ≥ 0, got {mu}")));
+            }
+        }
+        for &e in self.laws.restitution_table() {
+            if !(0.0..=1.0).contains(&e) {
+                return Err(perr("restitution", format!("must lie in [0, 1], got {e}")));
+            }
+        }
+        for (i, b) in self.bodies.iter().enumerate() {
+            let berr = |field: &str, reason: String| DemError::Body {
+                index: i,
+                label: if b.name.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", b.name)
+                },
+                field: field.into(),
+                reason,
+            };
+            let finite = b.position.iter().chain(b.velocity.iter()).all(|x| x.is_finite())
+                && b.angle.is_finite()
+                && b.omega.is_finite();
+            if !finite {
+                return Err(berr("position/velocity", "must be finite".into()));
+            }
+            if b.kind == BodyKind::Grain {
+                if !(b.radius.is_finite() && b.radius > 0.0) {
+                    return Err(berr("radius", format!("must be > 0 m, got {}", b.radius)));
+                }
+                if !(b.density.is_finite() && b.density > 0.0) {
+                    return Err(berr("density", format!("must be > 0 kg/m³, got {}", b.density)));
+                }
+                if !(b.thickness.is_finite() && b.thickness > 0.0) {
+                    return Err(berr("thickness", format!("must be > 0 m, got {}", b.thickness)));
+                }
+            }
+            for (d, &dof) in b.dofs.iter().enumerate() {
+                let m = if d < 2 { b.mass } else { b.inertia };
+                if dof == Dof::Free && !(m.is_finite() && m > 0.0) {
+                    return Err(berr("mass", format!("a free degree of freedom needs a finite positive mass, got {m}")));
+                }
+            }
+        }
+        for c in &self.colliders {
+            if c.body as usize >= self.bodies.len() {
+                return Err(perr("collider", format!("refers to body {} that does not exist", c.body)));
+            }
+            if c.material as usize >= self.laws.len() {
+                return Err(perr("collider", format!("material {} is not defined", c.material)));
+            }
+            let bad = match &c.shape {
+                Shape::Disk { radius, offset } => !(radius.is_finite() && *radius > 0.0 && offset.x.is_finite() && offset.y.is_finite()),
+                Shape::Line { point, normal } => !(point.x.is_finite() && point.y.is_finite() && normal.norm() > 0.0),
+                Shape::Segment { a, b } => !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite()),
+            };
+            if bad {
+                let b = &self.bodies[c.body as usize];
+                return Err(DemError::Body {
+                    index: c.body as usize,
+                    label: format!(" ({})", b.name),
+                    field: "shape".into(),
+                    reason: "has a non-finite or non-positive size".into(),
+                });
+            }
+        }
+        // Overlaps and grains behind walls, with the detector at zero gap.
+        self.refresh_inverse_mass();
+        let mut set = ContactSet::default();
+        let periodic = self.periodic();
+        self.detector
+            .detect(&self.bodies, &self.inv, &self.colliders, &self.laws, periodic, 0.0, 0.0, 0.0, &mut set)?;
+        for (row, g) in set.rows.iter().zip(&set.geometry) {
+            if g.gap < -tolerance {
+                let (a, b) = (row.a as usize, row.b as usize);
+                if self.bodies[a].kind == BodyKind::Wall {
+                    return Err(DemError::Outside {
+                        grain: b,
+                        wall: self.bodies[a].name.clone(),
+                        depth: -g.gap,
+                    });
+                }
+                return Err(DemError::Overlap {
+                    a,
+                    b,
+                    overlap: -g.gap,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn refresh_inverse_mass(&mut self) {
+        self.inv.clear();
+        self.inv.extend(self.bodies.iter().map(Body::inverse_mass));
+    }
+
+    /// Advance one time step (see the module documentation). Non-convergence of the contact
+    /// solver is reported in the returned [`StepReport`], never hidden; a non-finite state is an
+    /// error.
+    pub fn step(&mut self) -> Result<StepReport, DemError> {
+        let h = self.params.dt;
+        let theta = self.params.theta;
+        let g = self.params.gravity;
+        let periodic = self.periodic();
+        self.refresh_inverse_mass();
+
+        // 1. Detection at q⁻, warm start from the previous step.
+        std::mem::swap(&mut self.contacts, &mut self.previous);
+        self.detector.detect(
+            &self.bodies,
+            &self.inv,
+            &self.colliders,
+            &self.laws,
+            periodic,
+            self.params.detection_gap,
+            h,
+            g.norm(),
+            &mut self.contacts,
+        )?;
+        self.contacts.warm_start_from(&self.previous, 1.0);
+
+        // 2. Free velocities.
+        self.vel.clear();
+        for b in &self.bodies {
+            self.vel.push([b.velocity.x, b.velocity.y, b.omega]);
+        }
+        let mut max_pen = 0.0f64;
+        for (row, geo) in self.contacts.rows.iter_mut().zip(&self.contacts.geometry) {
+            let mut shift = geo.gap.max(0.0) / (h * theta);
+            max_pen = max_pen.max(-geo.gap);
+            if geo.restitution > 0.0 && geo.gap <= 0.0 {
+                // Detection leaves the shift at zero, so this is u_n⁻.
+                let un = row.velocity(&self.vel[row.a as usize], &self.vel[row.b as usize])[0];
+                shift += geo.restitution * un.min(0.0);
+            }
+            row.shift = shift;
+        }
+        for (i, b) in self.bodies.iter().enumerate() {
+            let inv = &self.inv[i];
+            let grav = if b.gravity { g * b.mass } else { Vector2::zeros() };
+            let f = [grav.x + b.applied_force.x, grav.y + b.applied_force.y, b.applied_torque];
+            for d in 0..3 {
+                if b.dofs[d] == Dof::Free {
+                    self.vel[i][d] += h * inv[d] * f[d];
+                }
+            }
+        }
+
+        // 3. Contact solve.
+        let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
+        solver::apply_impulses(&self.contacts.rows, &mut self.vel, &self.inv);
+        self.order.clear();
+        self.order.extend(0..self.contacts.len() as u32);
+        let report = solver::solve(
+            &mut self.contacts.rows,
+            &mut self.order,
+            &mut self.vel,
+            &self.inv,
+            q_norm,
+            &self.params.solver,
+        );
+        solver::classify(&self.contacts.rows, &mut self.contacts.status);
+
+        // 4. Positions, accelerations.
+        for (i, b) in self.bodies.iter_mut().enumerate() {
+            let v = self.vel[i];
+            for (d, x) in v.iter().enumerate() {
+                if !x.is_finite() {
+                    return Err(DemError::NonFinite {
+                        step: self.step_index + 1,
+                        body: i,
+                        what: ["x velocity", "y velocity", "angular velocity"][d].into(),
+                    });
+                }
+            }
+            let vm = [b.velocity.x, b.velocity.y, b.omega];
+            b.acceleration = Vector2::new((v[0] - vm[0]) / h, (v[1] - vm[1]) / h);
+            b.angular_acceleration = (v[2] - vm[2]) / h;
+            b.position.x += h * ((1.0 - theta) * vm[0] + theta * v[0]);
+            b.position.y += h * ((1.0 - theta) * vm[1] + theta * v[1]);
+            b.angle += h * ((1.0 - theta) * vm[2] + theta * v[2]);
+            b.velocity = Vector2::new(v[0], v[1]);
+            b.omega = v[2];
+            if let Some(p) = periodic {
+                if b.kind == BodyKind::Grain {
+                    b.position.x = p.wrap(b.position.x);
+                }
+            }
+        }
+
+        // Contact forces received by each body (walls' loads), N and N·m.
+        self.body_force.clear();
+        self.body_force.resize(self.bodies.len(), [0.0; 3]);
+        let mut active = 0;
+        for row in &self.contacts.rows {
+            if row.r[0] > 0.0 {
+                active += 1;
+            }
+            let [nx, ny] = row.n;
+            let fx = (row.r[0] * nx - row.r[1] * ny) / h;
+            let fy = (row.r[0] * ny + row.r[1] * nx) / h;
+            let ta = (row.k[0] * row.r[0] + row.k[1] * row.r[1]) / h;
+            let tb = (row.k[2] * row.r[0] + row.k[3] * row.r[1]) / h;
+            let fb = &mut self.body_force[row.b as usize];
+            fb[0] += fx;
+            fb[1] += fy;
+            fb[2] += tb;
+            let fa = &mut self.body_force[row.a as usize];
+            fa[0] -= fx;
+            fa[1] -= fy;
+            fa[2] -= ta;
+        }
+
+        self.step_index += 1;
+        self.time += h;
+        self.last = StepReport {
+            step: self.step_index,
+            time: self.time,
+            contacts: self.contacts.len(),
+            active_contacts: active,
+            solver: report,
+            max_penetration: max_pen,
+        };
+        Ok(self.last)
+    }
+
+    /// The state after the last step as plain data (see [`crate::snapshot`]).
+    pub fn snapshot(&self) -> Snapshot {
+        let h = self.params.dt;
+        let bodies = self
+            .bodies
+            .iter()
+            .map(|b| BodyState {
+                kind: b.kind,
+                name: b.name.clone(),
+                position: b.position,
+                angle: b.angle,
+                velocity: b.velocity,
+                omega: b.omega,
+                acceleration: b.acceleration,
+                angular_acceleration: b.angular_acceleration,
+                mass: b.mass,
+                inertia: b.inertia,
+                radius: b.radius,
+                density: b.density,
+                thickness: b.thickness,
+            })
+            .collect();
+        let contacts = self
+            .contacts
+            .rows
+            .iter()
+            .zip(&self.contacts.geometry)
+            .zip(&self.contacts.status)
+            .map(|((row, geo), st)| ContactState {
+                body_a: row.a,
+                body_b: row.b,
+                point: Vector2::new(geo.point[0], geo.point[1]),
+                normal: Vector2::new(row.n[0], row.n[1]),
+                force_n: row.r[0] / h,
+                force_t: row.r[1] / h,
+                gap: geo.gap,
+                mu: row.mu,
+                status: *st,
+                lever_a: Vector2::new(geo.lever_a[0], geo.lever_a[1]),
+                lever_b: Vector2::new(geo.lever_b[0], geo.lever_b[1]),
+            })
+            .collect();
+        let mut walls = Vec::new();
+        for (i, b) in self.bodies.iter().enumerate() {
+            if b.kind != BodyKind::Wall {
+                continue;
+            }
+            let mine: Vec<&Collider> = self.colliders.iter().filter(|c| c.body as usize == i).collect();
+            let geometry = match mine.first().map(|c| &c.shape) {
+                Some(Shape::Line { point, normal }) => WallGeometry::Line {
+                    point: b.position + rotate(*point, b.angle),
+                    normal: rotate(*normal, b.angle),
+                },
+                Some(Shape::Segment { a, b: e }) => WallGeometry::Segment {
+                    a: b.position + rotate(*a, b.angle),
+                    b: b.position + rotate(*e, b.angle),
+                },
+                _ => {
+                    let mut centres = Vec::new();
+                    let mut radii = Vec::new();
+                    for c in &mine {
+                        if let Shape::Disk { radius, offset } = c.shape {
+                            centres.push(b.position + rotate(offset, b.angle));
+                            radii.push(radius);
+                        }
+                    }
+                    WallGeometry::Clump { centres, radii }
+                }
+            };
+            let (force, torque) = self.contact_force(i);
+            walls.push(WallState {
+                body: i as u32,
+                name: b.name.clone(),
+                geometry,
+                force,
+                torque,
+            });
+        }
+        Snapshot {
+            step: self.step_index,
+            time: self.time,
+            dt: h,
+            gravity: self.params.gravity,
+            periodic_x: self.params.periodic_x,
+            bodies,
+            contacts,
+            walls,
+        }
+    }
+}
