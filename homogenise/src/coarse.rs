@@ -1,8 +1,9 @@
 //! Coarse-grained fields on a regular grid with a Gaussian kernel.
 //!
-//! Kernel of width (standard deviation) `w`, truncated at `r_c = cutoff · w` and renormalised so
-//! that it integrates to one on the plane:
-//! `φ(r) = exp(−r²/(2w²)) / (2π w² (1 − exp(−r_c²/(2w²))))` for `r < r_c`, 0 beyond.
+//! Kernel of width (standard deviation) `w`, truncated at `r_c = cutoff · w`, shifted to vanish
+//! continuously there and renormalised so that it integrates to one on the plane:
+//! `φ(r) = (exp(−r²/(2w²)) − e_c) / (2π w² (1 − e_c) − π r_c² e_c)` for `r < r_c`, 0 beyond,
+//! with `e_c = exp(−r_c²/(2w²))`.
 //! Each grain is a point at its centre (images at `x ± L` with a periodic x direction):
 //!
 //! - density `ρ(x) = Σ_p (m_p / t_p) φ(x − c_p)` (kg/m³, `t_p` the grain's thickness);
@@ -13,9 +14,10 @@
 //!   is `Σ_p A_p Σ_p`, the same total as the region means of [`crate::stress`];
 //! - kinetic (streaming) stress `σ_k(x) = −Σ_p (m_p/t_p) (v_p − V(x)) ⊗ (v_p − V(x)) φ(x − c_p)` (Pa).
 //!
-//! Mass is conserved: `∫ ρ dA = Σ_p m_p / t_p`; on the grid the midpoint sum
-//! `Σ_nodes ρ Δx Δy` reproduces it when the grid covers the sample with a margin of `r_c` and
-//! `Δ ≤ w` (the Gaussian's sampling error is then far below the truncation bound).
+//! Mass is conserved: `∫ ρ dA = Σ_p m_p / t_p` exactly for the continuous field; on the grid
+//! the node sum `Σ_nodes ρ Δ²` reproduces it up to the sampling error of the kernel's kink at
+//! `r_c`, when the grid covers the sample with a margin of `r_c`: relative error ≤ 1e-6 for
+//! `cutoff = 5`, `Δ ≤ w` (tested); about 5e-6 for `cutoff = 4`, `Δ = w/2`.
 
 use dem::snapshot::{BodyKind, Snapshot};
 use nalgebra::Vector2;
@@ -153,18 +155,48 @@ impl CoarseFields {
     }
 }
 
+/// The kernel: width `w`, cutoff radius `rc`, `e_c` and the normalisation.
+#[derive(Clone, Copy)]
+struct Kernel {
+    w: f64,
+    rc: f64,
+    ec: f64,
+    norm: f64,
+}
+
+impl Kernel {
+    fn new(w: f64, cutoff: f64) -> Self {
+        let rc = cutoff * w;
+        let ec = (-0.5 * cutoff * cutoff).exp();
+        let pi = std::f64::consts::PI;
+        let norm = 1.0 / (2.0 * pi * w * w * (1.0 - ec) - pi * rc * rc * ec);
+        Self { w, rc, ec, norm }
+    }
+
+    fn at(&self, r2: f64) -> f64 {
+        ((-r2 / (2.0 * self.w * self.w)).exp() - self.ec) * self.norm
+    }
+}
+
 /// Kernel evaluation over the grid nodes within the cutoff of a point (with periodic images).
 fn for_nodes(
     grid: &Grid,
     periodic: Option<[f64; 2]>,
     c: &Vector2<f64>,
-    rc: f64,
-    norm: f64,
-    w: f64,
+    kernel: &Kernel,
     mut f: impl FnMut(usize, usize, f64, Vector2<f64>),
 ) {
+    let rc = kernel.rc;
+    // every periodic image whose kernel reaches the grid's x range
     let shifts: Vec<f64> = match periodic {
-        Some([a, b]) => vec![-(b - a), 0.0, b - a],
+        Some([a, b]) => {
+            let l = b - a;
+            let x_lo = grid.origin.x;
+            let x_hi = grid.origin.x + grid.spacing * grid.nx.saturating_sub(1) as f64;
+            let k0 = ((x_lo - rc - c.x) / l).floor() as i64;
+            let k1 = ((x_hi + rc - c.x) / l).ceil() as i64;
+            (k0..=k1).map(|k| k as f64 * l).collect()
+        }
         None => vec![0.0],
     };
     let h = grid.spacing;
@@ -184,7 +216,7 @@ fn for_nodes(
                 let d = grid.node(i, j) - cs;
                 let r2 = d.norm_squared();
                 if r2 < rc * rc {
-                    f(i, j, (-r2 / (2.0 * w * w)).exp() * norm, d);
+                    f(i, j, kernel.at(r2), d);
                 }
             }
         }
@@ -192,7 +224,7 @@ fn for_nodes(
 }
 
 /// Coarse-grained density, velocity, stress and kinetic stress on `grid` with a Gaussian of
-/// width `width` (m) truncated at `cutoff · width` (`cutoff ≥ 2`; 4 is usual). `grains` are the
+/// width `width` (m) truncated at `cutoff · width` (`cutoff ≥ 2`; 5 recommended). `grains` are the
 /// snapshot's per-grain stresses ([`crate::stress::grain_stresses`]).
 pub fn coarse_grain(
     snapshot: &Snapshot,
@@ -216,9 +248,7 @@ pub fn coarse_grain(
             reason: "needs at least one node along x and y".into(),
         });
     }
-    let rc = cutoff * width;
-    let norm =
-        1.0 / (2.0 * std::f64::consts::PI * width * width * (1.0 - (-0.5 * cutoff * cutoff).exp()));
+    let kernel = Kernel::new(width, cutoff);
     let (ny, nx) = (grid.ny, grid.nx);
     let mut rho = Array2::<f64>::zeros((ny, nx));
     let mut px = Array2::<f64>::zeros((ny, nx));
@@ -232,7 +262,7 @@ pub fn coarse_grain(
         .collect();
     for b in &bodies {
         let m = b.mass / b.thickness;
-        for_nodes(grid, per, &b.position, rc, norm, width, |i, j, k, _| {
+        for_nodes(grid, per, &b.position, &kernel, |i, j, k, _| {
             rho[[j, i]] += m * k;
             px[[j, i]] += m * b.velocity.x * k;
             py[[j, i]] += m * b.velocity.y * k;
@@ -240,7 +270,7 @@ pub fn coarse_grain(
     }
     for g in grains {
         let s = g.total * g.area();
-        for_nodes(grid, per, &g.position, rc, norm, width, |i, j, k, _| {
+        for_nodes(grid, per, &g.position, &kernel, |i, j, k, _| {
             stress.add(j, i, &(s * k));
         });
     }
@@ -258,7 +288,7 @@ pub fn coarse_grain(
     let mut kinetic = TensorField::zeros(ny, nx);
     for b in &bodies {
         let m = b.mass / b.thickness;
-        for_nodes(grid, per, &b.position, rc, norm, width, |i, j, k, _| {
+        for_nodes(grid, per, &b.position, &kernel, |i, j, k, _| {
             let dv = b.velocity - Vector2::new(vx[[j, i]], vy[[j, i]]);
             kinetic.add(j, i, &(outer(&dv, &dv) * (-m * k)));
         });

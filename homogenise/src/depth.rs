@@ -22,7 +22,7 @@ impl DepthAxis {
     /// An axis along `down` (normalised) with depth 0 at `surface`.
     pub fn new(down: Vector2<f64>, surface: Vector2<f64>) -> Result<Self> {
         let n = down.norm();
-        if !(n.is_finite() && n > 0.0) || !(surface.x.is_finite() && surface.y.is_finite()) {
+        if !(n.is_finite() && n > 0.0 && surface.x.is_finite() && surface.y.is_finite()) {
             return Err(HomogeniseError::InvalidParameter {
                 name: "down",
                 reason: "needs a finite non-zero direction and a finite surface point".into(),

@@ -225,7 +225,7 @@ impl Sampler {
 
     /// Samples the snapshot if its step is a multiple of `every`; returns whether it did.
     pub fn observe(&mut self, snapshot: &Snapshot) -> Result<bool> {
-        if snapshot.step % self.config.every != 0 {
+        if !snapshot.step.is_multiple_of(self.config.every) {
             return Ok(false);
         }
         let row = sample_row(snapshot, &self.config)?;

@@ -105,7 +105,7 @@ pub fn velocity_gradient(
         b += outer(&(v - vm), &dx) * *w;
     }
     let scale = a.trace();
-    if !(scale > 0.0) || a.determinant() <= 1e-10 * scale * scale {
+    if scale.is_nan() || scale <= 0.0 || a.determinant() <= 1e-10 * scale * scale {
         return Err(HomogeniseError::NotEnoughData(
             "grains are aligned: the velocity gradient is not determined".into(),
         ));

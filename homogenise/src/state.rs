@@ -150,7 +150,8 @@ pub fn coordination(
         .filter(|c| c.force_n > counting.force_threshold)
     {
         let (a, b) = (c.body_a as usize, c.body_b as usize);
-        if !(is_grain(a) && is_grain(b)) && !counting.count_wall_contacts {
+        let bulk = is_grain(a) && is_grain(b);
+        if !bulk && !counting.count_wall_contacts {
             continue;
         }
         for (p, q) in [(a, b), (b, a)] {
@@ -201,7 +202,8 @@ pub fn fabric(snapshot: &Snapshot, region: &Region, counting: &ContactCounting) 
         if c.force_n <= counting.force_threshold || !rect.contains(&c.point) {
             continue;
         }
-        if !(is_grain(c.body_a) && is_grain(c.body_b)) && !counting.count_wall_contacts {
+        let bulk = is_grain(c.body_a) && is_grain(c.body_b);
+        if !bulk && !counting.count_wall_contacts {
             continue;
         }
         f += outer(&c.normal, &c.normal);

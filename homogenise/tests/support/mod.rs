@@ -108,7 +108,8 @@ impl Builder {
     }
 
     /// A contact between `a` and `b` at `point` with normal `n` (from a to b) and forces on b
-    /// `f_n n + f_t t`; levers from the bodies' positions.
+    /// `f_n n + f_t t`; levers from the bodies' positions. (Mirrors `ContactState`'s fields.)
+    #[allow(clippy::too_many_arguments)]
     pub fn contact(&mut self, a: u32, b: u32, point: V2, normal: V2, f_n: f64, f_t: f64, mu: f64) {
         let status = if f_n <= 0.0 {
             ContactStatus::Open
@@ -356,9 +357,9 @@ pub fn random_dynamic(seed: u64, nx: usize, ny: usize, offset: V2) -> Snapshot {
             }
         }
     }
-    for j in 0..ny {
+    for row in &ids {
         for (i, wall, n) in [(0usize, left, v(1.0, 0.0)), (nx - 1, right, v(-1.0, 0.0))] {
-            let id = ids[j][i];
+            let id = row[i];
             let (c, r) = (
                 b.snap.bodies[id as usize].position,
                 b.snap.bodies[id as usize].radius,
@@ -367,8 +368,7 @@ pub fn random_dynamic(seed: u64, nx: usize, ny: usize, offset: V2) -> Snapshot {
             b.contact(wall, id, c - n * r, n, f_n, f_t, mu);
         }
     }
-    for i in 0..nx {
-        let id = ids[0][i];
+    for &id in &ids[0] {
         let (c, r) = (
             b.snap.bodies[id as usize].position,
             b.snap.bodies[id as usize].radius,
