@@ -438,7 +438,7 @@ fn covariance(
 ) -> (DMatrix<f64>, Option<String>) {
     let p = jw.ncols();
     let norms: Vec<f64> = (0..p).map(|j| jw.column(j).norm()).collect();
-    if let Some(j) = norms.iter().position(|v| !(*v > 0.0) || !v.is_finite()) {
+    if let Some(j) = norms.iter().position(|v| *v <= 0.0 || !v.is_finite()) {
         return (
             DMatrix::from_element(p, p, f64::NAN),
             Some(format!(

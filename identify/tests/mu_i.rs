@@ -188,7 +188,11 @@ fn degenerate_series_give_typed_errors() {
     };
     assert!(matches!(
         fit_mu_i(&s, &o).unwrap_err(),
-        IdentifyError::TooFewPoints { needed: 5, got: 4, .. }
+        IdentifyError::TooFewPoints {
+            needed: 5,
+            got: 4,
+            ..
+        }
     ));
 
     // φ that grows with I ends on the bound φ_max − φ_min = 0.

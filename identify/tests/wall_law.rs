@@ -6,8 +6,7 @@ use common::gaussian;
 use identify::fit::FitOptions;
 use identify::laws::{VelocityBoundaryLayer, WallFrictionLaw};
 use identify::wall_law::{
-    fit_boundary_layer, fit_wall_law, select_wall_law, VelocityProfile, WallLawForm,
-    WallSlipSeries,
+    fit_boundary_layer, fit_wall_law, select_wall_law, VelocityProfile, WallLawForm, WallSlipSeries,
 };
 use identify::IdentifyError;
 
@@ -38,7 +37,11 @@ fn exponential_data_select_the_exponential_law() {
     assert_eq!(sel.best().form, WallLawForm::Exponential);
     assert_eq!(sel.comparison.best(), Some("wall-law-exponential"));
     assert_eq!(sel.comparison.ranking[0].delta_aic, 0.0);
-    assert!(sel.comparison.ranking[1].delta_aic > 4.0, "{:?}", sel.comparison);
+    assert!(
+        sel.comparison.ranking[1].delta_aic > 4.0,
+        "{:?}",
+        sel.comparison
+    );
     let w: f64 = sel.comparison.ranking.iter().map(|c| c.akaike_weight).sum();
     assert!((w - 1.0).abs() < 1e-12);
     for (p, t) in sel.best().report.parameters.iter().zip([0.15, 0.45, 0.5]) {
@@ -55,7 +58,12 @@ fn hyperbolic_data_select_the_hyperbolic_law() {
         v_star: 0.3,
     };
     let sel = select_wall_law(&series(&truth, 2, 0.003), &FitOptions::default()).unwrap();
-    assert_eq!(sel.best().form, WallLawForm::Hyperbolic, "{:?}", sel.comparison);
+    assert_eq!(
+        sel.best().form,
+        WallLawForm::Hyperbolic,
+        "{:?}",
+        sel.comparison
+    );
     for (p, t) in sel.best().report.parameters.iter().zip([0.1, 0.5, 0.3]) {
         assert!((p.value - t).abs() < 3.0 * p.std_error, "{p:?}");
     }
@@ -113,7 +121,11 @@ fn degenerate_wall_series() {
     s.mu_eff.truncate(4);
     assert!(matches!(
         select_wall_law(&s, &o).unwrap_err(),
-        IdentifyError::TooFewPoints { needed: 5, got: 4, .. }
+        IdentifyError::TooFewPoints {
+            needed: 5,
+            got: 4,
+            ..
+        }
     ));
 }
 
@@ -127,7 +139,11 @@ fn boundary_layer_thickness_in_grain_diameters() {
     let y: Vec<f64> = (0..30).map(|k| 0.5 * D * k as f64).collect();
     let e = gaussian(9, y.len(), 0.002);
     let profile = VelocityProfile {
-        velocity_m_s: y.iter().zip(&e).map(|(y, e)| truth.velocity(*y) + e).collect(),
+        velocity_m_s: y
+            .iter()
+            .zip(&e)
+            .map(|(y, e)| truth.velocity(*y) + e)
+            .collect(),
         distance_m: y,
         grain_diameter_m: D,
     };
