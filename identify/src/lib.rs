@@ -20,6 +20,32 @@
 //! | [`data`] | user tables read from CSV with typed, line-numbered errors |
 //! | [`user_fit`] | fitting a law by name from a CSV file |
 //!
+//! Example: a Janssen fit, its summary keys and its export.
+//! ```
+//! use identify::janssen::{fit_janssen, JanssenOptions, JanssenProfile, JanssenSetup};
+//! use identify::law::{CalibratedLaw, Provenance};
+//! use identify::laws::JanssenLaw;
+//!
+//! let setup = JanssenSetup::new(0.03, 1600.0, 0.25); // W (m), ρ_b (kg/m³), μ_wall
+//! let truth = JanssenLaw { k: 0.6, mu_w: 0.2, width_m: 0.03, bulk_density_kg_m3: 1600.0, gravity_m_s2: 9.81 };
+//! let z: Vec<f64> = (1..=20).map(|i| 0.01 * i as f64).collect();
+//! let wiggle = |i: usize| if i % 2 == 0 { 1.0 } else { -1.0 };
+//! let profile = JanssenProfile {
+//!     sigma_v_pa: z.iter().enumerate().map(|(i, z)| truth.sigma_v(*z) + 5.0 * wiggle(i)).collect(),
+//!     sigma_h_pa: Some(z.iter().enumerate().map(|(i, z)| truth.sigma_h(*z) - 3.0 * wiggle(i)).collect()),
+//!     tau_w_pa: None,
+//!     z_m: z,
+//! };
+//! let fit = fit_janssen(&profile, &setup, &JanssenOptions::default())?;
+//! assert!((fit.k.value - 0.6).abs() < 0.02);
+//! let keys = fit.summary_entries(); // janssen_K, janssen_K_ci_low, ...
+//! assert_eq!(keys[0].0, "janssen_K");
+//! let json = CalibratedLaw::from_janssen(&fit, Provenance::new("janssen", Some(1))).to_json_string()?;
+//! let law = CalibratedLaw::from_json_str(&json)?;
+//! assert!((law.evaluate(0.1)? - fit.law.sigma_v(0.1)).abs() < 1e-9);
+//! # Ok::<(), identify::IdentifyError>(())
+//! ```
+//!
 //! Units: SI throughout. Stresses entering the fits are compressive-positive magnitudes
 //! (pressure-like): with the project's tension-positive tensors, `σ_v = −Σ_yy`, `p = −tr Σ / 2`.
 

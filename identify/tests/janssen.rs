@@ -68,6 +68,9 @@ fn ninety_five_percent_intervals_cover_the_truth_in_at_least_90_of_100_draws() {
         let one = fit_janssen_k_mu(&profile, &setup, &JanssenOptions::default()).unwrap();
         kmu1 += one.k_mu_w.covers(0.12) as usize;
     }
+    eprintln!(
+        "coverage /100: K {k}, mu_w {mu}, K mu_w (joint) {kmu}, K mu_w (sigma_v only) {kmu1}"
+    );
     assert!(
         k >= 90 && mu >= 90 && kmu >= 90 && kmu1 >= 90,
         "{k} {mu} {kmu} {kmu1}"
@@ -159,6 +162,7 @@ fn mu_w_beyond_wall_friction_is_a_bound_error_and_full_mobilisation_is_the_fallb
                 .covers(0.6)
         })
         .count();
+    eprintln!("coverage /100 of K under full mobilisation: {covered}");
     assert!(covered >= 90, "{covered}");
 }
 

@@ -70,6 +70,7 @@ fn ninety_five_percent_intervals_cover_the_truth_in_at_least_90_of_100_draws() {
             *c += p.covers(truth) as usize;
         }
     }
+    eprintln!("coverage /100 of (mu_s, mu_2, I_0): {covered:?}");
     assert!(covered.iter().all(|&c| c >= 90), "{covered:?}");
 }
 
