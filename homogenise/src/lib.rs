@@ -20,8 +20,10 @@
 
 pub mod averaging;
 pub mod coarse;
+pub mod column;
 pub mod depth;
 pub mod error;
+pub mod flow;
 pub mod history;
 pub mod inertia_ratio;
 pub mod invariants;

@@ -21,6 +21,8 @@ pub enum ContactClass {
     Wall,
     /// Contacts between a grain and the wall of that name.
     WallNamed(String),
+    /// Contacts between a grain and any of the walls of these names.
+    WallsNamed(Vec<String>),
     /// Contacts between two grains.
     Bulk,
     /// All contacts.
@@ -125,6 +127,11 @@ pub(crate) fn in_class(snapshot: &Snapshot, c: &ContactState, class: &ContactCla
             .iter()
             .filter(|w| &w.name == name)
             .any(|w| w.body == c.body_a || w.body == c.body_b),
+        ContactClass::WallsNamed(names) => snapshot
+            .walls
+            .iter()
+            .filter(|w| names.contains(&w.name))
+            .any(|w| w.body == c.body_a || w.body == c.body_b),
     }
 }
 
@@ -135,7 +142,12 @@ pub fn contact_mobilisations(
     class: &ContactClass,
 ) -> Result<Vec<(usize, f64)>> {
     check_snapshot(snapshot)?;
-    if let ContactClass::WallNamed(name) = class {
+    let names: &[String] = match class {
+        ContactClass::WallNamed(name) => std::slice::from_ref(name),
+        ContactClass::WallsNamed(names) => names,
+        _ => &[],
+    };
+    for name in names {
         if !snapshot.walls.iter().any(|w| &w.name == name) {
             return Err(HomogeniseError::UnknownWall(name.clone()));
         }
