@@ -93,7 +93,8 @@ pub fn flow_profile(
             reason: format!("must be finite and ≥ 0, got {fluid_threshold}"),
         });
     }
-    if y_edges.len() < 2 || y_edges.windows(2).any(|w| !(w[1] > w[0])) {
+    let increasing = y_edges.windows(2).all(|w| w[1] > w[0]);
+    if y_edges.len() < 2 || !increasing || y_edges.iter().any(|y| !y.is_finite()) {
         return Err(HomogeniseError::InvalidParameter {
             name: "y_edges",
             reason: "needs at least two finite, strictly increasing edges".into(),
