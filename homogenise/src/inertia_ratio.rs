@@ -54,3 +54,43 @@ pub fn fluid_fraction(ratios: &[InertiaRatio], threshold: f64) -> Result<f64> {
         .count();
     Ok(fluid as f64 / ratios.len() as f64)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tensor::Tensor2;
+
+    fn grain(body: usize, contact: Tensor2, inertia: Tensor2) -> GrainStress {
+        GrainStress {
+            body,
+            position: Vector2::zeros(),
+            radius: 1e-3,
+            volume: 1e-6,
+            thickness: 1.0,
+            contact,
+            inertia,
+            total: contact + inertia,
+        }
+    }
+
+    #[test]
+    fn ratio_and_fluid_share() {
+        let c = Tensor2::new(-3.0, 0.0, 0.0, -4.0); // ‖·‖ = 5
+        let i = Tensor2::new(1.0, -1.0, 1.0, 1.0); // ‖·‖ = 2
+        let g = [
+            grain(0, c, i),
+            grain(1, c, i * 5.0),
+            grain(2, Tensor2::zeros(), i),
+            grain(3, c, Tensor2::zeros()),
+        ];
+        let r = inertia_ratios(&g);
+        assert!((r[0].ratio.unwrap() - 0.4).abs() < 1e-15);
+        assert!((r[1].ratio.unwrap() - 2.0).abs() < 1e-15);
+        assert_eq!(r[2].ratio, None);
+        assert_eq!(r[3].ratio, Some(0.0));
+        // above 1: grain 1, and grain 2 (no contact force) → 2 of 4
+        assert!((fluid_fraction(&r, 1.0).unwrap() - 0.5).abs() < 1e-15);
+        assert!((fluid_fraction(&r, 0.1).unwrap() - 0.75).abs() < 1e-15);
+        assert!(fluid_fraction(&r, -1.0).is_err());
+    }
+}

@@ -57,6 +57,14 @@ pub fn in_frame(t: &Tensor2, e1: &Vector2<f64>, e2: &Vector2<f64>) -> Tensor2 {
     q.transpose() * t * q
 }
 
+/// The slope frame of a plane inclined by `angle` (rad) going down towards +x under gravity
+/// along −y: `e1 = (cos φ, −sin φ)` down the slope, `e2 = (sin φ, cos φ)` the outward normal
+/// (right-handed). Use with [`in_frame`] for the rolling disk (DESIGN §2).
+pub fn slope_frame(angle: f64) -> (Vector2<f64>, Vector2<f64>) {
+    let (s, c) = angle.sin_cos();
+    (Vector2::new(c, -s), Vector2::new(s, c))
+}
+
 /// Cross product of plane vectors (z component), `a × b = a_x b_y − a_y b_x`.
 pub fn cross(a: &Vector2<f64>, b: &Vector2<f64>) -> f64 {
     a.x * b.y - a.y * b.x
@@ -81,6 +89,16 @@ mod tests {
         let l = Vector2::new(-0.5, 0.25);
         let s = skew_part(&outer(&r, &l));
         assert!((s[(0, 1)] + 0.5 * cross(&l, &r)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn slope_frame_is_orthonormal_and_right_handed() {
+        let (e1, e2) = slope_frame(0.4);
+        assert!((e1.norm() - 1.0).abs() < 1e-15 && (e2.norm() - 1.0).abs() < 1e-15);
+        assert!(e1.dot(&e2).abs() < 1e-15);
+        assert!((cross(&e1, &e2) - 1.0).abs() < 1e-15);
+        // gravity (0, −g) has component g sinφ down the slope
+        assert!((Vector2::new(0.0, -1.0).dot(&e1) - 0.4f64.sin()).abs() < 1e-15);
     }
 
     #[test]
