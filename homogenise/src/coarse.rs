@@ -29,6 +29,9 @@ use crate::stress::GrainStress;
 use crate::tensor::{outer, Tensor2};
 use crate::validate::check_snapshot;
 
+/// Largest number of grid nodes accepted by [`coarse_grain`] (each node holds 15 `f64`).
+pub const MAX_NODES: usize = 20_000_000;
+
 /// A regular grid of nodes `x_ij = origin + (i Δ, j Δ)`, `i < nx`, `j < ny`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Grid {
@@ -246,6 +249,15 @@ pub fn coarse_grain(
         return Err(HomogeniseError::InvalidParameter {
             name: "grid",
             reason: "needs at least one node along x and y".into(),
+        });
+    }
+    if grid.nx.checked_mul(grid.ny).is_none_or(|n| n > MAX_NODES) {
+        return Err(HomogeniseError::InvalidParameter {
+            name: "grid",
+            reason: format!(
+                "{} × {} nodes exceed the limit of {MAX_NODES}: use a coarser spacing",
+                grid.nx, grid.ny
+            ),
         });
     }
     let kernel = Kernel::new(width, cutoff);
