@@ -97,7 +97,7 @@ impl Detector {
             max_m = max_m.max(m);
         }
         let mut cell = max_d + detection_gap.max(0.0) + 2.0 * max_m;
-        if !(cell > 0.0) {
+        if cell.is_nan() || cell <= 0.0 {
             cell = 1.0;
         }
         // Grid extent.
@@ -256,21 +256,18 @@ impl Detector {
         self.radius.clear();
         self.margin.clear();
         for (ci, col) in colliders.iter().enumerate() {
-            match col.shape {
-                Shape::Disk { radius, offset } => {
-                    let b = &bodies[col.body as usize];
-                    let mut c = b.position + rotate(offset, b.angle);
-                    if let Some(p) = periodic {
-                        c.x = p.wrap(c.x);
-                    }
-                    self.disk_collider.push(ci as u32);
-                    self.centre.push([c.x, c.y]);
-                    self.radius.push(radius);
-                    let g = if b.gravity { gravity } else { 0.0 };
-                    self.margin
-                        .push(dt * (b.velocity.norm() + dt * g + b.omega.abs() * offset.norm()));
+            if let Shape::Disk { radius, offset } = col.shape {
+                let b = &bodies[col.body as usize];
+                let mut c = b.position + rotate(offset, b.angle);
+                if let Some(p) = periodic {
+                    c.x = p.wrap(c.x);
                 }
-                _ => {}
+                self.disk_collider.push(ci as u32);
+                self.centre.push([c.x, c.y]);
+                self.radius.push(radius);
+                let g = if b.gravity { gravity } else { 0.0 };
+                self.margin
+                    .push(dt * (b.velocity.norm() + dt * g + b.omega.abs() * offset.norm()));
             }
         }
     }
