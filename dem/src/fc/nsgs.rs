@@ -137,8 +137,15 @@ impl Workspace {
     fn new(p: &FcProblem, ordering: ContactOrdering) -> Self {
         let n = p.contacts();
         let perm = contact_order(ordering, p.w(), p.q());
-        let mut inv = vec![0u32; n];
+        // The sweep reads r through `inv` without bounds checks: perm must be a permutation.
+        assert_eq!(perm.len(), n, "contact ordering is not a permutation");
+        let mut inv = vec![u32::MAX; n];
         for (new, &old) in perm.iter().enumerate() {
+            assert_eq!(
+                inv[old as usize],
+                u32::MAX,
+                "contact ordering is not a permutation"
+            );
             inv[old as usize] = new as u32;
         }
         let w = p.w();
@@ -198,8 +205,14 @@ impl Workspace {
         let vals = &self.val[s..e];
         let mut it = cols.chunks_exact(2).zip(vals.chunks_exact(2));
         for (c, w) in &mut it {
-            let rb = self.r[c[0] as usize];
-            let rc = self.r[c[1] as usize];
+            // SAFETY: every column index is `inv[j] < n` (inverse of a permutation of 0..n, see
+            // `Workspace::new`), and `self.r.len() == n`.
+            let (rb, rc) = unsafe {
+                (
+                    *self.r.get_unchecked(c[0] as usize),
+                    *self.r.get_unchecked(c[1] as usize),
+                )
+            };
             x0 += w[0][0] * rb[0] + w[0][1] * rb[1];
             x1 += w[0][2] * rb[0] + w[0][3] * rb[1];
             y0 += w[1][0] * rc[0] + w[1][1] * rc[1];
@@ -433,4 +446,18 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
         seconds: t0.elapsed().as_secs_f64(),
         converged: error <= tol,
     })
+}
+
+/// Contact updates per second of `sweeps` plain Gauss–Seidel sweeps (no acceleration, no error
+/// evaluation) from `r = 0` on one core: the raw cost of one update, `nc · sweeps / seconds`.
+pub fn sweep_rate(problem: &FcProblem, sweeps: usize) -> f64 {
+    let mut ws = Workspace::new(problem, ContactOrdering::default());
+    let t = Instant::now();
+    let mut d = 0.0;
+    for _ in 0..sweeps {
+        d += ws.sweep(1.0);
+    }
+    let s = t.elapsed().as_secs_f64();
+    std::hint::black_box(d);
+    (problem.contacts() * sweeps) as f64 / s.max(1e-12)
 }

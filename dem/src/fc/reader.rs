@@ -231,7 +231,8 @@ fn usize_array(v: &Value, key: &str) -> Result<Vec<usize>, FcError> {
 }
 
 /// Turns a serde_json syntax error into [`FcError::Json`] with the enclosing key, or into
-/// [`FcError::NonFinite`] when the offending token is a `NaN` / `Infinity` literal.
+/// [`FcError::NonFinite`] when the offending token is a `NaN` / `Infinity` literal or a number
+/// beyond the range of f64.
 fn json_error(text: &[u8], e: &serde_json::Error) -> FcError {
     let offset = byte_offset(text, e.line(), e.column());
     let key = last_key_before(text, offset);
@@ -241,7 +242,7 @@ fn json_error(text: &[u8], e: &serde_json::Error) -> FcError {
     let non_finite = [&b"NaN"[..], b"Infinity"]
         .iter()
         .any(|lit| window.windows(lit.len()).any(|w| w == *lit));
-    if non_finite {
+    if non_finite || e.to_string().starts_with("number out of range") {
         return FcError::NonFinite {
             key: key.unwrap_or_else(|| "(unknown)".into()),
         };

@@ -1,0 +1,68 @@
+//! Writing a solution as JSON, atomically.
+
+use std::io::Write;
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::error::FcError;
+use super::nsgs::FcSolution;
+
+/// The solution file `{"r": [...], "u": [...], "iterations": n, "error": e, "seconds": s,
+/// "converged": b}` (impulses in N·s, velocities in m/s, interleaved `(n, t)` per contact).
+#[derive(Debug, Serialize)]
+struct SolutionFile<'a> {
+    r: &'a [f64],
+    u: &'a [f64],
+    iterations: usize,
+    error: f64,
+    seconds: f64,
+    converged: bool,
+}
+
+/// Writes `solution` to `path` as JSON, atomically: the text goes to a temporary file in the same
+/// directory, which is flushed to disk and then renamed over `path`, so a reader never sees a
+/// partial file (and an interrupted write leaves no file looking complete).
+pub fn write_solution(path: impl AsRef<Path>, solution: &FcSolution) -> Result<(), FcError> {
+    let file = SolutionFile {
+        r: &solution.r,
+        u: &solution.u,
+        iterations: solution.iterations,
+        error: solution.error,
+        seconds: solution.seconds,
+        converged: solution.converged,
+    };
+    let text = serde_json::to_vec(&file).map_err(|e| FcError::InvalidValue {
+        key: "solution".into(),
+        reason: e.to_string(),
+    })?;
+    write_atomically(path.as_ref(), &text)
+}
+
+/// Writes `bytes` to `path` through a temporary sibling file and a rename.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FcError> {
+    let io = |p: &Path| {
+        let p = p.display().to_string();
+        move |source| FcError::Io { path: p, source }
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "solution".into());
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp).map_err(io(&tmp))?;
+        f.write_all(bytes).map_err(io(&tmp))?;
+        f.sync_all().map_err(io(&tmp))?;
+        drop(f);
+        std::fs::rename(&tmp, path).map_err(io(path))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
