@@ -11,7 +11,8 @@
 //! contact statuses (open / stick / slide) stop changing, which is where its slow linear tail is.
 //! The least-squares problem is solved through its regularised normal equations
 //! (`(ΔFᵀΔF + λ I) γ = ΔFᵀ f`, `λ = 1e-12 · max diag`), the Gram matrix being updated by one
-//! column per step: O(m · len) per step, no allocation after construction.
+//! column per step: O(m · len) per step in two passes over the vectors, no allocation after
+//! construction.
 
 /// Anderson acceleration state for vectors of a fixed length.
 #[derive(Debug, Clone)]
@@ -29,6 +30,9 @@ pub struct Anderson {
     // small dense workspace
     a: Vec<f64>,
     b: Vec<f64>,
+    old: Vec<usize>,
+    gram_j: Vec<f64>,
+    rhs: Vec<f64>,
 }
 
 impl Anderson {
@@ -48,6 +52,9 @@ impl Anderson {
             has_prev: false,
             a: vec![0.0; m * m],
             b: vec![0.0; m],
+            old: Vec::with_capacity(m),
+            gram_j: vec![0.0; m],
+            rhs: vec![0.0; m],
         }
     }
 
@@ -60,37 +67,15 @@ impl Anderson {
 
     /// Given the previous iterate `x` and `g = G(x)` (in place), replaces `g` by the accelerated
     /// iterate `x_{k+1}`.
+    ///
+    /// Two passes over the vectors: one computes the new differences, the new Gram row and the
+    /// right-hand side `ΔFᵀ f` chunk by chunk (each stored vector read once), one applies the
+    /// combination.
     pub fn step(&mut self, x: &[f64], g: &mut [f64]) {
         debug_assert_eq!(x.len(), self.len);
         debug_assert_eq!(g.len(), self.len);
-        if self.has_prev {
-            let j = self.next;
-            {
-                let (dfj, dgj) = (&mut self.df[j], &mut self.dg[j]);
-                for ((((dfi, dgi), (&gi, &xi)), fp), gp) in dfj
-                    .iter_mut()
-                    .zip(dgj.iter_mut())
-                    .zip(g.iter().zip(x))
-                    .zip(self.f_prev.iter_mut())
-                    .zip(self.g_prev.iter_mut())
-                {
-                    let f = gi - xi;
-                    *dfi = f - *fp;
-                    *dgi = gi - *gp;
-                    *fp = f;
-                    *gp = gi;
-                }
-            }
-            self.count = (self.count + 1).min(self.m);
-            self.next = (self.next + 1) % self.m;
-            // Update row/column j of the Gram matrix.
-            for k in 0..self.count {
-                let kk = self.slot(k);
-                let d = dot(&self.df[j], &self.df[kk]);
-                self.gram[j * self.m + kk] = d;
-                self.gram[kk * self.m + j] = d;
-            }
-        } else {
+        const CHUNK: usize = 512;
+        if !self.has_prev {
             for (((fp, gp), &gi), &xi) in self
                 .f_prev
                 .iter_mut()
@@ -101,24 +86,77 @@ impl Anderson {
                 *fp = gi - xi;
                 *gp = gi;
             }
-        }
-        self.has_prev = true;
-        let c = self.count;
-        if c == 0 {
+            self.has_prev = true;
             return;
         }
+        let m = self.m;
+        let j = self.next;
+        // Stored columns that survive (the slot j is overwritten when the memory is full).
+        let mut old = std::mem::take(&mut self.old);
+        old.clear();
+        for p in 0..self.count {
+            let s = self.slot(p);
+            if s != j {
+                old.push(s);
+            }
+        }
+        let mut dfj = std::mem::take(&mut self.df[j]);
+        let mut dgj = std::mem::take(&mut self.dg[j]);
+        let mut gram_j = std::mem::take(&mut self.gram_j);
+        let mut rhs = std::mem::take(&mut self.rhs);
+        gram_j.iter_mut().for_each(|v| *v = 0.0);
+        rhs.iter_mut().for_each(|v| *v = 0.0);
+        let mut start = 0;
+        while start < self.len {
+            let end = (start + CHUNK).min(self.len);
+            let r = start..end;
+            for ((((dfi, dgi), (&gi, &xi)), fp), gp) in dfj[r.clone()]
+                .iter_mut()
+                .zip(dgj[r.clone()].iter_mut())
+                .zip(g[r.clone()].iter().zip(&x[r.clone()]))
+                .zip(self.f_prev[r.clone()].iter_mut())
+                .zip(self.g_prev[r.clone()].iter_mut())
+            {
+                let f = gi - xi;
+                *dfi = f - *fp;
+                *dgi = gi - *gp;
+                *fp = f;
+                *gp = gi;
+            }
+            let (dj, f) = (&dfj[r.clone()], &self.f_prev[r.clone()]);
+            gram_j[j] += dot(dj, dj);
+            rhs[j] += dot(dj, f);
+            for &k in &old {
+                let dk = &self.df[k][r.clone()];
+                gram_j[k] += dot(dj, dk);
+                rhs[k] += dot(dk, f);
+            }
+            start = end;
+        }
+        self.df[j] = dfj;
+        self.dg[j] = dgj;
+        for &k in old.iter().chain(std::iter::once(&j)) {
+            self.gram[j * m + k] = gram_j[k];
+            self.gram[k * m + j] = gram_j[k];
+        }
+        self.old = old;
+        self.gram_j = gram_j;
+        self.rhs = rhs;
+        self.count = (self.count + 1).min(m);
+        self.next = (self.next + 1) % m;
+        let c = self.count;
         // Normal equations on the c stored columns (slots in insertion order).
         let mut maxd = 0.0f64;
         for p in 0..c {
             let sp = self.slot(p);
-            self.b[p] = dot(&self.df[sp], &self.f_prev);
+            self.b[p] = self.rhs[sp];
             for q in 0..c {
                 let sq = self.slot(q);
-                self.a[p * c + q] = self.gram[sp * self.m + sq];
+                self.a[p * c + q] = self.gram[sp * m + sq];
             }
             maxd = maxd.max(self.a[p * c + p]);
         }
-        if !(maxd > 0.0) {
+        if maxd.is_nan() || maxd <= 0.0 {
             return;
         }
         for p in 0..c {
@@ -128,22 +166,18 @@ impl Anderson {
             self.reset();
             return;
         }
-        // g −= ΔG γ, two columns per pass.
-        let mut p = 0;
-        while p + 1 < c {
-            let (s0, s1) = (self.slot(p), self.slot(p + 1));
-            let (g0, g1) = (self.b[p], self.b[p + 1]);
-            for ((gi, &a), &b) in g.iter_mut().zip(&self.dg[s0]).zip(&self.dg[s1]) {
-                *gi -= g0 * a + g1 * b;
+        // g −= ΔG γ, chunk by chunk over all columns.
+        let mut start = 0;
+        while start < self.len {
+            let end = (start + CHUNK).min(self.len);
+            for p in 0..c {
+                let gam = self.b[p];
+                let dgp = &self.dg[self.slot(p)][start..end];
+                for (gi, &a) in g[start..end].iter_mut().zip(dgp) {
+                    *gi -= gam * a;
+                }
             }
-            p += 2;
-        }
-        if p < c {
-            let s0 = self.slot(p);
-            let g0 = self.b[p];
-            for (gi, &a) in g.iter_mut().zip(&self.dg[s0]) {
-                *gi -= g0 * a;
-            }
+            start = end;
         }
     }
 
@@ -181,7 +215,7 @@ fn solve_dense(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
                 piv = i;
             }
         }
-        if !(best > 0.0) {
+        if best.is_nan() || best <= 0.0 {
             return false;
         }
         if piv != k {

@@ -123,7 +123,7 @@ impl BlockCsr2 {
                 cols: r.len(),
             });
         }
-        if size % 2 != 0 {
+        if !size.is_multiple_of(2) {
             return Err(FcError::InvalidValue {
                 key: "W.data".into(),
                 reason: format!("size {size} is odd, a 2D problem has 2 rows per contact"),

@@ -296,7 +296,7 @@ fn validate(n: usize, options: &FcOptions) -> Result<(), FcError> {
             reason,
         })
     };
-    if !(options.tolerance > 0.0) {
+    if options.tolerance.is_nan() || options.tolerance <= 0.0 {
         return bad("tolerance", format!("{} is not > 0", options.tolerance));
     }
     if !(options.omega > 0.0 && options.omega < 2.0) {
@@ -375,7 +375,8 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
         let change = d2.sqrt() / ws.r_norm().max(f64::MIN_POSITIVE);
         let due =
             iterations - last_check >= options.check_every || iterations >= options.max_iterations;
-        if due || !(ratio * change > 0.9 * tol) {
+        let predicted = ratio * change;
+        if due || predicted.is_nan() || predicted <= 0.9 * tol {
             error = ws.error();
             last_check = iterations;
             if change > 0.0 {
