@@ -444,6 +444,16 @@ fn reader_errors_name_the_key() {
 }
 
 #[test]
+fn an_empty_problem_is_solved_by_r_empty() {
+    let p = parse(r#"{"dimension": 2, "nc": 0, "mu": [], "q": [], "W": {"shape": [0, 0], "row": [], "col": [], "val": []}}"#)
+        .unwrap();
+    let s = solve(&p, &FcOptions::default()).unwrap();
+    assert!(s.converged && s.r.is_empty() && s.u.is_empty() && s.iterations == 0 && s.error == 0.0);
+    let e = parse(&GOOD.replace("fc-problem-v1", "fc-problem-v9")).unwrap_err();
+    assert!(e.to_string().contains("key `format`"), "{e}");
+}
+
+#[test]
 fn invalid_options_are_rejected() {
     let p = parse(GOOD).unwrap();
     for o in [
@@ -635,5 +645,8 @@ fn random_rigid_body_problems_converge() {
         }
         solved += 1;
     }
-    assert!(solved >= 15, "only {solved} of 20 random problems were well posed");
+    assert!(
+        solved >= 15,
+        "only {solved} of 20 random problems were well posed"
+    );
 }
