@@ -14,7 +14,7 @@
 //! - [`anderson`]: Anderson acceleration of the sweeps;
 //! - [`output`]: the solution file, written atomically;
 //! - [`command`]: what `grainlaw solve-fc` does ([`solve_fc`]);
-//! - [`bench`]: the reference benchmark ([`run_reference_benchmarks`]).
+//! - [`bench`](mod@bench): the reference benchmark ([`run_reference_benchmarks`]).
 //!
 //! ```no_run
 //! use dem::fc::{read_problem, solve, FcOptions};
