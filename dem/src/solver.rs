@@ -14,6 +14,15 @@
 //! minimisation of the local problem, which is what makes the sweep converge on disk contacts
 //! (a single predictor–corrector step with ρ = 1/W_nn does not: W_tt = 3 W_nn).
 //!
+//! Once the contact statuses stop changing a sweep is an affine map of the impulses and
+//! Gauss–Seidel converges linearly and slowly (the weight of a pile diffuses through the
+//! network). After [`PLAIN_SWEEPS`] plain sweeps, the sweeps are accelerated by Anderson mixing
+//! of the impulse vector (GMRES on an affine map, [`crate::fc::anderson`]); after each mix the
+//! body velocities are rebuilt, `v = v_free + M⁻¹ Hᵀ R` (O(N)). The mixing is safeguarded as in
+//! [`crate::fc::nsgs`]: no progress by a factor 0.7 over [`STAGNATION_WINDOW`] sweeps clears the
+//! history and continues with plain sweeps for a while; an error that blows up restores the
+//! best iterate. A solve that does not converge returns its best iterate.
+//!
 //! Convergence is judged on the error measure of `formats/frictional-contact.md` (Siconos'
 //! natural-map error): `e = ‖r − proj_K(r − ū)‖ / max(‖q‖, ‖r‖, ‖u‖)`, `q` the local velocity at
 //! zero impulse, `ū = u + μ|u_t| n`.
@@ -21,6 +30,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contact::ContactRow;
+use crate::fc::anderson::Anderson;
 use crate::local::{natural_map_residual, project_on_cone, solve_local, ContactStatus};
 
 /// Parameters of the NLGS solver.
@@ -37,6 +47,13 @@ pub struct SolverParams {
     /// Alternate forward and backward sweeps (symmetric Gauss–Seidel).
     #[serde(default)]
     pub symmetric: bool,
+    /// Memory of the Anderson acceleration of the sweeps (0: plain Gauss–Seidel).
+    #[serde(default = "anderson_memory")]
+    pub anderson_memory: usize,
+}
+
+fn anderson_memory() -> usize {
+    4
 }
 
 fn one() -> f64 {
@@ -50,6 +67,7 @@ impl Default for SolverParams {
             max_iterations: 10_000,
             relaxation: 1.0,
             symmetric: false,
+            anderson_memory: 4,
         }
     }
 }
@@ -123,7 +141,10 @@ fn update(c: &mut ContactRow, vel: &mut [[f64; 3]], inv: &[[f64; 3]], omega: f64
     let q = [u[0] - wr[0], u[1] - wr[1]];
     let (mut r, _) = solve_local(&c.w, q, c.mu);
     if omega != 1.0 {
-        let t = [c.r[0] + omega * (r[0] - c.r[0]), c.r[1] + omega * (r[1] - c.r[1])];
+        let t = [
+            c.r[0] + omega * (r[0] - c.r[0]),
+            c.r[1] + omega * (r[1] - c.r[1]),
+        ];
         r = project_on_cone(t, c.mu).0;
     }
     let d = [r[0] - c.r[0], r[1] - c.r[1]];
@@ -157,46 +178,91 @@ pub fn sweep(
     }
 }
 
-/// Solve the contact problem of a step by NLGS, starting from the impulses stored in `rows`
-/// (already applied to `vel`, see [`apply_impulses`]). `q_norm` is [`free_velocity_norm`].
+/// Plain sweeps before Anderson mixing starts (easy, warm-started steps never pay for it).
+pub const PLAIN_SWEEPS: usize = 6;
+/// Stagnation window of the Anderson safeguard (sweeps).
+pub const STAGNATION_WINDOW: usize = 60;
+const STAGNATION_FACTOR: f64 = 0.7;
+const PLAIN_PHASE: usize = 32;
+const BLOW_UP: f64 = 1e3;
+
+/// Rebuild the body velocities from the free velocities and the impulses:
+/// `v = v_free + M⁻¹ Hᵀ R`.
+pub fn rebuild_velocities(
+    rows: &[ContactRow],
+    vel: &mut [[f64; 3]],
+    v_free: &[[f64; 3]],
+    inv: &[[f64; 3]],
+) {
+    vel.copy_from_slice(v_free);
+    apply_impulses(rows, vel, inv);
+}
+
+/// Solve the contact problem of a step by accelerated NLGS (see the module documentation),
+/// starting from the impulses stored in `rows`. On entry `vel` must equal
+/// `v_free + M⁻¹ Hᵀ R` for those impulses (see [`apply_impulses`]); `q_norm` is
+/// [`free_velocity_norm`].
 ///
 /// The error is evaluated after every sweep during the first ten, then every
 /// `max(1, iterations/10)` sweeps (at most 16): the reported error is always the true error at
 /// the returned impulses.
 ///
-/// Gauss–Seidel in a fixed order can cycle on statically indeterminate clusters of sticking
-/// contacts (closed loops of grains) instead of converging. When the error has not halved over
+/// Without acceleration, Gauss–Seidel in a fixed order can cycle on statically indeterminate
+/// clusters of sticking contacts (closed loops of grains). When the error has not halved over
 /// [`STALL_SWEEPS`] sweeps, the sweeps continue in a fresh pseudo-random order each time (seeded,
 /// so runs stay reproducible), which breaks the cycle.
+#[allow(clippy::too_many_arguments)]
 pub fn solve(
     rows: &mut [ContactRow],
     order: &mut [u32],
     vel: &mut [[f64; 3]],
+    v_free: &[[f64; 3]],
     inv: &[[f64; 3]],
     q_norm: f64,
     params: &SolverParams,
+    work: &mut SolverWork,
 ) -> SolveReport {
-    if rows.is_empty() {
+    let n = rows.len();
+    if n == 0 {
         return SolveReport {
             iterations: 0,
             error: 0.0,
             converged: true,
         };
     }
+    let tol = params.tolerance;
     let mut error = error_measure(rows, vel, q_norm);
-    if error <= params.tolerance {
+    if error <= tol {
         return SolveReport {
             iterations: 0,
             error,
             converged: true,
         };
     }
+    let use_aa = params.anderson_memory > 0;
+    if use_aa {
+        work.prepare(params.anderson_memory, n);
+    }
+    work.best.clear();
+    work.best.extend(rows.iter().map(|c| c.r));
+    let mut best_error = error;
+
     let mut it = 0;
     let mut next_check = 1;
-    let (mut best, mut best_it) = (error, 0usize);
+    let (mut halving_ref, mut halving_it) = (error, 0usize);
     let mut shuffling = false;
     let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+    // Anderson safeguard.
+    let mut plain_until = PLAIN_SWEEPS;
+    let mut plain_phase = PLAIN_PHASE;
+    let (mut window_start, mut window_error, mut window_best) = (0usize, error, error);
+
     while it < params.max_iterations {
+        let accelerate = use_aa && it >= plain_until;
+        if accelerate {
+            work.x.clear();
+            work.x.extend(rows.iter().flat_map(|c| c.r));
+        }
         if shuffling {
             for i in (1..order.len()).rev() {
                 seed = seed
@@ -205,25 +271,106 @@ pub fn solve(
                 order.swap(i, ((seed >> 33) as usize) % (i + 1));
             }
         }
-        sweep(rows, order, vel, inv, params.relaxation, params.symmetric && it % 2 == 1);
+        sweep(
+            rows,
+            order,
+            vel,
+            inv,
+            params.relaxation,
+            params.symmetric && it % 2 == 1,
+        );
         it += 1;
         if it >= next_check || it == params.max_iterations {
             error = error_measure(rows, vel, q_norm);
-            if error <= params.tolerance {
+            if error < best_error {
+                best_error = error;
+                for (b, c) in work.best.iter_mut().zip(rows.iter()) {
+                    *b = c.r;
+                }
+            } else if !error.is_finite() || error > BLOW_UP * best_error {
+                for (c, b) in rows.iter_mut().zip(work.best.iter()) {
+                    c.r = *b;
+                }
+                rebuild_velocities(rows, vel, v_free, inv);
+                error = error_measure(rows, vel, q_norm);
+                if let Some(aa) = work.anderson.as_mut() {
+                    aa.reset();
+                }
+                plain_until = it + plain_phase;
+                plain_phase = plain_phase.saturating_mul(2);
+            }
+            if error <= tol {
                 break;
             }
-            if error < 0.5 * best {
-                (best, best_it) = (error, it);
-            } else if !shuffling && it - best_it >= STALL_SWEEPS {
+            if use_aa {
+                if it <= plain_until {
+                    (window_start, window_error, window_best) = (it, error, error);
+                } else {
+                    window_best = window_best.min(error);
+                    if it - window_start >= STAGNATION_WINDOW {
+                        if window_best > STAGNATION_FACTOR * window_error {
+                            if let Some(aa) = work.anderson.as_mut() {
+                                aa.reset();
+                            }
+                            plain_until = it + plain_phase;
+                            plain_phase = plain_phase.saturating_mul(2);
+                        }
+                        (window_start, window_error, window_best) = (it, window_best, error);
+                    }
+                }
+            } else if error < 0.5 * halving_ref {
+                (halving_ref, halving_it) = (error, it);
+            } else if !shuffling && it - halving_it >= STALL_SWEEPS {
                 shuffling = true;
             }
             next_check = it + if it < 10 { 1 } else { (it / 10).clamp(1, 16) };
         }
+        if accelerate && it >= plain_until && it < params.max_iterations {
+            if let Some(aa) = work.anderson.as_mut() {
+                work.g.clear();
+                work.g.extend(rows.iter().flat_map(|c| c.r));
+                aa.step(&work.x, &mut work.g);
+                for (c, r) in rows.iter_mut().zip(work.g.chunks_exact(2)) {
+                    c.r = [r[0], r[1]];
+                }
+                rebuild_velocities(rows, vel, v_free, inv);
+            }
+        }
+    }
+    if error > tol && best_error < error {
+        for (c, b) in rows.iter_mut().zip(work.best.iter()) {
+            c.r = *b;
+        }
+        rebuild_velocities(rows, vel, v_free, inv);
+        error = error_measure(rows, vel, q_norm);
     }
     SolveReport {
         iterations: it,
         error,
-        converged: error <= params.tolerance,
+        converged: error <= tol,
+    }
+}
+
+/// Buffers of the solver kept between steps (no allocation in the steady state).
+#[derive(Debug, Clone, Default)]
+pub struct SolverWork {
+    anderson: Option<Anderson>,
+    shape: (usize, usize),
+    x: Vec<f64>,
+    g: Vec<f64>,
+    best: Vec<[f64; 2]>,
+}
+
+impl SolverWork {
+    fn prepare(&mut self, memory: usize, n: usize) {
+        if self.anderson.is_some() && self.shape == (memory, n) {
+            if let Some(a) = self.anderson.as_mut() {
+                a.reset();
+            }
+        } else {
+            self.anderson = Some(Anderson::new(memory, 2 * n));
+            self.shape = (memory, n);
+        }
     }
 }
 

@@ -99,6 +99,8 @@ pub struct World {
     inv: Vec<[f64; 3]>,
     body_force: Vec<[f64; 3]>,
     order: Vec<u32>,
+    v_free: Vec<[f64; 3]>,
+    work: solver::SolverWork,
     last: StepReport,
 }
 
@@ -119,12 +121,20 @@ impl World {
             inv: Vec::new(),
             body_force: Vec::new(),
             order: Vec::new(),
+            v_free: Vec::new(),
+            work: solver::SolverWork::default(),
             last: StepReport::default(),
         }
     }
 
     /// Add a free disk grain (thickness 1 m); returns its body index.
-    pub fn add_grain(&mut self, position: Vector2<f64>, radius: f64, density: f64, material: u16) -> u32 {
+    pub fn add_grain(
+        &mut self,
+        position: Vector2<f64>,
+        radius: f64,
+        density: f64,
+        material: u16,
+    ) -> u32 {
         self.add_grain_with_thickness(position, radius, density, 1.0, material)
     }
 
@@ -138,7 +148,8 @@ impl World {
         material: u16,
     ) -> u32 {
         let b = self.bodies.len() as u32;
-        self.bodies.push(Body::disk(position, radius, density, thickness));
+        self.bodies
+            .push(Body::disk(position, radius, density, thickness));
         self.colliders.push(Collider {
             body: b,
             shape: Shape::Disk {
@@ -152,7 +163,13 @@ impl World {
 
     /// Add a fixed (or, by setting its velocity, driven) infinite line wall through `point` with
     /// unit `normal` pointing to the grains; returns its body index.
-    pub fn add_line_wall(&mut self, name: &str, point: Vector2<f64>, normal: Vector2<f64>, material: u16) -> u32 {
+    pub fn add_line_wall(
+        &mut self,
+        name: &str,
+        point: Vector2<f64>,
+        normal: Vector2<f64>,
+        material: u16,
+    ) -> u32 {
         let b = self.bodies.len() as u32;
         self.bodies.push(Body::wall(name, point, Vector2::zeros()));
         self.colliders.push(Collider {
@@ -167,7 +184,13 @@ impl World {
     }
 
     /// Add a fixed segment wall from `a` to `b`; returns its body index (centre at the middle).
-    pub fn add_segment_wall(&mut self, name: &str, a: Vector2<f64>, b: Vector2<f64>, material: u16) -> u32 {
+    pub fn add_segment_wall(
+        &mut self,
+        name: &str,
+        a: Vector2<f64>,
+        b: Vector2<f64>,
+        material: u16,
+    ) -> u32 {
         let id = self.bodies.len() as u32;
         let c = (a + b) * 0.5;
         self.bodies.push(Body::wall(name, c, Vector2::zeros()));
@@ -182,7 +205,13 @@ impl World {
     /// Add a rigid clump of glued disks (a rough wall), fixed by default; returns its body index.
     /// Its centre is the mean of the disk centres. Give it free degrees of freedom, a mass and
     /// an applied force to control it (e.g. a platen at imposed pressure).
-    pub fn add_clump(&mut self, name: &str, centres: &[Vector2<f64>], radii: &[f64], material: u16) -> u32 {
+    pub fn add_clump(
+        &mut self,
+        name: &str,
+        centres: &[Vector2<f64>],
+        radii: &[f64],
+        material: u16,
+    ) -> u32 {
         let id = self.bodies.len() as u32;
         let n = centres.len().max(1) as f64;
         let c = centres.iter().fold(Vector2::zeros(), |s, x| s + x) / n;
@@ -258,24 +287,39 @@ impl World {
             reason,
         };
         if !(p.dt.is_finite() && p.dt > 0.0) {
-            return Err(perr("dt", format!("must be a positive time step in s, got {}", p.dt)));
+            return Err(perr(
+                "dt",
+                format!("must be a positive time step in s, got {}", p.dt),
+            ));
         }
         if !(0.5..=1.0).contains(&p.theta) {
-            return Err(perr("theta", format!("must lie in [0.5, 1], got {}", p.theta)));
+            return Err(perr(
+                "theta",
+                format!("must lie in [0.5, 1], got {}", p.theta),
+            ));
         }
         if !(p.gravity.x.is_finite() && p.gravity.y.is_finite()) {
             return Err(perr("gravity", "must be finite".into()));
         }
         if !(p.detection_gap.is_finite() && p.detection_gap >= 0.0) {
-            return Err(perr("detection_gap", format!("must be ≥ 0 m, got {}", p.detection_gap)));
+            return Err(perr(
+                "detection_gap",
+                format!("must be ≥ 0 m, got {}", p.detection_gap),
+            ));
         }
         if let Some([a, b]) = p.periodic_x {
             if !(a.is_finite() && b.is_finite() && b > a) {
-                return Err(perr("periodic_x", format!("needs x_min < x_max, got [{a}, {b}]")));
+                return Err(perr(
+                    "periodic_x",
+                    format!("needs x_min < x_max, got [{a}, {b}]"),
+                ));
             }
         }
         if !(p.solver.tolerance.is_finite() && p.solver.tolerance > 0.0) {
-            return Err(perr("solver.tolerance", format!("must be > 0, got {}", p.solver.tolerance)));
+            return Err(perr(
+                "solver.tolerance",
+                format!("must be > 0, got {}", p.solver.tolerance),
+            ));
         }
         if p.solver.max_iterations == 0 {
             return Err(perr("solver.max_iterations", "must be ≥ 1".into()));
@@ -301,7 +345,11 @@ impl World {
                 field: field.into(),
                 reason,
             };
-            let finite = b.position.iter().chain(b.velocity.iter()).all(|x| x.is_finite())
+            let finite = b
+                .position
+                .iter()
+                .chain(b.velocity.iter())
+                .all(|x| x.is_finite())
                 && b.angle.is_finite()
                 && b.omega.is_finite();
             if !finite {
@@ -312,30 +360,54 @@ impl World {
                     return Err(berr("radius", format!("must be > 0 m, got {}", b.radius)));
                 }
                 if !(b.density.is_finite() && b.density > 0.0) {
-                    return Err(berr("density", format!("must be > 0 kg/m³, got {}", b.density)));
+                    return Err(berr(
+                        "density",
+                        format!("must be > 0 kg/m³, got {}", b.density),
+                    ));
                 }
                 if !(b.thickness.is_finite() && b.thickness > 0.0) {
-                    return Err(berr("thickness", format!("must be > 0 m, got {}", b.thickness)));
+                    return Err(berr(
+                        "thickness",
+                        format!("must be > 0 m, got {}", b.thickness),
+                    ));
                 }
             }
             for (d, &dof) in b.dofs.iter().enumerate() {
                 let m = if d < 2 { b.mass } else { b.inertia };
                 if dof == Dof::Free && !(m.is_finite() && m > 0.0) {
-                    return Err(berr("mass", format!("a free degree of freedom needs a finite positive mass, got {m}")));
+                    return Err(berr(
+                        "mass",
+                        format!("a free degree of freedom needs a finite positive mass, got {m}"),
+                    ));
                 }
             }
         }
         for c in &self.colliders {
             if c.body as usize >= self.bodies.len() {
-                return Err(perr("collider", format!("refers to body {} that does not exist", c.body)));
+                return Err(perr(
+                    "collider",
+                    format!("refers to body {} that does not exist", c.body),
+                ));
             }
             if c.material as usize >= self.laws.len() {
-                return Err(perr("collider", format!("material {} is not defined", c.material)));
+                return Err(perr(
+                    "collider",
+                    format!("material {} is not defined", c.material),
+                ));
             }
             let bad = match &c.shape {
-                Shape::Disk { radius, offset } => !(radius.is_finite() && *radius > 0.0 && offset.x.is_finite() && offset.y.is_finite()),
-                Shape::Line { point, normal } => !(point.x.is_finite() && point.y.is_finite() && normal.norm() > 0.0),
-                Shape::Segment { a, b } => !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite()),
+                Shape::Disk { radius, offset } => {
+                    !(radius.is_finite()
+                        && *radius > 0.0
+                        && offset.x.is_finite()
+                        && offset.y.is_finite())
+                }
+                Shape::Line { point, normal } => {
+                    !(point.x.is_finite() && point.y.is_finite() && normal.norm() > 0.0)
+                }
+                Shape::Segment { a, b } => {
+                    !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite())
+                }
             };
             if bad {
                 let b = &self.bodies[c.body as usize];
@@ -351,8 +423,17 @@ impl World {
         self.refresh_inverse_mass();
         let mut set = ContactSet::default();
         let periodic = self.periodic();
-        self.detector
-            .detect(&self.bodies, &self.inv, &self.colliders, &self.laws, periodic, 0.0, 0.0, 0.0, &mut set)?;
+        self.detector.detect(
+            &self.bodies,
+            &self.inv,
+            &self.colliders,
+            &self.laws,
+            periodic,
+            0.0,
+            0.0,
+            0.0,
+            &mut set,
+        )?;
         for (row, g) in set.rows.iter().zip(&set.geometry) {
             if g.gap < -tolerance {
                 let (a, b) = (row.a as usize, row.b as usize);
@@ -421,8 +502,16 @@ impl World {
         }
         for (i, b) in self.bodies.iter().enumerate() {
             let inv = &self.inv[i];
-            let grav = if b.gravity { g * b.mass } else { Vector2::zeros() };
-            let f = [grav.x + b.applied_force.x, grav.y + b.applied_force.y, b.applied_torque];
+            let grav = if b.gravity {
+                g * b.mass
+            } else {
+                Vector2::zeros()
+            };
+            let f = [
+                grav.x + b.applied_force.x,
+                grav.y + b.applied_force.y,
+                b.applied_torque,
+            ];
             for d in 0..3 {
                 if b.dofs[d] == Dof::Free {
                     self.vel[i][d] += h * inv[d] * f[d];
@@ -432,6 +521,8 @@ impl World {
 
         // 3. Contact solve.
         let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
+        self.v_free.clear();
+        self.v_free.extend_from_slice(&self.vel);
         solver::apply_impulses(&self.contacts.rows, &mut self.vel, &self.inv);
         self.order.clear();
         self.order.extend(0..self.contacts.len() as u32);
@@ -439,9 +530,11 @@ impl World {
             &mut self.contacts.rows,
             &mut self.order,
             &mut self.vel,
+            &self.v_free,
             &self.inv,
             q_norm,
             &self.params.solver,
+            &mut self.work,
         );
         solver::classify(&self.contacts.rows, &mut self.contacts.status);
 
@@ -555,7 +648,11 @@ impl World {
             if b.kind != BodyKind::Wall {
                 continue;
             }
-            let mine: Vec<&Collider> = self.colliders.iter().filter(|c| c.body as usize == i).collect();
+            let mine: Vec<&Collider> = self
+                .colliders
+                .iter()
+                .filter(|c| c.body as usize == i)
+                .collect();
             let geometry = match mine.first().map(|c| &c.shape) {
                 Some(Shape::Line { point, normal }) => WallGeometry::Line {
                     point: b.position + rotate(*point, b.angle),
