@@ -1,1 +1,28 @@
-//! datasets
+//! # datasets — the paper's experiments as scenarios, and packing generators
+//!
+//! - [`builtin`]: the built-in scenarios, TOML files embedded in the binary (`janssen`, the
+//!   default; `rolling`, `arrangements`, `stick-slip`, `inclined-flow`, `shear-cell`);
+//! - [`scenario`]: loading a built-in or a TOML path, `--set KEY=VALUE` overrides
+//!   ([`overrides`]) applied on the TOML table, typed deserialisation with unknown keys refused
+//!   and validation that names the key at fault ([`config`]);
+//! - [`generators`]: seeded polydisperse radii, grains rained without overlap, regular stacks
+//!   (rectangular, triangular, cannonball);
+//! - [`build`]: the worlds of the scenarios (named walls, grains, contact laws);
+//! - [`phases`]: running a world to rest or for a number of steps while counting what the
+//!   contact solver did.
+//!
+//! Units: SI throughout (m, kg, s, N, Pa). Every scenario has a `seed`; the same seed gives the
+//! same numbers.
+
+pub mod build;
+pub mod builtin;
+pub mod config;
+pub mod error;
+pub mod generators;
+pub mod overrides;
+pub mod phases;
+pub mod scenario;
+
+pub use builtin::{builtin, Builtin, BUILTINS};
+pub use error::{DatasetError, Result};
+pub use scenario::{load, LoadedScenario, Scenario};

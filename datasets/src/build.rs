@@ -1,0 +1,287 @@
+//! Worlds of the scenarios, ready to step: walls (named), grains, contact laws.
+//!
+//! Materials: `grain` (0) and `wall` (1); friction from the scenario's [`FrictionSpec`].
+//! The engine's checks ([`dem::World::validate`]) run on every built world: no overlap, no
+//! grain behind a wall, finite positive sizes.
+
+use dem::{Dof, World, WorldParams};
+use nalgebra::Vector2;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::config::{
+    ArrangementsConfig, FrictionSpec, GrainSpec, InclinedFlowConfig, RollingConfig, ShearCellConfig,
+};
+use crate::error::{DatasetError, Result};
+use crate::generators::{lattice, rain, total_area, uniform_radii, Arrangement, RainBox};
+
+/// Material index of grains.
+pub const GRAIN: u16 = 0;
+/// Material index of walls.
+pub const WALL: u16 = 1;
+
+/// Solid fraction assumed to size a column before it is deposited (2D polydisperse disks).
+pub const PACKING_GUESS: f64 = 0.8;
+
+/// Tolerance of the overlap check of built worlds (m): rounding only.
+const BUILD_TOLERANCE: f64 = 1e-12;
+
+fn world(
+    dt: f64,
+    gravity: Vector2<f64>,
+    periodic_x: Option<[f64; 2]>,
+    r_min: f64,
+    friction: &FrictionSpec,
+) -> World {
+    let params = WorldParams {
+        dt,
+        gravity,
+        periodic_x,
+        detection_gap: 0.1 * r_min,
+        ..Default::default()
+    };
+    World::new(params, friction.laws())
+}
+
+/// A box of two vertical walls and a floor filled with rained grains.
+#[derive(Debug, Clone)]
+pub struct ColumnWorld {
+    /// The world: bodies 0, 1, 2 are the walls `bottom`, `left`, `right`, then the grains.
+    pub world: World,
+    /// Inner width of the box W (m).
+    pub width: f64,
+    /// Body index of the floor.
+    pub bottom: usize,
+    /// Body index of the left wall.
+    pub left: usize,
+    /// Body index of the right wall.
+    pub right: usize,
+}
+
+/// Width (m) of a column of `n` grains of `grain` whose settled height is `aspect` widths:
+/// `W = √(n π ⟨R²⟩ / (φ₀ aspect))`, φ₀ = [`PACKING_GUESS`].
+pub fn column_width(grain: &GrainSpec, n: usize, aspect: f64) -> f64 {
+    (n as f64 * std::f64::consts::PI * grain.mean_square_radius() / (PACKING_GUESS * aspect)).sqrt()
+}
+
+/// `n` seeded polydisperse grains rained without overlap into a box `width` wide with line
+/// walls `bottom` (y = 0), `left` (x = 0), `right` (x = W). Time step `dt`, gravity −9.81 ŷ.
+pub fn column(
+    grain: &GrainSpec,
+    n: usize,
+    width: f64,
+    friction: &FrictionSpec,
+    seed: u64,
+    dt: f64,
+) -> Result<ColumnWorld> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let radii = uniform_radii(&mut rng, n, grain);
+    let gap = 0.02 * grain.radius_min();
+    let centres = rain(
+        &mut rng,
+        &radii,
+        &RainBox {
+            x_min: 0.0,
+            x_max: width,
+            y_min: 0.0,
+            gap,
+            periodic: false,
+        },
+    )?;
+    let mut w = world(
+        dt,
+        Vector2::new(0.0, -9.81),
+        None,
+        grain.radius_min(),
+        friction,
+    );
+    let bottom = w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL) as usize;
+    let left = w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL) as usize;
+    let right = w.add_line_wall(
+        "right",
+        Vector2::new(width, 0.0),
+        Vector2::new(-1.0, 0.0),
+        WALL,
+    ) as usize;
+    for (c, r) in centres.iter().zip(&radii) {
+        w.add_grain(*c, *r, grain.density, GRAIN);
+    }
+    w.validate(BUILD_TOLERANCE)?;
+    Ok(ColumnWorld {
+        world: w,
+        width,
+        bottom,
+        left,
+        right,
+    })
+}
+
+/// The rolling disk: slope through the origin descending to the right, e₁ = (cos φ, −sin φ)
+/// down the slope, e₂ = (sin φ, cos φ) its outward normal; the disk touches the slope at the
+/// origin, at rest. Body 0 is the wall `slope`, body 1 the disk.
+pub fn rolling(c: &RollingConfig) -> Result<(World, Vector2<f64>, Vector2<f64>)> {
+    let phi = c.slope_deg.to_radians();
+    let e1 = Vector2::new(phi.cos(), -phi.sin());
+    let e2 = Vector2::new(phi.sin(), phi.cos());
+    let f = FrictionSpec {
+        grain_grain: c.friction,
+        grain_wall: c.friction,
+    };
+    let mut w = world(c.dt, Vector2::new(0.0, -9.81), None, c.radius, &f);
+    w.params.solver.tolerance = 1e-12;
+    w.params.solver.max_iterations = 100;
+    w.add_line_wall("slope", Vector2::zeros(), e2, WALL);
+    w.add_grain(e2 * c.radius, c.radius, c.density, GRAIN);
+    w.validate(BUILD_TOLERANCE)?;
+    Ok((w, e1, e2))
+}
+
+/// A box with four line walls `bottom`, `left`, `right`, `top` holding a regular stack
+/// ([`Arrangement`]); the top wall is one radius above the highest disk.
+pub fn arrangement(c: &ArrangementsConfig, kind: Arrangement) -> Result<World> {
+    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
+    let r = c.radius;
+    let centres = lattice(kind, c.columns, c.rows, r, c.gap, c.jitter, &mut rng);
+    let width = 2.0 * r * c.columns as f64;
+    let top = centres.iter().map(|p| p.y).fold(0.0, f64::max) + 2.0 * r;
+    let mut w = world(c.dt, Vector2::new(0.0, -9.81), None, r, &c.friction);
+    w.params.solver = c.solver.params();
+    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL);
+    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL);
+    w.add_line_wall(
+        "right",
+        Vector2::new(width, 0.0),
+        Vector2::new(-1.0, 0.0),
+        WALL,
+    );
+    w.add_line_wall("top", Vector2::new(0.0, top), Vector2::new(0.0, -1.0), WALL);
+    for p in centres {
+        w.add_grain(p, r, c.density, GRAIN);
+    }
+    w.validate(BUILD_TOLERANCE)?;
+    Ok(w)
+}
+
+/// Centres of a rough wall: disks of radius `r` evenly spaced along `[0, length)` at height `y`,
+/// `gap_fraction · 2r` apart (surface to surface).
+fn rough_row(length: f64, r: f64, y: f64) -> (Vec<Vector2<f64>>, Vec<f64>) {
+    let m = ((length / (2.0 * r)).floor() as usize).max(1);
+    let pitch = length / m as f64;
+    let centres = (0..m)
+        .map(|k| Vector2::new((k as f64 + 0.5) * pitch, y))
+        .collect();
+    (centres, vec![r; m])
+}
+
+/// A flow down a rough slope in the slope frame: x along the slope (periodic, length
+/// `cell_length_diameters · 2 R̄`), y its normal, gravity `g (sin θ, −cos θ)`. Body 0 is the rough
+/// bottom `base` (glued disks of the mean radius centred on y = 0), then the grains rained above.
+pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
+    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
+    let g = &c.grain;
+    let length = c.cell_length_diameters * 2.0 * g.radius_mean;
+    let radii = uniform_radii(&mut rng, c.grains, g);
+    let theta = c.slope_deg.to_radians();
+    let gravity = Vector2::new(9.81 * theta.sin(), -9.81 * theta.cos());
+    let mut w = world(
+        c.dt,
+        gravity,
+        Some([0.0, length]),
+        g.radius_min(),
+        &c.friction,
+    );
+    w.params.solver = c.solver.params();
+    let (bc, br) = rough_row(length, g.radius_mean, 0.0);
+    w.add_clump("base", &bc, &br, WALL);
+    let gap = 0.02 * g.radius_min();
+    let centres = rain(
+        &mut rng,
+        &radii,
+        &RainBox {
+            x_min: 0.0,
+            x_max: length,
+            y_min: g.radius_mean + gap,
+            gap,
+            periodic: true,
+        },
+    )?;
+    for (p, r) in centres.iter().zip(&radii) {
+        let b = w.add_grain(*p, *r, g.density, GRAIN);
+        // A small random velocity breaks the symmetry of the start.
+        w.bodies[b as usize].velocity = Vector2::new(rng.random_range(-0.01..0.01), 0.0);
+    }
+    w.validate(BUILD_TOLERANCE)?;
+    Ok(w)
+}
+
+/// A plane shear cell without gravity: x periodic (length `cell_length_diameters · 2 R̄`), a
+/// fixed rough wall `bottom` (body 0) at y = 0 and a rough wall `top` (body 1) whose y is free
+/// (mass `wall_mass_ratio ×` the grains' mass, applied force `−P L t` ŷ) and whose x velocity is
+/// imposed (zero until the runner sets it). Grains rained between them.
+pub fn shear_cell(c: &ShearCellConfig) -> Result<(World, f64)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
+    let g = &c.grain;
+    let length = c.cell_length_diameters * 2.0 * g.radius_mean;
+    let radii = uniform_radii(&mut rng, c.grains, g);
+    let mut w = world(
+        c.dt_max,
+        Vector2::zeros(),
+        Some([0.0, length]),
+        g.radius_min(),
+        &c.friction,
+    );
+    w.params.solver = c.solver.params();
+    let (bc, br) = rough_row(length, g.radius_mean, 0.0);
+    w.add_clump("bottom", &bc, &br, WALL);
+    let gap = 0.02 * g.radius_min();
+    let centres = rain(
+        &mut rng,
+        &radii,
+        &RainBox {
+            x_min: 0.0,
+            x_max: length,
+            y_min: g.radius_mean + gap,
+            gap,
+            periodic: true,
+        },
+    )?;
+    let top_y = centres
+        .iter()
+        .zip(&radii)
+        .map(|(p, r)| p.y + r)
+        .fold(0.0, f64::max)
+        + gap
+        + g.radius_mean;
+    let (tc, tr) = rough_row(length, g.radius_mean, top_y);
+    let top = w.add_clump("top", &tc, &tr, WALL) as usize;
+    let mut grain_mass = 0.0;
+    for (p, r) in centres.iter().zip(&radii) {
+        let b = w.add_grain(*p, *r, g.density, GRAIN);
+        grain_mass += w.bodies[b as usize].mass;
+    }
+    let body = &mut w.bodies[top];
+    body.dofs = [Dof::Imposed, Dof::Free, Dof::Imposed];
+    body.mass = c.wall_mass_ratio * grain_mass;
+    body.gravity = false;
+    body.applied_force = Vector2::new(0.0, -c.pressure * length * body.thickness);
+    if !(body.mass.is_finite() && body.mass > 0.0) {
+        return Err(DatasetError::Invalid {
+            key: "wall_mass_ratio".into(),
+            reason: "gives a top wall without positive finite mass".into(),
+        });
+    }
+    w.validate(BUILD_TOLERANCE)?;
+    Ok((w, length))
+}
+
+/// Total planar area of the grains of a world `Σ π R²` (m²).
+pub fn grain_area(world: &World) -> f64 {
+    total_area(
+        &world
+            .bodies
+            .iter()
+            .filter(|b| b.kind == dem::BodyKind::Grain)
+            .map(|b| b.radius)
+            .collect::<Vec<_>>(),
+    )
+}

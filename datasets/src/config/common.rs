@@ -1,0 +1,124 @@
+//! Pieces shared by several scenario configurations.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{at_least, in_range, non_negative, positive, DatasetError, Result};
+
+/// Polydisperse disk grains: radii uniform in `[radius_mean − radius_spread, radius_mean + radius_spread]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GrainSpec {
+    /// Material density ρ (kg/m³); a disk of radius R has mass ρ π R² per metre of thickness.
+    pub density: f64,
+    /// Mean radius (m).
+    pub radius_mean: f64,
+    /// Half-width of the uniform radius distribution (m), `0 ≤ spread < mean`.
+    pub radius_spread: f64,
+}
+
+impl GrainSpec {
+    /// Checks `density > 0`, `radius_mean > 0`, `0 ≤ radius_spread < radius_mean`; `prefix` is
+    /// the table's key (`grain`).
+    pub fn validate(&self, prefix: &str) -> Result<()> {
+        positive(&format!("{prefix}.density"), self.density)?;
+        positive(&format!("{prefix}.radius_mean"), self.radius_mean)?;
+        non_negative(&format!("{prefix}.radius_spread"), self.radius_spread)?;
+        if self.radius_spread >= self.radius_mean {
+            return Err(DatasetError::Invalid {
+                key: format!("{prefix}.radius_spread"),
+                reason: format!(
+                    "must be below radius_mean ({} m) so that every radius is positive, got {}",
+                    self.radius_mean, self.radius_spread
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Smallest radius (m).
+    pub fn radius_min(&self) -> f64 {
+        self.radius_mean - self.radius_spread
+    }
+
+    /// Largest radius (m).
+    pub fn radius_max(&self) -> f64 {
+        self.radius_mean + self.radius_spread
+    }
+
+    /// Mean of R² for the uniform distribution, `R̄² + s²/3` (m²).
+    pub fn mean_square_radius(&self) -> f64 {
+        self.radius_mean * self.radius_mean + self.radius_spread * self.radius_spread / 3.0
+    }
+}
+
+/// Coulomb friction coefficients between grains and between grains and walls.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionSpec {
+    /// Grain–grain μ (1).
+    pub grain_grain: f64,
+    /// Grain–wall μ (1).
+    pub grain_wall: f64,
+}
+
+impl FrictionSpec {
+    /// Checks both coefficients are finite and ≥ 0.
+    pub fn validate(&self, prefix: &str) -> Result<()> {
+        non_negative(&format!("{prefix}.grain_grain"), self.grain_grain)?;
+        non_negative(&format!("{prefix}.grain_wall"), self.grain_wall)?;
+        Ok(())
+    }
+
+    /// Contact laws with materials `grain` (0) and `wall` (1).
+    pub fn laws(&self) -> dem::ContactLaws {
+        let mut laws = dem::ContactLaws::new(&["grain", "wall"], self.grain_grain);
+        laws.set_friction(0, 1, self.grain_wall);
+        laws.set_friction(1, 1, self.grain_wall);
+        laws
+    }
+}
+
+/// Contact solver settings of one phase.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Tolerance on the natural-map error measure (1), > 0.
+    pub tolerance: f64,
+    /// Largest number of Gauss–Seidel sweeps per step, ≥ 1.
+    pub max_iterations: usize,
+}
+
+impl SolverSpec {
+    /// Checks `0 < tolerance < 1` and `max_iterations ≥ 1`.
+    pub fn validate(&self, prefix: &str) -> Result<()> {
+        in_range(
+            &format!("{prefix}.tolerance"),
+            self.tolerance,
+            f64::MIN_POSITIVE,
+            1.0,
+        )?;
+        at_least(&format!("{prefix}.max_iterations"), self.max_iterations, 1)?;
+        Ok(())
+    }
+
+    /// Engine parameters with this tolerance and sweep cap.
+    pub fn params(&self) -> dem::SolverParams {
+        dem::SolverParams {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+            ..Default::default()
+        }
+    }
+}
+
+/// `dt` must be positive and finite and at most `max` (s).
+pub fn check_dt(key: &str, dt: f64, max: f64) -> Result<f64> {
+    positive(key, dt)?;
+    if dt > max {
+        return Err(DatasetError::Invalid {
+            key: key.into(),
+            reason: format!("time step {dt} s is larger than {max} s"),
+        });
+    }
+    Ok(dt)
+}

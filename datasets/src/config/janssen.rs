@@ -1,0 +1,99 @@
+//! The `janssen` scenario (paper §4.3, Fig. 7): a polydisperse column deposited by gravity
+//! between two vertical walls, relaxed, then its wall stresses compared with Janssen's law.
+
+use serde::{Deserialize, Serialize};
+
+use super::common::{check_dt, FrictionSpec, GrainSpec};
+use super::deposit::{DepositSpec, RelaxSpec};
+use crate::error::{at_least, in_range, non_negative, positive, Result};
+
+/// Configuration of the `janssen` scenario (every key of `scenarios/janssen.toml`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JanssenConfig {
+    /// Always `"janssen"`.
+    pub scenario: String,
+    /// Seed of the radii and the initial placement.
+    pub seed: u64,
+    /// Number of grains.
+    pub grains: usize,
+    /// Height / width of the settled column; the box width follows from the grains' area,
+    /// `W = √(Σ π R² / (φ₀ · aspect))` with φ₀ = 0.8 (≈ 10 mean diameters for 350 grains).
+    pub column_aspect: f64,
+    /// Grain size and density.
+    pub grain: GrainSpec,
+    /// Friction coefficients.
+    pub friction: FrictionSpec,
+    /// Time step of the scenario (s), used in the relaxation.
+    pub dt: f64,
+    /// Deposition by gravity.
+    pub deposit: DepositSpec,
+    /// Release of the deposited column: the floor is lowered a little, slowly, so that the
+    /// grains slide along the walls and the wall friction is mobilised ("relâcher le système
+    /// afin de se mettre dans les conditions de Coulomb", paper §4.3).
+    pub release: ReleaseSpec,
+    /// Relaxation after the release.
+    pub relax: RelaxSpec,
+    /// Measurement and output settings.
+    pub analysis: JanssenAnalysis,
+}
+
+/// Lowering of the floor after the deposition.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReleaseSpec {
+    /// Distance the floor is lowered (m); 0 for none.
+    pub floor_drop: f64,
+    /// Speed of the floor while it is lowered (m/s).
+    pub speed: f64,
+}
+
+/// What to measure on the relaxed column.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JanssenAnalysis {
+    /// Number of depth bins of the wall-stress profile.
+    pub depth_bins: usize,
+    /// Depths above this many mean diameters are left out of the fit (loose top layer).
+    pub skip_top_diameters: f64,
+    /// Depths within this many mean diameters of the floor are left out of the fit.
+    pub skip_bottom_diameters: f64,
+    /// Number of VTK frames written during the deposition and relaxation (0: final only).
+    pub vtk_frames: usize,
+}
+
+impl JanssenConfig {
+    /// Checks every value (key named in the error).
+    pub fn validate(&self) -> Result<()> {
+        at_least("grains", self.grains, 10)?;
+        in_range("column_aspect", self.column_aspect, 0.2, 1000.0)?;
+        self.grain.validate("grain")?;
+        self.friction.validate("friction")?;
+        check_dt("dt", self.dt, 1.0)?;
+        self.deposit.validate("deposit")?;
+        non_negative("release.floor_drop", self.release.floor_drop)?;
+        positive("release.speed", self.release.speed)?;
+        if self.release.floor_drop > 10.0 * self.grain.radius_mean {
+            return Err(crate::error::DatasetError::Invalid {
+                key: "release.floor_drop".into(),
+                reason: format!(
+                    "must be at most 10 mean radii ({} m), got {}",
+                    10.0 * self.grain.radius_mean,
+                    self.release.floor_drop
+                ),
+            });
+        }
+        self.relax.validate("relax")?;
+        at_least("analysis.depth_bins", self.analysis.depth_bins, 4)?;
+        non_negative(
+            "analysis.skip_top_diameters",
+            self.analysis.skip_top_diameters,
+        )?;
+        non_negative(
+            "analysis.skip_bottom_diameters",
+            self.analysis.skip_bottom_diameters,
+        )?;
+        positive("grain.density", self.grain.density)?;
+        Ok(())
+    }
+}

@@ -1,0 +1,20 @@
+//! Typed scenario configurations (one struct per scenario, `deny_unknown_fields`), each with a
+//! `validate` that names the key of any out-of-range value.
+
+pub mod arrangements;
+pub mod common;
+pub mod deposit;
+pub mod inclined_flow;
+pub mod janssen;
+pub mod rolling;
+pub mod shear_cell;
+pub mod stick_slip;
+
+pub use arrangements::ArrangementsConfig;
+pub use common::{FrictionSpec, GrainSpec, SolverSpec};
+pub use deposit::{DepositSpec, RelaxSpec};
+pub use inclined_flow::InclinedFlowConfig;
+pub use janssen::{JanssenAnalysis, JanssenConfig, ReleaseSpec};
+pub use rolling::RollingConfig;
+pub use shear_cell::ShearCellConfig;
+pub use stick_slip::{StickSlipCases, StickSlipConfig};

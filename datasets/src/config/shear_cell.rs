@@ -1,0 +1,89 @@
+//! The `shear-cell` scenario (beyond the paper): steady plane shear of a periodic sample between
+//! two rough walls, the top wall at imposed normal pressure and velocity, swept over several
+//! inertial numbers; μ(I), φ(I) and the wall boundary-layer law are fitted.
+
+use serde::{Deserialize, Serialize};
+
+use super::common::{FrictionSpec, GrainSpec, SolverSpec};
+use crate::error::{at_least, in_range, positive, DatasetError, Result};
+
+/// Configuration of the `shear-cell` scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShearCellConfig {
+    /// Always `"shear-cell"`.
+    pub scenario: String,
+    /// Seed of the radii, placement and wall roughness.
+    pub seed: u64,
+    /// Number of grains.
+    pub grains: usize,
+    /// Length of the periodic cell, in mean grain diameters.
+    pub cell_length_diameters: f64,
+    /// Grain size and density.
+    pub grain: GrainSpec,
+    /// Friction coefficients (wall = the glued grains of the rough walls).
+    pub friction: FrictionSpec,
+    /// Normal pressure imposed on the top wall P (Pa).
+    pub pressure: f64,
+    /// Target inertial numbers `I = γ̇ d / √(P/ρ)`, one run each; the top wall velocity is
+    /// `V = I √(P/ρ) H / d` with H the sample height after compression.
+    pub inertial_numbers: Vec<f64>,
+    /// Shear strain of each run.
+    pub strain: f64,
+    /// The last `average_strain` of each run is averaged.
+    pub average_strain: f64,
+    /// Largest time step (s).
+    pub dt_max: f64,
+    /// Largest travel of the top wall per step, as a fraction of the mean radius (sets dt).
+    pub travel_per_step: f64,
+    /// Mass of the top wall over the grains' mass.
+    pub wall_mass_ratio: f64,
+    /// Duration of the initial compression at zero shear (s).
+    pub compression_time: f64,
+    /// Contact solver.
+    pub solver: SolverSpec,
+}
+
+impl ShearCellConfig {
+    /// Checks every value (key named in the error).
+    pub fn validate(&self) -> Result<()> {
+        at_least("grains", self.grains, 20)?;
+        in_range(
+            "cell_length_diameters",
+            self.cell_length_diameters,
+            4.0,
+            1e4,
+        )?;
+        self.grain.validate("grain")?;
+        self.friction.validate("friction")?;
+        positive("pressure", self.pressure)?;
+        if self.inertial_numbers.len() < 3 {
+            return Err(DatasetError::Invalid {
+                key: "inertial_numbers".into(),
+                reason: format!(
+                    "needs at least 3 values to fit μ(I), got {}",
+                    self.inertial_numbers.len()
+                ),
+            });
+        }
+        for (i, &v) in self.inertial_numbers.iter().enumerate() {
+            in_range(&format!("inertial_numbers[{i}]"), v, 1e-6, 2.0)?;
+        }
+        positive("strain", self.strain)?;
+        positive("average_strain", self.average_strain)?;
+        if self.average_strain > self.strain {
+            return Err(DatasetError::Invalid {
+                key: "average_strain".into(),
+                reason: format!(
+                    "must not exceed strain ({}), got {}",
+                    self.strain, self.average_strain
+                ),
+            });
+        }
+        positive("dt_max", self.dt_max)?;
+        in_range("travel_per_step", self.travel_per_step, 1e-4, 1.0)?;
+        positive("wall_mass_ratio", self.wall_mass_ratio)?;
+        positive("compression_time", self.compression_time)?;
+        self.solver.validate("solver")
+    }
+}

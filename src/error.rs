@@ -1,0 +1,66 @@
+//! The command line's error: every failure of the stages, rendered as one line.
+
+use thiserror::Error;
+
+/// Everything `grainlaw` can fail with. [`CliError::one_line`] is what is printed; the exit code
+/// is 2 for all of them (bad input, unreadable file, failed run), after no partial output that
+/// looks complete.
+#[derive(Debug, Error)]
+pub enum CliError {
+    /// Scenario loading, validation, generation.
+    #[error("{0}")]
+    Dataset(#[from] datasets::DatasetError),
+    /// The engine (non-finite state, bad world).
+    #[error("engine: {0}")]
+    Dem(#[from] dem::DemError),
+    /// Homogenisation.
+    #[error("homogenise: {0}")]
+    Homogenise(#[from] homogenise::HomogeniseError),
+    /// Identification (fits, CSV tables, law JSON).
+    #[error("{0}")]
+    Identify(#[from] identify::IdentifyError),
+    /// Frictional-contact problems.
+    #[error("{0}")]
+    Fc(#[from] dem::fc::FcError),
+    /// Reading or writing a file.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        reason: String,
+    },
+    /// Drawing a figure.
+    #[error("figure {file}: {reason}")]
+    Plot {
+        /// The figure's file.
+        file: String,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The user stopped the run (Ctrl-C).
+    #[error("interrupted by the user; no summary.json was written")]
+    Interrupted,
+    /// A command-line argument is wrong.
+    #[error("{0}")]
+    Usage(String),
+}
+
+impl CliError {
+    /// An I/O error on `path`.
+    pub fn io(path: impl AsRef<std::path::Path>, e: impl std::fmt::Display) -> Self {
+        CliError::Io {
+            path: path.as_ref().display().to_string(),
+            reason: e.to_string(),
+        }
+    }
+
+    /// The message on one line (newlines and runs of spaces folded).
+    pub fn one_line(&self) -> String {
+        let s = self.to_string();
+        s.split_whitespace().collect::<Vec<_>>().join(" ")
+    }
+}
+
+/// Result with [`CliError`].
+pub type Result<T> = std::result::Result<T, CliError>;

@@ -1,0 +1,17 @@
+//! # grainlaw — the command line and its pieces
+//!
+//! `grainlaw run [SCENARIO]` runs one of the paper's experiments end to end: simulation
+//! ([`dem`]), homogenisation ([`homogenise`]), identification ([`identify`]), figures
+//! ([`plot`]), CSV, VTK and `summary.json` ([`output`]). The scenarios and generators are in
+//! [`datasets`]; the runners in [`scenarios`]; the command line in [`cli`].
+
+pub mod cli;
+pub mod error;
+pub mod fc_cmd;
+pub mod fit_cmd;
+pub mod output;
+pub mod plot;
+pub mod progress;
+pub mod scenarios;
+
+pub use error::{CliError, Result};

@@ -1,0 +1,121 @@
+//! The output directory. Every file is written atomically: to a temporary file in the same
+//! directory, flushed, then renamed over its final name, so a reader never sees half a file and
+//! a run that fails leaves no complete-looking partial output. A stale `summary.json` from an
+//! earlier run is removed when the directory is opened, and the new one is written last.
+
+use std::fs::{self, File};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::error::{CliError, Result};
+
+/// An output directory and the files written into it.
+#[derive(Debug)]
+pub struct OutputDir {
+    root: PathBuf,
+    written: Vec<String>,
+}
+
+impl OutputDir {
+    /// Creates `root` (and parents) and removes a `summary.json` left by an earlier run.
+    pub fn create(root: &Path) -> Result<Self> {
+        fs::create_dir_all(root).map_err(|e| CliError::io(root, e))?;
+        let stale = root.join("summary.json");
+        if stale.exists() {
+            fs::remove_file(&stale).map_err(|e| CliError::io(&stale, e))?;
+        }
+        Ok(Self {
+            root: root.to_path_buf(),
+            written: Vec::new(),
+        })
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.root
+    }
+
+    /// Full path of a file in the directory.
+    pub fn file(&self, name: &str) -> PathBuf {
+        self.root.join(name)
+    }
+
+    /// A temporary path next to `name` for writers that need a path (e.g. image encoders);
+    /// pass it to [`OutputDir::commit`] once written. The extension is kept so that encoders
+    /// that choose the format from it still work.
+    pub fn temp_path(&self, name: &str) -> PathBuf {
+        let p = Path::new(name);
+        let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
+        let ext = p.extension().and_then(|s| s.to_str()).unwrap_or("tmp");
+        self.root
+            .join(format!(".{stem}.{}.partial.{ext}", std::process::id()))
+    }
+
+    /// Renames a finished temporary file to its final name.
+    pub fn commit(&mut self, temp: &Path, name: &str) -> Result<PathBuf> {
+        let target = self.file(name);
+        if let Some(parent) = target.parent() {
+            fs::create_dir_all(parent).map_err(|e| CliError::io(parent, e))?;
+        }
+        fs::rename(temp, &target).map_err(|e| {
+            let _ = fs::remove_file(temp);
+            CliError::io(&target, e)
+        })?;
+        self.written.push(name.to_string());
+        Ok(target)
+    }
+
+    /// Writes `bytes` to `name` atomically.
+    pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+        let target = self.file(name);
+        if let Some(parent) = target.parent() {
+            fs::create_dir_all(parent).map_err(|e| CliError::io(parent, e))?;
+        }
+        let tmp = self.temp_path(name);
+        let tmp = match target.parent() {
+            Some(parent) => parent.join(tmp.file_name().unwrap_or_default()),
+            None => tmp,
+        };
+        let res = (|| -> std::io::Result<()> {
+            let mut f = File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        if let Err(e) = res {
+            let _ = fs::remove_file(&tmp);
+            return Err(CliError::io(&target, e));
+        }
+        self.commit(&tmp, name)
+    }
+
+    /// Files written so far (names relative to the directory).
+    pub fn written(&self) -> &[String] {
+        &self.written
+    }
+}
+
+/// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .and_then(|s| s.to_str())
+        .ok_or_else(|| CliError::io(path, "not a file name"))?;
+    if !dir.exists() {
+        fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
+    }
+    let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
+    let res = (|| -> std::io::Result<()> {
+        let mut f = File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        fs::rename(&tmp, path)
+    })();
+    res.map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        CliError::io(path, e)
+    })
+}

@@ -1,0 +1,343 @@
+//! VTK files for ParaView: XML PolyData (`.vtp`, ASCII) per frame and `.pvd` collections that
+//! make them a time series.
+//!
+//! Per frame, in `vtk/`:
+//! - `grains_NNNN.vtp`: one vertex per grain at its centre; point data `radius` (m),
+//!   `velocity` (m/s), `omega` (rad/s), `stress` (the grain's mean stress with inertia Σ_p, Pa,
+//!   tension positive, 3×3 with zero z row and column) and `inertia_ratio` (‖Σ_i‖/‖Σ_c‖);
+//!   show them with the "Point Gaussian" representation scaled by `radius`;
+//! - `contacts_NNNN.vtp`: one line per contact with a force, from body a's centre (a wall's
+//!   contact point) to body b's centre; cell data `normal_force`, `tangential_force` (N),
+//!   `force` (vector on b, N), `mobilisation` |f_t|/(μ f_n);
+//! - `walls_NNNN.vtp`: line and segment walls as lines, rough-wall disks as vertices with `radius`.
+//!
+//! `grains.pvd`, `contacts.pvd`, `walls.pvd` list the frames with their times (s).
+
+use std::fmt::Write as _;
+
+use dem::snapshot::{BodyKind, Snapshot, WallGeometry};
+use homogenise::tensor::frobenius;
+use nalgebra::Vector2;
+
+use crate::error::Result;
+use crate::output::OutputDir;
+
+/// Frames written so far, to be listed in the `.pvd` collections.
+#[derive(Debug, Default)]
+pub struct VtkSeries {
+    frames: Vec<(f64, usize)>,
+}
+
+fn data_array(s: &mut String, name: &str, comps: usize, values: impl Iterator<Item = f64>) {
+    let _ = write!(
+        s,
+        "        <DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"ascii\">\n          "
+    );
+    for (i, v) in values.enumerate() {
+        let v = if v.is_finite() { v } else { 0.0 };
+        let _ = write!(s, "{v:e} ");
+        if i % 12 == 11 {
+            s.push_str("\n          ");
+        }
+    }
+    s.push_str("\n        </DataArray>\n");
+}
+
+fn int_array(s: &mut String, name: &str, values: impl Iterator<Item = usize>) {
+    let _ = write!(
+        s,
+        "        <DataArray type=\"Int64\" Name=\"{name}\" format=\"ascii\">\n          "
+    );
+    for (i, v) in values.enumerate() {
+        let _ = write!(s, "{v} ");
+        if i % 20 == 19 {
+            s.push_str("\n          ");
+        }
+    }
+    s.push_str("\n        </DataArray>\n");
+}
+
+fn header(nverts: usize, nlines: usize, npoints: usize) -> String {
+    format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n    <Piece NumberOfPoints=\"{npoints}\" NumberOfVerts=\"{nverts}\" NumberOfLines=\"{nlines}\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+    )
+}
+
+const FOOTER: &str = "    </Piece>\n  </PolyData>\n</VTKFile>\n";
+
+fn points(s: &mut String, p: &[Vector2<f64>]) {
+    s.push_str("      <Points>\n");
+    data_array(s, "Points", 3, p.iter().flat_map(|p| [p.x, p.y, 0.0]));
+    s.push_str("      </Points>\n");
+}
+
+/// The grains of a snapshot as `.vtp` text.
+pub fn grains_vtp(snap: &Snapshot) -> Result<String> {
+    let stresses = homogenise::grain_stresses(snap)?;
+    let grains: Vec<_> = snap
+        .bodies
+        .iter()
+        .filter(|b| b.kind == BodyKind::Grain)
+        .collect();
+    let n = grains.len();
+    let mut s = header(n, 0, n);
+    s.push_str("      <PointData Scalars=\"radius\" Vectors=\"velocity\" Tensors=\"stress\">\n");
+    data_array(&mut s, "radius", 1, grains.iter().map(|b| b.radius));
+    data_array(
+        &mut s,
+        "velocity",
+        3,
+        grains
+            .iter()
+            .flat_map(|b| [b.velocity.x, b.velocity.y, 0.0]),
+    );
+    data_array(&mut s, "omega", 1, grains.iter().map(|b| b.omega));
+    data_array(
+        &mut s,
+        "stress",
+        9,
+        stresses.iter().flat_map(|g| {
+            let t = g.total;
+            [
+                t[(0, 0)],
+                t[(0, 1)],
+                0.0,
+                t[(1, 0)],
+                t[(1, 1)],
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ]
+        }),
+    );
+    data_array(
+        &mut s,
+        "inertia_ratio",
+        1,
+        stresses.iter().map(|g| {
+            let c = frobenius(&g.contact);
+            if c > 0.0 {
+                frobenius(&g.inertia) / c
+            } else {
+                f64::NAN
+            }
+        }),
+    );
+    s.push_str("      </PointData>\n");
+    points(
+        &mut s,
+        &grains.iter().map(|b| b.position).collect::<Vec<_>>(),
+    );
+    s.push_str("      <Verts>\n");
+    int_array(&mut s, "connectivity", 0..n);
+    int_array(&mut s, "offsets", 1..=n);
+    s.push_str("      </Verts>\n");
+    s.push_str(FOOTER);
+    Ok(s)
+}
+
+/// Ends of the branch of a contact: body a's end (its centre, or the contact point for a
+/// wall) and body b's centre, both as seen from b (periodic images handled by the levers).
+pub fn branch(snap: &Snapshot, c: &dem::snapshot::ContactState) -> (Vector2<f64>, Vector2<f64>) {
+    let a = &snap.bodies[c.body_a as usize];
+    let pa = if a.kind == BodyKind::Grain {
+        c.point - c.lever_a
+    } else {
+        c.point
+    };
+    let b = &snap.bodies[c.body_b as usize];
+    let pb = if b.kind == BodyKind::Grain {
+        c.point - c.lever_b
+    } else {
+        c.point
+    };
+    (pa, pb)
+}
+
+/// The contacts of a snapshot that carry a force, as `.vtp` text.
+pub fn contacts_vtp(snap: &Snapshot) -> String {
+    let cs: Vec<_> = snap.contacts.iter().filter(|c| c.force_n > 0.0).collect();
+    let n = cs.len();
+    let mut s = header(0, n, 2 * n);
+    s.push_str("      <CellData Scalars=\"normal_force\" Vectors=\"force\">\n");
+    data_array(&mut s, "normal_force", 1, cs.iter().map(|c| c.force_n));
+    data_array(&mut s, "tangential_force", 1, cs.iter().map(|c| c.force_t));
+    data_array(
+        &mut s,
+        "force",
+        3,
+        cs.iter().flat_map(|c| {
+            let f = c.force_on_b();
+            [f.x, f.y, 0.0]
+        }),
+    );
+    data_array(
+        &mut s,
+        "mobilisation",
+        1,
+        cs.iter().map(|c| c.mobilisation().unwrap_or(0.0)),
+    );
+    s.push_str("      </CellData>\n");
+    let pts: Vec<Vector2<f64>> = cs
+        .iter()
+        .flat_map(|c| {
+            let (a, b) = branch(snap, c);
+            [a, b]
+        })
+        .collect();
+    points(&mut s, &pts);
+    s.push_str("      <Lines>\n");
+    int_array(&mut s, "connectivity", 0..2 * n);
+    int_array(&mut s, "offsets", (1..=n).map(|k| 2 * k));
+    s.push_str("      </Lines>\n");
+    s.push_str(FOOTER);
+    s
+}
+
+/// Extent of the grains `(x_min, x_max, y_min, y_max)` (m), with a margin of 2 largest radii.
+pub fn grain_extent(snap: &Snapshot) -> (f64, f64, f64, f64) {
+    let mut e = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    let mut rmax: f64 = 0.0;
+    for b in snap.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
+        e.0 = e.0.min(b.position.x - b.radius);
+        e.1 = e.1.max(b.position.x + b.radius);
+        e.2 = e.2.min(b.position.y - b.radius);
+        e.3 = e.3.max(b.position.y + b.radius);
+        rmax = rmax.max(b.radius);
+    }
+    if e.0 > e.1 {
+        return (0.0, 1.0, 0.0, 1.0);
+    }
+    (
+        e.0 - 2.0 * rmax,
+        e.1 + 2.0 * rmax,
+        e.2 - 2.0 * rmax,
+        e.3 + 2.0 * rmax,
+    )
+}
+
+/// Clips the infinite line through `p` with normal `n` to the box `(x0, x1, y0, y1)`.
+pub fn clip_line(
+    p: Vector2<f64>,
+    n: Vector2<f64>,
+    e: (f64, f64, f64, f64),
+) -> Option<(Vector2<f64>, Vector2<f64>)> {
+    let d = Vector2::new(-n.y, n.x);
+    let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+    for (pc, dc, lo, hi) in [(p.x, d.x, e.0, e.1), (p.y, d.y, e.2, e.3)] {
+        if dc.abs() < 1e-14 {
+            if pc < lo || pc > hi {
+                return None;
+            }
+        } else {
+            let (a, b) = ((lo - pc) / dc, (hi - pc) / dc);
+            t0 = t0.max(a.min(b));
+            t1 = t1.min(a.max(b));
+        }
+    }
+    (t0 <= t1).then(|| (p + d * t0, p + d * t1))
+}
+
+/// The walls of a snapshot as `.vtp` text (lines clipped to the grains' extent).
+pub fn walls_vtp(snap: &Snapshot) -> String {
+    let ext = grain_extent(snap);
+    let mut pts = Vec::new();
+    let mut radius = Vec::new();
+    let mut lines = Vec::new();
+    let mut verts = Vec::new();
+    for w in &snap.walls {
+        match &w.geometry {
+            WallGeometry::Line { point, normal } => {
+                if let Some((a, b)) = clip_line(*point, *normal, ext) {
+                    lines.push(pts.len());
+                    pts.push(a);
+                    pts.push(b);
+                    radius.extend([0.0, 0.0]);
+                }
+            }
+            WallGeometry::Segment { a, b } => {
+                lines.push(pts.len());
+                pts.push(*a);
+                pts.push(*b);
+                radius.extend([0.0, 0.0]);
+            }
+            WallGeometry::Clump { centres, radii } => {
+                for (c, r) in centres.iter().zip(radii) {
+                    verts.push(pts.len());
+                    pts.push(*c);
+                    radius.push(*r);
+                }
+            }
+        }
+    }
+    let mut s = header(verts.len(), lines.len(), pts.len());
+    s.push_str("      <PointData Scalars=\"radius\">\n");
+    data_array(&mut s, "radius", 1, radius.into_iter());
+    s.push_str("      </PointData>\n");
+    points(&mut s, &pts);
+    s.push_str("      <Verts>\n");
+    int_array(&mut s, "connectivity", verts.iter().copied());
+    int_array(&mut s, "offsets", 1..=verts.len());
+    s.push_str("      </Verts>\n      <Lines>\n");
+    int_array(
+        &mut s,
+        "connectivity",
+        lines.iter().flat_map(|&k| [k, k + 1]),
+    );
+    int_array(&mut s, "offsets", (1..=lines.len()).map(|k| 2 * k));
+    s.push_str("      </Lines>\n");
+    s.push_str(FOOTER);
+    s
+}
+
+impl VtkSeries {
+    /// An empty series.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Writes the three files of one frame under `vtk/`.
+    pub fn add_frame(&mut self, out: &mut OutputDir, snap: &Snapshot) -> Result<()> {
+        let k = self.frames.len();
+        out.write(
+            &format!("vtk/grains_{k:04}.vtp"),
+            grains_vtp(snap)?.as_bytes(),
+        )?;
+        out.write(
+            &format!("vtk/contacts_{k:04}.vtp"),
+            contacts_vtp(snap).as_bytes(),
+        )?;
+        out.write(&format!("vtk/walls_{k:04}.vtp"), walls_vtp(snap).as_bytes())?;
+        self.frames.push((snap.time, k));
+        Ok(())
+    }
+
+    /// Number of frames written.
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// True when no frame was written.
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+
+    /// Writes `grains.pvd`, `contacts.pvd` and `walls.pvd`.
+    pub fn finish(&self, out: &mut OutputDir) -> Result<()> {
+        for kind in ["grains", "contacts", "walls"] {
+            let mut s = String::from(
+                "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+            );
+            for (t, k) in &self.frames {
+                let _ = writeln!(
+                    s,
+                    "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"vtk/{kind}_{k:04}.vtp\"/>"
+                );
+            }
+            s.push_str("  </Collection>\n</VTKFile>\n");
+            out.write(&format!("{kind}.pvd"), s.as_bytes())?;
+        }
+        Ok(())
+    }
+}

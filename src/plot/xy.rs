@@ -1,0 +1,421 @@
+//! Curves, points and confidence bands on linear or logarithmic axes, with a legend.
+
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::CoordTranslate;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{font, padded_range, render, DrawResult};
+use crate::error::Result;
+use crate::output::OutputDir;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Style {
+    /// A solid line.
+    Line,
+    /// A dashed line.
+    Dashed,
+    /// Filled circles.
+    Points,
+    /// Hollow circles.
+    Circles,
+    /// A line with filled circles.
+    LinePoints,
+    /// A thin line (for long time series).
+    Thin,
+}
+
+/// One series.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend text (empty: not in the legend).
+    pub label: String,
+    /// How it is drawn.
+    pub style: Style,
+    /// Colour.
+    pub color: RGBColor,
+    /// Points `(x, y)`; non-finite points are skipped.
+    pub xy: Vec<(f64, f64)>,
+}
+
+impl Series {
+    /// A series.
+    pub fn new(label: &str, style: Style, color: RGBColor, xy: Vec<(f64, f64)>) -> Self {
+        Self {
+            label: label.to_string(),
+            style,
+            color,
+            xy: xy
+                .into_iter()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect(),
+        }
+    }
+}
+
+/// A shaded band between two curves (e.g. a 95 % confidence band), drawn under the series.
+#[derive(Debug, Clone)]
+pub struct Band {
+    /// Legend text.
+    pub label: String,
+    /// Colour (drawn at 25 % opacity).
+    pub color: RGBColor,
+    /// The closed outline: lower curve forward then upper curve backward.
+    pub outline: Vec<(f64, f64)>,
+}
+
+impl Band {
+    /// A band from points `(x, lo, hi)`.
+    pub fn between(label: &str, color: RGBColor, pts: &[(f64, f64, f64)]) -> Self {
+        let mut outline: Vec<(f64, f64)> = pts.iter().map(|&(x, lo, _)| (x, lo)).collect();
+        outline.extend(pts.iter().rev().map(|&(x, _, hi)| (x, hi)));
+        Self {
+            label: label.to_string(),
+            color,
+            outline: outline
+                .into_iter()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect(),
+        }
+    }
+
+    /// A band from points `(y, x_lo, x_hi)` (for profiles drawn with x as the value).
+    pub fn between_x(label: &str, color: RGBColor, pts: &[(f64, f64, f64)]) -> Self {
+        let mut outline: Vec<(f64, f64)> = pts.iter().map(|&(y, lo, _)| (lo, y)).collect();
+        outline.extend(pts.iter().rev().map(|&(y, _, hi)| (hi, y)));
+        Self {
+            label: label.to_string(),
+            color,
+            outline: outline
+                .into_iter()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect(),
+        }
+    }
+}
+
+/// Axis settings.
+#[derive(Debug, Clone, Default)]
+pub struct Axis {
+    /// Quantity and unit, e.g. `depth z (m)`.
+    pub label: String,
+    /// Fixed range; `None` fits the data.
+    pub range: Option<(f64, f64)>,
+    /// Logarithmic axis.
+    pub log: bool,
+    /// Drawn from high to low (e.g. depth downwards).
+    pub reversed: bool,
+}
+
+impl Axis {
+    /// A linear axis fitted to the data.
+    pub fn new(label: &str) -> Self {
+        Self {
+            label: label.to_string(),
+            ..Default::default()
+        }
+    }
+
+    /// Fixed range.
+    pub fn range(mut self, lo: f64, hi: f64) -> Self {
+        self.range = Some((lo, hi));
+        self
+    }
+
+    /// Logarithmic.
+    pub fn log(mut self) -> Self {
+        self.log = true;
+        self
+    }
+
+    /// Reversed.
+    pub fn reversed(mut self) -> Self {
+        self.reversed = true;
+        self
+    }
+}
+
+/// Where the legend goes.
+pub use plotters::chart::SeriesLabelPosition as LegendAt;
+
+/// A figure of curves.
+#[derive(Debug, Clone)]
+pub struct XyPlot {
+    /// Title above the axes (empty for none).
+    pub title: String,
+    /// Horizontal axis.
+    pub x: Axis,
+    /// Vertical axis.
+    pub y: Axis,
+    /// Series, drawn in order.
+    pub series: Vec<Series>,
+    /// Bands, drawn first.
+    pub bands: Vec<Band>,
+    /// Legend position.
+    pub legend: LegendAt,
+    /// Extra text lines in the upper left of the plotting area.
+    pub notes: Vec<String>,
+}
+
+impl XyPlot {
+    /// An empty figure.
+    pub fn new(title: &str, x: Axis, y: Axis) -> Self {
+        Self {
+            title: title.to_string(),
+            x,
+            y,
+            series: Vec::new(),
+            bands: Vec::new(),
+            legend: LegendAt::UpperRight,
+            notes: Vec::new(),
+        }
+    }
+
+    fn data_range(&self, xs: bool, axis: &Axis) -> (f64, f64) {
+        if let Some(r) = axis.range {
+            return r;
+        }
+        let vals = self
+            .series
+            .iter()
+            .flat_map(|s| s.xy.iter())
+            .chain(self.bands.iter().flat_map(|b| b.outline.iter()))
+            .map(|&(x, y)| if xs { x } else { y })
+            .filter(|v| !axis.log || *v > 0.0);
+        if axis.log {
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for v in vals {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+            if !lo.is_finite() {
+                return (1e-3, 1.0);
+            }
+            if hi <= lo * 1.0001 {
+                return (lo / 2.0, hi * 2.0);
+            }
+            let f = (hi / lo).powf(0.05);
+            (lo / f, hi * f)
+        } else {
+            padded_range(vals, 0.05)
+        }
+    }
+
+    /// Draws the figure into `area`.
+    pub fn draw_on(&self, area: &DrawingArea<BitMapBackend, Shift>) -> DrawResult {
+        let (x0, x1) = self.data_range(true, &self.x);
+        let (y0, y1) = self.data_range(false, &self.y);
+        let xr = if self.x.reversed { (x1, x0) } else { (x0, x1) };
+        let yr = if self.y.reversed { (y1, y0) } else { (y0, y1) };
+        match (self.x.log, self.y.log) {
+            (false, false) => self.draw_generic(area, xr.0..xr.1, yr.0..yr.1),
+            (true, false) => self.draw_generic(area, (xr.0..xr.1).log_scale(), yr.0..yr.1),
+            (false, true) => self.draw_generic(area, xr.0..xr.1, (yr.0..yr.1).log_scale()),
+            (true, true) => {
+                self.draw_generic(area, (xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
+            }
+        }
+    }
+
+    fn draw_generic<XR, YR>(
+        &self,
+        area: &DrawingArea<BitMapBackend, Shift>,
+        xr: XR,
+        yr: YR,
+    ) -> DrawResult
+    where
+        XR: AsRangedCoord<Value = f64>,
+        YR: AsRangedCoord<Value = f64>,
+        XR::CoordDescType: ValueFormatter<f64>,
+        YR::CoordDescType: ValueFormatter<f64>,
+    {
+        let mut builder = ChartBuilder::on(area);
+        builder
+            .margin(18)
+            .x_label_area_size(55)
+            .y_label_area_size(85);
+        if !self.title.is_empty() {
+            builder.caption(&self.title, font(22.0));
+        }
+        let mut chart = builder.build_cartesian_2d(xr, yr)?;
+        chart
+            .configure_mesh()
+            .x_desc(self.x.label.as_str())
+            .y_desc(self.y.label.as_str())
+            .label_style(font(16.0))
+            .axis_desc_style(font(18.0))
+            .light_line_style(RGBColor(235, 235, 235))
+            .bold_line_style(RGBColor(210, 210, 210))
+            .x_label_formatter(&|v| fmt_tick(*v))
+            .y_label_formatter(&|v| fmt_tick(*v))
+            .draw()?;
+        let mut labelled = false;
+        for b in &self.bands {
+            let c = b.color;
+            let poly = chart.draw_series(std::iter::once(Polygon::new(
+                b.outline.clone(),
+                c.mix(0.22).filled(),
+            )))?;
+            if !b.label.is_empty() {
+                labelled = true;
+                poly.label(b.label.as_str()).legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 6), (x + 22, y + 6)], c.mix(0.3).filled())
+                });
+            }
+        }
+        for s in &self.series {
+            let c = s.color;
+            let anno = match s.style {
+                Style::Line | Style::Thin | Style::LinePoints => {
+                    let w = if s.style == Style::Thin { 1 } else { 3 };
+                    if s.style == Style::LinePoints {
+                        chart.draw_series(s.xy.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
+                    }
+                    let a = chart.draw_series(LineSeries::new(s.xy.clone(), c.stroke_width(w)))?;
+                    Some((a, s.style))
+                }
+                Style::Dashed => {
+                    let pts = dash(&s.xy, |p| chart.as_coord_spec().translate(p));
+                    let mut a = None;
+                    for seg in pts {
+                        a = Some(chart.draw_series(LineSeries::new(seg, c.stroke_width(2)))?);
+                    }
+                    a.map(|a| (a, s.style))
+                }
+                Style::Points => Some((
+                    chart.draw_series(s.xy.iter().map(|&p| Circle::new(p, 4, c.filled())))?,
+                    s.style,
+                )),
+                Style::Circles => Some((
+                    chart
+                        .draw_series(s.xy.iter().map(|&p| Circle::new(p, 5, c.stroke_width(2))))?,
+                    s.style,
+                )),
+            };
+            if let (Some((a, style)), false) = (anno, s.label.is_empty()) {
+                labelled = true;
+                a.label(s.label.as_str()).legend(
+                    move |(x, y)| -> DynElement<'static, BitMapBackend, (i32, i32)> {
+                        match style {
+                            Style::Points => Circle::new((x + 11, y), 4, c.filled()).into_dyn(),
+                            Style::Circles => {
+                                Circle::new((x + 11, y), 5, c.stroke_width(2)).into_dyn()
+                            }
+                            Style::Dashed => {
+                                PathElement::new(vec![(x, y), (x + 8, y)], c.stroke_width(2))
+                                    .into_dyn()
+                            }
+                            _ => PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(3))
+                                .into_dyn(),
+                        }
+                    },
+                );
+            }
+        }
+        if labelled {
+            chart
+                .configure_series_labels()
+                .position(self.legend.clone())
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(150, 150, 150))
+                .label_font(font(16.0))
+                .draw()?;
+        }
+        if !self.notes.is_empty() {
+            let (px, py) = chart.plotting_area().get_pixel_range();
+            let _ = px;
+            for (k, n) in self.notes.iter().enumerate() {
+                area.draw(&Text::new(
+                    n.clone(),
+                    (
+                        chart.plotting_area().get_base_pixel().0 + 12,
+                        py.start + 10 + 22 * k as i32,
+                    ),
+                    font(16.0),
+                ))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Splits a polyline into dashes of about 10 px drawn, 6 px skipped.
+fn dash(xy: &[(f64, f64)], to_px: impl Fn(&(f64, f64)) -> (i32, i32)) -> Vec<Vec<(f64, f64)>> {
+    let mut out = Vec::new();
+    let mut cur = Vec::new();
+    let (on, off) = (10.0, 6.0);
+    let mut acc = 0.0;
+    let mut drawing = true;
+    for w in xy.windows(2) {
+        let (p, q) = (w[0], w[1]);
+        let (a, b) = (to_px(&p), to_px(&q));
+        let len = (((b.0 - a.0) as f64).powi(2) + ((b.1 - a.1) as f64).powi(2)).sqrt();
+        let steps = (len / 2.0).ceil().max(1.0) as usize;
+        for k in 0..steps {
+            let t0 = k as f64 / steps as f64;
+            let pt = (p.0 + (q.0 - p.0) * t0, p.1 + (q.1 - p.1) * t0);
+            if drawing {
+                cur.push(pt);
+            }
+            acc += len / steps as f64;
+            let limit = if drawing { on } else { off };
+            if acc >= limit {
+                acc = 0.0;
+                if drawing {
+                    cur.push(pt);
+                    out.push(std::mem::take(&mut cur));
+                }
+                drawing = !drawing;
+            }
+        }
+    }
+    if drawing {
+        if let Some(&l) = xy.last() {
+            cur.push(l);
+        }
+        if cur.len() >= 2 {
+            out.push(cur);
+        }
+    }
+    out
+}
+
+/// Tick label: plain decimals for moderate magnitudes, scientific otherwise.
+pub fn fmt_tick(v: f64) -> String {
+    let a = v.abs();
+    if a < 1e-13 {
+        "0".into()
+    } else if (1e-3..1e5).contains(&a) {
+        let s = format!("{v:.4}");
+        let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+        if s == "-0" {
+            "0".into()
+        } else {
+            s
+        }
+    } else {
+        let s = format!("{v:.1e}");
+        s.replace(".0e", "e")
+    }
+}
+
+/// Draws `plot` alone as `name` (1000 × 700 px).
+pub fn draw_xy(out: &mut OutputDir, name: &str, plot: &XyPlot) -> Result<()> {
+    render(out, name, (1000, 700), |root| plot.draw_on(root))
+}
+
+/// Draws several plots side by side (one row) as `name`.
+pub fn draw_row(out: &mut OutputDir, name: &str, plots: &[XyPlot], size: (u32, u32)) -> Result<()> {
+    render(out, name, size, |root| {
+        let areas = root.split_evenly((1, plots.len().max(1)));
+        for (p, a) in plots.iter().zip(areas.iter()) {
+            p.draw_on(a)?;
+        }
+        Ok(())
+    })
+}
+
+#[allow(dead_code)]
+type Lin = RangedCoordf64;

@@ -1,0 +1,178 @@
+//! Pieces every scenario runner uses: phases with progress and honest solver accounting,
+//! VTK frames at a fixed simulated-time interval, the solver keys of `summary.json`.
+
+use std::sync::atomic::Ordering;
+
+use datasets::phases::{run_steps, run_until_rest, PhaseStats, RunUntilRest};
+use dem::{StepReport, World};
+
+use super::PhaseEnv;
+use crate::error::{CliError, Result};
+use crate::output::vtk::VtkSeries;
+use crate::output::{OutputDir, Summary};
+use crate::progress::{warn, Phase};
+
+/// When a phase stops.
+#[derive(Debug, Clone, Copy)]
+pub enum Stop {
+    /// At rest (kinetic energy criterion) or at the time limit.
+    UntilRest(RunUntilRest),
+    /// After a number of steps.
+    Steps(u64),
+}
+
+/// Runs `world` through one phase with a progress bar; `each` is called after every step (its
+/// error stops the phase and is returned). Steps whose contact solve did not converge are
+/// counted and reported on stderr. Ctrl-C stops the phase with [`CliError::Interrupted`].
+pub fn run_phase(
+    ctx: &PhaseEnv,
+    name: &str,
+    world: &mut World,
+    stop: Stop,
+    mut each: impl FnMut(&World, &StepReport) -> Result<()>,
+) -> Result<PhaseStats> {
+    let dt = world.params.dt;
+    let len = match stop {
+        Stop::UntilRest(r) => (r.max_time / dt).ceil() as u64,
+        Stop::Steps(n) => n,
+    };
+    let bar = Phase::new(ctx.verbosity, name, len);
+    let mut failure: Option<CliError> = None;
+    let mut k = 0u64;
+    let flag = ctx.interrupted.clone();
+    let mut cb = |w: &World, r: &StepReport| -> bool {
+        k += 1;
+        if k % 25 == 0 {
+            bar.set(k);
+            bar.message(format!(
+                "t={:.3}s sweeps={} err={:.1e}",
+                w.time, r.solver.iterations, r.solver.error
+            ));
+        }
+        if flag.load(Ordering::Relaxed) {
+            failure = Some(CliError::Interrupted);
+            return false;
+        }
+        if let Err(e) = each(w, r) {
+            failure = Some(e);
+            return false;
+        }
+        true
+    };
+    let stats = match stop {
+        Stop::UntilRest(r) => run_until_rest(world, &r, &mut cb)?,
+        Stop::Steps(n) => run_steps(world, n, &mut cb)?,
+    };
+    if let Some(e) = failure {
+        bar.finish("stopped");
+        return Err(e);
+    }
+    let tol = world.params.solver.tolerance;
+    let rest = match stop {
+        Stop::UntilRest(_) if stats.at_rest => ", at rest",
+        Stop::UntilRest(_) => ", NOT at rest at the time limit",
+        Stop::Steps(_) => "",
+    };
+    bar.finish(&format!(
+        "{} steps of {:.2e} s, {:.3} s simulated, {:.0} sweeps/step on average{rest}",
+        stats.steps,
+        dt,
+        stats.simulated_time,
+        stats.mean_sweeps()
+    ));
+    if stats.unconverged_steps > 0 {
+        warn(&format!(
+            "{name}: {} of {} steps stopped at the sweep cap ({}) above the tolerance {tol:.0e}; worst error {:.2e}",
+            stats.unconverged_steps, stats.steps, world.params.solver.max_iterations, stats.worst_error
+        ));
+    }
+    if let Stop::UntilRest(_) = stop {
+        if !stats.at_rest {
+            warn(&format!(
+                "{name}: not at rest after {:.3} s (kinetic energy / Σ m g d = {:.2e})",
+                stats.simulated_time, stats.final_energy_ratio
+            ));
+        }
+    }
+    Ok(stats)
+}
+
+/// Solver accounting keys of `summary.json`: `solver_unconverged_steps`, `solver_worst_error`,
+/// `solver_steps`, `solver_mean_sweeps`, `solver_max_sweeps`, `max_penetration_m`.
+pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
+    s.int("solver_steps", stats.steps)
+        .int("solver_unconverged_steps", stats.unconverged_steps)
+        .num("solver_worst_error", stats.worst_error)
+        .num("solver_mean_sweeps", stats.mean_sweeps())
+        .int("solver_max_sweeps", stats.max_sweeps as u64)
+        .num("max_penetration_m", stats.max_penetration);
+}
+
+/// VTK frames every `interval` seconds of simulated time, at most `max_frames` (the final
+/// state is added by [`VtkFrames::finish`]).
+pub struct VtkFrames {
+    series: VtkSeries,
+    interval: f64,
+    next: f64,
+    max_frames: usize,
+}
+
+impl VtkFrames {
+    /// Frames every `interval` s, at most `max_frames` including the final one.
+    pub fn new(interval: f64, max_frames: usize) -> Self {
+        Self {
+            series: VtkSeries::new(),
+            interval,
+            next: 0.0,
+            max_frames,
+        }
+    }
+
+    /// Writes a frame if one is due.
+    pub fn maybe(&mut self, out: &mut OutputDir, world: &World) -> Result<()> {
+        if self.series.len() + 1 < self.max_frames && world.time + 1e-12 >= self.next {
+            self.series.add_frame(out, &world.snapshot())?;
+            self.next = world.time + self.interval;
+        }
+        Ok(())
+    }
+
+    /// Writes the final frame and the `.pvd` collections.
+    pub fn finish(mut self, out: &mut OutputDir, world: &World) -> Result<usize> {
+        self.series.add_frame(out, &world.snapshot())?;
+        self.series.finish(out)?;
+        Ok(self.series.len())
+    }
+}
+
+/// Weight of the grains `Σ m |g|` (N per metre of thickness... for unit thickness, N).
+pub fn grain_weight(world: &World) -> f64 {
+    let g = world.params.gravity.norm();
+    world
+        .bodies
+        .iter()
+        .filter(|b| b.kind == dem::BodyKind::Grain)
+        .map(|b| b.mass * g)
+        .sum()
+}
+
+/// Mean grain diameter (m).
+pub fn mean_diameter(world: &World) -> f64 {
+    let (s, n) = world
+        .bodies
+        .iter()
+        .filter(|b| b.kind == dem::BodyKind::Grain)
+        .fold((0.0, 0usize), |(s, n), b| (s + 2.0 * b.radius, n + 1));
+    if n > 0 {
+        s / n as f64
+    } else {
+        0.0
+    }
+}
+
+/// Writes a calibrated law as pretty JSON, atomically.
+pub fn write_law(out: &mut OutputDir, name: &str, law: &identify::CalibratedLaw) -> Result<()> {
+    let text = law.to_json_string()?;
+    out.write(name, (text + "\n").as_bytes())?;
+    Ok(())
+}

@@ -1,0 +1,329 @@
+//! The `rolling` scenario: one homogeneous disk released from rest on a slope (DESIGN §2, the
+//! paper's eq. 13–14), the exact check of the mean stress with inertia.
+//!
+//! In the slope frame (e₁ down the slope, e₂ the outward normal), for μ ≥ tan φ / 3 the disk
+//! rolls without slipping with acceleration `(2/3) g sin φ`, and when its centre has travelled L
+//!
+//! `Σ_p = ρ g a [[0, sin φ/6], [sin φ/6, −cos φ]] + (ρ g L sin φ / 3) 𝟙`,
+//! `Σ_c = ρ g a [[0, sin φ/3], [0, −cos φ]]` (the contact part alone, not symmetric).
+//!
+//! For μ < tan φ / 3 it rolls while sliding, acceleration `g (sin φ − μ cos φ)`; the exact stress
+//! then follows from the same formula with the friction force μ m g cos φ (also reported).
+
+use datasets::config::RollingConfig;
+use homogenise::tensor::{frobenius, in_frame, skew_ratio, Tensor2};
+use nalgebra::Vector2;
+
+use super::common::{run_phase, solver_keys, Stop, VtkFrames};
+use super::{RunContext, RunOutcome};
+use crate::error::{CliError, Result};
+use crate::output::{CsvTable, Summary};
+use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
+use crate::plot::PALETTE;
+
+/// Exact acceleration along the slope (m/s²), friction force over m g (up the slope), and
+/// whether the disk rolls without slipping.
+pub fn exact_motion(slope_rad: f64, mu: f64, g: f64) -> (f64, f64, bool) {
+    let (s, c) = slope_rad.sin_cos();
+    if mu >= slope_rad.tan() / 3.0 {
+        (2.0 / 3.0 * g * s, s / 3.0, true)
+    } else {
+        (g * (s - mu * c), mu * c, false)
+    }
+}
+
+/// Exact slope-frame mean stress `(Σ_p, Σ_c)` (Pa) of the disk (radius a, density ρ) after it
+/// travelled `l` with angular velocity `omega` and angular acceleration `omega_dot`, friction
+/// force `f m g` up the slope: contact term `(1/V)[(−f m g) e₁ + m g cos φ e₂] ⊗ (−a e₂)`, inertia
+/// term `(I/2V)(−ω̇ j + ω² 𝟙)` (the slope frame is a rotation of the world frame, so `j` keeps
+/// its components).
+pub fn exact_stress(
+    rho: f64,
+    g: f64,
+    a: f64,
+    slope_rad: f64,
+    f: f64,
+    omega: f64,
+    omega_dot: f64,
+) -> (Tensor2, Tensor2) {
+    let c = slope_rad.cos();
+    let contact = Tensor2::new(0.0, rho * g * a * f, 0.0, -rho * g * a * c);
+    let k = 0.25 * rho * a * a; // I/(2V) = (m a²/2)/(2 π a²) = ρ a²/4
+    let inertia = Tensor2::new(
+        k * omega * omega,
+        k * omega_dot,
+        -k * omega_dot,
+        k * omega * omega,
+    );
+    (contact + inertia, contact)
+}
+
+/// Runs the scenario.
+pub fn run(c: &RollingConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
+    let (mut world, e1, e2) = datasets::build::rolling(c)?;
+    let phi = c.slope_deg.to_radians();
+    let g = world.params.gravity.norm();
+    let c0 = world.bodies[1].position;
+    let steps = (c.duration / c.dt).round().max(1.0) as u64;
+    let mut hist = CsvTable::new(&[
+        "time_s",
+        "travelled_m",
+        "velocity_m_s",
+        "omega_rad_s",
+        "slip_velocity_m_s",
+        "stress_xx_Pa",
+        "stress_xy_Pa",
+        "stress_yx_Pa",
+        "stress_yy_Pa",
+        "contact_stress_xx_Pa",
+        "contact_stress_xy_Pa",
+        "contact_stress_yx_Pa",
+        "contact_stress_yy_Pa",
+    ]);
+    let mut vtk = VtkFrames::new(c.duration / 20.0, 21);
+    let env = ctx.env();
+    let out = &mut ctx.out;
+    let stats = run_phase(&env, "roll", &mut world, Stop::Steps(steps), |w, _| {
+        let snap = w.snapshot();
+        let gs = homogenise::grain_stresses(&snap)?;
+        let gr = gs
+            .first()
+            .ok_or_else(|| CliError::Usage("no grain".into()))?;
+        let tot = in_frame(&gr.total, &e1, &e2);
+        let con = in_frame(&gr.contact, &e1, &e2);
+        let b = &w.bodies[1];
+        let v = b.velocity.dot(&e1);
+        // Slip velocity of the contact point along e₁: v + ω a (ω counter-clockwise, the
+        // contact point is at −a e₂ from the centre: ω e_z × (−a e₂) = ω a e₁).
+        let slip = v + b.omega * c.radius;
+        hist.push(vec![
+            w.time,
+            (b.position - c0).dot(&e1),
+            v,
+            b.omega,
+            slip,
+            tot[(0, 0)],
+            tot[(0, 1)],
+            tot[(1, 0)],
+            tot[(1, 1)],
+            con[(0, 0)],
+            con[(0, 1)],
+            con[(1, 0)],
+            con[(1, 1)],
+        ]);
+        vtk.maybe(out, w)
+    })?;
+    let frames = vtk.finish(&mut ctx.out, &world)?;
+    let last = hist.rows.last().cloned().unwrap_or_default();
+    // Measured acceleration: least squares of v(t) = a t.
+    let (svt, stt) = hist
+        .rows
+        .iter()
+        .fold((0.0, 0.0), |(a, b), r| (a + r[2] * r[0], b + r[0] * r[0]));
+    let accel = svt / stt;
+    let (a_exact, f, rolls) = exact_motion(phi, c.friction, g);
+    let b = &world.bodies[1];
+    let (s_exact, c_exact) = exact_stress(
+        c.density,
+        g,
+        c.radius,
+        phi,
+        f,
+        b.omega,
+        b.angular_acceleration,
+    );
+    let tot = Tensor2::new(last[5], last[6], last[7], last[8]);
+    let con = Tensor2::new(last[9], last[10], last[11], last[12]);
+    let l = last[1];
+    let paper = Tensor2::new(0.0, phi.sin() / 6.0, phi.sin() / 6.0, -phi.cos())
+        * (c.density * g * c.radius)
+        + Tensor2::identity() * (c.density * g * l * phi.sin() / 3.0);
+
+    let mut s = Summary::new();
+    s.num("slope_deg", c.slope_deg)
+        .num("radius", c.radius)
+        .num("density", c.density)
+        .num("friction", c.friction)
+        .num("duration", c.duration)
+        .num("dt", c.dt)
+        .flag("rolls_without_slipping", rolls)
+        .num("acceleration", accel)
+        .num("expected_acceleration", a_exact)
+        .num(
+            "acceleration_rel_error",
+            (accel - a_exact).abs() / a_exact.abs().max(1e-300),
+        )
+        .num("travelled", l);
+    for (name, t) in [("stress", &tot), ("contact_stress", &con)] {
+        s.num(&format!("{name}_xx"), t[(0, 0)])
+            .num(&format!("{name}_xy"), t[(0, 1)])
+            .num(&format!("{name}_yx"), t[(1, 0)])
+            .num(&format!("{name}_yy"), t[(1, 1)]);
+    }
+    for (name, t) in [
+        ("expected_stress", &s_exact),
+        ("expected_contact_stress", &c_exact),
+    ] {
+        s.num(&format!("{name}_xx"), t[(0, 0)])
+            .num(&format!("{name}_xy"), t[(0, 1)])
+            .num(&format!("{name}_yx"), t[(1, 0)])
+            .num(&format!("{name}_yy"), t[(1, 1)]);
+    }
+    s.num(
+        "stress_rel_error",
+        frobenius(&(tot - s_exact)) / frobenius(&s_exact),
+    )
+    .num(
+        "contact_stress_rel_error",
+        frobenius(&(con - c_exact)) / frobenius(&c_exact),
+    )
+    .num(
+        "stress_rel_error_vs_paper_formula",
+        if rolls {
+            frobenius(&(tot - paper)) / frobenius(&paper)
+        } else {
+            f64::NAN
+        },
+    )
+    .num("stress_skew_ratio", skew_ratio(&tot))
+    .num("contact_stress_skew_ratio", skew_ratio(&con))
+    .int("vtk_frames", frames as u64);
+    solver_keys(&mut s, &stats);
+    hist.write(&mut ctx.out, "history.csv")?;
+
+    // Figures: stress components vs travelled distance, DEM against the exact formulas.
+    let rho_g_a = c.density * g * c.radius;
+    let mut p1 = XyPlot::new(
+        "Mean stress with inertia Σ_p (slope frame)",
+        Axis::new("distance travelled L (m)"),
+        Axis::new("stress / (ρ g a)"),
+    );
+    let mut p2 = XyPlot::new(
+        "Contact part alone Σ_c (not symmetric)",
+        Axis::new("distance travelled L (m)"),
+        Axis::new("stress / (ρ g a)"),
+    );
+    let every = (hist.rows.len() / 25).max(1);
+    let pts = |col: usize| -> Vec<(f64, f64)> {
+        hist.rows
+            .iter()
+            .step_by(every)
+            .map(|r| (r[1], r[col] / rho_g_a))
+            .collect()
+    };
+    let lmax = l.max(1e-12);
+    let line = |v0: f64, slope: f64| vec![(0.0, v0), (lmax, v0 + slope * lmax)];
+    let (sn, cs) = (phi.sin(), phi.cos());
+    let iso = if rolls {
+        sn / (3.0 * c.radius)
+    } else {
+        f64::NAN
+    };
+    let fxy = f;
+    let names = ["xx", "xy", "yx", "yy"];
+    let exact_total = [(0.0, iso), (fxy / 2.0, 0.0), (fxy / 2.0, 0.0), (-cs, iso)];
+    let exact_contact = [(0.0, 0.0), (fxy, 0.0), (0.0, 0.0), (-cs, 0.0)];
+    for (k, name) in names.iter().enumerate() {
+        let col = PALETTE[k];
+        p1.series.push(Series::new(
+            &format!("Σ_{name} exact"),
+            Style::Line,
+            col,
+            line(exact_total[k].0, if rolls { exact_total[k].1 } else { 0.0 }),
+        ));
+        p1.series.push(Series::new(
+            &format!("Σ_{name} DEM"),
+            if k == 2 {
+                Style::Circles
+            } else {
+                Style::Points
+            },
+            col,
+            pts(5 + k),
+        ));
+        p2.series.push(Series::new(
+            &format!("Σc_{name} exact"),
+            Style::Line,
+            col,
+            line(exact_contact[k].0, 0.0),
+        ));
+        p2.series.push(Series::new(
+            &format!("Σc_{name} DEM"),
+            if k == 2 {
+                Style::Circles
+            } else {
+                Style::Points
+            },
+            col,
+            pts(9 + k),
+        ));
+    }
+    p1.legend = LegendAt::MiddleRight;
+    p2.legend = LegendAt::MiddleRight;
+    if !rolls {
+        p1.notes
+            .push("μ < tan φ/3: rolls while sliding (isotropic term from ω² only)".into());
+    }
+    draw_row(&mut ctx.out, "stress_vs_travel.png", &[p1, p2], (1800, 700))?;
+    let mut m = XyPlot::new(
+        "Motion of the centre",
+        Axis::new("time t (s)"),
+        Axis::new("distance travelled L (m)"),
+    );
+    m.series.push(Series::new(
+        &format!("exact ½ a t², a = {a_exact:.4} m/s²"),
+        Style::Line,
+        PALETTE[1],
+        (0..=50)
+            .map(|k| {
+                let t = c.duration * k as f64 / 50.0;
+                (t, 0.5 * a_exact * t * t)
+            })
+            .collect(),
+    ));
+    m.series.push(Series::new(
+        "DEM",
+        Style::Points,
+        PALETTE[0],
+        hist.rows
+            .iter()
+            .step_by(every)
+            .map(|r| (r[0], r[1]))
+            .collect(),
+    ));
+    m.legend = LegendAt::UpperLeft;
+    let mut sv = XyPlot::new(
+        "Slip velocity of the contact point",
+        Axis::new("time t (s)"),
+        Axis::new("slip velocity v + ω a (m/s)"),
+    );
+    sv.series.push(Series::new(
+        "DEM",
+        Style::Line,
+        PALETTE[2],
+        hist.rows.iter().map(|r| (r[0], r[4])).collect(),
+    ));
+    draw_row(&mut ctx.out, "motion.png", &[m, sv], (1600, 600))?;
+
+    let headline = vec![
+        format!("report: {}/", ctx.out.path().display()),
+        format!(
+            "acceleration {accel:.5} m/s² (exact {a_exact:.5}), travelled L = {l:.4} m, {}",
+            if rolls { "rolling without slipping" } else { "rolling while sliding" }
+        ),
+        format!(
+            "Σ_p (slope frame) = [[{:.3}, {:.3}], [{:.3}, {:.3}]] Pa, exact [[{:.3}, {:.3}], [{:.3}, {:.3}]]",
+            tot[(0, 0)], tot[(0, 1)], tot[(1, 0)], tot[(1, 1)],
+            s_exact[(0, 0)], s_exact[(0, 1)], s_exact[(1, 0)], s_exact[(1, 1)]
+        ),
+        format!(
+            "Σ_c = [[{:.3}, {:.3}], [{:.3}, {:.3}]] Pa (not symmetric); skew ratio of Σ_p {:.1e}",
+            con[(0, 0)], con[(0, 1)], con[(1, 0)], con[(1, 1)], skew_ratio(&tot)
+        ),
+    ];
+    let _ = Vector2::<f64>::zeros();
+    Ok(RunOutcome {
+        summary: s,
+        headline,
+    })
+}
