@@ -106,7 +106,13 @@ impl Body {
     /// Inverse mass per degree of freedom `(1/m, 1/m, 1/I)`, zero where the motion is imposed.
     #[inline]
     pub fn inverse_mass(&self) -> [f64; 3] {
-        let inv = |d: Dof, m: f64| if d == Dof::Free && m > 0.0 { 1.0 / m } else { 0.0 };
+        let inv = |d: Dof, m: f64| {
+            if d == Dof::Free && m > 0.0 {
+                1.0 / m
+            } else {
+                0.0
+            }
+        };
         [
             inv(self.dofs[0], self.mass),
             inv(self.dofs[1], self.mass),

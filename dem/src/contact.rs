@@ -52,7 +52,14 @@ impl ContactRow {
     /// Apply an impulse increment `d = (Δr_n, Δr_t)` to the body velocities:
     /// `v_b += M_b⁻¹ H_bᵀ d`, `v_a −= M_a⁻¹ H_aᵀ d`.
     #[inline(always)]
-    pub fn apply(&self, d: [f64; 2], va: &mut [f64; 3], ia: &[f64; 3], vb: &mut [f64; 3], ib: &[f64; 3]) {
+    pub fn apply(
+        &self,
+        d: [f64; 2],
+        va: &mut [f64; 3],
+        ia: &[f64; 3],
+        vb: &mut [f64; 3],
+        ib: &[f64; 3],
+    ) {
         let [nx, ny] = self.n;
         let fx = d[0] * nx - d[1] * ny;
         let fy = d[0] * ny + d[1] * nx;

@@ -149,8 +149,10 @@ impl Detector {
         self.cell_start.clear();
         self.cell_start.resize(ncells + 1, 0);
         for c in &self.centre {
-            let ix = (((c[0] - xmin) / cx_size).floor() as isize).clamp(0, ncx as isize - 1) as usize;
-            let iy = (((c[1] - ymin) / cy_size).floor() as isize).clamp(0, ncy as isize - 1) as usize;
+            let ix =
+                (((c[0] - xmin) / cx_size).floor() as isize).clamp(0, ncx as isize - 1) as usize;
+            let iy =
+                (((c[1] - ymin) / cy_size).floor() as isize).clamp(0, ncy as isize - 1) as usize;
             let id = (iy * ncx + ix) as u32;
             self.cell_of.push(id);
             self.cell_start[id as usize + 1] += 1;
@@ -204,8 +206,17 @@ impl Detector {
                     for k in 0..self.neighbours.len() {
                         let (cj, e) = self.neighbours[k];
                         self.disk_disk(
-                            bodies, inv_mass, colliders, laws, periodic, detection_gap, ci as u32, d,
-                            cj, e as usize, out,
+                            bodies,
+                            inv_mass,
+                            colliders,
+                            laws,
+                            periodic,
+                            detection_gap,
+                            ci as u32,
+                            d,
+                            cj,
+                            e as usize,
+                            out,
                         );
                     }
                 }
@@ -363,7 +374,11 @@ impl Detector {
                     ac.x = per.min_image(ac.x);
                 }
                 let l2 = ab.norm_squared();
-                let s = if l2 > 0.0 { (ac.dot(&ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+                let s = if l2 > 0.0 {
+                    (ac.dot(&ab) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 let d = ac - ab * s;
                 let dist = d.norm();
                 if dist - r > gap_max {
@@ -421,7 +436,12 @@ fn push_contact(
 ) {
     let t = Vector2::new(-n.y, n.x);
     let cross = |r: Vector2<f64>, v: Vector2<f64>| r.x * v.y - r.y * v.x;
-    let k = [cross(lever_a, n), cross(lever_a, t), cross(lever_b, n), cross(lever_b, t)];
+    let k = [
+        cross(lever_a, n),
+        cross(lever_a, t),
+        cross(lever_b, n),
+        cross(lever_b, t),
+    ];
     let nn = [n.x, n.y];
     let w = ContactRow::delassus(nn, k, &inv_mass[ba], &inv_mass[bb]);
     out.rows.push(ContactRow {

@@ -11,7 +11,7 @@
 //! - [`measure`]: the error measure (Siconos' fc2d error);
 //! - [`nsgs`]: nonlinear block Gauss–Seidel with the exact local solver of [`crate::local`];
 //! - [`ordering`]: contact orderings of the sweeps;
-//! - [`anderson`]: Anderson acceleration of the sweeps;
+//! - [`crate::anderson`]: Anderson acceleration of the sweeps (shared with the engine);
 //! - [`output`]: the solution file, written atomically;
 //! - [`command`]: what `grainlaw solve-fc` does ([`solve_fc`]);
 //! - [`bench`](mod@bench): the reference benchmark ([`run_reference_benchmarks`]).
@@ -58,7 +58,6 @@
 //!   projecting the mixed iterate on the cones, restarting Anderson on a non-decreasing step.
 //! - Warm start ([`FcOptions::initial_guess`]) from a solution stops at once (0 sweeps).
 
-pub mod anderson;
 pub mod bench;
 pub mod block_csr;
 pub mod command;

@@ -15,6 +15,7 @@
 //! The same local law solves standalone frictional-contact problems given by `W`, `q`, `μ`
 //! ([`fc`]).
 
+pub mod anderson;
 pub mod bench;
 pub mod body;
 pub mod collider;

@@ -117,7 +117,12 @@ pub fn modified_velocity(u: [f64; 2], mu: f64) -> [f64; 2] {
 
 /// One predictor–corrector step of the paper: `τ = r − ρ ū(u)`, `r ← proj(τ, K_μ)`.
 #[inline(always)]
-pub fn predictor_corrector(r: [f64; 2], u: [f64; 2], rho: f64, mu: f64) -> ([f64; 2], ContactStatus) {
+pub fn predictor_corrector(
+    r: [f64; 2],
+    u: [f64; 2],
+    rho: f64,
+    mu: f64,
+) -> ([f64; 2], ContactStatus) {
     let ub = modified_velocity(u, mu);
     project_on_cone([r[0] - rho * ub[0], r[1] - rho * ub[1]], mu)
 }
@@ -216,7 +221,9 @@ mod tests {
     }
 
     fn lcg(state: &mut u64) -> f64 {
-        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((*state >> 11) as f64) / ((1u64 << 53) as f64)
     }
 
@@ -267,7 +274,11 @@ mod tests {
     fn single_scalar_step_with_normal_rho_overshoots_on_disks() {
         // The failure mode the design notes warn about: ρ = 1/W_nn on a disk block
         // (W_tt = 3 W_nn) makes the tangential update of the predictor–corrector diverge.
-        let w = Delassus2 { nn: 1.0, nt: 0.0, tt: 3.0 };
+        let w = Delassus2 {
+            nn: 1.0,
+            nt: 0.0,
+            tt: 3.0,
+        };
         let q = [-1.0, 0.3];
         let mu = 2.0; // sticking solution r = (1, -0.1)
         let mut r = [0.0, 0.0];
@@ -275,7 +286,10 @@ mod tests {
             let wr = w.mul(r);
             r = predictor_corrector(r, [wr[0] + q[0], wr[1] + q[1]], 1.0 / w.nn, mu).0;
         }
-        assert!(law_error(&w, q, mu, r) > 1e-3, "expected no convergence, r = {r:?}");
+        assert!(
+            law_error(&w, q, mu, r) > 1e-3,
+            "expected no convergence, r = {r:?}"
+        );
         let (rx, st) = solve_local(&w, q, mu);
         assert_eq!(st, ContactStatus::Stick);
         assert!((rx[0] - 1.0).abs() < 1e-15 && (rx[1] + 0.1).abs() < 1e-15);

@@ -17,7 +17,7 @@
 //! Once the contact statuses stop changing a sweep is an affine map of the impulses and
 //! Gauss–Seidel converges linearly and slowly (the weight of a pile diffuses through the
 //! network). After [`PLAIN_SWEEPS`] plain sweeps, the sweeps are accelerated by Anderson mixing
-//! of the impulse vector (GMRES on an affine map, [`crate::fc::anderson`]); after each mix the
+//! of the impulse vector (GMRES on an affine map, [`crate::anderson`]); after each mix the
 //! body velocities are rebuilt, `v = v_free + M⁻¹ Hᵀ R` (O(N)). The mixing is safeguarded as in
 //! [`crate::fc::nsgs`]: no progress by a factor 0.7 over [`STAGNATION_WINDOW`] sweeps clears the
 //! history and continues with plain sweeps for a while; an error that blows up restores the
@@ -29,8 +29,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::anderson::Anderson;
 use crate::contact::ContactRow;
-use crate::fc::anderson::Anderson;
 use crate::local::{natural_map_residual, project_on_cone, solve_local, ContactStatus};
 
 /// Parameters of the NLGS solver.

@@ -36,13 +36,25 @@ fn driven_floor_lifts_a_disk_and_records_its_weight() {
     for step in 0..1000 {
         assert!(w.step().unwrap().solver.converged);
         let (f, _) = w.contact_force(floor);
-        let expected = if step == 0 { mg + w.bodies[b].mass * 5e-3 / h } else { mg };
-        assert!((f.y + expected).abs() <= 1e-9 * expected, "step {step}: floor force {}", f.y);
+        let expected = if step == 0 {
+            mg + w.bodies[b].mass * 5e-3 / h
+        } else {
+            mg
+        };
+        assert!(
+            (f.y + expected).abs() <= 1e-9 * expected,
+            "step {step}: floor force {}",
+            f.y
+        );
         assert!((w.bodies[b].velocity.y - 5e-3).abs() < 1e-12);
     }
     // After 1 s both moved 5 mm; the disk still rests on the floor.
     assert!((w.bodies[floor].position.y - 5e-3).abs() < 1e-12);
-    assert!((w.bodies[b].position.y - (r + 5e-3)).abs() < 1e-12, "{}", w.bodies[b].position.y);
+    assert!(
+        (w.bodies[b].position.y - (r + 5e-3)).abs() < 1e-12,
+        "{}",
+        w.bodies[b].position.y
+    );
 }
 
 /// A disk on a horizontal segment rests on it; past the segment's end it falls freely.
@@ -69,7 +81,9 @@ fn disk_rests_in_the_hollow_of_a_rough_wall() {
     let h = 1e-3;
     let mut w = World::new(params(h), ContactLaws::new(&["m"], 0.0));
     let r = 0.01;
-    let centres: Vec<Vector2<f64>> = (0..5).map(|i| Vector2::new(2.0 * r * i as f64, 0.0)).collect();
+    let centres: Vec<Vector2<f64>> = (0..5)
+        .map(|i| Vector2::new(2.0 * r * i as f64, 0.0))
+        .collect();
     let clump = w.add_clump("rough", &centres, &[r; 5], 0) as usize;
     // On top of disks 1 and 2: centre at x = 3r, height √3 r.
     let b = w.add_grain(Vector2::new(3.0 * r, 3f64.sqrt() * r), r, 2500.0, 0) as usize;
@@ -78,7 +92,12 @@ fn disk_rests_in_the_hollow_of_a_rough_wall() {
         assert!(w.step().unwrap().solver.converged);
     }
     let snap = w.snapshot();
-    let loads: Vec<f64> = snap.contacts.iter().filter(|c| c.force_n > 0.0).map(|c| c.force_n).collect();
+    let loads: Vec<f64> = snap
+        .contacts
+        .iter()
+        .filter(|c| c.force_n > 0.0)
+        .map(|c| c.force_n)
+        .collect();
     assert_eq!(loads.len(), 2);
     // Each of the two normals is 30° from vertical: f_n = m g / (2 cos 30°).
     let expected = mg / (2.0 * (30f64).to_radians().cos());
@@ -110,7 +129,11 @@ fn periodic_boundary_carries_contacts_across() {
             assert!((0.0..0.1).contains(&body.position.x));
         }
     }
-    assert!((w.bodies[a].velocity.x - 0.5).abs() < 1e-12, "{}", w.bodies[a].velocity.x);
+    assert!(
+        (w.bodies[a].velocity.x - 0.5).abs() < 1e-12,
+        "{}",
+        w.bodies[a].velocity.x
+    );
     assert!((w.bodies[b].velocity.x - 0.5).abs() < 1e-12);
 }
 
@@ -128,7 +151,11 @@ fn restitution_reverses_the_normal_velocity() {
     w.bodies[b].velocity = Vector2::new(0.0, -1.0);
     w.params.gravity = Vector2::zeros();
     w.step().unwrap();
-    assert!((w.bodies[b].velocity.y - 0.5).abs() < 1e-9, "{}", w.bodies[b].velocity.y);
+    assert!(
+        (w.bodies[b].velocity.y - 0.5).abs() < 1e-9,
+        "{}",
+        w.bodies[b].velocity.y
+    );
 }
 
 /// Validation names what is wrong before anything runs.
@@ -162,7 +189,9 @@ fn validation_rejects_bad_worlds() {
     assert!(matches!(w.validate(1e-9), Err(DemError::Parameter { ref name, .. }) if name == "dt"));
     let mut w = base();
     w.laws.set_friction(0, 0, -0.1);
-    assert!(matches!(w.validate(1e-9), Err(DemError::Parameter { ref name, .. }) if name == "friction"));
+    assert!(
+        matches!(w.validate(1e-9), Err(DemError::Parameter { ref name, .. }) if name == "friction")
+    );
     // A valid world passes.
     let mut w = base();
     w.add_grain(Vector2::new(0.0, 0.02), 0.01, 2500.0, 0);

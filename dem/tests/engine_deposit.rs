@@ -37,11 +37,21 @@ fn energy_never_increases(theta: f64, allowance: f64) {
         worst = worst.max((e - e_prev) / scale);
         e_prev = e;
     }
-    assert!(worst <= allowance, "theta {theta}: largest energy increase {worst:e} of Σ m g d");
-    assert!(unconverged * 100 <= steps, "{unconverged} steps of {steps} did not converge");
+    assert!(
+        worst <= allowance,
+        "theta {theta}: largest energy increase {worst:e} of Σ m g d"
+    );
+    assert!(
+        unconverged * 100 <= steps,
+        "{unconverged} steps of {steps} did not converge"
+    );
     // The deposit has lost energy and nearly come to rest.
     assert!(e_prev < e0);
-    assert!(w.kinetic_energy() < 1e-4 * scale, "KE {}", w.kinetic_energy() / scale);
+    assert!(
+        w.kinetic_energy() < 1e-4 * scale,
+        "KE {}",
+        w.kinetic_energy() / scale
+    );
 }
 
 #[test]

@@ -25,7 +25,10 @@ fn params(dt: f64, gravity: Vector2<f64>) -> WorldParams {
 #[test]
 fn disk_resting_on_a_floor_receives_mgh_every_step_without_drift() {
     let h = 1e-3;
-    let mut w = World::new(params(h, Vector2::new(0.0, -G)), ContactLaws::new(&["m"], 0.4));
+    let mut w = World::new(
+        params(h, Vector2::new(0.0, -G)),
+        ContactLaws::new(&["m"], 0.4),
+    );
     w.add_line_wall("floor", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
     let r = 0.01;
     let b = w.add_grain(Vector2::new(0.3, r), r, 2500.0, 0) as usize;
@@ -35,11 +38,19 @@ fn disk_resting_on_a_floor_receives_mgh_every_step_without_drift() {
         assert!(rep.solver.converged);
         let c = &w.contacts().rows[0];
         // Normal impulse = m g h to 1e-12 relative, no tangential impulse.
-        assert!((c.r[0] - m * G * h).abs() <= 1e-12 * m * G * h, "r_n = {}", c.r[0]);
+        assert!(
+            (c.r[0] - m * G * h).abs() <= 1e-12 * m * G * h,
+            "r_n = {}",
+            c.r[0]
+        );
         assert!(c.r[1].abs() <= 1e-15);
     }
     // No drift: the centre stays at y = R to 1e-12 m, the velocity at 0.
-    assert!((w.bodies[b].position.y - r).abs() < 1e-12, "y = {}", w.bodies[b].position.y);
+    assert!(
+        (w.bodies[b].position.y - r).abs() < 1e-12,
+        "y = {}",
+        w.bodies[b].position.y
+    );
     assert!(w.bodies[b].velocity.norm() < 1e-12);
     assert!((w.bodies[b].position.x - 0.3).abs() < 1e-15);
 }
@@ -48,7 +59,10 @@ fn disk_resting_on_a_floor_receives_mgh_every_step_without_drift() {
 fn column_between_smooth_walls_each_contact_carries_the_weight_above() {
     let h = 1e-3;
     let r = 0.005;
-    let mut w = World::new(params(h, Vector2::new(0.0, -G)), ContactLaws::new(&["m"], 0.0));
+    let mut w = World::new(
+        params(h, Vector2::new(0.0, -G)),
+        ContactLaws::new(&["m"], 0.0),
+    );
     w.add_line_wall("bottom", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
     w.add_line_wall("left", Vector2::new(-r, 0.0), Vector2::new(1.0, 0.0), 0);
     w.add_line_wall("right", Vector2::new(r, 0.0), Vector2::new(-1.0, 0.0), 0);
@@ -88,7 +102,13 @@ fn column_between_smooth_walls_each_contact_carries_the_weight_above() {
 /// Measured acceleration of the centre along the slope and angular acceleration after `steps`
 /// steps from rest, for a disk on a slope of angle `phi` made either by rotating gravity or by
 /// tilting the wall.
-fn slope_run(phi: f64, mu: f64, lock_rotation: bool, tilted_wall: bool, steps: usize) -> (f64, f64, f64) {
+fn slope_run(
+    phi: f64,
+    mu: f64,
+    lock_rotation: bool,
+    tilted_wall: bool,
+    steps: usize,
+) -> (f64, f64, f64) {
     let h = 1e-3;
     let r = 0.02;
     let (gravity, normal, down) = if tilted_wall {
@@ -137,7 +157,10 @@ fn disk_on_a_slope_rolls_without_slipping_when_mu_exceeds_tan_phi_over_three() {
             assert!(mu >= phi.tan() / 3.0);
             let (a, alpha, travelled) = slope_run(phi, mu, false, tilted, 500);
             let expected = 2.0 / 3.0 * G * phi.sin();
-            assert!(rel(a, expected) <= 1e-6, "phi {phi_deg}: a = {a} vs {expected}");
+            assert!(
+                rel(a, expected) <= 1e-6,
+                "phi {phi_deg}: a = {a} vs {expected}"
+            );
             // Rolling without slipping: α = a / R.
             assert!(rel(alpha, expected / 0.02) <= 1e-6);
             // θ = 1/2 integrates a constant acceleration exactly: L = a t²/2.
@@ -154,7 +177,10 @@ fn disk_on_a_slope_rolls_and_slides_when_mu_is_below_tan_phi_over_three() {
             assert!(mu < phi.tan() / 3.0);
             let (a, alpha, _) = slope_run(phi, mu, false, tilted, 500);
             let expected = G * (phi.sin() - mu * phi.cos());
-            assert!(rel(a, expected) <= 1e-6, "phi {phi_deg}: a = {a} vs {expected}");
+            assert!(
+                rel(a, expected) <= 1e-6,
+                "phi {phi_deg}: a = {a} vs {expected}"
+            );
             // Friction torque μ m g cosφ R = I α, I = m R²/2.
             let alpha_expected = 2.0 * mu * G * phi.cos() / 0.02;
             assert!((alpha - alpha_expected).abs() <= 1e-6 * alpha_expected.max(1.0));

@@ -17,7 +17,7 @@
 //!
 //! **Acceleration.** Once the contact statuses stop changing, one sweep is an affine map and
 //! Gauss–Seidel converges linearly and slowly (the weight of a pile has to diffuse through the
-//! network). [`Acceleration::Anderson`] mixes the last `m` sweeps ([`super::anderson`]), which on
+//! network). [`Acceleration::Anderson`] mixes the last `m` sweeps ([`crate::anderson`]), which on
 //! an affine map is GMRES. It is safeguarded: the true error is evaluated every
 //! `check_every` sweeps; if it has not dropped by a factor 0.7 over a window of 60 sweeps, the
 //! history is cleared and plain sweeps are done for 32 sweeps (doubling at each new stagnation),
@@ -31,10 +31,10 @@
 
 use std::time::Instant;
 
-use super::anderson::Anderson;
 use super::error::FcError;
 use super::ordering::{contact_order, ContactOrdering};
 use super::problem::FcProblem;
+use crate::anderson::Anderson;
 use crate::local::{natural_map_residual, project_on_cone, solve_local, Delassus2};
 
 /// Acceleration of the Gauss–Seidel sweeps.

@@ -9,7 +9,15 @@ use rand_chacha::ChaCha8Rng;
 /// A box `[0, width] × [0, ∞)` with floor and two side walls (line walls), filled with `n`
 /// random disks of radius in `[r_min, r_max]` placed without overlap on a loose grid with small
 /// random velocities. Density 2500 kg/m³, friction `mu` everywhere.
-pub fn random_box(n: usize, width: f64, r_min: f64, r_max: f64, mu: f64, theta: f64, seed: u64) -> World {
+pub fn random_box(
+    n: usize,
+    width: f64,
+    r_min: f64,
+    r_max: f64,
+    mu: f64,
+    theta: f64,
+    seed: u64,
+) -> World {
     let params = WorldParams {
         dt: 1e-3,
         theta,
@@ -25,7 +33,12 @@ pub fn random_box(n: usize, width: f64, r_min: f64, r_max: f64, mu: f64, theta: 
     let mut w = World::new(params, ContactLaws::new(&["grain"], mu));
     w.add_line_wall("bottom", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
     w.add_line_wall("left", Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall("right", Vector2::new(width, 0.0), Vector2::new(-1.0, 0.0), 0);
+    w.add_line_wall(
+        "right",
+        Vector2::new(width, 0.0),
+        Vector2::new(-1.0, 0.0),
+        0,
+    );
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let pitch = 2.0 * r_max * 1.05;
     let per_row = ((width / pitch).floor() as usize).max(1);
