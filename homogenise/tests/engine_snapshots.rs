@@ -15,13 +15,20 @@ const G: f64 = 9.81;
 #[test]
 fn engine_rolling_disk_matches_the_exact_stress() {
     for tilted in [true, false] {
-        for (phi_deg, a, steps) in [(26.0f64, 0.01, 400usize), (15.0, 0.003, 900), (40.0, 0.05, 250)] {
+        for (phi_deg, a, steps) in [
+            (26.0f64, 0.01, 400usize),
+            (15.0, 0.003, 900),
+            (40.0, 0.05, 250),
+        ] {
             let phi = phi_deg.to_radians();
             let (e1, e2) = slope_frame(phi);
             let (gravity, normal) = if tilted {
                 (Vector2::new(0.0, -G), e2)
             } else {
-                (Vector2::new(G * phi.sin(), -G * phi.cos()), Vector2::new(0.0, 1.0))
+                (
+                    Vector2::new(G * phi.sin(), -G * phi.cos()),
+                    Vector2::new(0.0, 1.0),
+                )
             };
             let params = WorldParams {
                 dt: 1e-3,
@@ -43,7 +50,11 @@ fn engine_rolling_disk_matches_the_exact_stress() {
             }
             let snap = w.snapshot();
             let gs = grain_stresses(&snap).unwrap();
-            let (f1, f2) = if tilted { (e1, e2) } else { (Vector2::x(), Vector2::y()) };
+            let (f1, f2) = if tilted {
+                (e1, e2)
+            } else {
+                (Vector2::x(), Vector2::y())
+            };
             let l = (snap.bodies[b].position - x0).dot(&f1);
             let total = in_frame(&gs[0].total, &f1, &f2);
             let contact = in_frame(&gs[0].contact, &f1, &f2);
@@ -77,10 +88,17 @@ fn deposit(n: usize, seed: u64) -> World {
     let width = 0.06;
     w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
     w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall("right", Vector2::new(width, 0.0), Vector2::new(-1.0, 0.0), 0);
+    w.add_line_wall(
+        "right",
+        Vector2::new(width, 0.0),
+        Vector2::new(-1.0, 0.0),
+        0,
+    );
     let mut s = seed;
     let mut u = move || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
     let pitch = 4.2e-3;
