@@ -26,6 +26,7 @@ use crate::output::OutputDir;
 #[derive(Debug, Default)]
 pub struct VtkSeries {
     frames: Vec<(f64, usize)>,
+    prefix: String,
 }
 
 fn data_array(s: &mut String, name: &str, comps: usize, values: impl Iterator<Item = f64>) {
@@ -297,6 +298,14 @@ impl VtkSeries {
         Self::default()
     }
 
+    /// An empty series whose files are named `PREFIXgrains_NNNN.vtp`, `PREFIXgrains.pvd`, ...
+    pub fn with_prefix(prefix: &str) -> Self {
+        Self {
+            frames: Vec::new(),
+            prefix: prefix.to_string(),
+        }
+    }
+
     /// Writes the three files of one frame under `vtk/`.
     pub fn add_frame(&mut self, out: &mut OutputDir, snap: &Snapshot) -> Result<()> {
         let k = self.frames.len();
@@ -332,11 +341,12 @@ impl VtkSeries {
             for (t, k) in &self.frames {
                 let _ = writeln!(
                     s,
-                    "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"vtk/{kind}_{k:04}.vtp\"/>"
+                    "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"vtk/{}{kind}_{k:04}.vtp\"/>",
+                    self.prefix
                 );
             }
             s.push_str("  </Collection>\n</VTKFile>\n");
-            out.write(&format!("{kind}.pvd"), s.as_bytes())?;
+            out.write(&format!("{}{kind}.pvd", self.prefix), s.as_bytes())?;
         }
         Ok(())
     }

@@ -128,6 +128,16 @@ impl VtkFrames {
         }
     }
 
+    /// Like [`VtkFrames::new`] with file names prefixed by `prefix`.
+    pub fn with_prefix(prefix: &str, interval: f64, max_frames: usize) -> Self {
+        Self {
+            series: VtkSeries::with_prefix(prefix),
+            interval,
+            next: 0.0,
+            max_frames,
+        }
+    }
+
     /// Writes a frame if one is due.
     pub fn maybe(&mut self, out: &mut OutputDir, world: &World) -> Result<()> {
         if self.series.len() + 1 < self.max_frames && world.time + 1e-12 >= self.next {
