@@ -31,8 +31,10 @@ pub struct Body {
     /// Angular velocity (rad/s).
     pub omega: f64,
     /// Mass (kg); `m = ρ π R² · thickness` for a disk; infinite for a fixed wall.
+    #[serde(with = "crate::serde_float")]
     pub mass: f64,
     /// Moment of inertia about the centre (kg·m²); `I = m R² / 2` for a disk.
+    #[serde(with = "crate::serde_float")]
     pub inertia: f64,
     /// Disk radius (m) for grains, 0 otherwise.
     pub radius: f64,

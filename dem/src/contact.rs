@@ -14,7 +14,7 @@ use crate::local::{ContactStatus, Delassus2};
 /// u_t = t·(v_b − v_a) + (ρ_b×t) ω_b − (ρ_a×t) ω_a
 /// ```
 /// which is `u = H v + shift`; the impulse `R = r_n n + r_t t` acts on `b` and `−R` on `a`.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[repr(C)]
 pub struct ContactRow {
     /// Body `a` (the wall, or the disk of lower collider index).
@@ -111,7 +111,7 @@ pub struct ContactGeometry {
 }
 
 /// All contacts of a step, sorted by `geometry.key`.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct ContactSet {
     /// Solver rows.
     pub rows: Vec<ContactRow>,

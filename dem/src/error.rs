@@ -55,4 +55,12 @@ pub enum DemError {
         /// What became non-finite.
         what: String,
     },
+    /// A checkpoint could not be written or read.
+    #[error("checkpoint {path}: {reason}")]
+    Checkpoint {
+        /// File.
+        path: String,
+        /// What went wrong.
+        reason: String,
+    },
 }

@@ -18,6 +18,7 @@
 pub mod anderson;
 pub mod bench;
 pub mod body;
+pub mod checkpoint;
 pub mod collider;
 pub mod contact;
 pub mod detection;
@@ -25,6 +26,7 @@ pub mod error;
 pub mod fc;
 pub mod local;
 pub mod material;
+pub mod serde_float;
 pub mod snapshot;
 pub mod solver;
 pub mod world;

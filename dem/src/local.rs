@@ -54,7 +54,7 @@ impl ContactStatus {
 }
 
 /// Symmetric 2×2 local Delassus block `W = H M⁻¹ Hᵀ` of one contact, normal first.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Delassus2 {
     /// `W_nn` (1/kg for impulses in N·s and velocities in m/s).
     pub nn: f64,

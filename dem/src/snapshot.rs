@@ -40,8 +40,10 @@ pub struct BodyState {
     /// Mean angular acceleration over the step, `(ω⁺ − ω⁻)/h` (rad/s²).
     pub angular_acceleration: f64,
     /// Mass (kg); `f64::INFINITY` for a wall whose motion is imposed.
+    #[serde(with = "crate::serde_float")]
     pub mass: f64,
     /// Moment of inertia about the centre (kg·m²); `I = m R²/2` for a disk.
+    #[serde(with = "crate::serde_float")]
     pub inertia: f64,
     /// Disk radius (m) for grains; 0 for walls.
     pub radius: f64,

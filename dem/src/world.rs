@@ -20,6 +20,7 @@ use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::body::{Body, Dof};
+use crate::checkpoint::WorldState;
 use crate::collider::{rotate, Collider, Shape};
 use crate::contact::ContactSet;
 use crate::detection::{Detector, Periodic};
@@ -454,6 +455,34 @@ impl World {
         Ok(())
     }
 
+    /// Contact forces received by each body during the last step (walls' loads), N and N·m;
+    /// returns the number of contacts with a positive normal impulse.
+    fn refresh_body_forces(&mut self) -> usize {
+        let h = self.params.dt;
+        self.body_force.clear();
+        self.body_force.resize(self.bodies.len(), [0.0; 3]);
+        let mut active = 0;
+        for row in &self.contacts.rows {
+            if row.r[0] > 0.0 {
+                active += 1;
+            }
+            let [nx, ny] = row.n;
+            let fx = (row.r[0] * nx - row.r[1] * ny) / h;
+            let fy = (row.r[0] * ny + row.r[1] * nx) / h;
+            let ta = (row.k[0] * row.r[0] + row.k[1] * row.r[1]) / h;
+            let tb = (row.k[2] * row.r[0] + row.k[3] * row.r[1]) / h;
+            let fb = &mut self.body_force[row.b as usize];
+            fb[0] += fx;
+            fb[1] += fy;
+            fb[2] += tb;
+            let fa = &mut self.body_force[row.a as usize];
+            fa[0] -= fx;
+            fa[1] -= fy;
+            fa[2] -= ta;
+        }
+        active
+    }
+
     fn refresh_inverse_mass(&mut self) {
         self.inv.clear();
         self.inv.extend(self.bodies.iter().map(Body::inverse_mass));
@@ -565,28 +594,7 @@ impl World {
             }
         }
 
-        // Contact forces received by each body (walls' loads), N and N·m.
-        self.body_force.clear();
-        self.body_force.resize(self.bodies.len(), [0.0; 3]);
-        let mut active = 0;
-        for row in &self.contacts.rows {
-            if row.r[0] > 0.0 {
-                active += 1;
-            }
-            let [nx, ny] = row.n;
-            let fx = (row.r[0] * nx - row.r[1] * ny) / h;
-            let fy = (row.r[0] * ny + row.r[1] * nx) / h;
-            let ta = (row.k[0] * row.r[0] + row.k[1] * row.r[1]) / h;
-            let tb = (row.k[2] * row.r[0] + row.k[3] * row.r[1]) / h;
-            let fb = &mut self.body_force[row.b as usize];
-            fb[0] += fx;
-            fb[1] += fy;
-            fb[2] += tb;
-            let fa = &mut self.body_force[row.a as usize];
-            fa[0] -= fx;
-            fa[1] -= fy;
-            fa[2] -= ta;
-        }
+        let active = self.refresh_body_forces();
 
         self.step_index += 1;
         self.time += h;
@@ -599,6 +607,35 @@ impl World {
             max_penetration: max_pen,
         };
         Ok(self.last)
+    }
+
+    /// The complete state needed to continue the run exactly (see [`crate::checkpoint`]).
+    pub fn state(&self) -> WorldState {
+        WorldState {
+            params: self.params,
+            bodies: self.bodies.clone(),
+            colliders: self.colliders.clone(),
+            laws: self.laws.clone(),
+            time: self.time,
+            step_index: self.step_index,
+            contacts: self.contacts.clone(),
+            last: self.last,
+        }
+    }
+
+    /// Rebuild a world from [`World::state`]: stepping it gives bit-identical results to
+    /// stepping the original.
+    pub fn from_state(s: WorldState) -> Self {
+        let mut w = World::new(s.params, s.laws);
+        w.bodies = s.bodies;
+        w.colliders = s.colliders;
+        w.time = s.time;
+        w.step_index = s.step_index;
+        w.contacts = s.contacts;
+        w.last = s.last;
+        w.refresh_inverse_mass();
+        w.refresh_body_forces();
+        w
     }
 
     /// The state after the last step as plain data (see [`crate::snapshot`]).
