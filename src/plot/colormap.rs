@@ -81,8 +81,8 @@ pub fn colorbar(
         let mut chart = ChartBuilder::on(area)
             .margin_top(40)
             .margin_bottom(60)
-            .margin_right(10)
-            .y_label_area_size(70)
+            .margin_left(25)
+            .set_label_area_size(LabelAreaPosition::Right, 105)
             .build_cartesian_2d(0.0..1.0, (lo..hi).log_scale())?;
         chart
             .configure_mesh()
@@ -107,8 +107,8 @@ pub fn colorbar(
         let mut chart = ChartBuilder::on(area)
             .margin_top(40)
             .margin_bottom(60)
-            .margin_right(10)
-            .y_label_area_size(70)
+            .margin_left(25)
+            .set_label_area_size(LabelAreaPosition::Right, 105)
             .build_cartesian_2d(0.0..1.0, lo..hi)?;
         chart
             .configure_mesh()

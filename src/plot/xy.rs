@@ -240,16 +240,20 @@ impl XyPlot {
             builder.caption(&self.title, font(22.0));
         }
         let mut chart = builder.build_cartesian_2d(xr, yr)?;
+        let (xlog, ylog) = (self.x.log, self.y.log);
+        let xf = move |v: &f64| if xlog { fmt_log_tick(*v) } else { fmt_tick(*v) };
+        let yf = move |v: &f64| if ylog { fmt_log_tick(*v) } else { fmt_tick(*v) };
         chart
             .configure_mesh()
+            .max_light_lines(if xlog || ylog { 0 } else { 5 })
             .x_desc(self.x.label.as_str())
             .y_desc(self.y.label.as_str())
             .label_style(font(16.0))
             .axis_desc_style(font(18.0))
             .light_line_style(RGBColor(235, 235, 235))
             .bold_line_style(RGBColor(210, 210, 210))
-            .x_label_formatter(&|v| fmt_tick(*v))
-            .y_label_formatter(&|v| fmt_tick(*v))
+            .x_label_formatter(&xf)
+            .y_label_formatter(&yf)
             .draw()?;
         let mut labelled = false;
         for b in &self.bands {
@@ -398,6 +402,20 @@ pub fn fmt_tick(v: f64) -> String {
     } else {
         let s = format!("{v:.1e}");
         s.replace(".0e", "e")
+    }
+}
+
+/// Tick label of a logarithmic axis: only 1, 2 and 5 × 10^k are labelled.
+pub fn fmt_log_tick(v: f64) -> String {
+    if !(v.is_finite() && v > 0.0) {
+        return String::new();
+    }
+    let e = v.log10().floor();
+    let m = v / 10f64.powf(e);
+    if [1.0, 2.0, 5.0].iter().any(|t| (m - t).abs() < 1e-6 * t) || (m - 10.0).abs() < 1e-5 {
+        fmt_tick(v)
+    } else {
+        String::new()
     }
 }
 

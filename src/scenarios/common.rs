@@ -186,3 +186,37 @@ pub fn write_law(out: &mut OutputDir, name: &str, law: &identify::CalibratedLaw)
     out.write(name, (text + "\n").as_bytes())?;
     Ok(())
 }
+
+/// Pointwise confidence band of a fitted curve by the delta method: for each `x`, the value
+/// `f(p, x)`, and `f ∓ t √(gᵀ C g)` with `g = ∂f/∂p` by central differences (relative step 1e-6)
+/// and `C` the parameters' covariance. Returns `(x, f, lo, hi)`.
+pub fn delta_band(
+    p: &[f64],
+    cov: &[Vec<f64>],
+    t: f64,
+    xs: &[f64],
+    f: impl Fn(&[f64], f64) -> f64,
+) -> Vec<(f64, f64, f64, f64)> {
+    xs.iter()
+        .map(|&x| {
+            let y = f(p, x);
+            let mut g = vec![0.0; p.len()];
+            for k in 0..p.len() {
+                let h = 1e-6 * p[k].abs().max(1e-12);
+                let mut a = p.to_vec();
+                let mut b = p.to_vec();
+                a[k] += h;
+                b[k] -= h;
+                g[k] = (f(&a, x) - f(&b, x)) / (2.0 * h);
+            }
+            let mut var = 0.0;
+            for i in 0..p.len() {
+                for j in 0..p.len() {
+                    var += g[i] * cov.get(i).and_then(|r| r.get(j)).copied().unwrap_or(0.0) * g[j];
+                }
+            }
+            let e = t * var.max(0.0).sqrt();
+            (x, y, y - e, y + e)
+        })
+        .collect()
+}

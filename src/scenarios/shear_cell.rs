@@ -1,11 +1,325 @@
-//! The `shear_cell` scenario.
+//! The `shear-cell` scenario: steady plane shear without gravity of a periodic sample between
+//! two rough walls; the top wall is pushed with the imposed pressure P and moved at the velocity
+//! V that targets each inertial number `I = γ̇ d/√(P/ρ)` in turn (the runs follow each other,
+//! lowest I first, each starting from the previous steady state).
+//!
+//! Per run, averaged over the last `average_strain` of shear in the bulk (two diameters away
+//! from each wall): stress (μ = |σ_xy|/(−σ_yy), P = −σ_yy), solid fraction φ, shear rate γ̇ from
+//! the affine fit of the grain velocities, hence the measured I; at each wall the slip velocity
+//! of the first layer of grains and the effective friction τ_w/σ_w. Then μ(I) and φ(I) are fitted
+//! (identify::mu_i), and the wall friction law against the slip velocity (identify::wall_law,
+//! best of three forms by AIC).
 
 use datasets::config::ShearCellConfig;
+use dem::BodyKind;
+use homogenise::kinematics::{velocity_gradient, VelocityWeight};
+use homogenise::state::solid_fraction;
+use homogenise::walls::{near_wall_profile, NearWallSpec};
+use homogenise::Region;
+use identify::law::Provenance;
+use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
+use identify::wall_law::{select_wall_law, WallSlipSeries};
+use identify::{CalibratedLaw, FitOptions};
+use nalgebra::Vector2;
 
+use super::common::{delta_band, mean_diameter, run_phase, solver_keys, write_law, Stop, VtkFrames};
 use super::{RunContext, RunOutcome};
-use crate::error::{CliError, Result};
+use crate::error::Result;
+use crate::output::{CsvTable, Summary};
+use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
+use crate::plot::xy::{draw_row, Axis, Band, LegendAt, Series, Style, XyPlot};
+use crate::plot::PALETTE;
+use crate::progress::warn;
+
+/// Averages of one run.
+#[derive(Debug, Clone, Default)]
+struct RunAverages {
+    sxy: f64,
+    syy: f64,
+    phi: f64,
+    gamma_dot: f64,
+    samples: usize,
+    walls: [(f64, f64, f64, usize); 2],
+    profile: Vec<(f64, f64, f64)>,
+}
 
 /// Runs the scenario.
-pub fn run(_c: &ShearCellConfig, _ctx: &mut RunContext) -> Result<RunOutcome> {
-    Err(CliError::Usage("scenario not implemented yet".into()))
+pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
+    let (mut world, length) = datasets::build::shear_cell(c)?;
+    let r = c.grain.radius_mean;
+    let d = mean_diameter(&world);
+    let rho = c.grain.density;
+    let top = 1usize;
+    let env = ctx.env();
+    let mut all = datasets::phases::PhaseStats::default();
+    // Compression at zero shear.
+    world.params.dt = c.dt_max;
+    let comp = run_phase(&env, "compress", &mut world, Stop::Steps((c.compression_time / c.dt_max).ceil() as u64), |_, _| Ok(()))?;
+    all.merge(&comp);
+    let mut rows = Vec::new();
+    let mut mean_profiles = Vec::new();
+    let mut targets = c.inertial_numbers.clone();
+    targets.sort_by(f64::total_cmp);
+    let mut vtk = VtkFrames::new(f64::INFINITY, 1);
+    for (k, &i_target) in targets.iter().enumerate() {
+        let h = world.bodies[top].position.y - 2.0 * r;
+        let gamma_target = i_target * (c.pressure / rho).sqrt() / d;
+        let v = gamma_target * h;
+        let dt = c.dt_max.min(c.travel_per_step * r / v);
+        let steps = (c.strain * h / (v * dt)).ceil() as u64;
+        let avg_steps = (c.average_strain * h / (v * dt)).ceil() as u64;
+        world.params.dt = dt;
+        world.bodies[top].velocity.x = v;
+        let every = (avg_steps / 40).max(1);
+        let mut acc = RunAverages::default();
+        let mut n = 0u64;
+        let out = &mut ctx.out;
+        let _ = out;
+        let stats = run_phase(&env, &format!("I={i_target}"), &mut world, Stop::Steps(steps), |w, _| {
+            n += 1;
+            if n + avg_steps > steps && n % every == 0 {
+                sample(w, &mut acc, r, d, length)?;
+            }
+            Ok(())
+        })?;
+        all.merge(&stats);
+        let m = acc.samples.max(1) as f64;
+        let (sxy, syy, phi, gd) = (acc.sxy / m, acc.syy / m, acc.phi / m, acc.gamma_dot / m);
+        let p = -syy;
+        let mu = sxy.abs() / p;
+        let i_meas = gd.abs() * d / (p / rho).sqrt();
+        let wall = |j: usize| {
+            let (vs, ft, fnn, cnt) = acc.walls[j];
+            let cnt = cnt.max(1) as f64;
+            (vs / cnt, if fnn > 0.0 { ft.abs() / fnn } else { f64::NAN })
+        };
+        let (vb, mub) = wall(0);
+        let (vt, mut_) = wall(1);
+        rows.push(vec![i_target, i_meas, mu, phi, p, gd, v, h, dt, vb, mub, vt, mut_, acc.samples as f64]);
+        mean_profiles.push((i_meas, acc.profile.iter().map(|&(y, s, c)| (y, if c > 0.0 { s / c } else { f64::NAN })).collect::<Vec<_>>(), v, h));
+        if k + 1 == targets.len() {
+            vtk = VtkFrames::new(f64::INFINITY, 1);
+        }
+    }
+    vtk.finish(&mut ctx.out, &world)?;
+    let headers = [
+        "I_target", "I", "mu", "phi", "P_Pa", "shear_rate_1_s", "wall_velocity_m_s", "height_m", "dt_s",
+        "slip_velocity_bottom_m_s", "mu_eff_bottom", "slip_velocity_top_m_s", "mu_eff_top", "samples",
+    ];
+    let mut table = CsvTable::new(&headers);
+    for r in &rows {
+        table.push(r.clone());
+    }
+    table.comments.push("steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip; fit again with grainlaw fit mu-i rheology.csv".into());
+    table.write(&mut ctx.out, "rheology.csv")?;
+
+    // Fits.
+    let series = RheologySeries {
+        inertial_number: rows.iter().map(|r| r[1]).collect(),
+        mu: Some(rows.iter().map(|r| r[2]).collect()),
+        phi: Some(rows.iter().map(|r| r[3]).collect()),
+        pressure_pa: Some(rows.iter().map(|r| r[4]).collect()),
+    };
+    let opts = FitOptions::default();
+    let prov = || Provenance::new("shear-cell", Some(c.seed));
+    let mut s = Summary::new();
+    s.int("grains", c.grains as u64)
+        .num("pressure_Pa", c.pressure)
+        .num("mean_diameter_m", d)
+        .int("runs", rows.len() as u64)
+        .num("I_min", rows.iter().map(|r| r[1]).fold(f64::MAX, f64::min))
+        .num("I_max", rows.iter().map(|r| r[1]).fold(f64::MIN, f64::max));
+    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
+    let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+    let (imin, imax) = (is.iter().cloned().fold(f64::MAX, f64::min), is.iter().cloned().fold(f64::MIN, f64::max));
+    let xs: Vec<f64> = (0..=80).map(|k| imin * 0.7 * (imax * 1.4 / (imin * 0.7)).powf(k as f64 / 80.0)).collect();
+    let mut pmu = XyPlot::new("Friction law μ(I)", Axis::new("inertial number I").log(), Axis::new("μ = |σ_xy| / P"));
+    pmu.series.push(Series::new("DEM", Style::Points, PALETTE[0], rows.iter().map(|r| (r[1], r[2])).collect()));
+    match fit_mu_i(&series, &opts) {
+        Ok(f) => {
+            let p = f.report.values();
+            let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| {
+                identify::laws::mu_i::MuILaw { mu_s: p[0], mu_2: p[1], i0: p[2] }.mu(i)
+            });
+            pmu.bands.push(Band::between("95 % confidence band", PALETTE[0], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
+            pmu.series.push(Series::new("μ_s + (μ₂ − μ_s)/(1 + I₀/I)", Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+            for e in &f.report.parameters {
+                s.num(&format!("mu_i_{}", e.name), e.value)
+                    .num(&format!("mu_i_{}_ci_low", e.name), e.ci_low)
+                    .num(&format!("mu_i_{}_ci_high", e.name), e.ci_high);
+            }
+            s.text("mu_i_form", "mu-i").num("mu_i_r_squared", f.report.r_squared);
+            headline.push(format!(
+                "μ(I): μ_s = {:.3}, μ₂ = {:.3}, I₀ = {:.3} (R² = {:.3})",
+                f.law.mu_s, f.law.mu_2, f.law.i0, f.report.r_squared
+            ));
+            write_law(&mut ctx.out, "mu_i_law.json", &CalibratedLaw::from_mu_i(&f, prov()))?;
+        }
+        Err(e) => {
+            warn(&format!("μ(I) fit failed ({e}); fitting the linear form μ_s + b I"));
+            s.text("mu_i_fit_error", &e.to_string());
+            match fit_mu_i_linear(&series, &opts) {
+                Ok(f) => {
+                    let p = f.report.values();
+                    let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| p[0] + p[1] * i);
+                    pmu.bands.push(Band::between("95 % confidence band", PALETTE[0], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
+                    pmu.series.push(Series::new("μ_s + b I", Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+                    for e in &f.report.parameters {
+                        s.num(&format!("mu_i_{}", e.name), e.value)
+                            .num(&format!("mu_i_{}_ci_low", e.name), e.ci_low)
+                            .num(&format!("mu_i_{}_ci_high", e.name), e.ci_high);
+                    }
+                    s.text("mu_i_form", "mu-i-linear").num("mu_i_r_squared", f.report.r_squared);
+                    headline.push(format!("μ(I) (linear): μ_s = {:.3}, b = {:.3}", f.law.mu_s, f.law.slope));
+                    write_law(&mut ctx.out, "mu_i_law.json", &CalibratedLaw::from_mu_i_linear(&f, prov()))?;
+                }
+                Err(e2) => {
+                    warn(&format!("linear μ(I) fit failed too: {e2}"));
+                    s.text("mu_i_linear_fit_error", &e2.to_string());
+                }
+            }
+        }
+    }
+    pmu.legend = LegendAt::UpperLeft;
+    let mut pphi = XyPlot::new("Solid fraction φ(I)", Axis::new("inertial number I").log(), Axis::new("solid fraction φ"));
+    pphi.series.push(Series::new("DEM", Style::Points, PALETTE[2], rows.iter().map(|r| (r[1], r[3])).collect()));
+    match fit_phi_i(&series, &opts) {
+        Ok(f) => {
+            let p = f.report.values();
+            let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| p[0] - (p[0] - p[1]) * i);
+            pphi.bands.push(Band::between("95 % confidence band", PALETTE[2], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
+            pphi.series.push(Series::new("φ_max − (φ_max − φ_min) I", Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+            for e in &f.report.parameters {
+                s.num(&format!("phi_i_{}", e.name), e.value)
+                    .num(&format!("phi_i_{}_ci_low", e.name), e.ci_low)
+                    .num(&format!("phi_i_{}_ci_high", e.name), e.ci_high);
+            }
+            headline.push(format!("φ(I): φ_max = {:.3}, φ_min = {:.3}", f.law.phi_max, f.law.phi_min));
+            write_law(&mut ctx.out, "phi_i_law.json", &CalibratedLaw::from_phi_i(&f, prov()))?;
+        }
+        Err(e) => {
+            warn(&format!("φ(I) fit failed: {e}"));
+            s.text("phi_i_fit_error", &e.to_string());
+        }
+    }
+    pphi.legend = LegendAt::UpperRight;
+    // Wall law from both walls.
+    let mut vs = Vec::new();
+    let mut mus = Vec::new();
+    for r in &rows {
+        for (v, m) in [(r[9], r[10]), (r[11], r[12])] {
+            if v.is_finite() && m.is_finite() {
+                vs.push(v.abs());
+                mus.push(m);
+            }
+        }
+    }
+    let ws = WallSlipSeries::new(vs.clone(), mus.clone(), d);
+    let scale = (9.81 * d).sqrt();
+    let mut pw = XyPlot::new("Wall friction vs slip", Axis::new("slip velocity V_s / √(g d)"), Axis::new("μ_eff = τ_w / σ_w"));
+    pw.series.push(Series::new("DEM (both walls)", Style::Points, PALETTE[3], vs.iter().zip(&mus).map(|(v, m)| (v / scale, *m)).collect()));
+    match select_wall_law(&ws, &opts) {
+        Ok(sel) => {
+            let best = sel.best();
+            let vmax = vs.iter().cloned().fold(0.0, f64::max) / scale;
+            let vx: Vec<f64> = (0..=80).map(|k| vmax * 1.05 * k as f64 / 80.0).collect();
+            let p = best.report.values();
+            let form = best.form;
+            let band = delta_band(&p, &best.report.covariance, best.report.t_critical, &vx, |p, v| {
+                use identify::laws::wall_friction::WallFrictionLaw as W;
+                let law = match form {
+                    identify::wall_law::WallLawForm::Exponential => W::Exponential { mu_0: p[0], mu_inf: p[1], v_star: p[2] },
+                    identify::wall_law::WallLawForm::Hyperbolic => W::Hyperbolic { mu_0: p[0], mu_inf: p[1], v_star: p[2] },
+                    identify::wall_law::WallLawForm::PowerLaw => W::PowerLaw { mu_0: p[0], k: p[1], n: p[2] },
+                };
+                law.mu_eff(v)
+            });
+            pw.bands.push(Band::between("95 % confidence band", PALETTE[3], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
+            pw.series.push(Series::new(&format!("{} (best AIC)", form.law_name()), Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+            s.text("wall_law_form", form.law_name());
+            for e in &best.report.parameters {
+                s.num(&format!("wall_law_{}", e.name), e.value)
+                    .num(&format!("wall_law_{}_ci_low", e.name), e.ci_low)
+                    .num(&format!("wall_law_{}_ci_high", e.name), e.ci_high);
+            }
+            headline.push(format!("wall law: {} chosen by AIC", form.law_name()));
+            write_law(&mut ctx.out, "wall_law.json", &CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov()))?;
+        }
+        Err(e) => {
+            warn(&format!("wall-law fit failed: {e}"));
+            s.text("wall_law_fit_error", &e.to_string());
+            headline.push(format!("wall law not identified: {e}"));
+        }
+    }
+    pw.legend = LegendAt::LowerRight;
+    draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, pw], (1950, 650))?;
+    // Velocity profiles, normalised.
+    let mut pv = XyPlot::new("Velocity profiles", Axis::new("velocity / wall velocity v_x / V"), Axis::new("height / gap y / H"));
+    for (k, (i, prof, v, h)) in mean_profiles.iter().enumerate() {
+        pv.series.push(Series::new(&format!("I = {i:.3}"), Style::LinePoints, PALETTE[k % PALETTE.len()], prof.iter().filter(|p| p.1.is_finite()).map(|p| (p.1 / v, p.0 / h)).collect()));
+    }
+    pv.legend = LegendAt::UpperLeft;
+    crate::plot::xy::draw_xy(&mut ctx.out, "velocity_profiles.png", &pv)?;
+    let snap = world.snapshot();
+    draw_particles(
+        &mut ctx.out,
+        "force_chains.png",
+        &ParticleView {
+            snap: &snap,
+            title: format!("Shear cell at I = {:.3}: normal forces", is.last().copied().unwrap_or(0.0)),
+            fill: GrainFill::Plain,
+            forces: true,
+            axis_labels: ("x (m)".into(), "y (m)".into()),
+            width_px: 700,
+        },
+    )?;
+    solver_keys(&mut s, &all);
+    Ok(RunOutcome { summary: s, headline })
+}
+
+/// Adds one sample of the bulk and wall quantities to `acc`.
+fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64, length: f64) -> Result<()> {
+    let snap = w.snapshot();
+    let top_y = w.bodies[1].position.y;
+    let (lo, hi) = (r + 2.0 * d, top_y - r - 2.0 * d);
+    let region = Region::Slice { y_min: lo, y_max: hi.max(lo + d) };
+    let gs = homogenise::grain_stresses(&snap)?;
+    let st = homogenise::mean_stress(&snap, &gs, &region)?;
+    let sym = (st.total + st.total.transpose()) * 0.5;
+    acc.sxy += sym[(0, 1)];
+    acc.syy += sym[(1, 1)];
+    acc.phi += solid_fraction(&snap, &region)?;
+    acc.gamma_dot += velocity_gradient(&snap, &region, VelocityWeight::Mass)?.gradient[(0, 1)];
+    for (j, wall) in ["bottom", "top"].iter().enumerate() {
+        let h = top_y - 2.0 * r;
+        let spec = NearWallSpec {
+            wall: wall.to_string(),
+            flow_direction: Vector2::new(1.0, 0.0),
+            normal: Some(Vector2::new(0.0, if j == 0 { 1.0 } else { -1.0 })),
+            bin_width: 0.5 * d,
+            bins: ((h / (0.5 * d)).ceil() as usize).max(1),
+            first_layer: d,
+        };
+        let p = near_wall_profile(&snap, &spec)?;
+        if let Some(v) = p.slip_velocity {
+            acc.walls[j].0 += v.abs();
+            acc.walls[j].1 += p.tangential_force;
+            acc.walls[j].2 += p.normal_force;
+            acc.walls[j].3 += 1;
+        }
+        if j == 0 {
+            if acc.profile.is_empty() {
+                acc.profile = p.distance.iter().map(|&y| (y, 0.0, 0.0)).collect();
+            }
+            for (k, v) in p.velocity.iter().enumerate() {
+                if let (Some(v), Some(e)) = (v, acc.profile.get_mut(k)) {
+                    e.1 += v;
+                    e.2 += 1.0;
+                }
+            }
+        }
+    }
+    let _ = (length, BodyKind::Grain);
+    acc.samples += 1;
+    Ok(())
 }
