@@ -108,7 +108,17 @@ pub struct ContactGeometry {
     pub lever_b: [f64; 2],
     /// Normal restitution coefficient of the pair.
     pub restitution: f64,
+    /// Gap below which the contact counts as closed (m): [`CLOSED_GAP`] times the smaller
+    /// radius of the pair.
+    #[serde(default)]
+    pub closed_gap: f64,
 }
+
+/// A gap below this fraction of the smaller radius counts as closed: no gap-closing velocity is
+/// asked of it. Such gaps are rounding-level leftovers of settled packings; asking a statically
+/// indeterminate cluster to close them all within one step gives kinematically incompatible
+/// constraints, and the contact problem then has no exact solution.
+pub const CLOSED_GAP: f64 = 1e-4;
 
 /// All contacts of a step, sorted by `geometry.key`.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -119,6 +129,9 @@ pub struct ContactSet {
     pub geometry: Vec<ContactGeometry>,
     /// Local-law outcome after the solve, same order.
     pub status: Vec<ContactStatus>,
+    /// Time step (s) of the step these impulses belong to (0 before any step).
+    #[serde(default)]
+    pub dt: f64,
 }
 
 impl ContactSet {

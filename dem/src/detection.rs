@@ -12,7 +12,7 @@ use nalgebra::Vector2;
 
 use crate::body::Body;
 use crate::collider::{rotate, Collider, Shape};
-use crate::contact::{ContactGeometry, ContactRow, ContactSet};
+use crate::contact::{ContactGeometry, ContactRow, ContactSet, CLOSED_GAP};
 use crate::error::DemError;
 use crate::local::ContactStatus;
 use crate::material::ContactLaws;
@@ -332,7 +332,21 @@ impl Detector {
         let lever_a = Vector2::new(dx, dy) - n * rb + off_a;
         let point = Vector2::new(pb[0], pb[1]) - n * rb;
         push_contact(
-            out, inv_mass, laws, ca, cb, ci, cj, ba, bb, n, point, lever_a, lever_b, gap,
+            out,
+            inv_mass,
+            laws,
+            ca,
+            cb,
+            ci,
+            cj,
+            ba,
+            bb,
+            n,
+            point,
+            lever_a,
+            lever_b,
+            gap,
+            CLOSED_GAP * ra.min(rb),
         );
     }
 
@@ -403,7 +417,21 @@ impl Detector {
             lever_a.x = per.min_image(lever_a.x);
         }
         push_contact(
-            out, inv_mass, laws, ca, cb, cw, cj, ba, bb, n, point, lever_a, lever_b, gap,
+            out,
+            inv_mass,
+            laws,
+            ca,
+            cb,
+            cw,
+            cj,
+            ba,
+            bb,
+            n,
+            point,
+            lever_a,
+            lever_b,
+            gap,
+            CLOSED_GAP * r,
         );
     }
 }
@@ -433,6 +461,7 @@ fn push_contact(
     lever_a: Vector2<f64>,
     lever_b: Vector2<f64>,
     gap: f64,
+    closed_gap: f64,
 ) {
     let t = Vector2::new(-n.y, n.x);
     let cross = |r: Vector2<f64>, v: Vector2<f64>| r.x * v.y - r.y * v.x;
@@ -461,6 +490,7 @@ fn push_contact(
         lever_a: [lever_a.x, lever_a.y],
         lever_b: [lever_b.x, lever_b.y],
         restitution: laws.restitution(ca.material, cb.material),
+        closed_gap,
     });
     out.status.push(ContactStatus::Open);
 }

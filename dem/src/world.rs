@@ -6,12 +6,13 @@
 //! 1. detect contacts at q⁻ (gap ≤ detection gap), warm-start impulses by collider pair
 //! 2. v_free = v⁻ + h M⁻¹ f_ext                    (imposed degrees of freedom keep their velocity)
 //! 3. solve  u = H v⁺ + shift,  v⁺ = v_free + M⁻¹ Hᵀ R,  (u, R) extremal pairs of the bipotential
-//!    with shift = max(g⁻, 0)/(hθ) + e·min(u_n⁻, 0)
+//!    with shift = g⁻/(hθ) for an open gap (g⁻ above 10⁻⁴ of the smaller radius) + e·min(u_n⁻, 0)
 //! 4. q⁺ = q⁻ + h [(1 − θ) v⁻ + θ v⁺]
 //! ```
 //!
 //! The shift lets a contact that is still open at the start of the step close during it (it
-//! stops exactly at contact for θ = 1) and adds Newton restitution `u_n⁺ ≥ −e u_n⁻` on impacts;
+//! stops exactly at contact for θ = 1); a gap below 10⁻⁴ of the smaller radius counts as closed
+//! ([`crate::contact::CLOSED_GAP`]) and adds Newton restitution `u_n⁺ ≥ −e u_n⁻` on impacts;
 //! with `e = 0` (the default) an impact is perfectly inelastic. Overlaps are never pushed apart,
 //! so the scheme injects no energy: with θ = 1 the energy change of a step is
 //! `R·u⁺ − ½ ‖v⁺ − v⁻‖²_M ≤ 0`.
@@ -511,7 +512,14 @@ impl World {
             g.norm(),
             &mut self.contacts,
         )?;
-        self.contacts.warm_start_from(&self.previous, 1.0);
+        // Impulses scale with the time step (R = h r): rescale if it changed.
+        let scale = if self.previous.dt > 0.0 {
+            h / self.previous.dt
+        } else {
+            1.0
+        };
+        self.contacts.warm_start_from(&self.previous, scale);
+        self.contacts.dt = h;
 
         // 2. Free velocities.
         self.vel.clear();
@@ -520,7 +528,12 @@ impl World {
         }
         let mut max_pen = 0.0f64;
         for (row, geo) in self.contacts.rows.iter_mut().zip(&self.contacts.geometry) {
-            let mut shift = geo.gap.max(0.0) / (h * theta);
+            let open_gap = if geo.gap > geo.closed_gap {
+                geo.gap
+            } else {
+                0.0
+            };
+            let mut shift = open_gap / (h * theta);
             max_pen = max_pen.max(-geo.gap);
             if geo.restitution > 0.0 && geo.gap <= 0.0 {
                 // Detection leaves the shift at zero, so this is u_n⁻.

@@ -201,3 +201,24 @@ fn disk_with_locked_rotation_sticks_iff_tan_phi_at_most_mu() {
         assert!(rel(a, expected) <= 1e-6, "a = {a} vs {expected}");
     }
 }
+
+/// Changing the time step between steps keeps the warm start right: impulses are rescaled by
+/// the ratio of time steps, so a resting disk needs no sweep after the change (its warm-started
+/// impulse `m g h'` is already the solution).
+#[test]
+fn warm_start_rescales_impulses_when_the_time_step_changes() {
+    let mut w = World::new(
+        params(1e-3, Vector2::new(0.0, -G)),
+        ContactLaws::new(&["m"], 0.4),
+    );
+    w.add_line_wall("floor", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
+    let b = w.add_grain(Vector2::new(0.0, 0.01), 0.01, 2500.0, 0) as usize;
+    let m = w.bodies[b].mass;
+    for _ in 0..5 {
+        w.step().unwrap();
+    }
+    w.params.dt = 2.5e-4;
+    let rep = w.step().unwrap();
+    assert_eq!(rep.solver.iterations, 0, "{rep:?}");
+    assert!((w.contacts().rows[0].r[0] - m * G * 2.5e-4).abs() <= 1e-12 * m * G * 2.5e-4);
+}
