@@ -24,7 +24,7 @@ use crate::scenarios::{self, RunContext};
 
 /// grainlaw: discrete-element simulations of granular media turned into calibrated continuum laws.
 #[derive(Debug, Parser)]
-#[command(name = "grainlaw", version, about, long_about = None)]
+#[command(name = "grainlaw", version, about, long_about = None, allow_negative_numbers = true)]
 pub struct Cli {
     /// What to do (default: `run janssen`).
     #[command(subcommand)]
@@ -70,7 +70,7 @@ pub enum Command {
         /// The problem file.
         problem: PathBuf,
         /// Tolerance on the error measure.
-        #[arg(long, default_value_t = 1e-6)]
+        #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
         tol: f64,
         /// Largest number of Gauss–Seidel sweeps.
         #[arg(long, default_value_t = 100_000)]

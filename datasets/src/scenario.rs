@@ -111,6 +111,8 @@ pub fn typed<T: DeserializeOwned>(table: Table, source: &str) -> Result<T> {
             let (field, tail) = rest.split_once('`').unwrap_or((rest, ""));
             let key = if path == "." || path.is_empty() {
                 field.to_string()
+            } else if path == field || path.ends_with(&format!(".{field}")) {
+                path.clone()
             } else {
                 format!("{path}.{field}")
             };

@@ -70,7 +70,10 @@ pub fn draw_particles(out: &mut OutputDir, name: &str, view: &ParticleView) -> R
     render(out, name, size, |root| {
         let (main, bar_area) = root.split_horizontally(size.0 - right);
         let mut chart = ChartBuilder::on(&main)
-            .caption(&view.title, font((1.7 * size.0 as f64 / view.title.chars().count().max(1) as f64).min(22.0)))
+            .caption(
+                &view.title,
+                font((1.7 * size.0 as f64 / view.title.chars().count().max(1) as f64).min(22.0)),
+            )
             .margin_left(10)
             .margin_top(10)
             .x_label_area_size(bottom - 10)

@@ -436,7 +436,12 @@ pub fn draw_row(out: &mut OutputDir, name: &str, plots: &[XyPlot], size: (u32, u
 }
 
 /// Draws several plots stacked in one column as `name`.
-pub fn draw_column(out: &mut OutputDir, name: &str, plots: &[XyPlot], size: (u32, u32)) -> Result<()> {
+pub fn draw_column(
+    out: &mut OutputDir,
+    name: &str,
+    plots: &[XyPlot],
+    size: (u32, u32),
+) -> Result<()> {
     render(out, name, size, |root| {
         let areas = root.split_evenly((plots.len().max(1), 1));
         for (p, a) in plots.iter().zip(areas.iter()) {

@@ -63,15 +63,22 @@ pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                 .map(|w| w.force)
                 .unwrap_or_default()
         };
-        let (bottom, left, right, top) = (force("bottom"), force("left"), force("right"), force("top"));
+        let (bottom, left, right, top) =
+            (force("bottom"), force("left"), force("right"), force("top"));
         // Force received by a wall: the grains push it; the bottom wall is pushed down.
         let bottom_load = -bottom.y;
         let ratio = bottom_load / weight;
         s.int(&format!("grains_{name}"), (snap.bodies.len() - 4) as u64)
             .num(&format!("weight_N_{name}"), weight)
             .num(&format!("bottom_load_over_weight_{name}"), ratio)
-            .num(&format!("side_wall_load_over_weight_{name}"), -(left.y + right.y) / weight)
-            .num(&format!("side_wall_normal_force_N_{name}"), 0.5 * (-left.x + right.x))
+            .num(
+                &format!("side_wall_load_over_weight_{name}"),
+                -(left.y + right.y) / weight,
+            )
+            .num(
+                &format!("side_wall_normal_force_N_{name}"),
+                0.5 * (-left.x + right.x),
+            )
             .flag(&format!("at_rest_{name}"), stats.at_rest);
         table.push(vec![
             k as f64,
@@ -93,7 +100,9 @@ pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             &format!("normal_forces_{name}.png"),
             &ParticleView {
                 snap: &snap,
-                title: format!("{name} arrangement: normal forces (bottom load / weight = {ratio:.3})"),
+                title: format!(
+                    "{name} arrangement: normal forces (bottom load / weight = {ratio:.3})"
+                ),
                 fill: GrainFill::Plain,
                 forces: true,
                 axis_labels: ("x (m)".into(), "y (m)".into()),
@@ -104,5 +113,8 @@ pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     solver_keys(&mut s, &all);
     table.comments.push("one row per arrangement; forces of the grains on the walls at rest (N per metre of thickness)".into());
     table.write(&mut ctx.out, "wall_loads.csv")?;
-    Ok(RunOutcome { summary: s, headline })
+    Ok(RunOutcome {
+        summary: s,
+        headline,
+    })
 }

@@ -81,7 +81,13 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     let bins = c.profile_bins;
     let dy = 1.6 * h_est / bins as f64;
     let mut prof = Profiles::new(bins, dy);
-    let mut hist = CsvTable::new(&["time_s", "mean_velocity_m_s", "kinetic_energy_J", "sweeps", "solver_error"]);
+    let mut hist = CsvTable::new(&[
+        "time_s",
+        "mean_velocity_m_s",
+        "kinetic_energy_J",
+        "sweeps",
+        "solver_error",
+    ]);
     let mut vtk = VtkFrames::new(c.duration / c.vtk_frames.max(1) as f64, c.vtk_frames.max(1));
     let env = ctx.env();
     let out = &mut ctx.out;
@@ -94,7 +100,13 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             mv += b.mass * b.velocity.x;
             m += b.mass;
         }
-        hist.push(vec![w.time, mv / m, w.kinetic_energy(), r.solver.iterations as f64, r.solver.error]);
+        hist.push(vec![
+            w.time,
+            mv / m,
+            w.kinetic_energy(),
+            r.solver.iterations as f64,
+            r.solver.error,
+        ]);
         if k > avg_from && k % sample_every == 0 {
             prof.add(&w.snapshot(), base)?;
         }
@@ -108,15 +120,28 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     let values: Vec<f64> = ratios.iter().map(|r| r.ratio.unwrap_or(f64::NAN)).collect();
 
     // Profiles.
-    let mut table = CsvTable::new(&["height_m", "velocity_m_s", "solid_fraction", "mean_log10_inertia_ratio"]);
+    let mut table = CsvTable::new(&[
+        "height_m",
+        "velocity_m_s",
+        "solid_fraction",
+        "mean_log10_inertia_ratio",
+    ]);
     let mut vel = Vec::new();
     let mut phi = Vec::new();
     let mut lr = Vec::new();
     for i in 0..bins {
         let y = (i as f64 + 0.5) * dy;
-        let v = if prof.m[i] > 0.0 { prof.mv[i] / prof.m[i] } else { f64::NAN };
+        let v = if prof.m[i] > 0.0 {
+            prof.mv[i] / prof.m[i]
+        } else {
+            f64::NAN
+        };
         let f = prof.area[i] / (prof.samples.max(1) as f64 * length * dy);
-        let l = if prof.n_ratio[i] > 0.0 { prof.log_ratio[i] / prof.n_ratio[i] } else { f64::NAN };
+        let l = if prof.n_ratio[i] > 0.0 {
+            prof.log_ratio[i] / prof.n_ratio[i]
+        } else {
+            f64::NAN
+        };
         table.push(vec![y, v, f, l]);
         if v.is_finite() {
             vel.push((v, y));
@@ -134,9 +159,17 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     hist.write(&mut ctx.out, "history.csv")?;
     // Flow height: where the time-averaged solid fraction falls below half its bulk value.
     let bulk = phi.iter().map(|p| p.0).fold(0.0, f64::max);
-    let height = phi.iter().filter(|p| p.0 > 0.5 * bulk).map(|p| p.1 + 0.5 * dy).fold(0.0, f64::max);
+    let height = phi
+        .iter()
+        .filter(|p| p.0 > 0.5 * bulk)
+        .map(|p| p.1 + 0.5 * dy)
+        .fold(0.0, f64::max);
     let mean_v = hist.rows.last().map(|r| r[1]).unwrap_or(f64::NAN);
-    let surface_v = vel.iter().filter(|p| p.1 <= height).map(|p| p.0).fold(f64::NAN, f64::max);
+    let surface_v = vel
+        .iter()
+        .filter(|p| p.1 <= height)
+        .map(|p| p.0)
+        .fold(f64::NAN, f64::max);
     let n_contactless = ratios.iter().filter(|r| r.ratio.is_none()).count();
 
     let mut s = Summary::new();
@@ -149,7 +182,10 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         .num("surface_velocity_m_s", surface_v)
         .num("flow_height_m", height)
         .num("flow_height_diameters", height / d)
-        .num("froude_number", mean_v / (9.81 * c.slope_deg.to_radians().cos() * height).sqrt())
+        .num(
+            "froude_number",
+            mean_v / (9.81 * c.slope_deg.to_radians().cos() * height).sqrt(),
+        )
         .num("fluid_fraction", fluid)
         .num("fluid_threshold", c.fluid_threshold)
         .int("grains_without_contact", n_contactless as u64)
@@ -158,7 +194,11 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
 
     // Figures.
     // Colour range: the 2 % and 98 % quantiles, widened to whole decades.
-    let mut finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite() && *v > 0.0).collect();
+    let mut finite: Vec<f64> = values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
     finite.sort_by(f64::total_cmp);
     let (lo, hi) = if finite.len() >= 2 {
         let q = |p: f64| finite[((finite.len() - 1) as f64 * p).round() as usize];
@@ -179,11 +219,18 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             ),
             fill: GrainFill::Values {
                 values: values.clone(),
-                scale: Scale { min: lo, max: hi, log: true },
+                scale: Scale {
+                    min: lo,
+                    max: hi,
+                    log: true,
+                },
                 label: "‖Σ_i‖_F / ‖Σ_c‖_F".into(),
             },
             forces: false,
-            axis_labels: ("x along the slope (m)".into(), "y normal to the slope (m)".into()),
+            axis_labels: (
+                "x along the slope (m)".into(),
+                "y normal to the slope (m)".into(),
+            ),
             width_px: 1300,
         },
     )?;
@@ -192,19 +239,39 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         Axis::new("velocity along the slope (m/s)"),
         Axis::new("height above the base y (m)"),
     );
-    pv.series.push(Series::new("DEM", Style::LinePoints, PALETTE[0], vel.clone()));
+    pv.series.push(Series::new(
+        "DEM",
+        Style::LinePoints,
+        PALETTE[0],
+        vel.clone(),
+    ));
     pv.legend = LegendAt::UpperLeft;
-    let mut pf = XyPlot::new("Solid fraction", Axis::new("solid fraction φ"), Axis::new("height above the base y (m)"));
-    pf.series.push(Series::new("", Style::LinePoints, PALETTE[2], phi.clone()));
+    let mut pf = XyPlot::new(
+        "Solid fraction",
+        Axis::new("solid fraction φ"),
+        Axis::new("height above the base y (m)"),
+    );
+    pf.series
+        .push(Series::new("", Style::LinePoints, PALETTE[2], phi.clone()));
     let mut pr = XyPlot::new(
         "Inertia ratio across the layer",
         Axis::new("mean log₁₀ ‖Σ_i‖/‖Σ_c‖"),
         Axis::new("height above the base y (m)"),
     );
-    pr.series.push(Series::new("", Style::LinePoints, PALETTE[1], lr));
+    pr.series
+        .push(Series::new("", Style::LinePoints, PALETTE[1], lr));
     draw_row(&mut ctx.out, "profiles.png", &[pv, pf, pr], (1800, 650))?;
-    let mut ph = XyPlot::new("Mean velocity of the layer", Axis::new("time t (s)"), Axis::new("mean velocity along the slope (m/s)"));
-    ph.series.push(Series::new("", Style::Thin, PALETTE[0], hist.rows.iter().map(|r| (r[0], r[1])).collect()));
+    let mut ph = XyPlot::new(
+        "Mean velocity of the layer",
+        Axis::new("time t (s)"),
+        Axis::new("mean velocity along the slope (m/s)"),
+    );
+    ph.series.push(Series::new(
+        "",
+        Style::Thin,
+        PALETTE[0],
+        hist.rows.iter().map(|r| (r[0], r[1])).collect(),
+    ));
     draw_xy(&mut ctx.out, "velocity_history.png", &ph)?;
 
     let headline = vec![
@@ -216,5 +283,8 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             100.0 * fluid
         ),
     ];
-    Ok(RunOutcome { summary: s, headline })
+    Ok(RunOutcome {
+        summary: s,
+        headline,
+    })
 }

@@ -1,10 +1,15 @@
-//! The `janssen` scenario: deposit → relax → homogenise → fit → figures.
+//! The `janssen` scenario: deposit → relax → release → homogenise → fit → figures.
 //!
 //! 1. Grains rained without overlap into a box of two vertical walls and a floor fall under
 //!    gravity (deposition, sub-stepped: `dt / deposit.substeps`, loose solver tolerance) until at
 //!    rest; then the column is relaxed at the scenario's `dt` with a tight tolerance until at
-//!    rest again.
-//! 2. On the relaxed state: the wall normal and shear stress by depth bin on both side walls
+//!    rest again. The static forces of a rigid column at rest are indeterminate (how much weight
+//!    the walls carry depends on the solver's path), so the column is then released: the floor
+//!    is lowered slowly (`release`), the grains slide along the walls and the wall contacts reach
+//!    the Coulomb limit (the paper's "relâcher le système afin de se mettre dans les conditions
+//!    de Coulomb"). The last step of the release is solved to the tight tolerance with a large
+//!    sweep cap, and measured.
+//! 2. On the measured state: the wall normal and shear stress by depth bin on both side walls
 //!    (σ_h = −σ_nn, τ_w), the vertical stress across horizontal planes at the bins' middles
 //!    (σ_v = −σ_yy, method of planes), the bulk density ρ_b = φ ρ, the load on the floor over the
 //!    weight, and the friction mobilisation |f_t|/(μ f_n) of the side-wall contacts.
@@ -227,7 +232,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     let bottom = col.bottom;
     let mut history = CsvTable::new(&[
         "time_s",
-        "phase_0deposit_1release_2relax",
+        "phase_0deposit_1relax_2release_3measure",
         "kinetic_energy_J",
         "contacts",
         "sweeps",
@@ -266,26 +271,9 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         |w, r| record(w, r, 0.0, out),
     )?;
     let deposit_load = -world.contact_force(bottom).0.y / weight;
-    // 2. Release (floor lowered slowly) and relaxation at the scenario's time step, tight
-    //    tolerance.
+    // 2. Relaxation at the scenario's time step, tight tolerance.
     world.params.dt = c.dt;
     world.params.solver = c.relax.solver.params();
-    let release_steps = (c.release.floor_drop / (c.release.speed * c.dt)).ceil() as u64;
-    let mut release = datasets::phases::PhaseStats::default();
-    if release_steps > 0 {
-        world.bodies[bottom].velocity =
-            Vector2::new(0.0, -c.release.floor_drop / (release_steps as f64 * c.dt));
-        world.params.solver = c.deposit.solver.params();
-        release = run_phase(
-            &env,
-            "release",
-            world,
-            Stop::Steps(release_steps),
-            |w, r| record(w, r, 1.0, out),
-        )?;
-        world.bodies[bottom].velocity = Vector2::zeros();
-        world.params.solver = c.relax.solver.params();
-    }
     let relax = run_phase(
         &env,
         "relax",
@@ -295,13 +283,39 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             max_time: c.relax.max_time,
             rest_energy: c.relax.rest_energy,
         }),
-        |w, r| record(w, r, 2.0, out),
+        |w, r| record(w, r, 1.0, out),
     )?;
+    let relaxed_load = -world.contact_force(bottom).0.y / weight;
+    // 3. Release: the floor is lowered slowly so that the column slides along the walls
+    //    (Coulomb conditions at the wall contacts); the stresses are measured at the end of the
+    //    release, on a step solved to the tight tolerance while the floor still moves.
+    let release_steps = (c.release.floor_drop / (c.release.speed * c.dt)).ceil() as u64;
+    let mut release = datasets::phases::PhaseStats::default();
+    if release_steps > 0 {
+        world.bodies[bottom].velocity = Vector2::new(0.0, -c.release.speed);
+        world.params.solver = c.release.solver.params();
+        release = run_phase(
+            &env,
+            "release",
+            world,
+            Stop::Steps(release_steps),
+            |w, r| record(w, r, 2.0, out),
+        )?;
+        world.params.solver = dem::SolverParams {
+            tolerance: c.relax.solver.tolerance,
+            max_iterations: c.analysis.final_max_iterations,
+            ..Default::default()
+        };
+        let r = world.step()?;
+        record(world, &r, 3.0, out)?;
+        release.record(&r, c.dt);
+        world.params.solver = c.relax.solver.params();
+    }
     let final_report = world.last_report();
     if !final_report.solver.converged {
         warn(&format!(
-            "the measured (last) step did not converge: error {:.2e} > {:.0e}",
-            final_report.solver.error, c.relax.solver.tolerance
+            "the measured (last) step did not converge: error {:.2e} > {:.0e} after {} sweeps",
+            final_report.solver.error, c.relax.solver.tolerance, final_report.solver.iterations
         ));
     }
     let snap = world.snapshot();
@@ -423,25 +437,37 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         .num("deposit_time_s", deposit.simulated_time)
         .int("deposit_unconverged_steps", deposit.unconverged_steps)
         .num("deposit_bottom_load_over_weight", deposit_load)
+        .num("relaxed_bottom_load_over_weight", relaxed_load)
         .num("release_floor_drop_m", c.release.floor_drop)
+        .num("release_speed_m_s", c.release.speed)
         .int("release_steps", release.steps)
         .int("release_unconverged_steps", release.unconverged_steps)
+        .num("release_worst_error", release.worst_error)
         .int("relax_steps", relax.steps)
         .num("relax_time_s", relax.simulated_time)
         .int("relax_unconverged_steps", relax.unconverged_steps)
         .num("relax_worst_error", relax.worst_error)
-        .flag("at_rest", relax.at_rest)
+        .flag("relax_at_rest", relax.at_rest)
         .num("final_kinetic_energy_ratio", relax.final_energy_ratio)
         .num("final_solver_error", final_report.solver.error)
+        .int("final_solver_sweeps", final_report.solver.iterations as u64)
+        .flag("final_solver_converged", final_report.solver.converged)
         .int("vtk_frames", frames as u64);
 
     // CSV: history and the fit-ready profile.
     history.write(&mut ctx.out, "history.csv")?;
+    // τ_w is named `tau_w_Pa` (read by `grainlaw fit janssen`) only when the fit used it.
+    let uses_tau = fitted.as_ref().map(|o| o.uses_tau_w).unwrap_or(false);
+    let tau_header = if uses_tau {
+        "tau_w_Pa"
+    } else {
+        "tau_w_measured_Pa"
+    };
     let mut prof = CsvTable::new(&[
         "z_m",
         "sigma_v_Pa",
         "sigma_h_Pa",
-        "tau_w_Pa",
+        tau_header,
         "janssen_sigma_v_Pa",
         "janssen_sigma_h_Pa",
         "hydrostatic_Pa",
@@ -455,6 +481,11 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         ("depth_min_m".into(), window.0),
         ("depth_max_m".into(), window.1),
     ];
+    if let Ok(o) = &fitted {
+        if o.mode == "full_mobilisation" {
+            prof.metadata.push(("full_mobilisation".into(), 1.0));
+        }
+    }
     for (i, &z) in profile.z.iter().enumerate() {
         let (jv, jh) = match &fitted {
             Ok(o) => (o.fit.law.sigma_v(z), o.fit.law.sigma_h(z)),
@@ -603,6 +634,12 @@ fn figure_profile(
             Style::Line,
             PALETTE[1],
             zs.iter().map(|&z| (f.law.sigma_h(z), z)).collect(),
+        ));
+        plot.series.push(Series::new(
+            "Janssen τ_w = μ_w σ_h",
+            Style::Line,
+            PALETTE[2],
+            zs.iter().map(|&z| (f.law.tau_w(z), z)).collect(),
         ));
         let kmu = if o.mode == "joint" {
             format!(

@@ -22,7 +22,9 @@ use identify::wall_law::{select_wall_law, WallSlipSeries};
 use identify::{CalibratedLaw, FitOptions};
 use nalgebra::Vector2;
 
-use super::common::{delta_band, mean_diameter, run_phase, solver_keys, write_law, Stop, VtkFrames};
+use super::common::{
+    delta_band, mean_diameter, run_phase, solver_keys, write_law, Stop, VtkFrames,
+};
 use super::{RunContext, RunOutcome};
 use crate::error::Result;
 use crate::output::{CsvTable, Summary};
@@ -54,7 +56,13 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     let mut all = datasets::phases::PhaseStats::default();
     // Compression at zero shear.
     world.params.dt = c.dt_max;
-    let comp = run_phase(&env, "compress", &mut world, Stop::Steps((c.compression_time / c.dt_max).ceil() as u64), |_, _| Ok(()))?;
+    let comp = run_phase(
+        &env,
+        "compress",
+        &mut world,
+        Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
+        |_, _| Ok(()),
+    )?;
     all.merge(&comp);
     let mut rows = Vec::new();
     let mut mean_profiles = Vec::new();
@@ -75,13 +83,19 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         let mut n = 0u64;
         let out = &mut ctx.out;
         let _ = out;
-        let stats = run_phase(&env, &format!("I={i_target}"), &mut world, Stop::Steps(steps), |w, _| {
-            n += 1;
-            if n + avg_steps > steps && n % every == 0 {
-                sample(w, &mut acc, r, d, length)?;
-            }
-            Ok(())
-        })?;
+        let stats = run_phase(
+            &env,
+            &format!("I={i_target}"),
+            &mut world,
+            Stop::Steps(steps),
+            |w, _| {
+                n += 1;
+                if n + avg_steps > steps && n % every == 0 {
+                    sample(w, &mut acc, r, d, length)?;
+                }
+                Ok(())
+            },
+        )?;
         all.merge(&stats);
         let m = acc.samples.max(1) as f64;
         let (sxy, syy, phi, gd) = (acc.sxy / m, acc.syy / m, acc.phi / m, acc.gamma_dot / m);
@@ -95,16 +109,51 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         };
         let (vb, mub) = wall(0);
         let (vt, mut_) = wall(1);
-        rows.push(vec![i_target, i_meas, mu, phi, p, gd, v, h, dt, vb, mub, vt, mut_, acc.samples as f64]);
-        mean_profiles.push((i_meas, acc.profile.iter().map(|&(y, s, c)| (y, if c > 0.0 { s / c } else { f64::NAN })).collect::<Vec<_>>(), v, h));
+        rows.push(vec![
+            i_target,
+            i_meas,
+            mu,
+            phi,
+            p,
+            gd,
+            v,
+            h,
+            dt,
+            vb,
+            mub,
+            vt,
+            mut_,
+            acc.samples as f64,
+        ]);
+        mean_profiles.push((
+            i_meas,
+            acc.profile
+                .iter()
+                .map(|&(y, s, c)| (y, if c > 0.0 { s / c } else { f64::NAN }))
+                .collect::<Vec<_>>(),
+            v,
+            h,
+        ));
         if k + 1 == targets.len() {
             vtk = VtkFrames::new(f64::INFINITY, 1);
         }
     }
     vtk.finish(&mut ctx.out, &world)?;
     let headers = [
-        "I_target", "I", "mu", "phi", "P_Pa", "shear_rate_1_s", "wall_velocity_m_s", "height_m", "dt_s",
-        "slip_velocity_bottom_m_s", "mu_eff_bottom", "slip_velocity_top_m_s", "mu_eff_top", "samples",
+        "I_target",
+        "I",
+        "mu",
+        "phi",
+        "P_Pa",
+        "shear_rate_1_s",
+        "wall_velocity_m_s",
+        "height_m",
+        "dt_s",
+        "slip_velocity_bottom_m_s",
+        "mu_eff_bottom",
+        "slip_velocity_top_m_s",
+        "mu_eff_top",
+        "samples",
     ];
     let mut table = CsvTable::new(&headers);
     for r in &rows {
@@ -131,47 +180,111 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         .num("I_max", rows.iter().map(|r| r[1]).fold(f64::MIN, f64::max));
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
     let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
-    let (imin, imax) = (is.iter().cloned().fold(f64::MAX, f64::min), is.iter().cloned().fold(f64::MIN, f64::max));
-    let xs: Vec<f64> = (0..=80).map(|k| imin * 0.7 * (imax * 1.4 / (imin * 0.7)).powf(k as f64 / 80.0)).collect();
-    let mut pmu = XyPlot::new("Friction law μ(I)", Axis::new("inertial number I").log(), Axis::new("μ = |σ_xy| / P"));
-    pmu.series.push(Series::new("DEM", Style::Points, PALETTE[0], rows.iter().map(|r| (r[1], r[2])).collect()));
+    let (imin, imax) = (
+        is.iter().cloned().fold(f64::MAX, f64::min),
+        is.iter().cloned().fold(f64::MIN, f64::max),
+    );
+    let xs: Vec<f64> = (0..=80)
+        .map(|k| imin * 0.7 * (imax * 1.4 / (imin * 0.7)).powf(k as f64 / 80.0))
+        .collect();
+    let mut pmu = XyPlot::new(
+        "Friction law μ(I)",
+        Axis::new("inertial number I").log(),
+        Axis::new("μ = |σ_xy| / P"),
+    );
+    pmu.series.push(Series::new(
+        "DEM",
+        Style::Points,
+        PALETTE[0],
+        rows.iter().map(|r| (r[1], r[2])).collect(),
+    ));
     match fit_mu_i(&series, &opts) {
         Ok(f) => {
             let p = f.report.values();
-            let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| {
-                identify::laws::mu_i::MuILaw { mu_s: p[0], mu_2: p[1], i0: p[2] }.mu(i)
-            });
-            pmu.bands.push(Band::between("95 % confidence band", PALETTE[0], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
-            pmu.series.push(Series::new("μ_s + (μ₂ − μ_s)/(1 + I₀/I)", Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+            let band = delta_band(
+                &p,
+                &f.report.covariance,
+                f.report.t_critical,
+                &xs,
+                |p, i| {
+                    identify::laws::mu_i::MuILaw {
+                        mu_s: p[0],
+                        mu_2: p[1],
+                        i0: p[2],
+                    }
+                    .mu(i)
+                },
+            );
+            pmu.bands.push(Band::between(
+                "95 % confidence band",
+                PALETTE[0],
+                &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
+            ));
+            pmu.series.push(Series::new(
+                "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                Style::Line,
+                PALETTE[1],
+                band.iter().map(|b| (b.0, b.1)).collect(),
+            ));
             for e in &f.report.parameters {
                 s.num(&format!("mu_i_{}", e.name), e.value)
                     .num(&format!("mu_i_{}_ci_low", e.name), e.ci_low)
                     .num(&format!("mu_i_{}_ci_high", e.name), e.ci_high);
             }
-            s.text("mu_i_form", "mu-i").num("mu_i_r_squared", f.report.r_squared);
+            s.text("mu_i_form", "mu-i")
+                .num("mu_i_r_squared", f.report.r_squared);
             headline.push(format!(
                 "μ(I): μ_s = {:.3}, μ₂ = {:.3}, I₀ = {:.3} (R² = {:.3})",
                 f.law.mu_s, f.law.mu_2, f.law.i0, f.report.r_squared
             ));
-            write_law(&mut ctx.out, "mu_i_law.json", &CalibratedLaw::from_mu_i(&f, prov()))?;
+            write_law(
+                &mut ctx.out,
+                "mu_i_law.json",
+                &CalibratedLaw::from_mu_i(&f, prov()),
+            )?;
         }
         Err(e) => {
-            warn(&format!("μ(I) fit failed ({e}); fitting the linear form μ_s + b I"));
+            warn(&format!(
+                "μ(I) fit failed ({e}); fitting the linear form μ_s + b I"
+            ));
             s.text("mu_i_fit_error", &e.to_string());
             match fit_mu_i_linear(&series, &opts) {
                 Ok(f) => {
                     let p = f.report.values();
-                    let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| p[0] + p[1] * i);
-                    pmu.bands.push(Band::between("95 % confidence band", PALETTE[0], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
-                    pmu.series.push(Series::new("μ_s + b I", Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+                    let band = delta_band(
+                        &p,
+                        &f.report.covariance,
+                        f.report.t_critical,
+                        &xs,
+                        |p, i| p[0] + p[1] * i,
+                    );
+                    pmu.bands.push(Band::between(
+                        "95 % confidence band",
+                        PALETTE[0],
+                        &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
+                    ));
+                    pmu.series.push(Series::new(
+                        "μ_s + b I",
+                        Style::Line,
+                        PALETTE[1],
+                        band.iter().map(|b| (b.0, b.1)).collect(),
+                    ));
                     for e in &f.report.parameters {
                         s.num(&format!("mu_i_{}", e.name), e.value)
                             .num(&format!("mu_i_{}_ci_low", e.name), e.ci_low)
                             .num(&format!("mu_i_{}_ci_high", e.name), e.ci_high);
                     }
-                    s.text("mu_i_form", "mu-i-linear").num("mu_i_r_squared", f.report.r_squared);
-                    headline.push(format!("μ(I) (linear): μ_s = {:.3}, b = {:.3}", f.law.mu_s, f.law.slope));
-                    write_law(&mut ctx.out, "mu_i_law.json", &CalibratedLaw::from_mu_i_linear(&f, prov()))?;
+                    s.text("mu_i_form", "mu-i-linear")
+                        .num("mu_i_r_squared", f.report.r_squared);
+                    headline.push(format!(
+                        "μ(I) (linear): μ_s = {:.3}, b = {:.3}",
+                        f.law.mu_s, f.law.slope
+                    ));
+                    write_law(
+                        &mut ctx.out,
+                        "mu_i_law.json",
+                        &CalibratedLaw::from_mu_i_linear(&f, prov()),
+                    )?;
                 }
                 Err(e2) => {
                     warn(&format!("linear μ(I) fit failed too: {e2}"));
@@ -181,21 +294,52 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         }
     }
     pmu.legend = LegendAt::UpperLeft;
-    let mut pphi = XyPlot::new("Solid fraction φ(I)", Axis::new("inertial number I").log(), Axis::new("solid fraction φ"));
-    pphi.series.push(Series::new("DEM", Style::Points, PALETTE[2], rows.iter().map(|r| (r[1], r[3])).collect()));
+    let mut pphi = XyPlot::new(
+        "Solid fraction φ(I)",
+        Axis::new("inertial number I").log(),
+        Axis::new("solid fraction φ"),
+    );
+    pphi.series.push(Series::new(
+        "DEM",
+        Style::Points,
+        PALETTE[2],
+        rows.iter().map(|r| (r[1], r[3])).collect(),
+    ));
     match fit_phi_i(&series, &opts) {
         Ok(f) => {
             let p = f.report.values();
-            let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| p[0] - (p[0] - p[1]) * i);
-            pphi.bands.push(Band::between("95 % confidence band", PALETTE[2], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
-            pphi.series.push(Series::new("φ_max − (φ_max − φ_min) I", Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+            let band = delta_band(
+                &p,
+                &f.report.covariance,
+                f.report.t_critical,
+                &xs,
+                |p, i| p[0] - (p[0] - p[1]) * i,
+            );
+            pphi.bands.push(Band::between(
+                "95 % confidence band",
+                PALETTE[2],
+                &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
+            ));
+            pphi.series.push(Series::new(
+                "φ_max − (φ_max − φ_min) I",
+                Style::Line,
+                PALETTE[1],
+                band.iter().map(|b| (b.0, b.1)).collect(),
+            ));
             for e in &f.report.parameters {
                 s.num(&format!("phi_i_{}", e.name), e.value)
                     .num(&format!("phi_i_{}_ci_low", e.name), e.ci_low)
                     .num(&format!("phi_i_{}_ci_high", e.name), e.ci_high);
             }
-            headline.push(format!("φ(I): φ_max = {:.3}, φ_min = {:.3}", f.law.phi_max, f.law.phi_min));
-            write_law(&mut ctx.out, "phi_i_law.json", &CalibratedLaw::from_phi_i(&f, prov()))?;
+            headline.push(format!(
+                "φ(I): φ_max = {:.3}, φ_min = {:.3}",
+                f.law.phi_max, f.law.phi_min
+            ));
+            write_law(
+                &mut ctx.out,
+                "phi_i_law.json",
+                &CalibratedLaw::from_phi_i(&f, prov()),
+            )?;
         }
         Err(e) => {
             warn(&format!("φ(I) fit failed: {e}"));
@@ -216,8 +360,17 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     }
     let ws = WallSlipSeries::new(vs.clone(), mus.clone(), d);
     let scale = (9.81 * d).sqrt();
-    let mut pw = XyPlot::new("Wall friction vs slip", Axis::new("slip velocity V_s / √(g d)"), Axis::new("μ_eff = τ_w / σ_w"));
-    pw.series.push(Series::new("DEM (both walls)", Style::Points, PALETTE[3], vs.iter().zip(&mus).map(|(v, m)| (v / scale, *m)).collect()));
+    let mut pw = XyPlot::new(
+        "Wall friction vs slip",
+        Axis::new("slip velocity V_s / √(g d)"),
+        Axis::new("μ_eff = τ_w / σ_w"),
+    );
+    pw.series.push(Series::new(
+        "DEM (both walls)",
+        Style::Points,
+        PALETTE[3],
+        vs.iter().zip(&mus).map(|(v, m)| (v / scale, *m)).collect(),
+    ));
     match select_wall_law(&ws, &opts) {
         Ok(sel) => {
             let best = sel.best();
@@ -225,17 +378,44 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             let vx: Vec<f64> = (0..=80).map(|k| vmax * 1.05 * k as f64 / 80.0).collect();
             let p = best.report.values();
             let form = best.form;
-            let band = delta_band(&p, &best.report.covariance, best.report.t_critical, &vx, |p, v| {
-                use identify::laws::wall_friction::WallFrictionLaw as W;
-                let law = match form {
-                    identify::wall_law::WallLawForm::Exponential => W::Exponential { mu_0: p[0], mu_inf: p[1], v_star: p[2] },
-                    identify::wall_law::WallLawForm::Hyperbolic => W::Hyperbolic { mu_0: p[0], mu_inf: p[1], v_star: p[2] },
-                    identify::wall_law::WallLawForm::PowerLaw => W::PowerLaw { mu_0: p[0], k: p[1], n: p[2] },
-                };
-                law.mu_eff(v)
-            });
-            pw.bands.push(Band::between("95 % confidence band", PALETTE[3], &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>()));
-            pw.series.push(Series::new(&format!("{} (best AIC)", form.law_name()), Style::Line, PALETTE[1], band.iter().map(|b| (b.0, b.1)).collect()));
+            let band = delta_band(
+                &p,
+                &best.report.covariance,
+                best.report.t_critical,
+                &vx,
+                |p, v| {
+                    use identify::laws::wall_friction::WallFrictionLaw as W;
+                    let law = match form {
+                        identify::wall_law::WallLawForm::Exponential => W::Exponential {
+                            mu_0: p[0],
+                            mu_inf: p[1],
+                            v_star: p[2],
+                        },
+                        identify::wall_law::WallLawForm::Hyperbolic => W::Hyperbolic {
+                            mu_0: p[0],
+                            mu_inf: p[1],
+                            v_star: p[2],
+                        },
+                        identify::wall_law::WallLawForm::PowerLaw => W::PowerLaw {
+                            mu_0: p[0],
+                            k: p[1],
+                            n: p[2],
+                        },
+                    };
+                    law.mu_eff(v)
+                },
+            );
+            pw.bands.push(Band::between(
+                "95 % confidence band",
+                PALETTE[3],
+                &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
+            ));
+            pw.series.push(Series::new(
+                &format!("{} (best AIC)", form.law_name()),
+                Style::Line,
+                PALETTE[1],
+                band.iter().map(|b| (b.0, b.1)).collect(),
+            ));
             s.text("wall_law_form", form.law_name());
             for e in &best.report.parameters {
                 s.num(&format!("wall_law_{}", e.name), e.value)
@@ -243,7 +423,11 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                     .num(&format!("wall_law_{}_ci_high", e.name), e.ci_high);
             }
             headline.push(format!("wall law: {} chosen by AIC", form.law_name()));
-            write_law(&mut ctx.out, "wall_law.json", &CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov()))?;
+            write_law(
+                &mut ctx.out,
+                "wall_law.json",
+                &CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov()),
+            )?;
         }
         Err(e) => {
             warn(&format!("wall-law fit failed: {e}"));
@@ -254,9 +438,21 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     pw.legend = LegendAt::LowerRight;
     draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, pw], (1950, 650))?;
     // Velocity profiles, normalised.
-    let mut pv = XyPlot::new("Velocity profiles", Axis::new("velocity / wall velocity v_x / V"), Axis::new("height / gap y / H"));
+    let mut pv = XyPlot::new(
+        "Velocity profiles",
+        Axis::new("velocity / wall velocity v_x / V"),
+        Axis::new("height / gap y / H"),
+    );
     for (k, (i, prof, v, h)) in mean_profiles.iter().enumerate() {
-        pv.series.push(Series::new(&format!("I = {i:.3}"), Style::LinePoints, PALETTE[k % PALETTE.len()], prof.iter().filter(|p| p.1.is_finite()).map(|p| (p.1 / v, p.0 / h)).collect()));
+        pv.series.push(Series::new(
+            &format!("I = {i:.3}"),
+            Style::LinePoints,
+            PALETTE[k % PALETTE.len()],
+            prof.iter()
+                .filter(|p| p.1.is_finite())
+                .map(|p| (p.1 / v, p.0 / h))
+                .collect(),
+        ));
     }
     pv.legend = LegendAt::UpperLeft;
     crate::plot::xy::draw_xy(&mut ctx.out, "velocity_profiles.png", &pv)?;
@@ -266,7 +462,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         "force_chains.png",
         &ParticleView {
             snap: &snap,
-            title: format!("Shear cell at I = {:.3}: normal forces", is.last().copied().unwrap_or(0.0)),
+            title: format!(
+                "Shear cell at I = {:.3}: normal forces",
+                is.last().copied().unwrap_or(0.0)
+            ),
             fill: GrainFill::Plain,
             forces: true,
             axis_labels: ("x (m)".into(), "y (m)".into()),
@@ -274,7 +473,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         },
     )?;
     solver_keys(&mut s, &all);
-    Ok(RunOutcome { summary: s, headline })
+    Ok(RunOutcome {
+        summary: s,
+        headline,
+    })
 }
 
 /// Adds one sample of the bulk and wall quantities to `acc`.
@@ -282,7 +484,10 @@ fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64, length: f64) ->
     let snap = w.snapshot();
     let top_y = w.bodies[1].position.y;
     let (lo, hi) = (r + 2.0 * d, top_y - r - 2.0 * d);
-    let region = Region::Slice { y_min: lo, y_max: hi.max(lo + d) };
+    let region = Region::Slice {
+        y_min: lo,
+        y_max: hi.max(lo + d),
+    };
     let gs = homogenise::grain_stresses(&snap)?;
     let st = homogenise::mean_stress(&snap, &gs, &region)?;
     let sym = (st.total + st.total.transpose()) * 0.5;

@@ -78,10 +78,16 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         let mut vtk = VtkFrames::with_prefix(&format!("{name}_"), c.push_duration / 20.0, 21);
         let out = &mut ctx.out;
         let bottom = col.bottom;
-        let push = run_phase(&env, &format!("push {k}"), world, Stop::Steps(steps), |w, _| {
-            force.push(-w.contact_force(bottom).0.y);
-            vtk.maybe(out, w)
-        })?;
+        let push = run_phase(
+            &env,
+            &format!("push {k}"),
+            world,
+            Stop::Steps(steps),
+            |w, _| {
+                force.push(-w.contact_force(bottom).0.y);
+                vtk.maybe(out, w)
+            },
+        )?;
         all.merge(&push);
         vtk.finish(&mut ctx.out, world)?;
         for (i, f) in force.iter().enumerate() {
@@ -90,16 +96,24 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         // Statistics over the second half (after the start-up transient).
         let half = &force[force.len() / 2..];
         let (m, sd) = mean_std(half);
-        let (fmin, fmax) = half.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-        s.num(&format!("friction_grain_grain_{name}"), friction.grain_grain)
-            .num(&format!("friction_grain_wall_{name}"), friction.grain_wall)
-            .num(&format!("weight_N_{name}"), weight)
-            .num(&format!("force_mean_N_{name}"), m)
-            .num(&format!("force_std_N_{name}"), sd)
-            .num(&format!("force_fluctuation_{name}"), sd / m.abs().max(1e-300))
-            .num(&format!("force_min_N_{name}"), fmin)
-            .num(&format!("force_max_N_{name}"), fmax)
-            .num(&format!("force_mean_over_weight_{name}"), m / weight);
+        let (fmin, fmax) = half
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+        s.num(
+            &format!("friction_grain_grain_{name}"),
+            friction.grain_grain,
+        )
+        .num(&format!("friction_grain_wall_{name}"), friction.grain_wall)
+        .num(&format!("weight_N_{name}"), weight)
+        .num(&format!("force_mean_N_{name}"), m)
+        .num(&format!("force_std_N_{name}"), sd)
+        .num(
+            &format!("force_fluctuation_{name}"),
+            sd / m.abs().max(1e-300),
+        )
+        .num(&format!("force_min_N_{name}"), fmin)
+        .num(&format!("force_max_N_{name}"), fmax)
+        .num(&format!("force_mean_over_weight_{name}"), m / weight);
         headline.push(format!(
             "{name:<17}: force on the moving wall {m:.3} N ± {sd:.3} N (weight {weight:.3} N; relative fluctuation {:.3})",
             sd / m.abs().max(1e-300)
@@ -124,7 +138,11 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             "",
             Style::Thin,
             PALETTE[k],
-            force.iter().enumerate().map(|(i, f)| ((i + 1) as f64 * c.dt, *f)).collect(),
+            force
+                .iter()
+                .enumerate()
+                .map(|(i, f)| ((i + 1) as f64 * c.dt, *f))
+                .collect(),
         ));
         p.legend = LegendAt::UpperRight;
         plots.push(p);
@@ -135,7 +153,10 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             &format!("force_chains_{name}.png"),
             &ParticleView {
                 snap: &snap,
-                title: format!("{}: normal forces at the end of the push", name.replace('_', " ")),
+                title: format!(
+                    "{}: normal forces at the end of the push",
+                    name.replace('_', " ")
+                ),
                 fill: GrainFill::Plain,
                 forces: true,
                 axis_labels: ("x (m)".into(), "y (m)".into()),
@@ -144,8 +165,13 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         )?;
     }
     solver_keys(&mut s, &all);
-    table.comments.push("force received by the moving bottom wall from the grains, per metre of thickness".into());
+    table.comments.push(
+        "force received by the moving bottom wall from the grains, per metre of thickness".into(),
+    );
     table.write(&mut ctx.out, "wall_force.csv")?;
     draw_column(&mut ctx.out, "wall_force.png", &plots, (1200, 1350))?;
-    Ok(RunOutcome { summary: s, headline })
+    Ok(RunOutcome {
+        summary: s,
+        headline,
+    })
 }

@@ -46,6 +46,9 @@ pub struct ReleaseSpec {
     pub floor_drop: f64,
     /// Speed of the floor while it is lowered (m/s).
     pub speed: f64,
+    /// Contact solver during the release (the measured last step uses the relaxation's
+    /// tolerance with `analysis.final_max_iterations` sweeps).
+    pub solver: super::common::SolverSpec,
 }
 
 /// What to measure on the relaxed column.
@@ -58,8 +61,10 @@ pub struct JanssenAnalysis {
     pub skip_top_diameters: f64,
     /// Depths within this many mean diameters of the floor are left out of the fit.
     pub skip_bottom_diameters: f64,
-    /// Number of VTK frames written during the deposition and relaxation (0: final only).
+    /// Largest number of VTK frames (one every 0.02 s of simulated time; the final state always).
     pub vtk_frames: usize,
+    /// Sweep cap of the measured step (solved to `relax.solver.tolerance`).
+    pub final_max_iterations: usize,
 }
 
 impl JanssenConfig {
@@ -73,6 +78,12 @@ impl JanssenConfig {
         self.deposit.validate("deposit")?;
         non_negative("release.floor_drop", self.release.floor_drop)?;
         positive("release.speed", self.release.speed)?;
+        self.release.solver.validate("release.solver")?;
+        at_least(
+            "analysis.final_max_iterations",
+            self.analysis.final_max_iterations,
+            1,
+        )?;
         if self.release.floor_drop > 10.0 * self.grain.radius_mean {
             return Err(crate::error::DatasetError::Invalid {
                 key: "release.floor_drop".into(),

@@ -1,0 +1,379 @@
+//! Short versions of every scenario, run through the binary: they finish, write the files the
+//! contract names, and the paper's qualitative facts hold.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::Value;
+
+/// Runs `grainlaw run SCENARIO --out DIR --quiet --set ...` in `cwd`; panics with stderr on failure.
+fn run(scenario: &str, sets: &[&str], cwd: &Path) -> (PathBuf, Value) {
+    let out = cwd.join(scenario);
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_grainlaw"));
+    cmd.current_dir(cwd)
+        .args(["run", scenario, "--quiet", "--out"])
+        .arg(&out);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    let o = cmd.output().expect("grainlaw runs");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success(),
+        "{scenario}: exit {:?}\n{stderr}",
+        o.status.code()
+    );
+    assert!(o.stdout.is_empty(), "--quiet prints nothing on stdout");
+    assert!(!stderr.contains("panicked"));
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    (
+        out,
+        serde_json::from_str(&text).expect("summary.json is JSON"),
+    )
+}
+
+fn num(s: &Value, key: &str) -> f64 {
+    s.get(key)
+        .and_then(Value::as_f64)
+        .unwrap_or_else(|| panic!("summary key `{key}` missing or not a number in {s}"))
+}
+
+/// The files exist; PNG files are PNG images of reasonable size, JSON files parse.
+fn has_files(dir: &Path, names: &[&str]) {
+    for n in names {
+        let p = dir.join(n);
+        let bytes = std::fs::read(&p).unwrap_or_else(|_| panic!("missing {}", p.display()));
+        if n.ends_with(".png") {
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{n} is not a PNG");
+            assert!(
+                bytes.len() > 10_000,
+                "{n} is suspiciously small ({} bytes)",
+                bytes.len()
+            );
+        } else if n.ends_with(".json") {
+            serde_json::from_slice::<Value>(&bytes).unwrap_or_else(|e| panic!("{n}: {e}"));
+        } else if n.ends_with(".csv") {
+            let text = String::from_utf8(bytes).unwrap();
+            let header = text.lines().find(|l| !l.starts_with('#')).unwrap();
+            assert!(header.contains('_'), "{n}: header without units: {header}");
+            assert!(
+                text.lines().filter(|l| !l.starts_with('#')).count() >= 2,
+                "{n} has no rows"
+            );
+        } else if n.ends_with(".pvd") {
+            let text = String::from_utf8(bytes).unwrap();
+            assert!(
+                text.contains("<Collection>") && text.contains(".vtp"),
+                "{n}"
+            );
+        }
+    }
+    // No temporary file left behind.
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        assert!(!name.contains(".partial"), "temporary file left: {name}");
+    }
+}
+
+/// Janssen (the default scenario, full size): the contract's keys, a Janssen effect (the floor
+/// carries less than the weight), the fitted mobilised wall friction below the wall friction,
+/// intervals that contain their estimates, and the fit reproduced from the CSV it wrote.
+#[test]
+fn janssen_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, s) = run("janssen", &[], dir.path());
+    has_files(
+        &out,
+        &[
+            "summary.json",
+            "scenario.toml",
+            "history.csv",
+            "wall_profile.csv",
+            "janssen_law.json",
+            "wall_stress_profile.png",
+            "wall_mobilisation.png",
+            "force_chains.png",
+            "history.png",
+            "grains.pvd",
+            "contacts.pvd",
+            "walls.pvd",
+            "vtk/grains_0000.vtp",
+            "vtk/contacts_0000.vtp",
+        ],
+    );
+    assert_eq!(num(&s, "grains"), 350.0);
+    let ratio = num(&s, "bottom_load_over_weight");
+    assert!(ratio > 0.0 && ratio < 1.0, "bottom load / weight {ratio}");
+    let mu_wall = num(&s, "wall_friction");
+    for k in ["janssen_K", "janssen_mu_w", "janssen_K_mu_w"] {
+        let (v, lo, hi) = (
+            num(&s, k),
+            num(&s, &format!("{k}_ci_low")),
+            num(&s, &format!("{k}_ci_high")),
+        );
+        assert!(lo <= v && v <= hi, "{k}: {v} not in [{lo}, {hi}]");
+        assert!(v > 0.0, "{k} = {v}");
+    }
+    let mu_w = num(&s, "janssen_mu_w");
+    assert!(
+        mu_w < mu_wall,
+        "fitted μ_w {mu_w} should be below the wall friction {mu_wall}"
+    );
+    assert!((num(&s, "janssen_K_mu_w") - num(&s, "janssen_K") * mu_w).abs() < 1e-9);
+    let f = num(&s, "wall_sliding_fraction");
+    assert!((0.0..=1.0).contains(&f));
+    assert!(s
+        .get("solver_unconverged_steps")
+        .and_then(Value::as_u64)
+        .is_some());
+    assert!(num(&s, "solver_worst_error") >= 0.0);
+    // The column stands several widths tall.
+    assert!(num(&s, "column_height_over_width") > 3.0);
+    // `grainlaw fit janssen wall_profile.csv` gives the same K.
+    let law = out.join("refit.json");
+    let o = Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .args(["fit", "janssen"])
+        .arg(out.join("wall_profile.csv"))
+        .arg("--out")
+        .arg(&law)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let refit: Value = serde_json::from_str(&std::fs::read_to_string(&law).unwrap()).unwrap();
+    let k = refit["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "K")
+        .unwrap()["value"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (k - num(&s, "janssen_K")).abs() < 1e-6 * k,
+        "refit K {k} vs {}",
+        num(&s, "janssen_K")
+    );
+}
+
+/// The rolling disk: acceleration (2/3) g sin φ, the mean stress with inertia equal to the
+/// exact slope-frame tensor (symmetric), the contact part alone not symmetric.
+#[test]
+fn rolling_disk() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, s) = run("rolling", &[], dir.path());
+    has_files(
+        &out,
+        &[
+            "summary.json",
+            "history.csv",
+            "stress_vs_travel.png",
+            "motion.png",
+            "grains.pvd",
+        ],
+    );
+    let phi = num(&s, "slope_deg").to_radians();
+    let a = num(&s, "acceleration");
+    assert!(
+        (a - 2.0 / 3.0 * 9.81 * phi.sin()).abs() < 1e-6 * a,
+        "a = {a}"
+    );
+    assert!(num(&s, "stress_rel_error") < 1e-9);
+    assert!(num(&s, "contact_stress_rel_error") < 1e-9);
+    assert!(num(&s, "stress_rel_error_vs_paper_formula") < 0.01);
+    assert!(
+        (num(&s, "stress_xy") - num(&s, "stress_yx")).abs() < 1e-9 * num(&s, "stress_xy").abs()
+    );
+    // Contact part: ρ g a sin φ / 3 above the diagonal, 0 below.
+    let rho_g_a = num(&s, "density") * 9.81 * num(&s, "radius");
+    assert!((num(&s, "contact_stress_xy") - rho_g_a * phi.sin() / 3.0).abs() < 1e-9 * rho_g_a);
+    assert!(num(&s, "contact_stress_yx").abs() < 1e-9 * rho_g_a);
+    assert!((num(&s, "contact_stress_yy") + rho_g_a * phi.cos()).abs() < 1e-9 * rho_g_a);
+    // Travelled L = ½ a t².
+    let t = num(&s, "duration");
+    assert!((num(&s, "travelled") - 0.5 * a * t * t).abs() < 0.01 * num(&s, "travelled"));
+}
+
+/// Below μ = tan φ / 3 the disk rolls while sliding: a = g (sin φ − μ cos φ).
+#[test]
+fn rolling_disk_that_slides() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, s) = run("rolling", &["slope_deg=30", "friction=0.1"], dir.path());
+    let phi = 30f64.to_radians();
+    let expected = 9.81 * (phi.sin() - 0.1 * phi.cos());
+    let a = num(&s, "acceleration");
+    assert!(
+        (a - expected).abs() < 1e-6 * expected,
+        "a = {a}, expected {expected}"
+    );
+    assert_eq!(s["rolls_without_slipping"], Value::Bool(false));
+    assert!(num(&s, "stress_rel_error") < 1e-9);
+}
+
+/// The three stacks (Fig. 5): the rectangular stack loads the floor with its weight, the
+/// triangular one with rubbing walls with less.
+#[test]
+fn arrangements_load_transfer() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, s) = run("arrangements", &["columns=5", "rows=5"], dir.path());
+    has_files(
+        &out,
+        &[
+            "summary.json",
+            "wall_loads.csv",
+            "normal_forces_rectangular.png",
+            "normal_forces_triangular.png",
+            "normal_forces_cannonball.png",
+            "rectangular_grains.pvd",
+        ],
+    );
+    assert!((num(&s, "bottom_load_over_weight_rectangular") - 1.0).abs() < 1e-4);
+    let tri = num(&s, "bottom_load_over_weight_triangular");
+    assert!(tri < 1.0 - 1e-3, "triangular bottom load / weight = {tri}");
+    assert!(num(&s, "side_wall_load_over_weight_triangular") > 1e-3);
+    for k in ["rectangular", "triangular", "cannonball"] {
+        let total = num(&s, &format!("bottom_load_over_weight_{k}"))
+            + num(&s, &format!("side_wall_load_over_weight_{k}"));
+        assert!(
+            (total - 1.0).abs() < 1e-3,
+            "{k}: walls carry {total} of the weight"
+        );
+    }
+}
+
+/// Stick-slip (Fig. 6), short: without friction the force on the moving wall stays at the
+/// weight; with friction everywhere it fluctuates much more.
+#[test]
+fn stick_slip_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, s) = run(
+        "stick-slip",
+        &["grains=60", "push_duration=0.4"],
+        dir.path(),
+    );
+    has_files(
+        &out,
+        &[
+            "summary.json",
+            "wall_force.csv",
+            "wall_force.png",
+            "force_chains_walls_and_grains.png",
+        ],
+    );
+    let (m, w) = (
+        num(&s, "force_mean_N_frictionless"),
+        num(&s, "weight_N_frictionless"),
+    );
+    assert!(
+        (m - w).abs() < 0.01 * w,
+        "frictionless: force {m} vs weight {w}"
+    );
+    let flat = num(&s, "force_fluctuation_frictionless");
+    assert!(flat < 1e-3, "frictionless relative fluctuation {flat}");
+    assert!(num(&s, "force_fluctuation_walls_and_grains") > 10.0 * flat.max(1e-6));
+    assert!(num(&s, "force_mean_N_walls_and_grains") > w);
+}
+
+/// Inclined flow (Fig. 4), short: the layer flows down the slope; every grain gets an inertia
+/// ratio; the map and the profiles are written.
+#[test]
+fn inclined_flow_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, s) = run(
+        "inclined-flow",
+        &[
+            "grains=150",
+            "cell_length_diameters=20",
+            "duration=0.3",
+            "average=0.1",
+        ],
+        dir.path(),
+    );
+    has_files(
+        &out,
+        &[
+            "summary.json",
+            "profiles.csv",
+            "history.csv",
+            "inertia_ratio_map.png",
+            "profiles.png",
+            "grains.pvd",
+        ],
+    );
+    assert!(num(&s, "mean_velocity_m_s") > 0.0);
+    let f = num(&s, "fluid_fraction");
+    assert!((0.0..=1.0).contains(&f));
+    assert!(num(&s, "flow_height_diameters") > 2.0);
+}
+
+/// Shear cell, short: friction and solid fraction in their physical ranges, friction growing
+/// and solid fraction falling with I, a μ(I) law (or its linear form) and φ(I) written.
+#[test]
+fn shear_cell_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, s) = run(
+        "shear-cell",
+        &[
+            "grains=80",
+            "cell_length_diameters=10",
+            "inertial_numbers=[0.02, 0.04, 0.08, 0.15, 0.3]",
+            "strain=1.5",
+            "average_strain=0.75",
+        ],
+        dir.path(),
+    );
+    has_files(
+        &out,
+        &[
+            "summary.json",
+            "rheology.csv",
+            "rheology.png",
+            "velocity_profiles.png",
+            "mu_i_law.json",
+            "phi_i_law.json",
+        ],
+    );
+    let text = std::fs::read_to_string(out.join("rheology.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|c| c.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 5);
+    for r in &rows {
+        assert!(r[2] > 0.1 && r[2] < 0.9, "mu = {}", r[2]);
+        assert!(r[3] > 0.5 && r[3] < 0.9, "phi = {}", r[3]);
+    }
+    assert!(rows[4][2] > rows[0][2], "μ should grow with I");
+    assert!(rows[4][3] < rows[0][3], "φ should fall with I");
+    assert!(num(&s, "runs") == 5.0);
+}
+
+/// `grainlaw run rolling` without `--out` writes into `grainlaw-out/rolling`, and the same seed
+/// gives the same numbers.
+#[test]
+fn default_output_directory_and_reproducibility() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .current_dir(dir.path())
+        .args(["run", "rolling", "-q"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let first =
+        std::fs::read_to_string(dir.path().join("grainlaw-out/rolling/summary.json")).unwrap();
+    let (_, again) = run("rolling", &[], dir.path());
+    let first: Value = serde_json::from_str(&first).unwrap();
+    for (k, v) in first.as_object().unwrap() {
+        if k != "wall_seconds" && k != "source" {
+            assert_eq!(
+                &again[k], v,
+                "{k} differs between two runs with the same seed"
+            );
+        }
+    }
+}
