@@ -58,6 +58,7 @@ pub struct Detector {
     cell_items: Vec<u32>,
     neighbours: Vec<(u32, u32)>,
     fill: Vec<u32>,
+    fast: Vec<u32>,
 }
 
 /// A line or segment in world coordinates.
@@ -96,10 +97,17 @@ impl Detector {
             max_d = max_d.max(2.0 * r);
             max_m = max_m.max(m);
         }
-        let mut cell = max_d + detection_gap.max(0.0) + 2.0 * max_m;
+        // Cells are sized on geometry, the detection gap and a swept margin capped at one
+        // diameter; the few disks moving farther than that in one step ("fast") are tested
+        // against every disk, so one ejected grain does not coarsen the whole grid.
+        let margin_cap = max_m.min(max_d);
+        let mut cell = max_d + detection_gap.max(0.0) + 2.0 * margin_cap;
         if cell.is_nan() || cell <= 0.0 {
             cell = 1.0;
         }
+        self.fast.clear();
+        self.fast
+            .extend((0..nd as u32).filter(|&d| self.margin[d as usize] > margin_cap));
         // Grid extent.
         let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for c in &self.centre {
@@ -111,12 +119,23 @@ impl Detector {
         if nd == 0 {
             (xmin, xmax, ymin, ymax) = (0.0, 1.0, 0.0, 1.0);
         }
-        // Keep the number of cells O(N) even if one grain flies far away.
+        // Keep the number of cells O(N) even if one grain flies far away (counts computed in
+        // f64 and capped before any integer conversion).
         let cap = 4 * nd + 64;
+        let count = |extent: f64, size: f64, max: usize| -> usize {
+            let n = (extent / size).floor() + 1.0;
+            if n.is_finite() && n >= 1.0 {
+                (n.min(max as f64)) as usize
+            } else if n.is_finite() {
+                1
+            } else {
+                max
+            }
+        };
         let (ncx, cx_size) = match periodic {
             Some(p) => {
-                let n = (p.length / cell).floor() as usize;
-                if n < 3 {
+                let n = (p.length / cell).floor();
+                if !(n >= 3.0) {
                     return Err(DemError::Parameter {
                         name: "periodic_x".into(),
                         reason: format!(
@@ -126,23 +145,17 @@ impl Detector {
                         ),
                     });
                 }
-                let n = n.min(cap);
+                let n = (n.min(cap as f64)) as usize;
                 xmin = p.x_min;
                 (n, p.length / n as f64)
             }
             None => {
-                let n = (((xmax - xmin) / cell).floor() as usize + 1).min(cap);
+                let n = count(xmax - xmin, cell, cap).max(1);
                 (n, ((xmax - xmin) / n as f64).max(cell))
             }
         };
-        let ncy0 = ((ymax - ymin) / cell).floor() as usize + 1;
-        let mut cy_size = cell;
-        let mut ncy = ncy0;
-        if ncx * ncy > cap {
-            ncy = (cap / ncx).max(1);
-            cy_size = ((ymax - ymin) / ncy as f64).max(cell) * (1.0 + 1e-12);
-            ncy = ((ymax - ymin) / cy_size).floor() as usize + 1;
-        }
+        let ncy = count(ymax - ymin, cell, (cap / ncx).max(1)).max(1);
+        let cy_size = ((ymax - ymin) / ncy as f64).max(cell) * (1.0 + 1e-12);
         let ncells = ncx * ncy;
         // Counting sort of disks into cells.
         self.cell_of.clear();
@@ -178,6 +191,18 @@ impl Detector {
                     let d = disk_pos;
                     disk_pos += 1;
                     self.neighbours.clear();
+                    // Fast disks meet every disk; every disk meets the fast ones.
+                    if self.fast.binary_search(&(d as u32)).is_ok() {
+                        for e in d + 1..nd {
+                            self.neighbours.push((self.disk_collider[e], e as u32));
+                        }
+                    } else {
+                        for &e in &self.fast {
+                            if e as usize > d {
+                                self.neighbours.push((self.disk_collider[e as usize], e));
+                            }
+                        }
+                    }
                     let cid = self.cell_of[d] as usize;
                     let (ix, iy) = ((cid % ncx) as isize, (cid / ncx) as isize);
                     for dy in -1isize..=1 {
@@ -203,6 +228,7 @@ impl Detector {
                         }
                     }
                     self.neighbours.sort_unstable();
+                    self.neighbours.dedup();
                     for k in 0..self.neighbours.len() {
                         let (cj, e) = self.neighbours[k];
                         self.disk_disk(
@@ -222,7 +248,12 @@ impl Detector {
                 }
                 Shape::Line { .. } | Shape::Segment { .. } => {
                     let wb = &bodies[col.body as usize];
-                    let wall_margin = dt * wb.velocity.norm();
+                    let extent = match &col.shape {
+                        Shape::Segment { a, b } => a.norm().max(b.norm()),
+                        Shape::Line { point, .. } => point.norm(),
+                        Shape::Disk { .. } => 0.0,
+                    };
+                    let wall_margin = dt * (wb.velocity.norm() + wb.omega.abs() * extent);
                     let shape = match &col.shape {
                         Shape::Line { point, normal } => WallShape::Line {
                             p: wb.position + rotate(*point, wb.angle),
@@ -276,9 +307,15 @@ impl Detector {
                 self.disk_collider.push(ci as u32);
                 self.centre.push([c.x, c.y]);
                 self.radius.push(radius);
+                // Acceleration bound: gravity plus the applied force per unit mass.
                 let g = if b.gravity { gravity } else { 0.0 };
+                let f = if b.mass > 0.0 && b.mass.is_finite() {
+                    b.applied_force.norm() / b.mass
+                } else {
+                    0.0
+                };
                 self.margin
-                    .push(dt * (b.velocity.norm() + dt * g + b.omega.abs() * offset.norm()));
+                    .push(dt * (b.velocity.norm() + dt * (g + f) + b.omega.abs() * offset.norm()));
             }
         }
     }
@@ -320,10 +357,13 @@ impl Detector {
             return;
         }
         let dist = d2.sqrt();
-        if dist <= 0.0 {
-            return;
-        }
-        let n = Vector2::new(dx / dist, dy / dist);
+        // Coincident centres: a full overlap with an arbitrary normal, so that validation
+        // reports it and the solver keeps them from approaching further.
+        let n = if dist > 0.0 {
+            Vector2::new(dx / dist, dy / dist)
+        } else {
+            Vector2::new(0.0, 1.0)
+        };
         let gap = dist - ra - rb;
         // Contact point on the surface of b; levers from the bodies' centres of mass.
         let off_a = disk_offset(&bodies[ba], ca);
@@ -383,17 +423,26 @@ impl Detector {
             }
             WallShape::Segment { a, b } => {
                 let ab = b - a;
-                let mut ac = c - a;
-                if let Some(per) = periodic {
-                    ac.x = per.min_image(ac.x);
-                }
                 let l2 = ab.norm_squared();
-                let s = if l2 > 0.0 {
-                    (ac.dot(&ab) / l2).clamp(0.0, 1.0)
-                } else {
-                    0.0
+                // With a periodic x, the nearest of the disk's images (a segment may be longer
+                // than half the cell).
+                let shifts: &[f64] = match periodic {
+                    Some(per) => &[0.0, per.length, -per.length],
+                    None => &[0.0],
                 };
-                let d = ac - ab * s;
+                let mut d = Vector2::new(f64::INFINITY, 0.0);
+                for &sx in shifts {
+                    let ac = c + Vector2::new(sx, 0.0) - a;
+                    let s = if l2 > 0.0 {
+                        (ac.dot(&ab) / l2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    let di = ac - ab * s;
+                    if di.norm_squared() < d.norm_squared() {
+                        d = di;
+                    }
+                }
                 let dist = d.norm();
                 if dist - r > gap_max {
                     return;

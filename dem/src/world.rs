@@ -326,6 +326,18 @@ impl World {
         if p.solver.max_iterations == 0 {
             return Err(perr("solver.max_iterations", "must be ≥ 1".into()));
         }
+        if !(p.solver.relaxation > 0.0 && p.solver.relaxation < 2.0) {
+            return Err(perr(
+                "solver.relaxation",
+                format!("must lie in (0, 2), got {}", p.solver.relaxation),
+            ));
+        }
+        if p.solver.anderson_memory > 64 {
+            return Err(perr(
+                "solver.anderson_memory",
+                format!("must be at most 64, got {}", p.solver.anderson_memory),
+            ));
+        }
         for &mu in self.laws.friction_table() {
             if !(mu.is_finite() && mu >= 0.0) {
                 return Err(perr("friction", format!("must be ≥ 0, got {mu}")));
@@ -459,7 +471,7 @@ impl World {
     /// Contact forces received by each body during the last step (walls' loads), N and N·m;
     /// returns the number of contacts with a positive normal impulse.
     fn refresh_body_forces(&mut self) -> usize {
-        let h = self.params.dt;
+        let h = self.impulse_dt();
         self.body_force.clear();
         self.body_force.resize(self.bodies.len(), [0.0; 3]);
         let mut active = 0;
@@ -535,10 +547,14 @@ impl World {
             };
             let mut shift = open_gap / (h * theta);
             max_pen = max_pen.max(-geo.gap);
-            if geo.restitution > 0.0 && geo.gap <= 0.0 {
+            if geo.restitution > 0.0 {
                 // Detection leaves the shift at zero, so this is u_n⁻.
                 let un = row.velocity(&self.vel[row.a as usize], &self.vel[row.b as usize])[0];
-                shift += geo.restitution * un.min(0.0);
+                // An impact during this step (closed gap, or one that closes within the step
+                // at the approach velocity): Newton's law u_n⁺ ≥ −e u_n⁻ from now on.
+                if un < 0.0 && open_gap + h * un <= 0.0 {
+                    shift = geo.restitution * un;
+                }
             }
             row.shift = shift;
         }
@@ -622,6 +638,15 @@ impl World {
         Ok(self.last)
     }
 
+    /// Time step (s) of the impulses held in the contact set: forces are impulses divided by it.
+    fn impulse_dt(&self) -> f64 {
+        if self.contacts.dt > 0.0 {
+            self.contacts.dt
+        } else {
+            self.params.dt
+        }
+    }
+
     /// The complete state needed to continue the run exactly (see [`crate::checkpoint`]).
     pub fn state(&self) -> WorldState {
         WorldState {
@@ -653,7 +678,7 @@ impl World {
 
     /// The state after the last step as plain data (see [`crate::snapshot`]).
     pub fn snapshot(&self) -> Snapshot {
-        let h = self.params.dt;
+        let h = self.impulse_dt();
         let bodies = self
             .bodies
             .iter()
@@ -717,7 +742,11 @@ impl World {
                     let mut radii = Vec::new();
                     for c in &mine {
                         if let Shape::Disk { radius, offset } = c.shape {
-                            centres.push(b.position + rotate(offset, b.angle));
+                            let mut x = b.position + rotate(offset, b.angle);
+                            if let Some(p) = self.periodic() {
+                                x.x = p.wrap(x.x);
+                            }
+                            centres.push(x);
                             radii.push(radius);
                         }
                     }

@@ -197,3 +197,131 @@ fn validation_rejects_bad_worlds() {
     w.add_grain(Vector2::new(0.0, 0.02), 0.01, 2500.0, 0);
     assert!(w.validate(1e-9).is_ok());
 }
+
+/// Restitution also holds for an impact that happens inside a step (the swept detection finds
+/// the contact while the gap is still open): the disk leaves with −e times its approach velocity.
+#[test]
+fn restitution_holds_when_the_impact_happens_inside_a_step() {
+    for gap in [0.0, 5e-5, 1.5e-4] {
+        let h = 1e-4;
+        let mut laws = ContactLaws::new(&["m"], 0.0);
+        laws.set_restitution(0, 0, 0.5);
+        let mut p = params(h);
+        p.gravity = Vector2::zeros();
+        let mut w = World::new(p, laws);
+        w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
+        let r = 0.01;
+        let b = w.add_grain(Vector2::new(0.0, r + gap), r, 2500.0, 0) as usize;
+        w.bodies[b].velocity = Vector2::new(0.0, -1.0);
+        for _ in 0..5 {
+            w.step().unwrap();
+        }
+        assert!(
+            (w.bodies[b].velocity.y - 0.5).abs() < 1e-9,
+            "gap {gap}: {}",
+            w.bodies[b].velocity.y
+        );
+    }
+}
+
+/// One fast grain does not coarsen the grid nor break a periodic run; contacts are still found.
+#[test]
+fn a_fast_grain_in_a_periodic_cell_is_handled() {
+    let h = 1e-3;
+    let mut p = params(h);
+    p.gravity = Vector2::zeros();
+    p.periodic_x = Some([0.0, 0.1]);
+    let mut w = World::new(p, ContactLaws::new(&["m"], 0.0));
+    let r = 0.005;
+    let fast = w.add_grain(Vector2::new(0.02, 0.05), r, 2500.0, 0) as usize;
+    w.add_grain(Vector2::new(0.08, 0.05), r, 2500.0, 0);
+    w.bodies[fast].velocity = Vector2::new(20.0, 0.0);
+    w.validate(1e-12).unwrap();
+    let mut met = false;
+    for _ in 0..10 {
+        w.step().unwrap();
+        met |= w.contacts().rows.iter().any(|c| c.r[0] > 0.0);
+    }
+    assert!(met, "the fast grain never met the other one");
+    // Inelastic frictionless impact: momentum shared equally.
+    assert!((w.bodies[fast].velocity.x - 10.0).abs() < 1e-9);
+}
+
+/// An applied force counts in the swept margin: a disk pushed hard onto a floor does not overlap.
+#[test]
+fn applied_force_is_in_the_swept_margin() {
+    let h = 1e-3;
+    let mut w = World::new(params(h), ContactLaws::new(&["m"], 0.3));
+    w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
+    let r = 0.01;
+    let b = w.add_grain(Vector2::new(0.0, r + 2e-4), r, 2500.0, 0) as usize;
+    let m = w.bodies[b].mass;
+    w.bodies[b].applied_force = Vector2::new(0.0, -50.0 * m * G);
+    for _ in 0..20 {
+        let rep = w.step().unwrap();
+        assert!(
+            rep.max_penetration <= 1e-12,
+            "overlap {}",
+            rep.max_penetration
+        );
+    }
+    assert!(w.bodies[b].position.y >= r - 1e-12);
+}
+
+/// A segment longer than half the periodic cell supports disks along its whole length.
+#[test]
+fn long_segment_in_a_periodic_cell_supports_everywhere() {
+    let mut p = params(1e-3);
+    p.periodic_x = Some([0.0, 0.1]);
+    let mut w = World::new(p, ContactLaws::new(&["m"], 0.3));
+    w.add_segment_wall("floor", Vector2::new(0.0, 0.0), Vector2::new(0.1, 0.0), 0);
+    let r = 0.005;
+    let ids: Vec<usize> = [0.03, 0.07, 0.095]
+        .iter()
+        .map(|&x| w.add_grain(Vector2::new(x, r), r, 2500.0, 0) as usize)
+        .collect();
+    for _ in 0..100 {
+        w.step().unwrap();
+    }
+    for i in ids {
+        assert!(
+            (w.bodies[i].position.y - r).abs() < 1e-12,
+            "{}",
+            w.bodies[i].position.y
+        );
+    }
+}
+
+/// Far-away and coincident grains give errors, not panics or silent passes.
+#[test]
+fn degenerate_positions_are_reported() {
+    let mut w = World::new(params(1e-3), ContactLaws::new(&["m"], 0.3));
+    w.add_grain(Vector2::new(0.0, 1e20), 0.01, 2500.0, 0);
+    w.add_grain(Vector2::new(0.0, 0.0), 0.01, 2500.0, 0);
+    assert!(w.validate(1e-9).is_ok());
+    w.step().unwrap();
+    let mut w = World::new(params(1e-3), ContactLaws::new(&["m"], 0.3));
+    w.add_grain(Vector2::new(0.0, 0.0), 0.01, 2500.0, 0);
+    w.add_grain(Vector2::new(0.0, 0.0), 0.01, 2500.0, 0);
+    assert!(matches!(w.validate(1e-9), Err(DemError::Overlap { .. })));
+}
+
+/// Snapshot forces are the step's impulses over that step's time step, even if the time step is
+/// changed before the snapshot is taken; bad solver parameters are rejected.
+#[test]
+fn snapshot_forces_use_the_step_time_step_and_solver_parameters_are_checked() {
+    let mut w = World::new(params(1e-3), ContactLaws::new(&["m"], 0.3));
+    w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
+    let b = w.add_grain(Vector2::new(0.0, 0.01), 0.01, 2500.0, 0) as usize;
+    w.step().unwrap();
+    w.params.dt = 1e-4;
+    let mg = w.bodies[b].mass * G;
+    let f = w.snapshot().contacts[0].force_n;
+    assert!((f - mg).abs() <= 1e-9 * mg, "{f} vs {mg}");
+    for bad in [0.0, 2.0, f64::NAN] {
+        w.params.solver.relaxation = bad;
+        assert!(
+            matches!(w.validate(1e-9), Err(DemError::Parameter { ref name, .. }) if name == "solver.relaxation")
+        );
+    }
+}
