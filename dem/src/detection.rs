@@ -135,7 +135,7 @@ impl Detector {
         let (ncx, cx_size) = match periodic {
             Some(p) => {
                 let n = (p.length / cell).floor();
-                if !(n >= 3.0) {
+                if n.is_nan() || n < 3.0 {
                     return Err(DemError::Parameter {
                         name: "periodic_x".into(),
                         reason: format!(
