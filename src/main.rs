@@ -18,10 +18,7 @@ fn main() {
             msg.split_whitespace().collect::<Vec<_>>().join(" ")
         );
     }));
-    let code = match std::panic::catch_unwind(|| grainlaw::cli::main_with_args(std::env::args_os()))
-    {
-        Ok(c) => c,
-        Err(_) => 2,
-    };
+    let code = std::panic::catch_unwind(|| grainlaw::cli::main_with_args(std::env::args_os()))
+        .unwrap_or(2);
     std::process::exit(code);
 }

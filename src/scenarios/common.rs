@@ -42,7 +42,7 @@ pub fn run_phase(
     let flag = ctx.interrupted.clone();
     let mut cb = |w: &World, r: &StepReport| -> bool {
         k += 1;
-        if k % 25 == 0 {
+        if k.is_multiple_of(25) {
             bar.set(k);
             bar.message(format!(
                 "t={:.3}s sweeps={} err={:.1e}",

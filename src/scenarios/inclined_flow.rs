@@ -107,7 +107,7 @@ pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             r.solver.iterations as f64,
             r.solver.error,
         ]);
-        if k > avg_from && k % sample_every == 0 {
+        if k > avg_from && k.is_multiple_of(sample_every) {
             prof.add(&w.snapshot(), base)?;
         }
         vtk.maybe(out, w)

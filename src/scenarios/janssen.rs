@@ -73,7 +73,7 @@ pub fn surface_height(snap: &Snapshot, width: f64, d: f64) -> f64 {
     for b in snap.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
         let k = ((b.position.x / width * n as f64).floor().max(0.0) as usize).min(n - 1);
         let t = b.position.y + b.radius;
-        if !(top[k] >= t) {
+        if top[k].is_nan() || top[k] < t {
             top[k] = t;
         }
     }

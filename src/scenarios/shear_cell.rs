@@ -90,7 +90,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             Stop::Steps(steps),
             |w, _| {
                 n += 1;
-                if n + avg_steps > steps && n % every == 0 {
+                if n + avg_steps > steps && n.is_multiple_of(every) {
                     sample(w, &mut acc, r, d, length)?;
                 }
                 Ok(())
