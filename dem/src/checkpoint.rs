@@ -8,7 +8,7 @@
 //! leaves a file that looks complete.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Write};
+use std::io::BufReader;
 use std::path::Path;
 
 use flate2::read::GzDecoder;
@@ -62,38 +62,16 @@ fn err(path: &Path, reason: impl std::fmt::Display) -> DemError {
 
 /// Write `world` to `path` atomically (gzip JSON, temp file then rename).
 pub fn write_checkpoint(world: &World, path: &Path) -> Result<(), DemError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .ok_or_else(|| err(path, "not a file name"))?;
-    let tmp = dir.join(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| -> Result<(), DemError> {
-        let f = File::create(&tmp).map_err(|e| err(path, e))?;
-        let mut gz = GzEncoder::new(BufWriter::new(f), Compression::fast());
-        let file = File_ {
-            format: FORMAT.to_string(),
-            world: world.state(),
-        };
-        serde_json::to_writer(&mut gz, &file).map_err(|e| err(path, e))?;
-        let mut w = gz.finish().map_err(|e| err(path, e))?;
-        w.flush().map_err(|e| err(path, e))?;
-        w.get_ref().sync_all().map_err(|e| err(path, e))?;
-        Ok(())
-    })();
-    match result {
-        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| err(path, e)),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
+    let file = File_ {
+        format: FORMAT.to_string(),
+        world: world.state(),
+    };
+    crate::atomic::write_atomic(path, |w| {
+        let mut gz = GzEncoder::new(w, Compression::fast());
+        serde_json::to_writer(&mut gz, &file).map_err(std::io::Error::other)?;
+        gz.finish().map(|_| ())
+    })
+    .map_err(|e| err(path, e))
 }
 
 /// Read a checkpoint written by [`write_checkpoint`] and rebuild the world.

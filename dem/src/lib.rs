@@ -16,6 +16,7 @@
 //! ([`fc`]).
 
 pub mod anderson;
+pub mod atomic;
 pub mod bench;
 pub mod body;
 pub mod checkpoint;

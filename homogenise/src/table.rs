@@ -5,9 +5,7 @@
 //! A missing value (a quantity undefined at that sample, e.g. the stress ratio at zero pressure)
 //! is stored as NaN and written as an empty CSV field; reading gives NaN back.
 
-use std::fs::File;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ndarray::{Array1, Array2};
 use serde::{Deserialize, Serialize};
@@ -174,32 +172,10 @@ impl Table {
     /// missing values empty), atomically: `path` either keeps its old content or gets the whole
     /// new table.
     pub fn write_csv(&self, path: &Path) -> Result<()> {
-        let io = |source| HomogeniseError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let dir = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let file_name = path.file_name().ok_or_else(|| {
-            HomogeniseError::Table(format!("{} is not a file path", path.display()))
-        })?;
-        let tmp = dir.join(format!(
-            ".{}.tmp{}",
-            file_name.to_string_lossy(),
-            std::process::id()
-        ));
-        let result = (|| -> Result<()> {
-            let file = File::create(&tmp).map_err(io)?;
+        let k = self.columns.len();
+        dem::atomic::write_atomic(path, |file| {
             let mut w = csv::Writer::from_writer(file);
-            let csv_err = |source| HomogeniseError::Csv {
-                path: path.to_path_buf(),
-                source,
-            };
-            w.write_record(self.columns.iter().map(Column::header))
-                .map_err(csv_err)?;
-            let k = self.columns.len();
+            w.write_record(self.columns.iter().map(Column::header))?;
             for i in 0..self.rows {
                 w.write_record(self.data[i * k..(i + 1) * k].iter().map(|v| {
                     if v.is_nan() {
@@ -207,20 +183,14 @@ impl Table {
                     } else {
                         format!("{v}")
                     }
-                }))
-                .map_err(csv_err)?;
+                }))?;
             }
-            let mut file = w
-                .into_inner()
-                .map_err(|e| io(std::io::Error::other(e.to_string())))?;
-            file.flush().map_err(io)?;
-            file.sync_all().map_err(io)?;
-            std::fs::rename(&tmp, path).map_err(io)
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        result
+            w.flush()
+        })
+        .map_err(|source| HomogeniseError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
     }
 
     /// Reads a table written by [`Table::write_csv`] (header fields `name [unit]`).

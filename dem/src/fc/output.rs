@@ -1,6 +1,5 @@
 //! Writing a solution as JSON, atomically.
 
-use std::io::Write;
 use std::path::Path;
 
 use serde::Serialize;
@@ -39,30 +38,11 @@ pub fn write_solution(path: impl AsRef<Path>, solution: &FcSolution) -> Result<(
     write_atomically(path.as_ref(), &text)
 }
 
-/// Writes `bytes` to `path` through a temporary sibling file and a rename.
+/// Writes `bytes` to `path` through a temporary sibling file and a rename
+/// ([`crate::atomic`]).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FcError> {
-    let io = |p: &Path| {
-        let p = p.display().to_string();
-        move |source| FcError::Io { path: p, source }
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "solution".into());
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp).map_err(io(&tmp))?;
-        f.write_all(bytes).map_err(io(&tmp))?;
-        f.sync_all().map_err(io(&tmp))?;
-        drop(f);
-        std::fs::rename(&tmp, path).map_err(io(path))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    crate::atomic::write_bytes_atomic(path, bytes).map_err(|source| FcError::Io {
+        path: path.display().to_string(),
+        source,
+    })
 }
