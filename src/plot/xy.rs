@@ -328,15 +328,13 @@ impl XyPlot {
                 .draw()?;
         }
         if !self.notes.is_empty() {
+            // Pixel ranges are absolute; `area.draw` takes coordinates relative to the area.
             let (px, py) = chart.plotting_area().get_pixel_range();
-            let _ = px;
+            let (ax, ay) = area.get_base_pixel();
             for (k, n) in self.notes.iter().enumerate() {
                 area.draw(&Text::new(
                     n.clone(),
-                    (
-                        chart.plotting_area().get_base_pixel().0 + 12,
-                        py.start + 10 + 22 * k as i32,
-                    ),
+                    (px.start - ax + 12, py.start - ay + 10 + 22 * k as i32),
                     font(16.0),
                 ))?;
             }
@@ -413,7 +411,11 @@ pub fn fmt_log_tick(v: f64) -> String {
     let e = v.log10().floor();
     let m = v / 10f64.powf(e);
     if [1.0, 2.0, 5.0].iter().any(|t| (m - t).abs() < 1e-6 * t) || (m - 10.0).abs() < 1e-5 {
-        fmt_tick(v)
+        if (1e-3..1e5).contains(&v) {
+            fmt_tick(v)
+        } else {
+            format!("{v:.0e}")
+        }
     } else {
         String::new()
     }

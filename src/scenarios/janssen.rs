@@ -576,6 +576,30 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         PALETTE[6],
         vec![(0.0, 1.0), (world.time, 1.0)],
     ));
+    // Phase boundaries (history column 1 holds the phase code).
+    let starts: Vec<(f64, f64)> = history
+        .rows
+        .windows(2)
+        .filter(|w| w[1][1] != w[0][1])
+        .map(|w| (w[1][1], w[0][0]))
+        .collect();
+    let names = ["deposit", "relax", "release", "measure"];
+    let mut note = String::from("phases: deposit from 0 s");
+    for (code, t) in &starts {
+        if let Some(n) = names.get(*code as usize) {
+            note.push_str(&format!(", {n} from {t:.3} s"));
+        }
+    }
+    bl.notes.push(note);
+    bl.legend = LegendAt::LowerRight;
+    for (_, t) in &starts {
+        bl.series.push(Series::new(
+            "",
+            Style::Dashed,
+            PALETTE[4],
+            vec![(*t, 0.0), (*t, 1.5)],
+        ));
+    }
     draw_row(&mut ctx.out, "history.png", &[ke, bl], (1600, 600))?;
 
     let mut lines = vec![format!("report: {}/", ctx.out.path().display())];

@@ -292,10 +292,16 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             .collect(),
     ));
     m.legend = LegendAt::UpperLeft;
+    // Rolling without slipping: the slip is round-off (1e-16 m/s); show it on a ±1 μm/s scale.
+    let slip_axis = if rolls {
+        Axis::new("slip velocity v + ω a (m/s)").range(-1e-6, 1e-6)
+    } else {
+        Axis::new("slip velocity v + ω a (m/s)")
+    };
     let mut sv = XyPlot::new(
         "Slip velocity of the contact point",
         Axis::new("time t (s)"),
-        Axis::new("slip velocity v + ω a (m/s)"),
+        slip_axis,
     );
     sv.series.push(Series::new(
         "DEM",
