@@ -15,7 +15,7 @@ pub struct Builtin {
 pub const BUILTINS: [Builtin; 6] = [
     Builtin {
         name: "janssen",
-        description: "350 grains deposited in a column, relaxed: wall stress vs depth and Janssen fit (Fig. 7)",
+        description: "350 grains deposited in a column, relaxed, released: wall stress vs depth, Janssen fit (Fig. 7)",
         toml: include_str!("../scenarios/janssen.toml"),
     },
     Builtin {
