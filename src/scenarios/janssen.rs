@@ -306,6 +306,13 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             max_iterations: c.analysis.final_max_iterations,
             ..Default::default()
         };
+        info(
+            env.verbosity,
+            &format!(
+                "     measure: one step solved to {:.0e} (at most {} sweeps)",
+                c.relax.solver.tolerance, c.analysis.final_max_iterations
+            ),
+        );
         let r = world.step()?;
         record(world, &r, 3.0, out)?;
         release.record(&r, c.dt);
