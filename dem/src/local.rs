@@ -91,7 +91,7 @@ impl Delassus2 {
 /// Euclidean projection of `tau = (τ_n, τ_t)` on the Coulomb cone `K_μ` (the corrector).
 ///
 /// ```text
-/// |τ_t| ≤ μ τ_n          → τ                         (inside: sticking)
+/// |τ_t| ≤ μ τ_n, τ_n ≥ 0 → τ                         (inside: sticking)
 /// μ|τ_t| ≤ −τ_n          → 0                         (polar cone: no contact)
 /// otherwise              → r_n = (τ_n + μ|τ_t|)/(1+μ²), r_t = μ r_n sign τ_t   (sliding)
 /// ```
@@ -99,7 +99,8 @@ impl Delassus2 {
 pub fn project_on_cone(tau: [f64; 2], mu: f64) -> ([f64; 2], ContactStatus) {
     let [tn, tt] = tau;
     let at = tt.abs();
-    if at <= mu * tn {
+    // τ_n ≥ 0 matters for μ = 0, where |τ_t| ≤ μ τ_n alone would accept (τ_n < 0, 0).
+    if tn >= 0.0 && at <= mu * tn {
         (tau, ContactStatus::Stick)
     } else if mu * at <= -tn {
         ([0.0, 0.0], ContactStatus::Open)
@@ -157,7 +158,7 @@ pub fn solve_local(w: &Delassus2, q: [f64; 2], mu: f64) -> ([f64; 2], ContactSta
     if det > 0.0 {
         let rn = (-w.tt * qn + w.nt * qt) / det;
         let rt = (w.nt * qn - w.nn * qt) / det;
-        if rt.abs() <= mu * rn {
+        if rn >= 0.0 && rt.abs() <= mu * rn {
             return ([rn, rt], ContactStatus::Stick);
         }
         // Sliding: the direction is the one the sticking impulse points away from first.
@@ -238,6 +239,31 @@ mod tests {
         // The projection is idempotent and orthogonal: (τ − p)·p = 0.
         let tau = [1.0, 2.0];
         assert!(((tau[0] - r[0]) * r[0] + (tau[1] - r[1]) * r[1]).abs() < 1e-14);
+    }
+
+    #[test]
+    fn frictionless_projection_is_onto_the_normal_half_line() {
+        // K_0 = {r_t = 0, r_n ≥ 0}.
+        assert_eq!(
+            project_on_cone([-0.357, 0.0], 0.0),
+            ([0.0, 0.0], ContactStatus::Open)
+        );
+        assert_eq!(project_on_cone([-1.0, 0.5], 0.0).0, [0.0, 0.0]);
+        assert_eq!(project_on_cone([2.0, 0.5], 0.0).0, [2.0, 0.0]);
+        // An open frictionless contact separating at 0.357 m/s satisfies the law exactly.
+        assert_eq!(
+            natural_map_residual([0.0, 0.0], [0.357, 0.0], 0.0),
+            [0.0, 0.0]
+        );
+        // The same for μ > 0 and for a sticking contact.
+        assert_eq!(
+            natural_map_residual([0.0, 0.0], [0.357, 0.1], 0.3),
+            [0.0, 0.0]
+        );
+        assert_eq!(
+            natural_map_residual([1.0, 0.1], [0.0, 0.0], 0.3),
+            [0.0, 0.0]
+        );
     }
 
     #[test]

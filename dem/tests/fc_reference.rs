@@ -78,7 +78,7 @@ fn read_raw(path: &Path) -> Raw {
 
 /// Projection on {(x_n, x_t): |x_t| ≤ μ x_n}, written from the formula.
 fn project(xn: f64, xt: f64, mu: f64) -> (f64, f64) {
-    if xt.abs() <= mu * xn {
+    if xn >= 0.0 && xt.abs() <= mu * xn {
         (xn, xt)
     } else if mu * xt.abs() <= -xn {
         (0.0, 0.0)
