@@ -81,15 +81,13 @@ pub enum Command {
     },
     /// Solve the reference frictional-contact problems and compare with Siconos' times.
     Bench {
-        /// Directory of the reference problems (with `piles/` and `siconos-2d/`).
+        /// Directory of the reference problems (default: the repository's
+        /// `datasets/fc-problems`, or `GRAINLAW_FC_DIR`).
         #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
-        /// Tolerance on the error measure.
-        #[arg(long, default_value_t = 1e-6)]
-        tol: f64,
-        /// Repetitions per problem (the best time is reported).
-        #[arg(long, default_value_t = 3)]
-        repeat: usize,
+        /// Grain counts of the engine benchmark (settled deposits); none to skip it.
+        #[arg(long, value_name = "N", num_args = 0.., default_values_t = [1000usize])]
+        engine_grains: Vec<usize>,
     },
 }
 
@@ -150,7 +148,9 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             max_iterations,
             out,
         } => crate::fc_cmd::solve_fc(&problem, tol, max_iterations, out.as_deref()),
-        Command::Bench { dir, tol, repeat } => crate::fc_cmd::bench(dir.as_deref(), tol, repeat),
+        Command::Bench { dir, engine_grains } => {
+            crate::fc_cmd::bench(dir.as_deref(), &engine_grains)
+        }
     }
 }
 

@@ -1,13 +1,13 @@
 //! `grainlaw solve-fc` and `grainlaw bench`: standalone frictional-contact problems
-//! (`formats/frictional-contact.md`) solved by `dem::fc` (NSGS with the exact bipotential local
-//! solver), with the error measure of Siconos' fc2d.
+//! (`formats/frictional-contact.md`) solved by [`dem::fc`] (NSGS with the exact bipotential
+//! local step, Anderson-accelerated), with the error measure of Siconos' fc2d; and the engine's
+//! time per step ([`dem::bench`]).
 
 use std::path::{Path, PathBuf};
 
-use dem::fc::{read_problem, solve, FcOptions};
+use dem::fc::FcOptions;
 
 use crate::error::{CliError, Result};
-use crate::output::dir::write_atomic;
 
 fn check_tol(tol: f64) -> Result<()> {
     if tol.is_finite() && tol > 0.0 && tol < 1.0 {
@@ -19,143 +19,68 @@ fn check_tol(tol: f64) -> Result<()> {
     }
 }
 
-/// Solves one problem; prints contacts, iterations, error and seconds; writes the solution
-/// JSON `{"r": [...], "u": [...], "iterations": n, "error": e, "seconds": s, "converged": b}`.
+/// Solves one problem ([`dem::fc::solve_file`]); prints one line (contacts, iterations, error,
+/// seconds); with `out`, writes `{"r", "u", "iterations", "error", "seconds", "converged"}`
+/// atomically. Non-convergence is printed and warned, and recorded in the file.
 pub fn solve_fc(problem: &Path, tol: f64, max_iterations: usize, out: Option<&Path>) -> Result<()> {
     check_tol(tol)?;
     if max_iterations == 0 {
         return Err(CliError::Usage("--max-iterations must be ≥ 1".into()));
     }
-    let p = read_problem(problem)?;
-    let opts = FcOptions {
+    let options = FcOptions {
         tolerance: tol,
         max_iterations,
         ..Default::default()
     };
-    let s = solve(&p, &opts)?;
-    println!(
-        "{}: {} contacts, {} iterations, error {:.3e}, {:.4} s{}",
-        problem.display(),
-        p.contacts(),
-        s.iterations,
-        s.error,
-        s.seconds,
-        if s.converged { "" } else { " (NOT converged)" }
-    );
-    if !s.converged {
+    let report = dem::fc::solve_file(problem, &options, out)?;
+    println!("{report}");
+    if !report.solution.converged {
         crate::progress::warn(&format!(
             "did not reach the tolerance {tol:.0e} within {max_iterations} iterations"
         ));
     }
-    if let Some(path) = out {
-        let json = serde_json::json!({
-            "r": s.r,
-            "u": s.u,
-            "iterations": s.iterations,
-            "error": s.error,
-            "seconds": s.seconds,
-            "converged": s.converged,
-        });
-        write_atomic(path, (json.to_string() + "\n").as_bytes())?;
-    }
     Ok(())
 }
 
-/// Siconos 4.4 fc2d NSGS reference (tolerance 1e-6, from r = 0, one core): problem stem,
-/// iterations, seconds (middle of the published range).
-const SICONOS: [(&str, usize, f64); 4] = [
-    ("pile_pert_100", 118, 0.002),
-    ("pile_pert_1000", 862, 0.255),
-    ("fc2d_granularflowonwall_02020_00213", 1064, 0.16),
-    ("fc2d_granularflowonwall_07002_00801", 1461, 1.45),
-];
-
+/// The reference problems shipped with the repository (`datasets/fc-problems`), unless
+/// `GRAINLAW_FC_DIR` names another directory.
 fn default_dir() -> PathBuf {
-    if let Some(d) = std::env::var_os("GRAINLAW_FC_DIR") {
-        return PathBuf::from(d);
-    }
-    for c in [
-        "../shared/reference/fc-problems",
-        "/work/shared/reference/fc-problems",
-    ] {
-        let p = PathBuf::from(c);
-        if p.is_dir() {
-            return p;
-        }
-    }
-    PathBuf::from("../shared/reference/fc-problems")
+    std::env::var_os("GRAINLAW_FC_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/datasets/fc-problems"))
+        })
 }
 
-/// Solves every 2D reference problem under `dir` (`piles/`, `siconos-2d/`) and prints a table
-/// with Siconos' times where known.
-pub fn bench(dir: Option<&Path>, tol: f64, repeat: usize) -> Result<()> {
-    check_tol(tol)?;
+/// Solves every reference problem under `dir` (tolerance 1e-6, from r = 0, best of several
+/// runs) and prints the table against Siconos' times; then times the engine on settled
+/// deposits of `engine_grains` grains (time per step, contact updates per second).
+pub fn bench(dir: Option<&Path>, engine_grains: &[usize]) -> Result<()> {
     let dir = dir.map(Path::to_path_buf).unwrap_or_else(default_dir);
-    let mut files = Vec::new();
-    for sub in ["piles", "siconos-2d"] {
-        let d = dir.join(sub);
-        let rd = std::fs::read_dir(&d).map_err(|e| CliError::io(&d, e))?;
-        for e in rd.flatten() {
-            let p = e.path();
-            let name = p.file_name().and_then(|s| s.to_str()).unwrap_or("");
-            if name.ends_with(".json") || name.ends_with(".json.gz") {
-                files.push(p);
-            }
-        }
+    let rows = dem::fc::bench::run_reference_benchmarks(&dir)?;
+    if rows.is_empty() {
+        return Err(CliError::io(&dir, "no .json or .json.gz problems found"));
     }
-    files.sort();
-    if files.is_empty() {
-        return Err(CliError::io(
-            &dir,
-            "no .json problems under piles/ or siconos-2d/",
-        ));
-    }
-    println!(
-        "{:<42} {:>7} {:>8} {:>10} {:>10} {:>9} {:>10} {:>8}",
-        "problem", "contacts", "iters", "error", "seconds", "Siconos", "Siconos s", "speed-up"
-    );
-    for f in files {
-        let p = read_problem(&f)?;
-        let opts = FcOptions {
-            tolerance: tol,
-            ..Default::default()
-        };
-        let mut best: Option<dem::fc::FcSolution> = None;
-        for _ in 0..repeat.max(1) {
-            let s = solve(&p, &opts)?;
-            if best.as_ref().is_none_or(|b| s.seconds < b.seconds) {
-                best = Some(s);
-            }
-        }
-        let Some(s) = best else { continue };
-        let stem = f
-            .file_name()
-            .and_then(|s| s.to_str())
-            .unwrap_or("")
-            .trim_end_matches(".gz")
-            .trim_end_matches(".json")
-            .to_string();
-        let reference = SICONOS.iter().find(|r| r.0 == stem);
-        let (ri, rs, sp) = match reference {
-            Some(&(_, it, sec)) => (
-                it.to_string(),
-                format!("{sec:.3}"),
-                format!("{:.1}×", sec / s.seconds.max(1e-9)),
-            ),
-            None => ("-".into(), "-".into(), "-".into()),
-        };
+    println!("frictional-contact problems ({}):", dir.display());
+    print!("{}", dem::fc::bench::format_table(&rows));
+    if !engine_grains.is_empty() {
+        println!("\nengine, settled deposit (radius 1–2 mm, μ = 0.3, h = 0.2 ms, tolerance 1e-4):");
         println!(
-            "{:<42} {:>7} {:>8} {:>10.2e} {:>10.4} {:>9} {:>10} {:>8}{}",
-            stem,
-            p.contacts(),
-            s.iterations,
-            s.error,
-            s.seconds,
-            ri,
-            rs,
-            sp,
-            if s.converged { "" } else { "  NOT converged" }
+            "{:>8} {:>9} {:>7} {:>12} {:>16} {:>12}",
+            "grains", "contacts", "sweeps", "s/step", "updates/s", "unconverged"
         );
+        for &n in engine_grains {
+            let r = dem::bench::deposit_benchmark(n, 1500, 100);
+            println!(
+                "{:>8} {:>9.0} {:>7.1} {:>12.3e} {:>16.3e} {:>12}",
+                r.grains,
+                r.contacts,
+                r.sweeps,
+                r.seconds_per_step,
+                r.contact_updates_per_second,
+                r.unconverged_steps
+            );
+        }
     }
     Ok(())
 }
