@@ -3,8 +3,7 @@
 //! a run that fails leaves no complete-looking partial output. A stale `summary.json` from an
 //! earlier run is removed when the directory is opened, and the new one is written last.
 
-use std::fs::{self, File};
-use std::io::Write;
+use std::fs;
 use std::path::{Path, PathBuf};
 
 use crate::error::{CliError, Result};
@@ -65,27 +64,12 @@ impl OutputDir {
         Ok(target)
     }
 
-    /// Writes `bytes` to `name` atomically.
+    /// Writes `bytes` to `name` atomically ([`dem::atomic`]).
     pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf> {
         let target = self.file(name);
-        if let Some(parent) = target.parent() {
-            fs::create_dir_all(parent).map_err(|e| CliError::io(parent, e))?;
-        }
-        let tmp = self.temp_path(name);
-        let tmp = match target.parent() {
-            Some(parent) => parent.join(tmp.file_name().unwrap_or_default()),
-            None => tmp,
-        };
-        let res = (|| -> std::io::Result<()> {
-            let mut f = File::create(&tmp)?;
-            f.write_all(bytes)?;
-            f.sync_all()
-        })();
-        if let Err(e) = res {
-            let _ = fs::remove_file(&tmp);
-            return Err(CliError::io(&target, e));
-        }
-        self.commit(&tmp, name)
+        write_atomic(&target, bytes)?;
+        self.written.push(name.to_string());
+        Ok(target)
     }
 
     /// Files written so far (names relative to the directory).
@@ -94,28 +78,11 @@ impl OutputDir {
     }
 }
 
-/// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
+/// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename;
+/// [`dem::atomic`]), creating the directory if needed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .and_then(|s| s.to_str())
-        .ok_or_else(|| CliError::io(path, "not a file name"))?;
-    if !dir.exists() {
+    if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
     }
-    let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
-    let res = (|| -> std::io::Result<()> {
-        let mut f = File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    res.map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        CliError::io(path, e)
-    })
+    dem::atomic::write_bytes_atomic(path, bytes).map_err(|e| CliError::io(path, e))
 }
