@@ -82,7 +82,8 @@ pub fn colorbar(
             .margin_top(40)
             .margin_bottom(60)
             .margin_left(25)
-            .set_label_area_size(LabelAreaPosition::Right, 105)
+            .margin_right(20)
+            .set_label_area_size(LabelAreaPosition::Right, 110)
             .build_cartesian_2d(0.0..1.0, (lo..hi).log_scale())?;
         chart
             .configure_mesh()
@@ -108,7 +109,8 @@ pub fn colorbar(
             .margin_top(40)
             .margin_bottom(60)
             .margin_left(25)
-            .set_label_area_size(LabelAreaPosition::Right, 105)
+            .margin_right(20)
+            .set_label_area_size(LabelAreaPosition::Right, 110)
             .build_cartesian_2d(0.0..1.0, lo..hi)?;
         chart
             .configure_mesh()

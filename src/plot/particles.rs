@@ -65,7 +65,7 @@ pub fn draw_particles(out: &mut OutputDir, name: &str, view: &ParticleView) -> R
     let plot_w = view.width_px.max(200);
     let plot_h = ((plot_w as f64) * dy / dx).clamp(150.0, 4000.0) as u32;
     let bar = matches!(view.fill, GrainFill::Values { .. });
-    let (left, bottom, top, right) = (90u32, 70u32, 50u32, if bar { 190u32 } else { 30u32 });
+    let (left, bottom, top, right) = (90u32, 70u32, 50u32, if bar { 215u32 } else { 30u32 });
     let size = (plot_w + left + right, plot_h + bottom + top);
     render(out, name, size, |root| {
         let (main, bar_area) = root.split_horizontally(size.0 - right);
