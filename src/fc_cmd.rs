@@ -82,5 +82,12 @@ pub fn bench(dir: Option<&Path>, engine_grains: &[usize]) -> Result<()> {
             );
         }
     }
+    let mem = dem::bench::MemoryFootprint::current(4);
+    println!(
+        "\nmemory: {} B per grain, {} B per contact; at 2 contacts per grain, 24 GiB hold about {:.1e} grains",
+        mem.per_grain,
+        mem.per_contact,
+        mem.largest_sample(24 << 30, 2.0) as f64
+    );
     Ok(())
 }

@@ -105,3 +105,60 @@ pub fn deposit_benchmark(n: usize, settle_steps: usize, steps: usize) -> EngineB
         unconverged_steps: unconverged,
     }
 }
+
+/// Bytes held by the engine per grain and per contact, from the sizes of its data structures
+/// (bodies, colliders, solver and detection buffers; contact rows, geometry, status, the previous
+/// step's copy kept for warm starting, sweep order, Anderson history with memory `m`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MemoryFootprint {
+    /// Bytes per grain (B).
+    pub per_grain: usize,
+    /// Bytes per contact (B).
+    pub per_contact: usize,
+}
+
+impl MemoryFootprint {
+    /// The footprint of the current layout with Anderson memory `m`.
+    pub fn current(anderson_memory: usize) -> Self {
+        use std::mem::size_of;
+        let per_grain = size_of::<crate::Body>()
+            + size_of::<crate::collider::Collider>()
+            + 3 * size_of::<[f64; 3]>() // velocities, inverse masses, free velocities
+            + 3 * size_of::<[f64; 3]>() // body forces
+            + 4 + 16 + 8 + 8 + 4 + 4 + 4; // detector: collider, centre, radius, margin, cells
+        let one_set = size_of::<crate::contact::ContactRow>()
+            + size_of::<crate::contact::ContactGeometry>()
+            + size_of::<crate::local::ContactStatus>();
+        let per_contact = 2 * one_set // current and previous step
+            + 4 // sweep order
+            + 8 // detection neighbour list
+            + 2 * 8 * (2 * anderson_memory + 2) // Anderson differences and iterates
+            + 16; // best iterate
+        MemoryFootprint {
+            per_grain,
+            per_contact,
+        }
+    }
+
+    /// The largest number of grains that fits in `bytes` with `contacts_per_grain` contacts each
+    /// (about 2 in a dense 2D packing).
+    pub fn largest_sample(&self, bytes: usize, contacts_per_grain: f64) -> usize {
+        (bytes as f64 / (self.per_grain as f64 + contacts_per_grain * self.per_contact as f64))
+            as usize
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn largest_sample_fits_in_the_budget() {
+        let m = MemoryFootprint::current(4);
+        assert!(m.per_contact >= 2 * std::mem::size_of::<crate::contact::ContactRow>());
+        let n = m.largest_sample(24 << 30, 2.0);
+        let used = n as f64 * (m.per_grain as f64 + 2.0 * m.per_contact as f64);
+        assert!(used <= (24u64 << 30) as f64);
+        assert!(used + m.per_grain as f64 + 2.0 * m.per_contact as f64 > (24u64 << 30) as f64);
+    }
+}
