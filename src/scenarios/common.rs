@@ -220,3 +220,34 @@ pub fn delta_band(
         })
         .collect()
 }
+
+/// Summary keys of a fit's parameters: `{prefix}_{name}` with `_ci_low` / `_ci_high` (95 %).
+pub fn fit_keys(s: &mut Summary, prefix: &str, parameters: &[identify::Estimate]) {
+    for e in parameters {
+        s.num(&format!("{prefix}_{}", e.name), e.value)
+            .num(&format!("{prefix}_{}_ci_low", e.name), e.ci_low)
+            .num(&format!("{prefix}_{}_ci_high", e.name), e.ci_high);
+    }
+}
+
+/// Adds a fitted curve and its 95 % confidence band (from [`delta_band`]) to `plot`.
+pub fn add_fitted_curve(
+    plot: &mut crate::plot::xy::XyPlot,
+    label: &str,
+    band_color: plotters::style::RGBColor,
+    line_color: plotters::style::RGBColor,
+    band: &[(f64, f64, f64, f64)],
+) {
+    use crate::plot::xy::{Band, Series, Style};
+    plot.bands.push(Band::between(
+        "95 % confidence band",
+        band_color,
+        &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
+    ));
+    plot.series.push(Series::new(
+        label,
+        Style::Line,
+        line_color,
+        band.iter().map(|b| (b.0, b.1)).collect(),
+    ));
+}

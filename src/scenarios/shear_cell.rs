@@ -23,13 +23,14 @@ use identify::{CalibratedLaw, FitOptions};
 use nalgebra::Vector2;
 
 use super::common::{
-    delta_band, mean_diameter, run_phase, solver_keys, write_law, Stop, VtkFrames,
+    add_fitted_curve, delta_band, fit_keys, mean_diameter, run_phase, solver_keys, write_law, Stop,
+    VtkFrames,
 };
 use super::{RunContext, RunOutcome};
 use crate::error::Result;
 use crate::output::{CsvTable, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
-use crate::plot::xy::{draw_row, Axis, Band, LegendAt, Series, Style, XyPlot};
+use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::warn;
 
@@ -215,22 +216,14 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                     .mu(i)
                 },
             );
-            pmu.bands.push(Band::between(
-                "95 % confidence band",
-                PALETTE[0],
-                &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
-            ));
-            pmu.series.push(Series::new(
+            add_fitted_curve(
+                &mut pmu,
                 "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                Style::Line,
+                PALETTE[0],
                 PALETTE[1],
-                band.iter().map(|b| (b.0, b.1)).collect(),
-            ));
-            for e in &f.report.parameters {
-                s.num(&format!("mu_i_{}", e.name), e.value)
-                    .num(&format!("mu_i_{}_ci_low", e.name), e.ci_low)
-                    .num(&format!("mu_i_{}_ci_high", e.name), e.ci_high);
-            }
+                &band,
+            );
+            fit_keys(&mut s, "mu_i", &f.report.parameters);
             s.text("mu_i_form", "mu-i")
                 .num("mu_i_r_squared", f.report.r_squared);
             headline.push(format!(
@@ -258,22 +251,8 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                         &xs,
                         |p, i| p[0] + p[1] * i,
                     );
-                    pmu.bands.push(Band::between(
-                        "95 % confidence band",
-                        PALETTE[0],
-                        &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
-                    ));
-                    pmu.series.push(Series::new(
-                        "μ_s + b I",
-                        Style::Line,
-                        PALETTE[1],
-                        band.iter().map(|b| (b.0, b.1)).collect(),
-                    ));
-                    for e in &f.report.parameters {
-                        s.num(&format!("mu_i_{}", e.name), e.value)
-                            .num(&format!("mu_i_{}_ci_low", e.name), e.ci_low)
-                            .num(&format!("mu_i_{}_ci_high", e.name), e.ci_high);
-                    }
+                    add_fitted_curve(&mut pmu, "μ_s + b I", PALETTE[0], PALETTE[1], &band);
+                    fit_keys(&mut s, "mu_i", &f.report.parameters);
                     s.text("mu_i_form", "mu-i-linear")
                         .num("mu_i_r_squared", f.report.r_squared);
                     headline.push(format!(
@@ -315,22 +294,14 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                 &xs,
                 |p, i| p[0] - (p[0] - p[1]) * i,
             );
-            pphi.bands.push(Band::between(
-                "95 % confidence band",
-                PALETTE[2],
-                &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
-            ));
-            pphi.series.push(Series::new(
+            add_fitted_curve(
+                &mut pphi,
                 "φ_max − (φ_max − φ_min) I",
-                Style::Line,
+                PALETTE[2],
                 PALETTE[1],
-                band.iter().map(|b| (b.0, b.1)).collect(),
-            ));
-            for e in &f.report.parameters {
-                s.num(&format!("phi_i_{}", e.name), e.value)
-                    .num(&format!("phi_i_{}_ci_low", e.name), e.ci_low)
-                    .num(&format!("phi_i_{}_ci_high", e.name), e.ci_high);
-            }
+                &band,
+            );
+            fit_keys(&mut s, "phi_i", &f.report.parameters);
             headline.push(format!(
                 "φ(I): φ_max = {:.3}, φ_min = {:.3}",
                 f.law.phi_max, f.law.phi_min
@@ -405,23 +376,15 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                     law.mu_eff(v)
                 },
             );
-            pw.bands.push(Band::between(
-                "95 % confidence band",
-                PALETTE[3],
-                &band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
-            ));
-            pw.series.push(Series::new(
+            add_fitted_curve(
+                &mut pw,
                 &format!("{} (best AIC)", form.law_name()),
-                Style::Line,
+                PALETTE[3],
                 PALETTE[1],
-                band.iter().map(|b| (b.0, b.1)).collect(),
-            ));
+                &band,
+            );
             s.text("wall_law_form", form.law_name());
-            for e in &best.report.parameters {
-                s.num(&format!("wall_law_{}", e.name), e.value)
-                    .num(&format!("wall_law_{}_ci_low", e.name), e.ci_low)
-                    .num(&format!("wall_law_{}_ci_high", e.name), e.ci_high);
-            }
+            fit_keys(&mut s, "wall_law", &best.report.parameters);
             headline.push(format!("wall law: {} chosen by AIC", form.law_name()));
             write_law(
                 &mut ctx.out,
