@@ -173,26 +173,33 @@ fn rough_row(length: f64, r: f64, y: f64) -> (Vec<Vector2<f64>>, Vec<f64>) {
     (centres, vec![r; m])
 }
 
-/// A flow down a rough slope in the slope frame: x along the slope (periodic, length
-/// `cell_length_diameters · 2 R̄`), y its normal, gravity `g (sin θ, −cos θ)`. Body 0 is the rough
-/// bottom `base` (glued disks of the mean radius centred on y = 0), then the grains rained above.
-pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
-    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
-    let g = &c.grain;
-    let length = c.cell_length_diameters * 2.0 * g.radius_mean;
-    let radii = uniform_radii(&mut rng, c.grains, g);
-    let theta = c.slope_deg.to_radians();
-    let gravity = Vector2::new(9.81 * theta.sin(), -9.81 * theta.cos());
-    let mut w = world(
-        c.dt,
-        gravity,
-        Some([0.0, length]),
-        g.radius_min(),
-        &c.friction,
-    );
-    w.params.solver = c.solver.params();
+/// A periodic bed shared by the sheared scenarios: a world periodic along x over `length`
+/// (m) with a rough bottom `base_name` (glued disks of the mean radius centred on y = 0, body 0),
+/// and the seeded radii and centres of `grains` grains rained above it (not yet added).
+struct RoughBed {
+    world: World,
+    rng: ChaCha8Rng,
+    radii: Vec<f64>,
+    centres: Vec<Vector2<f64>>,
+    gap: f64,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn rough_bed(
+    seed: u64,
+    g: &GrainSpec,
+    grains: usize,
+    length: f64,
+    dt: f64,
+    gravity: Vector2<f64>,
+    friction: &FrictionSpec,
+    base_name: &str,
+) -> Result<RoughBed> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let radii = uniform_radii(&mut rng, grains, g);
+    let mut world = world(dt, gravity, Some([0.0, length]), g.radius_min(), friction);
     let (bc, br) = rough_row(length, g.radius_mean, 0.0);
-    w.add_clump("base", &bc, &br, WALL);
+    world.add_clump(base_name, &bc, &br, WALL);
     let gap = 0.02 * g.radius_min();
     let centres = rain(
         &mut rng,
@@ -205,6 +212,40 @@ pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
             periodic: true,
         },
     )?;
+    Ok(RoughBed {
+        world,
+        rng,
+        radii,
+        centres,
+        gap,
+    })
+}
+
+/// A flow down a rough slope in the slope frame: x along the slope (periodic, length
+/// `cell_length_diameters · 2 R̄`), y its normal, gravity `g (sin θ, −cos θ)`. Body 0 is the rough
+/// bottom `base` (glued disks of the mean radius centred on y = 0), then the grains rained above.
+pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
+    let g = &c.grain;
+    let length = c.cell_length_diameters * 2.0 * g.radius_mean;
+    let theta = c.slope_deg.to_radians();
+    let gravity = Vector2::new(9.81 * theta.sin(), -9.81 * theta.cos());
+    let RoughBed {
+        world: mut w,
+        mut rng,
+        radii,
+        centres,
+        ..
+    } = rough_bed(
+        c.seed,
+        g,
+        c.grains,
+        length,
+        c.dt,
+        gravity,
+        &c.friction,
+        "base",
+    )?;
+    w.params.solver = c.solver.params();
     for (p, r) in centres.iter().zip(&radii) {
         let b = w.add_grain(*p, *r, g.density, GRAIN);
         // A small random velocity breaks the symmetry of the start.
@@ -219,32 +260,25 @@ pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
 /// (mass `wall_mass_ratio ×` the grains' mass, applied force `−P L t` ŷ) and whose x velocity is
 /// imposed (zero until the runner sets it). Grains rained between them.
 pub fn shear_cell(c: &ShearCellConfig) -> Result<(World, f64)> {
-    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
     let g = &c.grain;
     let length = c.cell_length_diameters * 2.0 * g.radius_mean;
-    let radii = uniform_radii(&mut rng, c.grains, g);
-    let mut w = world(
+    let RoughBed {
+        world: mut w,
+        radii,
+        centres,
+        gap,
+        ..
+    } = rough_bed(
+        c.seed,
+        g,
+        c.grains,
+        length,
         c.dt_max,
         Vector2::zeros(),
-        Some([0.0, length]),
-        g.radius_min(),
         &c.friction,
-    );
-    w.params.solver = c.solver.params();
-    let (bc, br) = rough_row(length, g.radius_mean, 0.0);
-    w.add_clump("bottom", &bc, &br, WALL);
-    let gap = 0.02 * g.radius_min();
-    let centres = rain(
-        &mut rng,
-        &radii,
-        &RainBox {
-            x_min: 0.0,
-            x_max: length,
-            y_min: g.radius_mean + gap,
-            gap,
-            periodic: true,
-        },
+        "bottom",
     )?;
+    w.params.solver = c.solver.params();
     let top_y = centres
         .iter()
         .zip(&radii)
