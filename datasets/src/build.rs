@@ -299,10 +299,10 @@ pub fn shear_cell(c: &ShearCellConfig) -> Result<(World, f64)> {
     body.gravity = false;
     body.applied_force = Vector2::new(0.0, -c.pressure * length * body.thickness);
     if !(body.mass.is_finite() && body.mass > 0.0) {
-        return Err(DatasetError::Invalid {
-            key: "wall_mass_ratio".into(),
-            reason: "gives a top wall without positive finite mass".into(),
-        });
+        return Err(DatasetError::invalid(
+            "wall_mass_ratio",
+            "gives a top wall without positive finite mass",
+        ));
     }
     w.validate(BUILD_TOLERANCE)?;
     Ok((w, length))

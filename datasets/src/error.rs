@@ -64,8 +64,11 @@ pub enum DatasetError {
         reason: String,
     },
     /// A value is out of its physical range (negative radius, NaN, slope ≥ 90°, ...).
-    #[error("key `{key}`: {reason}")]
+    #[error("{}key `{key}`: {reason}", source_prefix(.source_name))]
     Invalid {
+        /// File path or `builtin:NAME` followed by `: ` in the message; empty when the value was
+        /// checked outside a loaded file (see [`DatasetError::in_source`]).
+        source_name: String,
         /// Dotted key.
         key: String,
         /// What is wrong, with the value found.
@@ -79,6 +82,43 @@ pub enum DatasetError {
     World(#[from] dem::DemError),
 }
 
+/// `"{source}: "`, or nothing for an empty source.
+fn source_prefix(source: &str) -> String {
+    if source.is_empty() {
+        String::new()
+    } else {
+        format!("{source}: ")
+    }
+}
+
+impl DatasetError {
+    /// [`DatasetError::Invalid`] for `key` (no source yet; [`DatasetError::in_source`] adds it).
+    pub fn invalid(key: impl Into<String>, reason: impl Into<String>) -> Self {
+        DatasetError::Invalid {
+            source_name: String::new(),
+            key: key.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Names `source` (file path or `builtin:NAME`) in an [`DatasetError::Invalid`] that does not
+    /// name one yet; other errors are returned unchanged.
+    pub fn in_source(self, source: &str) -> Self {
+        match self {
+            DatasetError::Invalid {
+                source_name,
+                key,
+                reason,
+            } if source_name.is_empty() => DatasetError::Invalid {
+                source_name: source.to_string(),
+                key,
+                reason,
+            },
+            other => other,
+        }
+    }
+}
+
 /// Result with [`DatasetError`].
 pub type Result<T> = std::result::Result<T, DatasetError>;
 
@@ -87,10 +127,10 @@ pub fn positive(key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(DatasetError::Invalid {
-            key: key.into(),
-            reason: format!("must be a finite number > 0, got {v}"),
-        })
+        Err(DatasetError::invalid(
+            key,
+            format!("must be a finite number > 0, got {v}"),
+        ))
     }
 }
 
@@ -99,10 +139,10 @@ pub fn non_negative(key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
-        Err(DatasetError::Invalid {
-            key: key.into(),
-            reason: format!("must be a finite number ≥ 0, got {v}"),
-        })
+        Err(DatasetError::invalid(
+            key,
+            format!("must be a finite number ≥ 0, got {v}"),
+        ))
     }
 }
 
@@ -111,10 +151,10 @@ pub fn in_range(key: &str, v: f64, lo: f64, hi: f64) -> Result<f64> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(v)
     } else {
-        Err(DatasetError::Invalid {
-            key: key.into(),
-            reason: format!("must lie in [{lo}, {hi}], got {v}"),
-        })
+        Err(DatasetError::invalid(
+            key,
+            format!("must lie in [{lo}, {hi}], got {v}"),
+        ))
     }
 }
 
@@ -123,9 +163,9 @@ pub fn at_least(key: &str, v: usize, min: usize) -> Result<usize> {
     if v >= min {
         Ok(v)
     } else {
-        Err(DatasetError::Invalid {
-            key: key.into(),
-            reason: format!("must be ≥ {min}, got {v}"),
-        })
+        Err(DatasetError::invalid(
+            key,
+            format!("must be ≥ {min}, got {v}"),
+        ))
     }
 }

@@ -19,6 +19,7 @@ pub mod builtin;
 pub mod config;
 pub mod error;
 pub mod generators;
+pub mod limits;
 pub mod overrides;
 pub mod phases;
 pub mod scenario;

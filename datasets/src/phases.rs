@@ -1,9 +1,41 @@
 //! Running a world through a phase (deposition, relaxation, a driven run) and accounting for
-//! what the contact solver did: non-converged steps and the worst error are counted, never
-//! hidden.
+//! what the contact solver and the time stepping did: non-converged steps and the worst error,
+//! steps whose mechanical energy grew, steps whose overlap went beyond a limit. Everything is
+//! counted, never hidden.
+//!
+//! A phase can be stopped after any step and continued later from a [`PhaseProgress`] (with the
+//! world restored from its checkpoint) with bit-identical results: [`continue_until_rest`] and
+//! [`continue_steps`] keep every loop counter in the progress, and check their stop criterion
+//! before each step, so a phase saved on the step where it ended ends at once when continued.
+//!
+//! ## Energy balance of a step
+//!
+//! With θ-method positions `q⁺ = q⁻ + h[(1 − θ) v⁻ + θ v⁺]`, the free degrees of freedom of a
+//! step satisfy
+//!
+//! `ΔK = W_ext + W_drive + uᵀR − ½‖v⁺ − v⁻‖²_M + (1 − θ) h f·(v⁺ − v⁻)`,
+//!
+//! where `K = Σ ½ m |v|² + ½ I ω²` (free degrees of freedom), `W_ext = h Σ f·[(1 − θ) v⁻ + θ v⁺]`
+//! is the work of gravity and applied loads `f` (it replaces `−ΔE_pot`, and stays right across a
+//! periodic boundary where the position jumps), and `W_drive = −h Σ F_c·v` is the work that the
+//! drives of imposed degrees of freedom (a wall moved at a given velocity) put in to keep their
+//! velocity against the contact force `F_c` they receive. For θ = 1 and an exact contact solve,
+//! `uᵀR ≤ 0` (Signorini: `u_n r_n = 0`, with the gap shift `−g r_n/(hθ) ≤ 0`; Coulomb:
+//! `u_t r_t ≤ 0`), so the residual `δ = ΔK − W_ext − W_drive ≤ 0`: the scheme only dissipates.
+//! [`EnergyProbe`] measures δ; a step with `δ > ENERGY_GROWTH_TOLERANCE · E_load` (see
+//! [`load_energy_scale`]) is counted as an energy growth. It is flagged, not fatal: θ = 1/2, a
+//! non-converged contact solve or Newton restitution between several contacts can produce one.
 
-use dem::{StepReport, World};
+use dem::{BodyKind, Dof, StepReport, World};
 use serde::{Deserialize, Serialize};
+
+/// A step whose energy residual δ exceeds this fraction of [`load_energy_scale`] is counted as
+/// an energy growth (1).
+pub const ENERGY_GROWTH_TOLERANCE: f64 = 1e-6;
+
+/// A step whose largest overlap at its start exceeds this fraction of the smallest grain radius
+/// is counted as a penetration beyond the limit (1).
+pub const PENETRATION_LIMIT: f64 = 0.01;
 
 /// What the contact solver and the engine did over a phase.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -11,25 +43,52 @@ pub struct PhaseStats {
     /// Steps done.
     pub steps: u64,
     /// Simulated time (s).
+    #[serde(with = "dem::serde_float")]
     pub simulated_time: f64,
     /// Steps whose contact solve stopped at the sweep cap above its tolerance.
     pub unconverged_steps: u64,
     /// Largest error measure at the end of a step's solve (1).
+    #[serde(with = "dem::serde_float")]
     pub worst_error: f64,
     /// Largest number of sweeps of one step.
     pub max_sweeps: usize,
     /// Sum of sweeps over the steps.
     pub total_sweeps: u64,
     /// Largest overlap at the start of a step (m).
+    #[serde(with = "dem::serde_float")]
     pub max_penetration: f64,
+    /// Largest overlap at the start of a step over the smallest grain radius (1).
+    #[serde(with = "dem::serde_float")]
+    pub max_penetration_ratio: f64,
+    /// Steps whose overlap exceeded [`PENETRATION_LIMIT`] of the smallest grain radius.
+    pub penetration_flagged_steps: u64,
+    /// World step index of the first such step.
+    pub first_penetration_step: Option<u64>,
+    /// Steps whose energy residual δ exceeded [`ENERGY_GROWTH_TOLERANCE`] · E_load.
+    pub energy_growth_steps: u64,
+    /// World step index of the first such step.
+    pub first_energy_growth_step: Option<u64>,
+    /// Largest energy residual of a step over E_load, `max(δ / E_load, 0)` (1).
+    #[serde(with = "dem::serde_float")]
+    pub worst_energy_growth: f64,
     /// Whether the rest criterion was met (phases that look for rest).
     pub at_rest: bool,
     /// Translational kinetic energy over `Σ m g d` at the end (1).
+    #[serde(with = "dem::serde_float")]
     pub final_energy_ratio: f64,
 }
 
+/// The earlier of two optional step indices.
+fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}
+
 impl PhaseStats {
-    /// Accounts for one step.
+    /// Accounts for one step's solve and time.
     pub fn record(&mut self, r: &StepReport, dt: f64) {
         self.steps += 1;
         self.simulated_time += dt;
@@ -42,6 +101,28 @@ impl PhaseStats {
         self.max_penetration = self.max_penetration.max(r.max_penetration);
     }
 
+    /// Accounts for one step's numerics checks: its overlap against [`PENETRATION_LIMIT`] of
+    /// `min_radius` (m), and its energy residual `growth = δ / E_load` against
+    /// [`ENERGY_GROWTH_TOLERANCE`] (`None` where no balance is checked).
+    pub fn record_checks(&mut self, r: &StepReport, min_radius: f64, growth: Option<f64>) {
+        if min_radius > 0.0 {
+            let ratio = r.max_penetration / min_radius;
+            self.max_penetration_ratio = self.max_penetration_ratio.max(ratio);
+            if ratio > PENETRATION_LIMIT {
+                self.penetration_flagged_steps += 1;
+                self.first_penetration_step = earliest(self.first_penetration_step, Some(r.step));
+            }
+        }
+        if let Some(g) = growth {
+            self.worst_energy_growth = self.worst_energy_growth.max(g);
+            if g > ENERGY_GROWTH_TOLERANCE {
+                self.energy_growth_steps += 1;
+                self.first_energy_growth_step =
+                    earliest(self.first_energy_growth_step, Some(r.step));
+            }
+        }
+    }
+
     /// Adds another phase's counts (the rest flag and energy are the other's).
     pub fn merge(&mut self, o: &PhaseStats) {
         self.steps += o.steps;
@@ -51,6 +132,14 @@ impl PhaseStats {
         self.max_sweeps = self.max_sweeps.max(o.max_sweeps);
         self.total_sweeps += o.total_sweeps;
         self.max_penetration = self.max_penetration.max(o.max_penetration);
+        self.max_penetration_ratio = self.max_penetration_ratio.max(o.max_penetration_ratio);
+        self.penetration_flagged_steps += o.penetration_flagged_steps;
+        self.first_penetration_step =
+            earliest(self.first_penetration_step, o.first_penetration_step);
+        self.energy_growth_steps += o.energy_growth_steps;
+        self.first_energy_growth_step =
+            earliest(self.first_energy_growth_step, o.first_energy_growth_step);
+        self.worst_energy_growth = self.worst_energy_growth.max(o.worst_energy_growth);
         self.at_rest = o.at_rest;
         self.final_energy_ratio = o.final_energy_ratio;
     }
@@ -71,13 +160,58 @@ pub fn energy_scale(world: &World) -> f64 {
     let s: f64 = world
         .bodies
         .iter()
-        .filter(|b| b.kind == dem::BodyKind::Grain)
+        .filter(|b| b.kind == BodyKind::Grain)
         .map(|b| b.mass * g * 2.0 * b.radius)
         .sum();
     if s > 0.0 {
         s
     } else {
         1.0
+    }
+}
+
+/// Energy scale of the energy-balance check, `E_load = Σ_grains m |g| d + Σ_bodies |f_a| d̄`
+/// (J): the work of every external load over one diameter (`d = 2R` of the grain, `d̄` the mean
+/// grain diameter for a load `f_a` applied on another body, e.g. a pressure-controlled platen).
+/// Without loads it falls back to `Σ m d̄²/s²` (1 J for a world without grains).
+pub fn load_energy_scale(world: &World) -> f64 {
+    let g = world.params.gravity.norm();
+    let (mut n, mut dsum, mut mass, mut s) = (0usize, 0.0, 0.0, 0.0);
+    for b in world.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
+        n += 1;
+        dsum += 2.0 * b.radius;
+        mass += b.mass;
+        if b.gravity {
+            s += b.mass * g * 2.0 * b.radius;
+        }
+    }
+    let dmean = if n > 0 { dsum / n as f64 } else { 0.0 };
+    for b in &world.bodies {
+        if b.dofs.iter().any(|d| *d == Dof::Free) {
+            s += (b.applied_force.norm() + b.applied_torque.abs() / dmean.max(1e-300)) * dmean;
+        }
+    }
+    if s > 0.0 && s.is_finite() {
+        s
+    } else if mass > 0.0 && dmean > 0.0 {
+        mass * dmean * dmean
+    } else {
+        1.0
+    }
+}
+
+/// Smallest grain radius (m), 0 without grains.
+pub fn min_grain_radius(world: &World) -> f64 {
+    let r = world
+        .bodies
+        .iter()
+        .filter(|b| b.kind == BodyKind::Grain)
+        .map(|b| b.radius)
+        .fold(f64::INFINITY, f64::min);
+    if r.is_finite() {
+        r
+    } else {
+        0.0
     }
 }
 
@@ -88,13 +222,98 @@ pub fn translational_energy(world: &World) -> f64 {
     world
         .bodies
         .iter()
-        .filter(|b| b.kind == dem::BodyKind::Grain)
+        .filter(|b| b.kind == BodyKind::Grain)
         .map(|b| 0.5 * b.mass * b.velocity.norm_squared())
         .sum()
 }
 
-/// How long to run and when to stop.
+/// The external loads `f` on the free degrees of freedom of body `b` (gravity if it applies,
+/// applied force and torque), per degree of freedom (N, N, N·m), zero on imposed ones.
+fn free_loads(world: &World, b: &dem::Body) -> [f64; 3] {
+    let g = if b.gravity {
+        world.params.gravity * b.mass
+    } else {
+        nalgebra::Vector2::zeros()
+    };
+    let f = [
+        g.x + b.applied_force.x,
+        g.y + b.applied_force.y,
+        b.applied_torque,
+    ];
+    let mut out = [0.0; 3];
+    for d in 0..3 {
+        if b.dofs[d] == Dof::Free {
+            out[d] = f[d];
+        }
+    }
+    out
+}
+
+/// The power of the external loads on the free degrees of freedom, `Σ f·v` (W).
+fn load_power(world: &World) -> f64 {
+    world
+        .bodies
+        .iter()
+        .map(|b| {
+            let f = free_loads(world, b);
+            f[0] * b.velocity.x + f[1] * b.velocity.y + f[2] * b.omega
+        })
+        .sum()
+}
+
+/// What the energy balance of one step needs from the state before it: the kinetic energy of
+/// the free degrees of freedom and the power of the external loads, with the step's `h` and θ.
 #[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergyProbe {
+    /// Kinetic energy `K⁻` of the free degrees of freedom (J).
+    pub kinetic: f64,
+    /// Power of the external loads `Σ f·v⁻` (W).
+    pub load_power: f64,
+    /// Time step h (s).
+    pub dt: f64,
+    /// θ of the step.
+    pub theta: f64,
+}
+
+impl EnergyProbe {
+    /// Measures `world` before a step.
+    pub fn before(world: &World) -> Self {
+        EnergyProbe {
+            kinetic: world.kinetic_energy(),
+            load_power: load_power(world),
+            dt: world.params.dt,
+            theta: world.params.theta,
+        }
+    }
+
+    /// The residual `δ = ΔK − W_ext − W_drive` (J) of the step that took the world from the
+    /// probed state to `after` (module documentation): `W_ext = h[(1 − θ) Σ f·v⁻ + θ Σ f·v⁺]`,
+    /// `W_drive = −h Σ F_c·v` over imposed degrees of freedom, `F_c` the contact force received
+    /// during the step. At most round-off for θ = 1 and an exact solve.
+    pub fn residual(&self, after: &World) -> f64 {
+        let h = self.dt;
+        let th = self.theta;
+        let w_ext = h * ((1.0 - th) * self.load_power + th * load_power(after));
+        let mut w_drive = 0.0;
+        for (i, b) in after.bodies.iter().enumerate() {
+            if b.dofs.iter().all(|d| *d == Dof::Free) {
+                continue;
+            }
+            let (f, t) = after.contact_force(i);
+            let fc = [f.x, f.y, t];
+            let v = [b.velocity.x, b.velocity.y, b.omega];
+            for d in 0..3 {
+                if b.dofs[d] == Dof::Imposed && v[d] != 0.0 {
+                    w_drive -= h * fc[d] * v[d];
+                }
+            }
+        }
+        after.kinetic_energy() - self.kinetic - w_ext - w_drive
+    }
+}
+
+/// How long to run and when to stop.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RunUntilRest {
     /// Shortest run (s).
     pub min_time: f64,
@@ -108,6 +327,41 @@ pub struct RunUntilRest {
 /// Consecutive steps the rest criterion must hold.
 pub const REST_STEPS: usize = 20;
 
+/// Where a phase stands: its statistics so far (`stats.steps` steps done) and the loop
+/// counters of its stop criterion. Saved in checkpoints; a phase continued from it gives the
+/// same steps as one never stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct PhaseProgress {
+    /// What the phase did so far.
+    pub stats: PhaseStats,
+    /// Consecutive steps the rest criterion has held.
+    pub quiet_steps: usize,
+}
+
+impl PhaseProgress {
+    /// Steps done in the phase.
+    pub fn steps(&self) -> u64 {
+        self.stats.steps
+    }
+}
+
+/// One step with its accounting: solve, time, overlap and energy balance.
+fn accounted_step(
+    world: &mut World,
+    progress: &mut PhaseProgress,
+    e_load: f64,
+    min_radius: f64,
+) -> Result<StepReport, dem::DemError> {
+    let probe = EnergyProbe::before(world);
+    let r = world.step()?;
+    progress.stats.record(&r, probe.dt);
+    let growth = probe.residual(world) / e_load;
+    progress
+        .stats
+        .record_checks(&r, min_radius, growth.is_finite().then_some(growth));
+    Ok(r)
+}
+
 /// Steps `world` (with its current parameters) until rest or `max_time`. `on_step` is called
 /// after every step with the step's report; returning `false` stops the phase early (e.g. on
 /// Ctrl-C). An engine error (non-finite state) ends the phase with that error.
@@ -116,31 +370,46 @@ pub fn run_until_rest(
     run: &RunUntilRest,
     mut on_step: impl FnMut(&World, &StepReport) -> bool,
 ) -> Result<PhaseStats, dem::DemError> {
+    let mut progress = PhaseProgress::default();
+    continue_until_rest(world, run, &mut progress, |w, r, _| on_step(w, r))
+}
+
+/// [`run_until_rest`] continued from `progress` (default for a new phase), which it keeps up to
+/// date; `on_step` also receives it, updated for the step just done. The rest criterion is
+/// checked before each step, so a phase saved on the step that met it ends without stepping.
+pub fn continue_until_rest(
+    world: &mut World,
+    run: &RunUntilRest,
+    progress: &mut PhaseProgress,
+    mut on_step: impl FnMut(&World, &StepReport, &PhaseProgress) -> bool,
+) -> Result<PhaseStats, dem::DemError> {
     let scale = energy_scale(world);
+    let e_load = load_energy_scale(world);
+    let min_radius = min_grain_radius(world);
     let dt = world.params.dt;
     let max_steps = (run.max_time / dt).ceil() as u64;
     let min_steps = (run.min_time / dt).ceil() as u64;
-    let mut stats = PhaseStats::default();
-    let mut quiet = 0usize;
-    for s in 0..max_steps {
-        let r = world.step()?;
-        stats.record(&r, dt);
-        let ratio = translational_energy(world) / scale;
-        stats.final_energy_ratio = ratio;
-        if ratio < run.rest_energy {
-            quiet += 1;
-        } else {
-            quiet = 0;
-        }
-        if !on_step(world, &r) {
+    loop {
+        if progress.steps() >= min_steps && progress.quiet_steps >= REST_STEPS {
+            progress.stats.at_rest = true;
             break;
         }
-        if s + 1 >= min_steps && quiet >= REST_STEPS {
-            stats.at_rest = true;
+        if progress.steps() >= max_steps {
+            break;
+        }
+        let r = accounted_step(world, progress, e_load, min_radius)?;
+        let ratio = translational_energy(world) / scale;
+        progress.stats.final_energy_ratio = ratio;
+        if ratio < run.rest_energy {
+            progress.quiet_steps += 1;
+        } else {
+            progress.quiet_steps = 0;
+        }
+        if !on_step(world, &r, progress) {
             break;
         }
     }
-    Ok(stats)
+    Ok(progress.stats)
 }
 
 /// Steps `world` `steps` times, calling `on_step` after each (returning `false` stops early).
@@ -149,16 +418,28 @@ pub fn run_steps(
     steps: u64,
     mut on_step: impl FnMut(&World, &StepReport) -> bool,
 ) -> Result<PhaseStats, dem::DemError> {
-    let dt = world.params.dt;
+    let mut progress = PhaseProgress::default();
+    continue_steps(world, steps, &mut progress, |w, r, _| on_step(w, r))
+}
+
+/// [`run_steps`] continued from `progress` (default for a new phase): steps until `steps` are
+/// done in the phase.
+pub fn continue_steps(
+    world: &mut World,
+    steps: u64,
+    progress: &mut PhaseProgress,
+    mut on_step: impl FnMut(&World, &StepReport, &PhaseProgress) -> bool,
+) -> Result<PhaseStats, dem::DemError> {
     let scale = energy_scale(world);
-    let mut stats = PhaseStats::default();
-    for _ in 0..steps {
-        let r = world.step()?;
-        stats.record(&r, dt);
-        if !on_step(world, &r) {
+    let e_load = load_energy_scale(world);
+    let min_radius = min_grain_radius(world);
+    while progress.steps() < steps {
+        let r = accounted_step(world, progress, e_load, min_radius)?;
+        progress.stats.final_energy_ratio = translational_energy(world) / scale;
+        if !on_step(world, &r, progress) {
             break;
         }
     }
-    stats.final_energy_ratio = translational_energy(world) / scale;
-    Ok(stats)
+    progress.stats.final_energy_ratio = translational_energy(world) / scale;
+    Ok(progress.stats)
 }

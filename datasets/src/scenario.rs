@@ -125,6 +125,18 @@ pub fn typed<T: DeserializeOwned>(table: Table, source: &str) -> Result<T> {
                 key,
                 known,
             }
+        } else if let Some(rest) = msg.strip_prefix("missing field `") {
+            let field = rest.split('`').next().unwrap_or(rest);
+            let key = if path == "." || path.is_empty() {
+                field.to_string()
+            } else {
+                format!("{path}.{field}")
+            };
+            DatasetError::Type {
+                source_name: source.to_string(),
+                key,
+                reason: "missing (every key of the scenario must be given)".into(),
+            }
         } else {
             DatasetError::Type {
                 source_name: source.to_string(),
@@ -170,9 +182,22 @@ pub fn load(spec: &str, sets: &[String]) -> Result<LoadedScenario> {
 /// Like [`load`] from TOML text already read; `source` names it in messages.
 pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Result<LoadedScenario> {
     let mut table = parse_table(text, source)?;
+    let kind_before = table.get("scenario").cloned();
     for s in sets {
         let o = parse_override(s)?;
         apply_override(&mut table, &o, source)?;
+    }
+    if kind_before.is_some() && table.get("scenario") != kind_before.as_ref() {
+        return Err(DatasetError::BadOverride {
+            arg: sets
+                .iter()
+                .find(|s| s.trim_start().starts_with("scenario"))
+                .cloned()
+                .unwrap_or_default(),
+            reason: "the scenario kind cannot be changed with --set (its keys differ); \
+                     name the built-in or TOML file of that kind instead"
+                .into(),
+        });
     }
     let effective_toml = if sets.is_empty() {
         text.to_string()
@@ -201,42 +226,43 @@ pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Resul
     let scenario = match kind.as_str() {
         "janssen" => {
             let c: JanssenConfig = typed(table, source)?;
-            c.validate()?;
+            c.validate().map_err(|e| e.in_source(source))?;
             Scenario::Janssen(c)
         }
         "rolling" => {
             let c: RollingConfig = typed(table, source)?;
-            c.validate()?;
+            c.validate().map_err(|e| e.in_source(source))?;
             Scenario::Rolling(c)
         }
         "arrangements" => {
             let c: ArrangementsConfig = typed(table, source)?;
-            c.validate()?;
+            c.validate().map_err(|e| e.in_source(source))?;
             Scenario::Arrangements(c)
         }
         "stick-slip" => {
             let c: StickSlipConfig = typed(table, source)?;
-            c.validate()?;
+            c.validate().map_err(|e| e.in_source(source))?;
             Scenario::StickSlip(c)
         }
         "inclined-flow" => {
             let c: InclinedFlowConfig = typed(table, source)?;
-            c.validate()?;
+            c.validate().map_err(|e| e.in_source(source))?;
             Scenario::InclinedFlow(c)
         }
         "shear-cell" => {
             let c: ShearCellConfig = typed(table, source)?;
-            c.validate()?;
+            c.validate().map_err(|e| e.in_source(source))?;
             Scenario::ShearCell(c)
         }
         other => {
-            return Err(DatasetError::Invalid {
-                key: "scenario".into(),
-                reason: format!(
+            return Err(DatasetError::invalid(
+                "scenario",
+                format!(
                     "unknown scenario kind `{other}` (known: {})",
                     builtin_names()
                 ),
-            })
+            )
+            .in_source(source))
         }
     };
     Ok(LoadedScenario {

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{check_dt, FrictionSpec, SolverSpec};
 use crate::error::{at_least, in_range, positive, Result};
+use crate::limits;
 
 /// Configuration of the `arrangements` scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -42,21 +43,18 @@ pub struct ArrangementsConfig {
 impl ArrangementsConfig {
     /// Checks every value (key named in the error).
     pub fn validate(&self) -> Result<()> {
-        positive("radius", self.radius)?;
-        positive("density", self.density)?;
+        limits::radius("radius", self.radius)?;
+        limits::density("density", self.density)?;
         at_least("columns", self.columns, 2)?;
+        limits::at_most("columns", self.columns, 200)?;
         at_least("rows", self.rows, 1)?;
-        if self.columns > 200 || self.rows > 200 {
-            return Err(crate::error::DatasetError::Invalid {
-                key: "columns".into(),
-                reason: "columns and rows must be at most 200".into(),
-            });
-        }
+        limits::at_most("rows", self.rows, 200)?;
         self.friction.validate("friction")?;
         in_range("gap", self.gap, 0.0, 1.0)?;
         in_range("jitter", self.jitter, 0.0, 1.0)?;
         positive("duration", self.duration)?;
         check_dt("dt", self.dt, self.duration)?;
+        limits::steps("dt", "duration / dt", self.duration, self.dt)?;
         self.solver.validate("solver")
     }
 }

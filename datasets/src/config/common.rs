@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{at_least, in_range, non_negative, positive, DatasetError, Result};
+use crate::limits;
 
 /// Polydisperse disk grains: radii uniform in `[radius_mean − radius_spread, radius_mean + radius_spread]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -17,20 +18,35 @@ pub struct GrainSpec {
 }
 
 impl GrainSpec {
-    /// Checks `density > 0`, `radius_mean > 0`, `0 ≤ radius_spread < radius_mean`; `prefix` is
-    /// the table's key (`grain`).
+    /// Checks `density` within [`limits::DENSITY_RANGE`], `radius_mean` within
+    /// [`limits::RADIUS_RANGE`], `0 ≤ radius_spread < radius_mean` and the smallest radius
+    /// `radius_mean − radius_spread` at least the range's lower end; `prefix` is the table's key
+    /// (`grain`).
     pub fn validate(&self, prefix: &str) -> Result<()> {
-        positive(&format!("{prefix}.density"), self.density)?;
-        positive(&format!("{prefix}.radius_mean"), self.radius_mean)?;
+        limits::density(&format!("{prefix}.density"), self.density)?;
+        limits::radius(&format!("{prefix}.radius_mean"), self.radius_mean)?;
         non_negative(&format!("{prefix}.radius_spread"), self.radius_spread)?;
         if self.radius_spread >= self.radius_mean {
-            return Err(DatasetError::Invalid {
-                key: format!("{prefix}.radius_spread"),
-                reason: format!(
+            return Err(DatasetError::invalid(
+                format!("{prefix}.radius_spread"),
+                format!(
                     "must be below radius_mean ({} m) so that every radius is positive, got {}",
                     self.radius_mean, self.radius_spread
                 ),
-            });
+            ));
+        }
+        if self.radius_min() < limits::RADIUS_RANGE.0 || self.radius_max() > limits::RADIUS_RANGE.1
+        {
+            return Err(DatasetError::invalid(
+                format!("{prefix}.radius_spread"),
+                format!(
+                    "gives radii in [{:e}, {:e}] m, outside [{:e}, {:e}] m",
+                    self.radius_min(),
+                    self.radius_max(),
+                    limits::RADIUS_RANGE.0,
+                    limits::RADIUS_RANGE.1
+                ),
+            ));
         }
         Ok(())
     }
@@ -115,10 +131,10 @@ impl SolverSpec {
 pub fn check_dt(key: &str, dt: f64, max: f64) -> Result<f64> {
     positive(key, dt)?;
     if dt > max {
-        return Err(DatasetError::Invalid {
-            key: key.into(),
-            reason: format!("time step {dt} s is larger than {max} s"),
-        });
+        return Err(DatasetError::invalid(
+            key,
+            format!("time step {dt} s is larger than {max} s"),
+        ));
     }
     Ok(dt)
 }

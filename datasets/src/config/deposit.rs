@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::SolverSpec;
 use crate::error::{at_least, positive, Result};
+use crate::limits;
 
 /// A deposition by gravity: grains placed without overlap above the floor fall and settle.
 ///
@@ -25,10 +26,23 @@ pub struct DepositSpec {
 }
 
 impl DepositSpec {
-    /// Checks every field; `prefix` is the table's key.
-    pub fn validate(&self, prefix: &str) -> Result<()> {
+    /// Checks every field; `prefix` is the table's key and `dt` (s) the scenario's time step,
+    /// which the deposition divides by `substeps` (at most [`limits::MAX_SUBSTEPS`], and at most
+    /// [`limits::MAX_STEPS`] steps up to `max_time`).
+    pub fn validate(&self, prefix: &str, dt: f64) -> Result<()> {
         at_least(&format!("{prefix}.substeps"), self.substeps, 1)?;
+        limits::at_most(
+            &format!("{prefix}.substeps"),
+            self.substeps,
+            limits::MAX_SUBSTEPS,
+        )?;
         positive(&format!("{prefix}.max_time"), self.max_time)?;
+        limits::steps(
+            &format!("{prefix}.max_time"),
+            &format!("{prefix}.max_time / (dt / {prefix}.substeps)"),
+            self.max_time,
+            dt / self.substeps as f64,
+        )?;
         positive(&format!("{prefix}.rest_energy"), self.rest_energy)?;
         self.solver.validate(&format!("{prefix}.solver"))
     }
@@ -50,18 +64,25 @@ pub struct RelaxSpec {
 }
 
 impl RelaxSpec {
-    /// Checks every field; `prefix` is the table's key.
-    pub fn validate(&self, prefix: &str) -> Result<()> {
+    /// Checks every field; `prefix` is the table's key and `dt` (s) the time step of the
+    /// relaxation (at most [`limits::MAX_STEPS`] steps up to `max_time`).
+    pub fn validate(&self, prefix: &str, dt: f64) -> Result<()> {
         crate::error::non_negative(&format!("{prefix}.min_time"), self.min_time)?;
         positive(&format!("{prefix}.max_time"), self.max_time)?;
+        limits::steps(
+            &format!("{prefix}.max_time"),
+            &format!("{prefix}.max_time / dt"),
+            self.max_time,
+            dt,
+        )?;
         if self.min_time > self.max_time {
-            return Err(crate::error::DatasetError::Invalid {
-                key: format!("{prefix}.min_time"),
-                reason: format!(
+            return Err(crate::error::DatasetError::invalid(
+                format!("{prefix}.min_time"),
+                format!(
                     "must not exceed max_time ({} s), got {}",
                     self.max_time, self.min_time
                 ),
-            });
+            ));
         }
         positive(&format!("{prefix}.rest_energy"), self.rest_energy)?;
         self.solver.validate(&format!("{prefix}.solver"))

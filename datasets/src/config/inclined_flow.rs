@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{check_dt, FrictionSpec, GrainSpec, SolverSpec};
 use crate::error::{at_least, in_range, positive, DatasetError, Result};
+use crate::limits;
 
 /// Configuration of the `inclined-flow` scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -43,13 +44,13 @@ pub struct InclinedFlowConfig {
 impl InclinedFlowConfig {
     /// Checks every value (key named in the error).
     pub fn validate(&self) -> Result<()> {
-        at_least("grains", self.grains, 10)?;
+        limits::grains("grains", self.grains, 10)?;
         in_range("slope_deg", self.slope_deg, 0.0, 89.999)?;
         if self.slope_deg <= 0.0 {
-            return Err(DatasetError::Invalid {
-                key: "slope_deg".into(),
-                reason: format!("must be in (0, 90)°, got {}", self.slope_deg),
-            });
+            return Err(DatasetError::invalid(
+                "slope_deg",
+                format!("must be in (0, 90)°, got {}", self.slope_deg),
+            ));
         }
         in_range(
             "cell_length_diameters",
@@ -61,18 +62,21 @@ impl InclinedFlowConfig {
         self.friction.validate("friction")?;
         positive("duration", self.duration)?;
         check_dt("dt", self.dt, self.duration)?;
+        limits::steps("dt", "duration / dt", self.duration, self.dt)?;
         positive("average", self.average)?;
         if self.average > self.duration {
-            return Err(DatasetError::Invalid {
-                key: "average".into(),
-                reason: format!(
+            return Err(DatasetError::invalid(
+                "average",
+                format!(
                     "must not exceed duration ({} s), got {}",
                     self.duration, self.average
                 ),
-            });
+            ));
         }
         self.solver.validate("solver")?;
         at_least("profile_bins", self.profile_bins, 2)?;
+        limits::at_most("profile_bins", self.profile_bins, limits::MAX_BINS)?;
+        limits::at_most("vtk_frames", self.vtk_frames, limits::MAX_FRAMES)?;
         positive("fluid_threshold", self.fluid_threshold)?;
         Ok(())
     }

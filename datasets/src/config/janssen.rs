@@ -5,7 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{check_dt, FrictionSpec, GrainSpec};
 use super::deposit::{DepositSpec, RelaxSpec};
-use crate::error::{at_least, in_range, non_negative, positive, Result};
+use crate::error::{at_least, in_range, non_negative, positive, DatasetError, Result};
+use crate::limits;
 
 /// Configuration of the `janssen` scenario (every key of `scenarios/janssen.toml`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -68,14 +69,16 @@ pub struct JanssenAnalysis {
 }
 
 impl JanssenConfig {
-    /// Checks every value (key named in the error).
+    /// Checks every value (key named in the error), including the derived ones: the box width
+    /// `W` ([`crate::build::column_width`]) must hold the largest grain with the generator's gaps,
+    /// and no phase may take more than [`limits::MAX_STEPS`] steps.
     pub fn validate(&self) -> Result<()> {
-        at_least("grains", self.grains, 10)?;
+        limits::grains("grains", self.grains, 10)?;
         in_range("column_aspect", self.column_aspect, 0.2, 1000.0)?;
         self.grain.validate("grain")?;
         self.friction.validate("friction")?;
         check_dt("dt", self.dt, 1.0)?;
-        self.deposit.validate("deposit")?;
+        self.deposit.validate("deposit", self.dt)?;
         non_negative("release.floor_drop", self.release.floor_drop)?;
         positive("release.speed", self.release.speed)?;
         self.release.solver.validate("release.solver")?;
@@ -85,17 +88,33 @@ impl JanssenConfig {
             1,
         )?;
         if self.release.floor_drop > 10.0 * self.grain.radius_mean {
-            return Err(crate::error::DatasetError::Invalid {
-                key: "release.floor_drop".into(),
-                reason: format!(
+            return Err(DatasetError::invalid(
+                "release.floor_drop",
+                format!(
                     "must be at most 10 mean radii ({} m), got {}",
                     10.0 * self.grain.radius_mean,
                     self.release.floor_drop
                 ),
-            });
+            ));
         }
-        self.relax.validate("relax")?;
+        limits::steps(
+            "release.speed",
+            "release.floor_drop / (release.speed · dt)",
+            self.release.floor_drop / self.release.speed,
+            self.dt,
+        )?;
+        self.relax.validate("relax", self.dt)?;
         at_least("analysis.depth_bins", self.analysis.depth_bins, 4)?;
+        limits::at_most(
+            "analysis.depth_bins",
+            self.analysis.depth_bins,
+            limits::MAX_BINS,
+        )?;
+        limits::at_most(
+            "analysis.vtk_frames",
+            self.analysis.vtk_frames,
+            limits::MAX_FRAMES,
+        )?;
         non_negative(
             "analysis.skip_top_diameters",
             self.analysis.skip_top_diameters,
@@ -104,7 +123,19 @@ impl JanssenConfig {
             "analysis.skip_bottom_diameters",
             self.analysis.skip_bottom_diameters,
         )?;
-        positive("grain.density", self.grain.density)?;
+        // The rain generator puts a gap of 2 % of the smallest radius on each side of a grain.
+        let width = crate::build::column_width(&self.grain, self.grains, self.column_aspect);
+        let needed = 2.0 * self.grain.radius_max() + 2.0 * 0.02 * self.grain.radius_min();
+        if width < needed {
+            return Err(DatasetError::invalid(
+                "column_aspect",
+                format!(
+                    "{} gives a box {width:.3e} m wide for {} grains, narrower than the largest \
+                     grain with its gaps ({needed:.3e} m): lower column_aspect or add grains",
+                    self.column_aspect, self.grains
+                ),
+            ));
+        }
         Ok(())
     }
 }

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::check_dt;
 use crate::error::{in_range, non_negative, positive, DatasetError, Result};
+use crate::limits;
 
 /// Configuration of the `rolling` scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -33,25 +34,17 @@ impl RollingConfig {
     pub fn validate(&self) -> Result<()> {
         in_range("slope_deg", self.slope_deg, 0.0, 90.0)?;
         if self.slope_deg >= 90.0 {
-            return Err(DatasetError::Invalid {
-                key: "slope_deg".into(),
-                reason: format!("must be below 90°, got {}", self.slope_deg),
-            });
+            return Err(DatasetError::invalid(
+                "slope_deg",
+                format!("must be below 90°, got {}", self.slope_deg),
+            ));
         }
-        positive("radius", self.radius)?;
-        positive("density", self.density)?;
+        limits::radius("radius", self.radius)?;
+        limits::density("density", self.density)?;
         non_negative("friction", self.friction)?;
         positive("duration", self.duration)?;
         check_dt("dt", self.dt, self.duration)?;
-        if self.duration / self.dt > 1e7 {
-            return Err(DatasetError::Invalid {
-                key: "dt".into(),
-                reason: format!(
-                    "duration / dt = {:.0} steps is more than 10⁷",
-                    self.duration / self.dt
-                ),
-            });
-        }
+        limits::steps("dt", "duration / dt", self.duration, self.dt)?;
         Ok(())
     }
 }

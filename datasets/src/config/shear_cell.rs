@@ -5,7 +5,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::common::{FrictionSpec, GrainSpec, SolverSpec};
-use crate::error::{at_least, in_range, positive, DatasetError, Result};
+use crate::error::{in_range, positive, DatasetError, Result};
+use crate::limits;
 
 /// Configuration of the `shear-cell` scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -45,9 +46,14 @@ pub struct ShearCellConfig {
 }
 
 impl ShearCellConfig {
-    /// Checks every value (key named in the error).
+    /// Checks every value (key named in the error), and that no phase takes more than
+    /// [`limits::MAX_STEPS`] steps. A run at inertial number `I` shears at `γ̇ = I √(P/ρ) / d`
+    /// (d = 2 R̄) with the step `dt = min(dt_max, travel_per_step · R̄ / V)`, `V = γ̇ H`, so it takes
+    /// `strain · H / (V dt) = max(strain / (γ̇ dt_max), strain · H / (travel_per_step · R̄))`
+    /// steps; the sample height is estimated as `H ≈ N π ⟨R²⟩ / (φ₀ L)` with φ₀ =
+    /// [`crate::build::PACKING_GUESS`] (the settled sample is a little looser, so a little higher).
     pub fn validate(&self) -> Result<()> {
-        at_least("grains", self.grains, 20)?;
+        limits::grains("grains", self.grains, 20)?;
         in_range(
             "cell_length_diameters",
             self.cell_length_diameters,
@@ -56,34 +62,66 @@ impl ShearCellConfig {
         )?;
         self.grain.validate("grain")?;
         self.friction.validate("friction")?;
-        positive("pressure", self.pressure)?;
+        limits::pressure("pressure", self.pressure)?;
         if self.inertial_numbers.len() < 3 {
-            return Err(DatasetError::Invalid {
-                key: "inertial_numbers".into(),
-                reason: format!(
+            return Err(DatasetError::invalid(
+                "inertial_numbers",
+                format!(
                     "needs at least 3 values to fit μ(I), got {}",
                     self.inertial_numbers.len()
                 ),
-            });
+            ));
         }
+        limits::at_most("inertial_numbers", self.inertial_numbers.len(), 100)?;
         for (i, &v) in self.inertial_numbers.iter().enumerate() {
             in_range(&format!("inertial_numbers[{i}]"), v, 1e-6, 2.0)?;
         }
         positive("strain", self.strain)?;
         positive("average_strain", self.average_strain)?;
         if self.average_strain > self.strain {
-            return Err(DatasetError::Invalid {
-                key: "average_strain".into(),
-                reason: format!(
+            return Err(DatasetError::invalid(
+                "average_strain",
+                format!(
                     "must not exceed strain ({}), got {}",
                     self.strain, self.average_strain
                 ),
-            });
+            ));
         }
         positive("dt_max", self.dt_max)?;
         in_range("travel_per_step", self.travel_per_step, 1e-4, 1.0)?;
         positive("wall_mass_ratio", self.wall_mass_ratio)?;
         positive("compression_time", self.compression_time)?;
-        self.solver.validate("solver")
+        limits::steps(
+            "compression_time",
+            "compression_time / dt_max",
+            self.compression_time,
+            self.dt_max,
+        )?;
+        self.solver.validate("solver")?;
+        let r = self.grain.radius_mean;
+        let length = self.cell_length_diameters * 2.0 * r;
+        let height = self.grains as f64 * std::f64::consts::PI * self.grain.mean_square_radius()
+            / (crate::build::PACKING_GUESS * length);
+        let i_min = self
+            .inertial_numbers
+            .iter()
+            .cloned()
+            .fold(f64::MAX, f64::min);
+        let gamma_dot = i_min * (self.pressure / self.grain.density).sqrt() / (2.0 * r);
+        limits::steps(
+            "inertial_numbers",
+            &format!(
+                "strain / (γ̇ dt_max) of the slowest run (I = {i_min:e}, γ̇ = {gamma_dot:.3e} 1/s)"
+            ),
+            self.strain / gamma_dot,
+            self.dt_max,
+        )?;
+        limits::steps(
+            "travel_per_step",
+            "strain · H / (travel_per_step · radius_mean)",
+            self.strain * height,
+            self.travel_per_step * r,
+        )?;
+        Ok(())
     }
 }

@@ -6,7 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{check_dt, FrictionSpec, GrainSpec, SolverSpec};
 use super::deposit::DepositSpec;
-use crate::error::{at_least, in_range, positive, Result};
+use crate::error::{in_range, positive, Result};
+use crate::limits;
 
 /// Configuration of the `stick-slip` scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -60,15 +61,17 @@ impl StickSlipCases {
 }
 
 impl StickSlipConfig {
-    /// Checks every value (key named in the error).
+    /// Checks every value (key named in the error); the deposition and the push take at most
+    /// [`limits::MAX_STEPS`] steps each.
     pub fn validate(&self) -> Result<()> {
-        at_least("grains", self.grains, 3)?;
+        limits::grains("grains", self.grains, 3)?;
         in_range("width_diameters", self.width_diameters, 2.0, 1e4)?;
         self.grain.validate("grain")?;
         positive("push_velocity", self.push_velocity)?;
         positive("push_duration", self.push_duration)?;
         check_dt("dt", self.dt, self.push_duration)?;
-        self.deposit.validate("deposit")?;
+        limits::steps("dt", "push_duration / dt", self.push_duration, self.dt)?;
+        self.deposit.validate("deposit", self.dt)?;
         self.solver.validate("solver")?;
         self.cases.frictionless.validate("cases.frictionless")?;
         self.cases.walls_only.validate("cases.walls_only")?;
