@@ -122,6 +122,16 @@ impl DatasetError {
 /// Result with [`DatasetError`].
 pub type Result<T> = std::result::Result<T, DatasetError>;
 
+/// `v` as written in messages: plain decimal for 10⁻⁴ ≤ |v| < 10⁹ (and 0), else scientific
+/// (`1e-300`, not three hundred zeros).
+pub fn num(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// `key` must be finite and > 0.
 pub fn positive(key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
@@ -129,7 +139,7 @@ pub fn positive(key: &str, v: f64) -> Result<f64> {
     } else {
         Err(DatasetError::invalid(
             key,
-            format!("must be a finite number > 0, got {v}"),
+            format!("must be a finite number > 0, got {}", num(v)),
         ))
     }
 }
@@ -141,7 +151,7 @@ pub fn non_negative(key: &str, v: f64) -> Result<f64> {
     } else {
         Err(DatasetError::invalid(
             key,
-            format!("must be a finite number ≥ 0, got {v}"),
+            format!("must be a finite number ≥ 0, got {}", num(v)),
         ))
     }
 }
@@ -153,7 +163,7 @@ pub fn in_range(key: &str, v: f64, lo: f64, hi: f64) -> Result<f64> {
     } else {
         Err(DatasetError::invalid(
             key,
-            format!("must lie in [{lo}, {hi}], got {v}"),
+            format!("must lie in [{}, {}], got {}", num(lo), num(hi), num(v)),
         ))
     }
 }

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{at_least, in_range, non_negative, positive, DatasetError, Result};
+use crate::error::{at_least, in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
 
 /// Polydisperse disk grains: radii uniform in `[radius_mean − radius_spread, radius_mean + radius_spread]`.
@@ -31,7 +31,8 @@ impl GrainSpec {
                 format!("{prefix}.radius_spread"),
                 format!(
                     "must be below radius_mean ({} m) so that every radius is positive, got {}",
-                    self.radius_mean, self.radius_spread
+                    num(self.radius_mean),
+                    num(self.radius_spread)
                 ),
             ));
         }
@@ -127,13 +128,33 @@ impl SolverSpec {
     }
 }
 
+/// A periodic cell `cell_length_diameters · 2 R̄` long must hold three cells of the engine's
+/// contact-detection grid in its worst case, `L ≥ 3 (3 d_max + g)`: a grid cell is the largest
+/// diameter `d_max = 2 R_max` plus the detection gap `g = R_min / 10` plus twice a swept margin
+/// of at most one diameter. `key` names the length in the error.
+pub fn check_periodic_cell(key: &str, cell_length_diameters: f64, grain: &GrainSpec) -> Result<()> {
+    let length = cell_length_diameters * 2.0 * grain.radius_mean;
+    let needed = 3.0 * (3.0 * 2.0 * grain.radius_max() + 0.1 * grain.radius_min());
+    if length < needed {
+        return Err(DatasetError::invalid(
+            key,
+            format!(
+                "{} gives a periodic cell {length:.3e} m long, shorter than the {needed:.3e} m \
+                 (9 largest diameters and 3 detection gaps) the contact detection needs",
+                num(cell_length_diameters)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// `dt` must be positive and finite and at most `max` (s).
 pub fn check_dt(key: &str, dt: f64, max: f64) -> Result<f64> {
     positive(key, dt)?;
     if dt > max {
         return Err(DatasetError::invalid(
             key,
-            format!("time step {dt} s is larger than {max} s"),
+            format!("time step {} s is larger than {} s", num(dt), num(max)),
         ));
     }
     Ok(dt)

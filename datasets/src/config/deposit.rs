@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::common::SolverSpec;
-use crate::error::{at_least, positive, Result};
+use crate::error::{at_least, num, positive, Result};
 use crate::limits;
 
 /// A deposition by gravity: grains placed without overlap above the floor fall and settle.
@@ -80,7 +80,8 @@ impl RelaxSpec {
                 format!("{prefix}.min_time"),
                 format!(
                     "must not exceed max_time ({} s), got {}",
-                    self.max_time, self.min_time
+                    num(self.max_time),
+                    num(self.min_time)
                 ),
             ));
         }

@@ -3,8 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_dt, FrictionSpec, GrainSpec, SolverSpec};
-use crate::error::{at_least, in_range, positive, DatasetError, Result};
+use super::common::{check_dt, check_periodic_cell, FrictionSpec, GrainSpec, SolverSpec};
+use crate::error::{at_least, in_range, num, positive, DatasetError, Result};
 use crate::limits;
 
 /// Configuration of the `inclined-flow` scenario.
@@ -49,7 +49,7 @@ impl InclinedFlowConfig {
         if self.slope_deg <= 0.0 {
             return Err(DatasetError::invalid(
                 "slope_deg",
-                format!("must be in (0, 90)°, got {}", self.slope_deg),
+                format!("must be in (0, 90)°, got {}", num(self.slope_deg)),
             ));
         }
         in_range(
@@ -59,6 +59,11 @@ impl InclinedFlowConfig {
             1e4,
         )?;
         self.grain.validate("grain")?;
+        check_periodic_cell(
+            "cell_length_diameters",
+            self.cell_length_diameters,
+            &self.grain,
+        )?;
         self.friction.validate("friction")?;
         positive("duration", self.duration)?;
         check_dt("dt", self.dt, self.duration)?;
@@ -69,7 +74,8 @@ impl InclinedFlowConfig {
                 "average",
                 format!(
                     "must not exceed duration ({} s), got {}",
-                    self.duration, self.average
+                    num(self.duration),
+                    num(self.average)
                 ),
             ));
         }

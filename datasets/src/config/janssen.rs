@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{check_dt, FrictionSpec, GrainSpec};
 use super::deposit::{DepositSpec, RelaxSpec};
-use crate::error::{at_least, in_range, non_negative, positive, DatasetError, Result};
+use crate::error::{at_least, in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
 
 /// Configuration of the `janssen` scenario (every key of `scenarios/janssen.toml`).
@@ -92,8 +92,8 @@ impl JanssenConfig {
                 "release.floor_drop",
                 format!(
                     "must be at most 10 mean radii ({} m), got {}",
-                    10.0 * self.grain.radius_mean,
-                    self.release.floor_drop
+                    num(10.0 * self.grain.radius_mean),
+                    num(self.release.floor_drop)
                 ),
             ));
         }
@@ -132,7 +132,8 @@ impl JanssenConfig {
                 format!(
                     "{} gives a box {width:.3e} m wide for {} grains, narrower than the largest \
                      grain with its gaps ({needed:.3e} m): lower column_aspect or add grains",
-                    self.column_aspect, self.grains
+                    num(self.column_aspect),
+                    self.grains
                 ),
             ));
         }

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::common::check_dt;
-use crate::error::{in_range, non_negative, positive, DatasetError, Result};
+use crate::error::{in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
 
 /// Configuration of the `rolling` scenario.
@@ -36,7 +36,7 @@ impl RollingConfig {
         if self.slope_deg >= 90.0 {
             return Err(DatasetError::invalid(
                 "slope_deg",
-                format!("must be below 90°, got {}", self.slope_deg),
+                format!("must be below 90°, got {}", num(self.slope_deg)),
             ));
         }
         limits::radius("radius", self.radius)?;

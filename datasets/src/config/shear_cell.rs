@@ -4,8 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{FrictionSpec, GrainSpec, SolverSpec};
-use crate::error::{in_range, positive, DatasetError, Result};
+use super::common::{check_periodic_cell, FrictionSpec, GrainSpec, SolverSpec};
+use crate::error::{in_range, num, positive, DatasetError, Result};
 use crate::limits;
 
 /// Configuration of the `shear-cell` scenario.
@@ -37,7 +37,7 @@ pub struct ShearCellConfig {
     pub dt_max: f64,
     /// Largest travel of the top wall per step, as a fraction of the mean radius (sets dt).
     pub travel_per_step: f64,
-    /// Mass of the top wall over the grains' mass.
+    /// Mass of the top wall over the grains' mass, in [10⁻³, 10³].
     pub wall_mass_ratio: f64,
     /// Duration of the initial compression at zero shear (s).
     pub compression_time: f64,
@@ -61,6 +61,11 @@ impl ShearCellConfig {
             1e4,
         )?;
         self.grain.validate("grain")?;
+        check_periodic_cell(
+            "cell_length_diameters",
+            self.cell_length_diameters,
+            &self.grain,
+        )?;
         self.friction.validate("friction")?;
         limits::pressure("pressure", self.pressure)?;
         if self.inertial_numbers.len() < 3 {
@@ -83,13 +88,14 @@ impl ShearCellConfig {
                 "average_strain",
                 format!(
                     "must not exceed strain ({}), got {}",
-                    self.strain, self.average_strain
+                    num(self.strain),
+                    num(self.average_strain)
                 ),
             ));
         }
         positive("dt_max", self.dt_max)?;
         in_range("travel_per_step", self.travel_per_step, 1e-4, 1.0)?;
-        positive("wall_mass_ratio", self.wall_mass_ratio)?;
+        in_range("wall_mass_ratio", self.wall_mass_ratio, 1e-3, 1e3)?;
         positive("compression_time", self.compression_time)?;
         limits::steps(
             "compression_time",
