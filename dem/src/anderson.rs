@@ -12,7 +12,10 @@
 //! The least-squares problem is solved through its regularised normal equations
 //! (`(ΔFᵀΔF + λ I) γ = ΔFᵀ f`, `λ = 1e-12 · max diag`), the Gram matrix being updated by one
 //! column per step: O(m · len) per step in two passes over the vectors, no allocation after
-//! construction.
+//! construction. Both passes run over fixed chunks on the rayon pool (same bits on any thread
+//! count).
+
+use rayon::prelude::*;
 
 /// Anderson acceleration state for vectors of a fixed length.
 #[derive(Debug, Clone)]
@@ -33,7 +36,13 @@ pub struct Anderson {
     old: Vec<usize>,
     gram_j: Vec<f64>,
     rhs: Vec<f64>,
+    partials: Vec<f64>,
+    slots: Vec<usize>,
 }
+
+/// Entries per chunk of the parallel passes; the partial sums of the chunks are added in chunk
+/// order, so the result does not depend on the number of threads.
+const CHUNK: usize = 2 * crate::parallel::CHUNK;
 
 impl Anderson {
     /// Acceleration with memory `m ≥ 1` for vectors of length `len`.
@@ -55,6 +64,8 @@ impl Anderson {
             old: Vec::with_capacity(m),
             gram_j: vec![0.0; m],
             rhs: vec![0.0; m],
+            partials: Vec::new(),
+            slots: Vec::with_capacity(m),
         }
     }
 
@@ -74,7 +85,6 @@ impl Anderson {
     pub fn step(&mut self, x: &[f64], g: &mut [f64]) {
         debug_assert_eq!(x.len(), self.len);
         debug_assert_eq!(g.len(), self.len);
-        const CHUNK: usize = 512;
         if !self.has_prev {
             for (((fp, gp), &gi), &xi) in self
                 .f_prev
@@ -104,35 +114,51 @@ impl Anderson {
         let mut dgj = std::mem::take(&mut self.dg[j]);
         let mut gram_j = std::mem::take(&mut self.gram_j);
         let mut rhs = std::mem::take(&mut self.rhs);
+        let mut partials = std::mem::take(&mut self.partials);
+        partials.clear();
+        partials.resize(self.len.div_ceil(CHUNK) * 2 * m, 0.0);
+        {
+            let (df, old) = (&self.df, &old);
+            dfj.par_chunks_mut(CHUNK)
+                .zip(dgj.par_chunks_mut(CHUNK))
+                .zip(self.f_prev.par_chunks_mut(CHUNK))
+                .zip(self.g_prev.par_chunks_mut(CHUNK))
+                .zip(partials.par_chunks_mut(2 * m))
+                .enumerate()
+                .for_each(|(ci, ((((dfc, dgc), fpc), gpc), part))| {
+                    let r = ci * CHUNK..ci * CHUNK + dfc.len();
+                    for ((((dfi, dgi), (&gi, &xi)), fp), gp) in dfc
+                        .iter_mut()
+                        .zip(dgc.iter_mut())
+                        .zip(g[r.clone()].iter().zip(&x[r.clone()]))
+                        .zip(fpc.iter_mut())
+                        .zip(gpc.iter_mut())
+                    {
+                        let f = gi - xi;
+                        *dfi = f - *fp;
+                        *dgi = gi - *gp;
+                        *fp = f;
+                        *gp = gi;
+                    }
+                    part[j] = dot(dfc, dfc);
+                    part[m + j] = dot(dfc, fpc);
+                    for &k in old {
+                        let dk = &df[k][r.clone()];
+                        part[k] = dot(dfc, dk);
+                        part[m + k] = dot(dk, fpc);
+                    }
+                });
+        }
+        // Partial sums added in chunk order: the same bits on any number of threads.
         gram_j.iter_mut().for_each(|v| *v = 0.0);
         rhs.iter_mut().for_each(|v| *v = 0.0);
-        let mut start = 0;
-        while start < self.len {
-            let end = (start + CHUNK).min(self.len);
-            let r = start..end;
-            for ((((dfi, dgi), (&gi, &xi)), fp), gp) in dfj[r.clone()]
-                .iter_mut()
-                .zip(dgj[r.clone()].iter_mut())
-                .zip(g[r.clone()].iter().zip(&x[r.clone()]))
-                .zip(self.f_prev[r.clone()].iter_mut())
-                .zip(self.g_prev[r.clone()].iter_mut())
-            {
-                let f = gi - xi;
-                *dfi = f - *fp;
-                *dgi = gi - *gp;
-                *fp = f;
-                *gp = gi;
+        for part in partials.chunks_exact(2 * m) {
+            for &k in old.iter().chain(std::iter::once(&j)) {
+                gram_j[k] += part[k];
+                rhs[k] += part[m + k];
             }
-            let (dj, f) = (&dfj[r.clone()], &self.f_prev[r.clone()]);
-            gram_j[j] += dot(dj, dj);
-            rhs[j] += dot(dj, f);
-            for &k in &old {
-                let dk = &self.df[k][r.clone()];
-                gram_j[k] += dot(dj, dk);
-                rhs[k] += dot(dk, f);
-            }
-            start = end;
         }
+        self.partials = partials;
         self.df[j] = dfj;
         self.dg[j] = dgj;
         for &k in old.iter().chain(std::iter::once(&j)) {
@@ -167,18 +193,20 @@ impl Anderson {
             return;
         }
         // g −= ΔG γ, chunk by chunk over all columns.
-        let mut start = 0;
-        while start < self.len {
-            let end = (start + CHUNK).min(self.len);
-            for p in 0..c {
-                let gam = self.b[p];
-                let dgp = &self.dg[self.slot(p)][start..end];
-                for (gi, &a) in g[start..end].iter_mut().zip(dgp) {
+        let mut slots = std::mem::take(&mut self.slots);
+        slots.clear();
+        slots.extend((0..c).map(|p| self.slot(p)));
+        let (dg, gamma) = (&self.dg, &self.b[..c]);
+        g.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, gc)| {
+            let start = ci * CHUNK;
+            for (p, &gam) in gamma.iter().enumerate() {
+                let dgp = &dg[slots[p]][start..start + gc.len()];
+                for (gi, &a) in gc.iter_mut().zip(dgp) {
                     *gi -= gam * a;
                 }
             }
-            start = end;
-        }
+        });
+        self.slots = slots;
     }
 
     /// Slot of the p-th stored column (oldest first).

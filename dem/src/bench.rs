@@ -33,6 +33,11 @@ pub struct EngineBenchRow {
 /// A box `width` wide holding `n` disks of radius in [1, 2] mm on a loose seeded grid, μ = 0.3,
 /// density 2500 kg/m³, time step 2·10⁻⁴ s.
 pub fn deposit_world(n: usize, width: f64, seed: u64) -> World {
+    grid_world(n, width, 0.3, seed)
+}
+
+/// [`deposit_world`] with friction coefficient `mu`.
+pub fn grid_world(n: usize, width: f64, mu: f64, seed: u64) -> World {
     let (r_min, r_max) = (1e-3, 2e-3);
     let params = WorldParams {
         dt: 2e-4,
@@ -46,7 +51,7 @@ pub fn deposit_world(n: usize, width: f64, seed: u64) -> World {
             ..Default::default()
         },
     };
-    let mut w = World::new(params, ContactLaws::new(&["grain"], 0.3));
+    let mut w = World::new(params, ContactLaws::new(&["grain"], mu));
     w.add_line_wall("bottom", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
     w.add_line_wall("left", Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0), 0);
     w.add_line_wall(
@@ -103,6 +108,111 @@ pub fn deposit_benchmark(n: usize, settle_steps: usize, steps: usize) -> EngineB
         seconds_per_step: secs / steps_f,
         contact_updates_per_second: updates / secs.max(1e-12),
         unconverged_steps: unconverged,
+    }
+}
+
+/// Outcome of settling a column to rest.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SettleReport {
+    /// Grains.
+    pub grains: usize,
+    /// Box width (m); NaN when unknown ([`settle`] of a given world).
+    pub width: f64,
+    /// Steps until rest.
+    pub steps: u64,
+    /// Simulated time (s).
+    pub simulated_seconds: f64,
+    /// Wall-clock seconds (building excluded).
+    pub wall_seconds: f64,
+    /// Mean sweeps per step.
+    pub mean_sweeps: f64,
+    /// Steps that stopped at the sweep cap.
+    pub unconverged_steps: u64,
+    /// Final kinetic / potential energy (potential `Σ m g y`, y above the floor).
+    pub energy_ratio: f64,
+    /// Whether the ratio went below the target before the time limit.
+    pub settled: bool,
+    /// Height of the highest grain top (m).
+    pub height: f64,
+}
+
+/// Kinetic energy `Σ ½ m |v|² + ½ I ω²` over potential energy `Σ m g y` of the grains (floor at
+/// y = 0).
+pub fn energy_ratio(w: &World) -> f64 {
+    let g = w.params.gravity.norm();
+    let (mut ke, mut pe) = (0.0, 0.0);
+    for b in w.bodies.iter().filter(|b| b.kind == crate::BodyKind::Grain) {
+        ke += 0.5 * b.mass * b.velocity.norm_squared() + 0.5 * b.inertia * b.omega * b.omega;
+        pe += b.mass * g * b.position.y;
+    }
+    if pe > 0.0 {
+        ke / pe
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// A Janssen column: `n` disks of radius uniform in [1, 2] mm (density 2500 kg/m³) on a loose
+/// seeded grid between two vertical walls 40 mean diameters (0.12 m) apart, μ = 0.5 between
+/// grains and with the walls, e = 0; settled under gravity with time step `dt` and solver
+/// tolerance `tolerance` until kinetic / potential energy < `target` (or `max_time` s).
+pub fn janssen_settle(
+    n: usize,
+    dt: f64,
+    tolerance: f64,
+    parallel: bool,
+    seed: u64,
+) -> SettleReport {
+    let width = 40.0 * 3e-3;
+    let mut w = grid_world(n, width, 0.5, seed);
+    w.params.dt = dt;
+    w.params.solver.tolerance = tolerance;
+    w.params.solver.max_iterations = 2000;
+    w.params.solver.parallel = parallel;
+    SettleReport {
+        width,
+        ..settle(&mut w, 1e-8, 10.0)
+    }
+}
+
+/// Steps `w` until [`energy_ratio`] < `target` (or `max_time` simulated seconds), timed.
+pub fn settle(w: &mut World, target: f64, max_time: f64) -> SettleReport {
+    let t0 = Instant::now();
+    let (mut steps, mut sweeps, mut unconverged) = (0u64, 0u64, 0u64);
+    let max_steps = (max_time / w.params.dt).ceil() as u64;
+    let mut ratio = energy_ratio(w);
+    while steps < max_steps {
+        let Ok(rep) = w.step() else { break };
+        steps += 1;
+        sweeps += rep.solver.iterations as u64;
+        unconverged += u64::from(!rep.solver.converged);
+        ratio = energy_ratio(w);
+        if ratio < target {
+            break;
+        }
+    }
+    let height = w
+        .bodies
+        .iter()
+        .filter(|b| b.kind == crate::BodyKind::Grain)
+        .map(|b| b.position.y + b.radius)
+        .fold(0.0, f64::max);
+    let grains = w
+        .bodies
+        .iter()
+        .filter(|b| b.kind == crate::BodyKind::Grain)
+        .count();
+    SettleReport {
+        grains,
+        width: f64::NAN,
+        steps,
+        simulated_seconds: steps as f64 * w.params.dt,
+        wall_seconds: t0.elapsed().as_secs_f64(),
+        mean_sweeps: sweeps as f64 / steps.max(1) as f64,
+        unconverged_steps: unconverged,
+        energy_ratio: ratio,
+        settled: ratio < target,
+        height,
     }
 }
 

@@ -10,7 +10,9 @@
 //!
 //! Algorithms, in the order of one step ([`world::World::step`]):
 //! [`detection`] (cell grid, O(N)) → free velocities → [`solver`] (NLGS, O(1) per contact
-//! update, local law in [`local`]) → θ-method position update.
+//! update, local law in [`local`]; optionally in colour order on several threads,
+//! [`colouring`] and [`parallel`], with the same numbers on any thread count) → θ-method
+//! position update.
 //!
 //! The same local law solves standalone frictional-contact problems given by `W`, `q`, `μ`
 //! ([`fc`]).
@@ -21,12 +23,14 @@ pub mod bench;
 pub mod body;
 pub mod checkpoint;
 pub mod collider;
+pub mod colouring;
 pub mod contact;
 pub mod detection;
 pub mod error;
 pub mod fc;
 pub mod local;
 pub mod material;
+pub mod parallel;
 pub mod serde_float;
 pub mod snapshot;
 pub mod solver;

@@ -27,11 +27,14 @@
 //! natural-map error): `e = ‖r − proj_K(r − ū)‖ / max(‖q‖, ‖r‖, ‖u‖)`, `q` the local velocity at
 //! zero impulse, `ū = u + μ|u_t| n`.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::anderson::Anderson;
+use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
-use crate::local::{natural_map_residual, project_on_cone, solve_local, ContactStatus};
+use crate::local::{natural_map_residual, ContactStatus};
+use crate::parallel::{coloured_apply, coloured_sweep, local_update, reduce_chunks, CHUNK};
 
 /// Parameters of the NLGS solver.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -47,6 +50,11 @@ pub struct SolverParams {
     /// Memory of the Anderson acceleration of the sweeps (0: plain Gauss–Seidel).
     #[serde(default = "anderson_memory")]
     pub anderson_memory: usize,
+    /// Sweep the contacts in colour order ([`crate::colouring`]) on all rayon threads. The
+    /// numbers do not depend on the thread count (one thread gives the same bits); they differ
+    /// from the natural order's (`false`) within the solver tolerance.
+    #[serde(default)]
+    pub parallel: bool,
 }
 
 fn anderson_memory() -> usize {
@@ -64,6 +72,7 @@ impl Default for SolverParams {
             max_iterations: 10_000,
             relaxation: 1.0,
             anderson_memory: 4,
+            parallel: false,
         }
     }
 }
@@ -97,15 +106,17 @@ pub fn apply_impulses(rows: &[ContactRow], vel: &mut [[f64; 3]], inv: &[[f64; 3]
 }
 
 /// Error measure of the current state: `‖r − proj_K(r − ū)‖ / max(q_norm, ‖r‖, ‖u‖)`.
+/// Summed over fixed chunks ([`reduce_chunks`]): the same bits on any number of threads.
 pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 {
-    let (mut e2, mut r2, mut u2) = (0.0, 0.0, 0.0);
-    for c in rows {
+    let [e2, r2, u2] = reduce_chunks(rows, |c| {
         let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
         let e = natural_map_residual(c.r, u, c.mu);
-        e2 += e[0] * e[0] + e[1] * e[1];
-        r2 += c.r[0] * c.r[0] + c.r[1] * c.r[1];
-        u2 += u[0] * u[0] + u[1] * u[1];
-    }
+        [
+            e[0] * e[0] + e[1] * e[1],
+            c.r[0] * c.r[0] + c.r[1] * c.r[1],
+            u[0] * u[0] + u[1] * u[1],
+        ]
+    });
     let den = q_norm.max(r2.sqrt()).max(u2.sqrt());
     if den > 0.0 {
         e2.sqrt() / den
@@ -117,13 +128,11 @@ pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 
 /// Norm of the free local velocities `‖q‖`, `q_α = H_α v_free + shift_α`, computed from the
 /// velocities *before* the warm-start impulses are applied.
 pub fn free_velocity_norm(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
-    rows.iter()
-        .map(|c| {
-            let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
-            u[0] * u[0] + u[1] * u[1]
-        })
-        .sum::<f64>()
-        .sqrt()
+    let [s] = reduce_chunks(rows, |c| {
+        let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
+        [u[0] * u[0] + u[1] * u[1]]
+    });
+    s.sqrt()
 }
 
 /// Update of one contact: exact local solve, optional relaxation projected back on the cone,
@@ -132,23 +141,9 @@ pub fn free_velocity_norm(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
 fn update(c: &mut ContactRow, vel: &mut [[f64; 3]], inv: &[[f64; 3]], omega: f64) {
     let (a, b) = (c.a as usize, c.b as usize);
     let (mut va, mut vb) = (vel[a], vel[b]);
-    let u = c.velocity(&va, &vb);
-    let wr = c.w.mul(c.r);
-    let q = [u[0] - wr[0], u[1] - wr[1]];
-    let (mut r, _) = solve_local(&c.w, q, c.mu);
-    if omega != 1.0 {
-        let t = [
-            c.r[0] + omega * (r[0] - c.r[0]),
-            c.r[1] + omega * (r[1] - c.r[1]),
-        ];
-        r = project_on_cone(t, c.mu).0;
-    }
-    let d = [r[0] - c.r[0], r[1] - c.r[1]];
-    if d != [0.0, 0.0] {
-        c.apply(d, &mut va, &inv[a], &mut vb, &inv[b]);
+    if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
         vel[a] = va;
         vel[b] = vb;
-        c.r = r;
     }
 }
 
@@ -182,9 +177,67 @@ pub fn rebuild_velocities(
     vel: &mut [[f64; 3]],
     v_free: &[[f64; 3]],
     inv: &[[f64; 3]],
+    order: &SweepOrder,
 ) {
     vel.copy_from_slice(v_free);
-    apply_impulses(rows, vel, inv);
+    match order {
+        SweepOrder::Natural(_) => apply_impulses(rows, vel, inv),
+        SweepOrder::Coloured { colouring, mobile } => {
+            coloured_apply(rows, colouring, vel, inv, mobile)
+        }
+    }
+}
+
+/// The order of the Gauss–Seidel sweeps.
+#[derive(Debug)]
+pub enum SweepOrder<'a> {
+    /// One thread, contacts in the given order (a permutation of `0..n`).
+    Natural(&'a mut [u32]),
+    /// Colour classes in turn, each class on all rayon threads ([`crate::parallel`]).
+    Coloured {
+        /// Colour classes of the rows.
+        colouring: &'a mut ContactColouring,
+        /// Whether each body has a non-zero inverse mass component.
+        mobile: &'a [bool],
+    },
+}
+
+impl SweepOrder<'_> {
+    fn sweep(
+        &mut self,
+        rows: &mut [ContactRow],
+        vel: &mut [[f64; 3]],
+        inv: &[[f64; 3]],
+        omega: f64,
+    ) {
+        match self {
+            SweepOrder::Natural(order) => sweep(rows, order, vel, inv, omega),
+            SweepOrder::Coloured { colouring, mobile } => {
+                coloured_sweep(rows, colouring, vel, inv, mobile, omega)
+            }
+        }
+    }
+
+    /// Shuffles the order (within each colour class when coloured) with the LCG state `seed`.
+    fn shuffle(&mut self, seed: &mut u64) {
+        let mut shuffle = |order: &mut [u32]| {
+            for i in (1..order.len()).rev() {
+                *seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                order.swap(i, ((*seed >> 33) as usize) % (i + 1));
+            }
+        };
+        match self {
+            SweepOrder::Natural(order) => shuffle(order),
+            SweepOrder::Coloured { colouring, .. } => {
+                for k in 0..colouring.colours() {
+                    let (lo, hi) = (colouring.offsets[k], colouring.offsets[k + 1]);
+                    shuffle(&mut colouring.order[lo..hi]);
+                }
+            }
+        }
+    }
 }
 
 /// Solve the contact problem of a step by accelerated NLGS (see the module documentation),
@@ -203,7 +256,7 @@ pub fn rebuild_velocities(
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     rows: &mut [ContactRow],
-    order: &mut [u32],
+    mut order: SweepOrder,
     vel: &mut [[f64; 3]],
     v_free: &[[f64; 3]],
     inv: &[[f64; 3]],
@@ -249,18 +302,12 @@ pub fn solve(
     while it < params.max_iterations {
         let accelerate = use_aa && it >= plain_until;
         if accelerate {
-            work.x.clear();
-            work.x.extend(rows.iter().flat_map(|c| c.r));
+            copy_impulses(rows, &mut work.x);
         }
         if shuffling {
-            for i in (1..order.len()).rev() {
-                seed = seed
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                order.swap(i, ((seed >> 33) as usize) % (i + 1));
-            }
+            order.shuffle(&mut seed);
         }
-        sweep(rows, order, vel, inv, params.relaxation);
+        order.sweep(rows, vel, inv, params.relaxation);
         it += 1;
         if it >= next_check || it == params.max_iterations {
             error = error_measure(rows, vel, q_norm);
@@ -273,7 +320,7 @@ pub fn solve(
                 for (c, b) in rows.iter_mut().zip(work.best.iter()) {
                     c.r = *b;
                 }
-                rebuild_velocities(rows, vel, v_free, inv);
+                rebuild_velocities(rows, vel, v_free, inv, &order);
                 error = error_measure(rows, vel, q_norm);
                 if let Some(aa) = work.anderson.as_mut() {
                     aa.reset();
@@ -309,13 +356,16 @@ pub fn solve(
         }
         if accelerate && it >= plain_until && it < params.max_iterations {
             if let Some(aa) = work.anderson.as_mut() {
-                work.g.clear();
-                work.g.extend(rows.iter().flat_map(|c| c.r));
+                copy_impulses(rows, &mut work.g);
                 aa.step(&work.x, &mut work.g);
-                for (c, r) in rows.iter_mut().zip(work.g.chunks_exact(2)) {
-                    c.r = [r[0], r[1]];
-                }
-                rebuild_velocities(rows, vel, v_free, inv);
+                rows.par_chunks_mut(CHUNK)
+                    .zip(work.g.par_chunks(2 * CHUNK))
+                    .for_each(|(rs, g)| {
+                        for (c, r) in rs.iter_mut().zip(g.chunks_exact(2)) {
+                            c.r = [r[0], r[1]];
+                        }
+                    });
+                rebuild_velocities(rows, vel, v_free, inv, &order);
             }
         }
     }
@@ -323,7 +373,7 @@ pub fn solve(
         for (c, b) in rows.iter_mut().zip(work.best.iter()) {
             c.r = *b;
         }
-        rebuild_velocities(rows, vel, v_free, inv);
+        rebuild_velocities(rows, vel, v_free, inv, &order);
         error = error_measure(rows, vel, q_norm);
     }
     SolveReport {
@@ -331,6 +381,19 @@ pub fn solve(
         error,
         converged: error <= tol,
     }
+}
+
+/// `x ← (r_α)` flattened, in parallel over fixed chunks.
+fn copy_impulses(rows: &[ContactRow], x: &mut Vec<f64>) {
+    x.resize(2 * rows.len(), 0.0);
+    rows.par_chunks(CHUNK)
+        .zip(x.par_chunks_mut(2 * CHUNK))
+        .for_each(|(rs, x)| {
+            for (c, x) in rs.iter().zip(x.chunks_exact_mut(2)) {
+                x[0] = c.r[0];
+                x[1] = c.r[1];
+            }
+        });
 }
 
 /// Buffers of the solver kept between steps (no allocation in the steady state).

@@ -23,12 +23,13 @@ use serde::{Deserialize, Serialize};
 use crate::body::{Body, Dof};
 use crate::checkpoint::WorldState;
 use crate::collider::{rotate, Collider, Shape};
+use crate::colouring::ContactColouring;
 use crate::contact::ContactSet;
 use crate::detection::{Detector, Periodic};
 use crate::error::DemError;
 use crate::material::ContactLaws;
 use crate::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
-use crate::solver::{self, SolveReport, SolverParams};
+use crate::solver::{self, SolveReport, SolverParams, SweepOrder};
 
 /// Parameters of the time stepping.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -101,6 +102,8 @@ pub struct World {
     inv: Vec<[f64; 3]>,
     body_force: Vec<[f64; 3]>,
     order: Vec<u32>,
+    mobile: Vec<bool>,
+    colouring: ContactColouring,
     v_free: Vec<[f64; 3]>,
     work: solver::SolverWork,
     last: StepReport,
@@ -123,6 +126,8 @@ impl World {
             inv: Vec::new(),
             body_force: Vec::new(),
             order: Vec::new(),
+            mobile: Vec::new(),
+            colouring: ContactColouring::default(),
             v_free: Vec::new(),
             work: solver::SolverWork::default(),
             last: StepReport::default(),
@@ -581,12 +586,30 @@ impl World {
         let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
         self.v_free.clear();
         self.v_free.extend_from_slice(&self.vel);
-        solver::apply_impulses(&self.contacts.rows, &mut self.vel, &self.inv);
-        self.order.clear();
-        self.order.extend(0..self.contacts.len() as u32);
+        let order = if self.params.solver.parallel {
+            self.mobile.clear();
+            self.mobile
+                .extend(self.inv.iter().map(|i| i.iter().any(|&x| x != 0.0)));
+            self.colouring.build(&self.contacts.rows, &self.mobile);
+            SweepOrder::Coloured {
+                colouring: &mut self.colouring,
+                mobile: &self.mobile,
+            }
+        } else {
+            self.order.clear();
+            self.order.extend(0..self.contacts.len() as u32);
+            SweepOrder::Natural(&mut self.order)
+        };
+        solver::rebuild_velocities(
+            &self.contacts.rows,
+            &mut self.vel,
+            &self.v_free,
+            &self.inv,
+            &order,
+        );
         let report = solver::solve(
             &mut self.contacts.rows,
-            &mut self.order,
+            order,
             &mut self.vel,
             &self.v_free,
             &self.inv,

@@ -1,0 +1,213 @@
+//! Parallel kernels of the contact solve, with results independent of the number of threads.
+//!
+//! - [`coloured_sweep`]: one Gauss–Seidel sweep visiting the colour classes of a
+//!   [`ContactColouring`] in turn; the contacts of a class share no mobile body, so they are
+//!   updated concurrently on the rayon pool and the numbers are exactly those of the same
+//!   class order swept by one thread.
+//! - [`coloured_apply`]: `v ← v + M⁻¹ Hᵀ R` class by class (the same argument).
+//! - [`reduce_chunks`]: sums over contacts as partial sums over fixed chunks of [`CHUNK`]
+//!   contacts added in chunk order, so the rounding does not depend on the thread count.
+//!
+//! The thread count is rayon's (`RAYON_NUM_THREADS`, or a pool installed by the caller); with
+//! one thread the same code runs sequentially and gives bit-identical results.
+
+use rayon::prelude::*;
+
+use crate::colouring::ContactColouring;
+use crate::contact::ContactRow;
+use crate::local::{project_on_cone, solve_local};
+
+/// Contacts per chunk of the fixed-partition reductions.
+pub const CHUNK: usize = 4096;
+/// Contacts per parallel task inside a colour class.
+pub const TASK: usize = 512;
+/// Classes with fewer contacts than this are swept on the calling thread (the same numbers, no
+/// fork–join overhead).
+pub const PARALLEL_MIN: usize = 2 * TASK;
+
+/// A raw pointer shared between the tasks of one colour class.
+#[derive(Clone, Copy)]
+struct Shared<T>(*mut T);
+// SAFETY: a `Shared` is only dereferenced at indices that no other task of the same class
+// touches (see `update_shared`); the pointee outlives the parallel section.
+unsafe impl<T> Send for Shared<T> {}
+unsafe impl<T> Sync for Shared<T> {}
+
+impl<T> Shared<T> {
+    /// The pointer (a method, so that closures capture the whole `Shared`, not its field).
+    #[inline(always)]
+    fn ptr(self) -> *mut T {
+        self.0
+    }
+}
+
+/// The exact local update of one contact on given body velocities: `r ← solve_local(W, u − W r)`,
+/// optionally relaxed and projected back on the cone; returns the impulse increment.
+#[inline(always)]
+pub(crate) fn local_update(
+    c: &mut ContactRow,
+    va: &mut [f64; 3],
+    ia: &[f64; 3],
+    vb: &mut [f64; 3],
+    ib: &[f64; 3],
+    omega: f64,
+) -> bool {
+    let u = c.velocity(va, vb);
+    let wr = c.w.mul(c.r);
+    let q = [u[0] - wr[0], u[1] - wr[1]];
+    let (mut r, _) = solve_local(&c.w, q, c.mu);
+    if omega != 1.0 {
+        let t = [
+            c.r[0] + omega * (r[0] - c.r[0]),
+            c.r[1] + omega * (r[1] - c.r[1]),
+        ];
+        r = project_on_cone(t, c.mu).0;
+    }
+    let d = [r[0] - c.r[0], r[1] - c.r[1]];
+    if d != [0.0, 0.0] {
+        c.apply(d, va, ia, vb, ib);
+        c.r = r;
+        true
+    } else {
+        false
+    }
+}
+
+/// Updates contact `i` through shared pointers, writing back only the velocities of mobile
+/// bodies.
+///
+/// # Safety
+/// No other thread may access row `i` or the velocity of a mobile body of row `i` at the same
+/// time; immobile bodies are only read (their velocity is never written by the solver).
+#[inline(always)]
+unsafe fn update_shared(
+    rows: Shared<ContactRow>,
+    i: usize,
+    vel: Shared<[f64; 3]>,
+    inv: &[[f64; 3]],
+    mobile: &[bool],
+    omega: f64,
+) {
+    // SAFETY: guaranteed by the caller (colour classes, `i` in bounds).
+    let c = unsafe { &mut *rows.ptr().add(i) };
+    let (a, b) = (c.a as usize, c.b as usize);
+    assert!(a < inv.len() && b < inv.len(), "contact body out of range");
+    let (pa, pb) = unsafe { (vel.ptr().add(a), vel.ptr().add(b)) };
+    let (mut va, mut vb) = unsafe { (*pa, *pb) };
+    if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
+        if mobile[a] {
+            unsafe { *pa = va };
+        }
+        if mobile[b] {
+            unsafe { *pb = vb };
+        }
+    }
+}
+
+/// Runs `f(i)` for every contact `i` of every class, classes in turn, the contacts of a
+/// parallel class concurrently.
+#[inline]
+fn for_each_coloured(colouring: &ContactColouring, f: impl Fn(usize) + Sync) {
+    for k in 0..colouring.colours() {
+        let class = colouring.class(k);
+        if colouring.is_sequential(k) || class.len() < PARALLEL_MIN {
+            for &i in class {
+                f(i as usize);
+            }
+        } else {
+            class.par_chunks(TASK).for_each(|chunk| {
+                for &i in chunk {
+                    f(i as usize);
+                }
+            });
+        }
+    }
+}
+
+/// One Gauss–Seidel sweep in colour order (see the module documentation). `mobile[i]` is true
+/// when body `i` has a non-zero inverse mass component; `colouring` must have been built from
+/// `rows` and `mobile`.
+pub fn coloured_sweep(
+    rows: &mut [ContactRow],
+    colouring: &ContactColouring,
+    vel: &mut [[f64; 3]],
+    inv: &[[f64; 3]],
+    mobile: &[bool],
+    omega: f64,
+) {
+    assert_eq!(colouring.order.len(), rows.len(), "colouring of other rows");
+    assert!(vel.len() == inv.len() && vel.len() == mobile.len());
+    let n_rows = rows.len();
+    let (pr, pv) = (Shared(rows.as_mut_ptr()), Shared(vel.as_mut_ptr()));
+    for_each_coloured(colouring, |i| {
+        assert!(i < n_rows);
+        // SAFETY: within a parallel class no two contacts share a row or a mobile body
+        // (`ContactColouring::build`); sequential classes run on one thread; `i` checked, body
+        // indices checked in `update_shared`.
+        unsafe { update_shared(pr, i, pv, inv, mobile, omega) }
+    });
+}
+
+/// `v ← v + M⁻¹ Hᵀ R` with the impulses stored in `rows`, class by class.
+pub fn coloured_apply(
+    rows: &[ContactRow],
+    colouring: &ContactColouring,
+    vel: &mut [[f64; 3]],
+    inv: &[[f64; 3]],
+    mobile: &[bool],
+) {
+    assert_eq!(colouring.order.len(), rows.len(), "colouring of other rows");
+    let pv = Shared(vel.as_mut_ptr());
+    let n_bodies = inv.len();
+    assert!(vel.len() == n_bodies && mobile.len() == n_bodies);
+    for_each_coloured(colouring, |i| {
+        let c = &rows[i];
+        if c.r == [0.0, 0.0] {
+            return;
+        }
+        let (a, b) = (c.a as usize, c.b as usize);
+        assert!(a < n_bodies && b < n_bodies);
+        // SAFETY: as in `coloured_sweep`: the mobile bodies of a parallel class are distinct.
+        unsafe {
+            let (pa, pb) = (pv.ptr().add(a), pv.ptr().add(b));
+            let (mut va, mut vb) = (*pa, *pb);
+            c.apply(c.r, &mut va, &inv[a], &mut vb, &inv[b]);
+            if mobile[a] {
+                *pa = va;
+            }
+            if mobile[b] {
+                *pb = vb;
+            }
+        }
+    });
+}
+
+/// `Σ_α f(α)` over the contacts as partial sums over fixed chunks of [`CHUNK`] contacts, added
+/// in chunk order: the result does not depend on the thread count. `N` sums at once.
+pub fn reduce_chunks<const N: usize>(
+    rows: &[ContactRow],
+    f: impl Fn(&ContactRow) -> [f64; N] + Sync,
+) -> [f64; N] {
+    let partial = |chunk: &[ContactRow]| {
+        let mut s = [0.0; N];
+        for c in chunk {
+            let v = f(c);
+            for k in 0..N {
+                s[k] += v[k];
+            }
+        }
+        s
+    };
+    let mut total = [0.0; N];
+    if rows.len() <= CHUNK {
+        total = partial(rows);
+    } else {
+        let parts: Vec<[f64; N]> = rows.par_chunks(CHUNK).map(partial).collect();
+        for p in parts {
+            for k in 0..N {
+                total[k] += p[k];
+            }
+        }
+    }
+    total
+}
