@@ -11,16 +11,18 @@
 //! Every error is one line on stderr and exit code 2.
 
 use std::ffi::OsString;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
 
+use crate::checkpoint::{self, RunCheckpoint};
 use crate::error::{CliError, Result};
 use crate::output::OutputDir;
 use crate::progress::Verbosity;
-use crate::scenarios::{self, RunContext};
+use crate::scenarios::phased::DEFAULT_CHECKPOINT_SECONDS;
+use crate::scenarios::{self, CheckpointPolicy, RunContext, RunControl};
 
 /// grainlaw: discrete-element simulations of granular media turned into calibrated continuum laws.
 #[derive(Debug, Parser)]
@@ -36,11 +38,11 @@ pub struct Cli {
 pub enum Command {
     /// Run a scenario end to end (simulation, homogenisation, fits, figures, summary.json).
     Run {
-        /// A built-in scenario name (see `grainlaw scenarios`) or a TOML file path.
-        #[arg(default_value = "janssen")]
-        scenario: String,
+        /// A built-in scenario name (see `grainlaw scenarios`) or a TOML file path (default
+        /// `janssen`; with `--resume`, the checkpoint's).
+        scenario: Option<String>,
         /// Output directory (default `grainlaw-out/SCENARIO`).
-        #[arg(long, value_name = "DIR")]
+        #[arg(long, value_name = "DIR", conflicts_with = "resume")]
         out: Option<PathBuf>,
         /// Override a scenario key (dotted keys for tables), e.g. `--set grains=2000`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -48,6 +50,19 @@ pub enum Command {
         /// No progress bars and no report on stdout (warnings and errors still go to stderr).
         #[arg(long, short)]
         quiet: bool,
+        /// Continue the interrupted run whose output directory is DIR, from its checkpoint
+        /// (scenario and overrides are the checkpoint's; output continues in DIR).
+        #[arg(long, value_name = "DIR")]
+        resume: Option<PathBuf>,
+        /// Write a checkpoint every STEPS steps (all phases together; 0: not by steps).
+        #[arg(long, value_name = "STEPS", default_value_t = 0)]
+        checkpoint_every: u64,
+        /// Write a checkpoint every S seconds of wall-clock time (0: not by time).
+        #[arg(long, value_name = "S", default_value_t = DEFAULT_CHECKPOINT_SECONDS)]
+        checkpoint_seconds: f64,
+        /// Test hook: stop as Ctrl-C does after this many steps of this invocation.
+        #[arg(long, value_name = "STEPS", hide = true)]
+        stop_after_steps: Option<u64>,
     },
     /// List the built-in scenarios, or print one's full TOML.
     Scenarios {
@@ -122,24 +137,62 @@ where
         Ok(()) => 0,
         Err(e) => {
             eprintln!("error: {}", e.one_line());
-            2
+            e.exit_code()
         }
     }
 }
 
+/// The options of `grainlaw run`.
+#[derive(Debug, Clone, Default)]
+pub struct RunArgs {
+    /// Scenario name or TOML path (`None`: janssen, or the checkpoint's with `resume`).
+    pub scenario: Option<String>,
+    /// Output directory.
+    pub out: Option<PathBuf>,
+    /// `KEY=VALUE` overrides.
+    pub set: Vec<String>,
+    /// No progress and no report on stdout.
+    pub quiet: bool,
+    /// Output directory of the run to resume.
+    pub resume: Option<PathBuf>,
+    /// Checkpoint every this many steps (0: not by steps).
+    pub checkpoint_every: u64,
+    /// Checkpoint every this many wall-clock seconds (0: not by time).
+    pub checkpoint_seconds: f64,
+    /// Stop as Ctrl-C does after this many steps (tests).
+    pub stop_after_steps: Option<u64>,
+}
+
 fn dispatch(cmd: Option<Command>) -> Result<()> {
     match cmd.unwrap_or(Command::Run {
-        scenario: "janssen".into(),
+        scenario: None,
         out: None,
         set: Vec::new(),
         quiet: false,
+        resume: None,
+        checkpoint_every: 0,
+        checkpoint_seconds: DEFAULT_CHECKPOINT_SECONDS,
+        stop_after_steps: None,
     }) {
         Command::Run {
             scenario,
             out,
             set,
             quiet,
-        } => run(&scenario, out, &set, quiet),
+            resume,
+            checkpoint_every,
+            checkpoint_seconds,
+            stop_after_steps,
+        } => run(RunArgs {
+            scenario,
+            out,
+            set,
+            quiet,
+            resume,
+            checkpoint_every,
+            checkpoint_seconds,
+            stop_after_steps,
+        }),
         Command::Scenarios { show } => scenarios_cmd(show.as_deref()),
         Command::Fit { law, data, out } => crate::fit_cmd::fit(&law, &data, out.as_deref()),
         Command::SolveFc {
@@ -154,10 +207,34 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
     }
 }
 
-fn run(spec: &str, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result<()> {
-    let loaded = datasets::load(spec, set)?;
-    let dir = out.unwrap_or_else(|| PathBuf::from("grainlaw-out").join(&loaded.name));
-    let verbosity = if quiet {
+/// `grainlaw run`: a new run, or with `resume` the continuation of an interrupted one.
+pub fn run(args: RunArgs) -> Result<()> {
+    if !(args.checkpoint_seconds >= 0.0 && args.checkpoint_seconds.is_finite()) {
+        return Err(CliError::Usage(format!(
+            "--checkpoint-seconds must be a finite number ≥ 0, got {}",
+            args.checkpoint_seconds
+        )));
+    }
+    let policy = CheckpointPolicy {
+        every_steps: (args.checkpoint_every > 0).then_some(args.checkpoint_every),
+        every_seconds: (args.checkpoint_seconds > 0.0).then_some(args.checkpoint_seconds),
+    };
+    let (loaded, dir, sets) = match &args.resume {
+        Some(dir) => {
+            let loaded = resumed_scenario(dir, args.scenario.as_deref(), &args.set)?;
+            (loaded.0, dir.clone(), loaded.1)
+        }
+        None => {
+            let spec = args.scenario.as_deref().unwrap_or("janssen");
+            let loaded = datasets::load(spec, &args.set)?;
+            let dir = args
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("grainlaw-out").join(&loaded.name));
+            (loaded, dir, args.set.clone())
+        }
+    };
+    let verbosity = if args.quiet {
         Verbosity::Quiet
     } else {
         Verbosity::Normal
@@ -165,8 +242,16 @@ fn run(spec: &str, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result<
     let interrupted = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupted.clone();
-        // A second handler cannot be installed (tests run several times in one process): ignore.
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+        // The first Ctrl-C asks for a checkpoint and a clean stop after the current step; a
+        // second one stops at once (files are written atomically: nothing half-written is
+        // left that looks complete). A second handler cannot be installed (library callers
+        // may run several times in one process): ignore.
+        let _ = ctrlc::set_handler(move || {
+            if flag.swap(true, Ordering::SeqCst) {
+                eprintln!("error: interrupted twice: stopped at once (the last checkpoint, if any, is kept)");
+                std::process::exit(130);
+            }
+        });
     }
     let mut ctx = RunContext {
         out: OutputDir::create(&dir)?,
@@ -174,13 +259,63 @@ fn run(spec: &str, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result<
         loaded,
         interrupted,
     };
-    let outcome = scenarios::run(&mut ctx)?;
-    if !quiet {
+    let mut ctl = RunControl::new(sets, policy);
+    ctl.resume = args.resume.is_some();
+    ctl.stop_after_steps = args.stop_after_steps;
+    let outcome = scenarios::run_controlled(&mut ctx, &mut ctl)?;
+    if !args.quiet {
         for l in outcome.headline {
             println!("{l}");
         }
     }
     Ok(())
+}
+
+/// The scenario of the checkpoint in `dir`, with its overrides; refuses a missing or unreadable
+/// checkpoint, and a SCENARIO or `--set` given on the command line that differs from it.
+fn resumed_scenario(
+    dir: &Path,
+    scenario: Option<&str>,
+    set: &[String],
+) -> Result<(datasets::LoadedScenario, Vec<String>)> {
+    let cp: RunCheckpoint<serde::de::IgnoredAny> = checkpoint::read(dir)?;
+    let rec = cp.scenario;
+    let refuse = |given: String| CliError::Checkpoint {
+        path: checkpoint::file_of(dir).display().to_string(),
+        reason: format!(
+            "the run there is `{}`, not `{given}`: resume it with `grainlaw run --resume {}` alone",
+            rec.describe(),
+            dir.display()
+        ),
+    };
+    match scenario {
+        Some(spec) => {
+            let given = datasets::load(spec, set)?;
+            if given.effective_toml != rec.effective_toml {
+                let mut g = given.source.clone();
+                for o in set {
+                    g.push_str(" --set ");
+                    g.push_str(o);
+                }
+                return Err(refuse(g));
+            }
+        }
+        None if !set.is_empty() && set != rec.sets.as_slice() => {
+            let g = set
+                .iter()
+                .map(|o| format!("--set {o}"))
+                .collect::<Vec<_>>()
+                .join(" ");
+            return Err(refuse(format!("{} {g}", rec.source)));
+        }
+        None => {}
+    }
+    let loaded = datasets::scenario::from_text(&rec.name, &rec.source, &rec.effective_toml, &[])
+        .map_err(|e| CliError::Checkpoint {
+            path: checkpoint::file_of(dir).display().to_string(),
+            reason: format!("its scenario does not load any more ({e})"),
+        })?;
+    Ok((loaded, rec.sets))
 }
 
 fn scenarios_cmd(show: Option<&str>) -> Result<()> {

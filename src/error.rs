@@ -3,8 +3,8 @@
 use thiserror::Error;
 
 /// Everything `grainlaw` can fail with. [`CliError::one_line`] is what is printed; the exit code
-/// is 2 for all of them (bad input, unreadable file, failed run), after no partial output that
-/// looks complete.
+/// ([`CliError::exit_code`]) is 2 for all of them (bad input, unreadable file, failed run),
+/// after no partial output that looks complete, except 130 for [`CliError::Interrupted`].
 #[derive(Debug, Error)]
 pub enum CliError {
     /// Scenario loading, validation, generation.
@@ -38,9 +38,26 @@ pub enum CliError {
         /// What went wrong.
         reason: String,
     },
-    /// The user stopped the run (Ctrl-C).
-    #[error("interrupted by the user; no summary.json was written")]
-    Interrupted,
+    /// The user stopped the run (Ctrl-C): a checkpoint was written, the run can be resumed.
+    #[error(
+        "interrupted at step {step} of phase `{phase}`: checkpoint written to {dir}/checkpoint, no summary.json; continue with: grainlaw run --resume {dir}"
+    )]
+    Interrupted {
+        /// The phase stopped.
+        phase: String,
+        /// Steps the phase had done.
+        step: u64,
+        /// The output directory (as to type it).
+        dir: String,
+    },
+    /// A run checkpoint cannot be written, read, or used for this resume.
+    #[error("{path}: {reason}")]
+    Checkpoint {
+        /// The checkpoint file (or output directory).
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// A command-line argument is wrong.
     #[error("{0}")]
     Usage(String),
@@ -52,6 +69,15 @@ impl CliError {
         CliError::Io {
             path: path.as_ref().display().to_string(),
             reason: e.to_string(),
+        }
+    }
+
+    /// The process exit code: 130 (128 + SIGINT, the shells' convention) for a run stopped by
+    /// the user, which can be resumed; 2 for every error.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            CliError::Interrupted { .. } => 130,
+            _ => 2,
         }
     }
 

@@ -5,10 +5,12 @@
 //! ([`plot`]), CSV, VTK and `summary.json` ([`output`]). The scenarios and generators are in
 //! [`datasets`]; the runners in [`scenarios`]; the command line in [`cli`].
 
+pub mod checkpoint;
 pub mod cli;
 pub mod error;
 pub mod fc_cmd;
 pub mod fit_cmd;
+pub mod floats;
 pub mod output;
 pub mod plot;
 pub mod progress;

@@ -1,19 +1,24 @@
 //! Small CSV tables with the unit in each header (`time_s`, `force_N`), optional `# key = value`
 //! metadata lines (readable by `grainlaw fit`), written through [`super::OutputDir`].
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::Result;
 use crate::output::OutputDir;
 
-/// Columns of numbers with headers that carry their unit.
-#[derive(Debug, Clone, Default)]
+/// Columns of numbers with headers that carry their unit. Serialisable exactly (NaN cells
+/// included) so that a table filled step by step can be saved in a run checkpoint.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct CsvTable {
     /// `# key = value` lines written before the header.
+    #[serde(with = "crate::floats::pairs")]
     pub metadata: Vec<(String, f64)>,
     /// `# text` comment lines written first.
     pub comments: Vec<String>,
     /// Headers, e.g. `z_m`, `sigma_v_Pa`.
     pub headers: Vec<String>,
     /// Rows of values (NaN written as an empty cell).
+    #[serde(with = "crate::floats::table")]
     pub rows: Vec<Vec<f64>>,
 }
 

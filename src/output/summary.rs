@@ -1,10 +1,12 @@
 //! `summary.json`: the key results of a run as one flat JSON object, SI units, keys in the order
 //! they were added. Non-finite numbers are written as `null`.
 
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-/// Flat, ordered key → value pairs.
-#[derive(Debug, Clone, Default)]
+/// Flat, ordered key → value pairs (serialisable, for run checkpoints of summaries built step
+/// by step).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Summary {
     entries: Vec<(String, Value)>,
 }

@@ -18,12 +18,14 @@ use std::fmt::Write as _;
 use dem::snapshot::{BodyKind, Snapshot, WallGeometry};
 use homogenise::tensor::frobenius;
 use nalgebra::Vector2;
+use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 use crate::output::OutputDir;
 
-/// Frames written so far, to be listed in the `.pvd` collections.
-#[derive(Debug, Default)]
+/// Frames written so far, to be listed in the `.pvd` collections (serialisable, for run
+/// checkpoints).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct VtkSeries {
     frames: Vec<(f64, usize)>,
     prefix: String,
@@ -306,18 +308,22 @@ impl VtkSeries {
         }
     }
 
-    /// Writes the three files of one frame under `vtk/`.
+    /// Writes the three files of one frame under `vtk/` (`PREFIXgrains_NNNN.vtp`, ...).
     pub fn add_frame(&mut self, out: &mut OutputDir, snap: &Snapshot) -> Result<()> {
         let k = self.frames.len();
+        let p = &self.prefix;
         out.write(
-            &format!("vtk/grains_{k:04}.vtp"),
+            &format!("vtk/{p}grains_{k:04}.vtp"),
             grains_vtp(snap)?.as_bytes(),
         )?;
         out.write(
-            &format!("vtk/contacts_{k:04}.vtp"),
+            &format!("vtk/{p}contacts_{k:04}.vtp"),
             contacts_vtp(snap).as_bytes(),
         )?;
-        out.write(&format!("vtk/walls_{k:04}.vtp"), walls_vtp(snap).as_bytes())?;
+        out.write(
+            &format!("vtk/{p}walls_{k:04}.vtp"),
+            walls_vtp(snap).as_bytes(),
+        )?;
         self.frames.push((snap.time, k));
         Ok(())
     }

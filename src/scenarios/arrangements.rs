@@ -8,53 +8,91 @@ use datasets::config::ArrangementsConfig;
 use datasets::generators::Arrangement;
 use datasets::phases::RunUntilRest;
 
-use super::common::{grain_weight, run_phase, solver_keys, Stop, VtkFrames};
-use super::{RunContext, RunOutcome};
+use datasets::phases::PhaseStats;
+use serde::{Deserialize, Serialize};
+
+use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, Summary};
+use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 
-/// Runs the scenario.
-pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
-    let mut s = Summary::new();
-    s.num("radius", c.radius)
-        .int("columns", c.columns as u64)
-        .int("rows", c.rows as u64)
-        .num("grain_friction", c.friction.grain_grain)
-        .num("wall_friction", c.friction.grain_wall);
-    let mut table = CsvTable::new(&[
-        "arrangement_0rect_1tri_2cannon",
-        "grains",
-        "weight_N",
-        "bottom_load_N",
-        "left_wall_normal_N",
-        "right_wall_normal_N",
-        "left_wall_friction_up_N",
-        "right_wall_friction_up_N",
-        "top_load_N",
-    ]);
-    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
-    let mut all = datasets::phases::PhaseStats::default();
-    let env = ctx.env();
-    for (k, kind) in Arrangement::ALL.iter().enumerate() {
-        let name = kind.name();
-        let mut world = datasets::build::arrangement(c, *kind)?;
-        let weight = grain_weight(&world);
-        let mut vtk = VtkFrames::with_prefix(&format!("{name}_"), c.duration / 10.0, 11);
-        let out = &mut ctx.out;
-        let stats = run_phase(
-            &env,
-            name,
-            &mut world,
-            Stop::UntilRest(RunUntilRest {
+/// One phase per arrangement (rectangular, triangular, cannonball), each settling its own
+/// stack to rest.
+struct Stacks<'a> {
+    c: &'a ArrangementsConfig,
+}
+
+/// What the stacks' phases collect.
+#[derive(Serialize, Deserialize)]
+struct StacksState {
+    /// Summary entries so far.
+    s: Summary,
+    /// One row per arrangement: `wall_loads.csv`.
+    table: CsvTable,
+    headline: Vec<String>,
+    all: PhaseStats,
+    /// VTK frames of the current arrangement.
+    vtk: VtkFrames,
+    /// Weight of the current stack (N).
+    weight: f64,
+}
+
+impl PhasedRun for Stacks<'_> {
+    type State = StacksState;
+
+    fn phase_count(&self) -> usize {
+        Arrangement::ALL.len()
+    }
+
+    fn enter(
+        &self,
+        k: usize,
+        _env: &PhaseEnv,
+        world: &mut dem::World,
+        st: &mut StacksState,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        let c = self.c;
+        let kind = Arrangement::ALL[k];
+        *world = datasets::build::arrangement(c, kind)?;
+        st.weight = grain_weight(world);
+        st.vtk = VtkFrames::with_prefix(&format!("{}_", kind.name()), c.duration / 10.0, 11);
+        Ok(Some(PhasePlan {
+            name: kind.name().into(),
+            stop: Stop::UntilRest(RunUntilRest {
                 min_time: 0.2 * c.duration,
                 max_time: c.duration,
                 rest_energy: 1e-12,
             }),
-            |w, _| vtk.maybe(out, w),
-        )?;
-        all.merge(&stats);
-        vtk.finish(&mut ctx.out, &world)?;
+        }))
+    }
+
+    fn step(
+        &self,
+        _k: usize,
+        st: &mut StacksState,
+        out: &mut OutputDir,
+        w: &dem::World,
+        _r: &dem::StepReport,
+    ) -> Result<()> {
+        st.vtk.maybe(out, w)
+    }
+
+    fn leave(
+        &self,
+        k: usize,
+        st: &mut StacksState,
+        out: &mut OutputDir,
+        world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        let name = Arrangement::ALL[k].name();
+        st.all.merge(stats);
+        std::mem::replace(&mut st.vtk, VtkFrames::new(f64::INFINITY, 1)).finish(out, world)?;
+        let weight = st.weight;
         let snap = world.snapshot();
         let force = |wall: &str| {
             snap.walls
@@ -68,7 +106,7 @@ pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         // Force received by a wall: the grains push it; the bottom wall is pushed down.
         let bottom_load = -bottom.y;
         let ratio = bottom_load / weight;
-        s.int(&format!("grains_{name}"), (snap.bodies.len() - 4) as u64)
+        st.s.int(&format!("grains_{name}"), (snap.bodies.len() - 4) as u64)
             .num(&format!("weight_N_{name}"), weight)
             .num(&format!("bottom_load_over_weight_{name}"), ratio)
             .num(
@@ -80,7 +118,7 @@ pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                 0.5 * (-left.x + right.x),
             )
             .flag(&format!("at_rest_{name}"), stats.at_rest);
-        table.push(vec![
+        st.table.push(vec![
             k as f64,
             (snap.bodies.len() - 4) as f64,
             weight,
@@ -91,12 +129,12 @@ pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             -right.y,
             top.y,
         ]);
-        headline.push(format!(
+        st.headline.push(format!(
             "{name:<12}: bottom load / weight = {ratio:.3}, side walls carry {:.3} of the weight",
             -(left.y + right.y) / weight
         ));
         draw_particles(
-            &mut ctx.out,
+            out,
             &format!("normal_forces_{name}.png"),
             &ParticleView {
                 snap: &snap,
@@ -108,8 +146,50 @@ pub fn run(c: &ArrangementsConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
                 axis_labels: ("x (m)".into(), "y (m)".into()),
                 width_px: 560,
             },
-        )?;
+        )
     }
+}
+
+/// Runs the scenario.
+pub fn run(
+    c: &ArrangementsConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    let mut s = Summary::new();
+    s.num("radius", c.radius)
+        .int("columns", c.columns as u64)
+        .int("rows", c.rows as u64)
+        .num("grain_friction", c.friction.grain_grain)
+        .num("wall_friction", c.friction.grain_wall);
+    let state = StacksState {
+        s,
+        table: CsvTable::new(&[
+            "arrangement_0rect_1tri_2cannon",
+            "grains",
+            "weight_N",
+            "bottom_load_N",
+            "left_wall_normal_N",
+            "right_wall_normal_N",
+            "left_wall_friction_up_N",
+            "right_wall_friction_up_N",
+            "top_load_N",
+        ]),
+        headline: vec![format!("report: {}/", ctx.out.path().display())],
+        all: PhaseStats::default(),
+        vtk: VtkFrames::new(f64::INFINITY, 1),
+        weight: f64::NAN,
+    };
+    // Each phase builds its own stack; the initial world is a placeholder.
+    let empty = dem::World::new(dem::WorldParams::default(), dem::ContactLaws::new(&[], 0.0));
+    let (_, st) = drive(ctx, ctl, &Stacks { c }, || Ok((empty, state)))?;
+    let StacksState {
+        mut s,
+        mut table,
+        headline,
+        all,
+        ..
+    } = st;
     solver_keys(&mut s, &all);
     table.comments.push("one row per arrangement; forces of the grains on the walls at rest (N per metre of thickness)".into());
     table.write(&mut ctx.out, "wall_loads.csv")?;

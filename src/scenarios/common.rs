@@ -1,10 +1,13 @@
-//! Pieces every scenario runner uses: phases with progress and honest solver accounting,
-//! VTK frames at a fixed simulated-time interval, the solver keys of `summary.json`.
+//! Pieces every scenario runner uses: phases with progress and honest solver and numerics
+//! accounting, VTK frames at a fixed simulated-time interval, the solver keys of
+//! `summary.json`.
 
-use std::sync::atomic::Ordering;
-
-use datasets::phases::{run_steps, run_until_rest, PhaseStats, RunUntilRest};
+use datasets::phases::{
+    continue_steps, continue_until_rest, PhaseProgress, PhaseStats, RunUntilRest,
+    ENERGY_GROWTH_TOLERANCE, PENETRATION_LIMIT,
+};
 use dem::{StepReport, World};
+use serde::{Deserialize, Serialize};
 
 use super::PhaseEnv;
 use crate::error::{CliError, Result};
@@ -13,7 +16,7 @@ use crate::output::{OutputDir, Summary};
 use crate::progress::{warn, Phase};
 
 /// When a phase stops.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Stop {
     /// At rest (kinetic energy criterion) or at the time limit.
     UntilRest(RunUntilRest),
@@ -21,15 +24,19 @@ pub enum Stop {
     Steps(u64),
 }
 
-/// Runs `world` through one phase with a progress bar; `each` is called after every step (its
-/// error stops the phase and is returned). Steps whose contact solve did not converge are
-/// counted and reported on stderr. Ctrl-C stops the phase with [`CliError::Interrupted`].
+/// Runs `world` through one phase with a progress bar, from `progress` (default for a new
+/// phase; kept up to date, so that a checkpoint can save it). `each` is called after every step
+/// with the updated progress; its error stops the phase and is returned (the run driver's
+/// Ctrl-C stop is one). At the end, one line on stderr per problem the phase met: steps whose
+/// contact solve did not converge, steps whose energy grew, overlaps beyond the limit, a rest
+/// not reached; each names the first step concerned.
 pub fn run_phase(
     ctx: &PhaseEnv,
     name: &str,
     world: &mut World,
     stop: Stop,
-    mut each: impl FnMut(&World, &StepReport) -> Result<()>,
+    progress: &mut PhaseProgress,
+    mut each: impl FnMut(&World, &StepReport, &PhaseProgress) -> Result<()>,
 ) -> Result<PhaseStats> {
     let dt = world.params.dt;
     let len = match stop {
@@ -37,37 +44,30 @@ pub fn run_phase(
         Stop::Steps(n) => n,
     };
     let bar = Phase::new(ctx.verbosity, name, len);
+    bar.set(progress.steps());
     let mut failure: Option<CliError> = None;
-    let mut k = 0u64;
-    let flag = ctx.interrupted.clone();
-    let mut cb = |w: &World, r: &StepReport| -> bool {
-        k += 1;
-        if k.is_multiple_of(25) {
-            bar.set(k);
+    let mut cb = |w: &World, r: &StepReport, p: &PhaseProgress| -> bool {
+        if p.steps().is_multiple_of(25) {
+            bar.set(p.steps());
             bar.message(format!(
                 "t={:.3}s sweeps={} err={:.1e}",
                 w.time, r.solver.iterations, r.solver.error
             ));
         }
-        if flag.load(Ordering::Relaxed) {
-            failure = Some(CliError::Interrupted);
-            return false;
-        }
-        if let Err(e) = each(w, r) {
+        if let Err(e) = each(w, r, p) {
             failure = Some(e);
             return false;
         }
         true
     };
     let stats = match stop {
-        Stop::UntilRest(r) => run_until_rest(world, &r, &mut cb)?,
-        Stop::Steps(n) => run_steps(world, n, &mut cb)?,
+        Stop::UntilRest(r) => continue_until_rest(world, &r, progress, &mut cb)?,
+        Stop::Steps(n) => continue_steps(world, n, progress, &mut cb)?,
     };
     if let Some(e) = failure {
         bar.finish("stopped");
         return Err(e);
     }
-    let tol = world.params.solver.tolerance;
     let rest = match stop {
         Stop::UntilRest(_) if stats.at_rest => ", at rest",
         Stop::UntilRest(_) => ", NOT at rest at the time limit",
@@ -80,39 +80,92 @@ pub fn run_phase(
         stats.simulated_time,
         stats.mean_sweeps()
     ));
-    if stats.unconverged_steps > 0 {
-        warn(&format!(
-            "{name}: {} of {} steps stopped at the sweep cap ({}) above the tolerance {tol:.0e}; worst error {:.2e}",
-            stats.unconverged_steps, stats.steps, world.params.solver.max_iterations, stats.worst_error
-        ));
-    }
-    if let Stop::UntilRest(_) = stop {
-        if !stats.at_rest {
-            warn(&format!(
-                "{name}: not at rest after {:.3} s (kinetic energy / Σ m g d = {:.2e})",
-                stats.simulated_time, stats.final_energy_ratio
-            ));
-        }
+    for line in phase_warnings(name, &stats, world, matches!(stop, Stop::UntilRest(_))) {
+        warn(&line);
     }
     Ok(stats)
 }
 
-/// Solver accounting keys of `summary.json`: `solver_unconverged_steps`, `solver_worst_error`,
-/// `solver_steps`, `solver_mean_sweeps`, `solver_max_sweeps`, `max_penetration_m`.
+/// The warnings of a finished phase (one line each): non-converged steps, energy growth,
+/// overlaps beyond [`PENETRATION_LIMIT`], rest not reached (`looks_for_rest`).
+pub fn phase_warnings(
+    name: &str,
+    stats: &PhaseStats,
+    world: &World,
+    looks_for_rest: bool,
+) -> Vec<String> {
+    let mut lines = Vec::new();
+    let solver = &world.params.solver;
+    if stats.unconverged_steps > 0 {
+        lines.push(format!(
+            "{name}: {} of {} steps stopped at the sweep cap ({}) above the tolerance {:.0e}; worst error {:.2e}",
+            stats.unconverged_steps, stats.steps, solver.max_iterations, solver.tolerance, stats.worst_error
+        ));
+    }
+    let first = |s: Option<u64>| s.map_or_else(|| "?".to_string(), |s| s.to_string());
+    if stats.energy_growth_steps > 0 {
+        lines.push(format!(
+            "{name}: the mechanical energy grew in {} of {} steps, first at step {}; worst growth {:.2e} of Σ m g d (tolerance {ENERGY_GROWTH_TOLERANCE:.0e})",
+            stats.energy_growth_steps,
+            stats.steps,
+            first(stats.first_energy_growth_step),
+            stats.worst_energy_growth
+        ));
+    }
+    if stats.penetration_flagged_steps > 0 {
+        lines.push(format!(
+            "{name}: overlap above {:.0} % of the smallest radius in {} of {} steps, first at step {}; largest {:.2e} m ({:.1} % of the smallest radius)",
+            100.0 * PENETRATION_LIMIT,
+            stats.penetration_flagged_steps,
+            stats.steps,
+            first(stats.first_penetration_step),
+            stats.max_penetration,
+            100.0 * stats.max_penetration_ratio
+        ));
+    }
+    if looks_for_rest && !stats.at_rest {
+        lines.push(format!(
+            "{name}: not at rest after {:.3} s (kinetic energy / Σ m g d = {:.2e})",
+            stats.simulated_time, stats.final_energy_ratio
+        ));
+    }
+    lines
+}
+
+/// Solver and numerics keys of `summary.json`: `solver_steps`, `solver_unconverged_steps`,
+/// `solver_worst_error`, `solver_mean_sweeps`, `solver_max_sweeps`; `max_penetration_m`,
+/// `max_penetration_over_radius` (over the smallest grain radius), `penetration_flagged_steps`
+/// (overlap above [`PENETRATION_LIMIT`] of it) and `penetration_first_step`;
+/// `energy_growth_steps` (energy residual above [`ENERGY_GROWTH_TOLERANCE`] of the load energy
+/// scale), `energy_growth_first_step` and `energy_growth_worst` (largest residual over the
+/// scale). A first step is the world's step index, `null` when there is none.
 pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
+    let step = |v: Option<u64>| v.map_or(serde_json::Value::Null, serde_json::Value::from);
     s.int("solver_steps", stats.steps)
         .int("solver_unconverged_steps", stats.unconverged_steps)
         .num("solver_worst_error", stats.worst_error)
         .num("solver_mean_sweeps", stats.mean_sweeps())
         .int("solver_max_sweeps", stats.max_sweeps as u64)
-        .num("max_penetration_m", stats.max_penetration);
+        .num("max_penetration_m", stats.max_penetration)
+        .num("max_penetration_over_radius", stats.max_penetration_ratio)
+        .int("penetration_flagged_steps", stats.penetration_flagged_steps)
+        .set("penetration_first_step", step(stats.first_penetration_step))
+        .int("energy_growth_steps", stats.energy_growth_steps)
+        .set(
+            "energy_growth_first_step",
+            step(stats.first_energy_growth_step),
+        )
+        .num("energy_growth_worst", stats.worst_energy_growth);
 }
 
 /// VTK frames every `interval` seconds of simulated time, at most `max_frames` (the final
-/// state is added by [`VtkFrames::finish`]).
+/// state is added by [`VtkFrames::finish`]). Serialisable, for run checkpoints.
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct VtkFrames {
     series: VtkSeries,
+    #[serde(with = "dem::serde_float")]
     interval: f64,
+    #[serde(with = "dem::serde_float")]
     next: f64,
     max_frames: usize,
 }

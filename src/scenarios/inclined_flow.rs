@@ -12,22 +12,33 @@ use dem::snapshot::Snapshot;
 use dem::BodyKind;
 use homogenise::inertia_ratio::{fluid_fraction, inertia_ratios};
 
-use super::common::{mean_diameter, run_phase, solver_keys, Stop, VtkFrames};
-use super::{RunContext, RunOutcome};
+use datasets::phases::PhaseStats;
+use serde::{Deserialize, Serialize};
+
+use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, Summary};
+use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::colormap::Scale;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 
 /// Accumulated profiles across the layer (bins of height y above the base).
+#[derive(Serialize, Deserialize)]
 struct Profiles {
     dy: f64,
+    #[serde(with = "crate::floats::vec")]
     mv: Vec<f64>,
+    #[serde(with = "crate::floats::vec")]
     m: Vec<f64>,
+    #[serde(with = "crate::floats::vec")]
     area: Vec<f64>,
+    #[serde(with = "crate::floats::vec")]
     log_ratio: Vec<f64>,
+    #[serde(with = "crate::floats::vec")]
     n_ratio: Vec<f64>,
     samples: usize,
 }
@@ -67,51 +78,137 @@ impl Profiles {
     }
 }
 
-/// Runs the scenario.
-pub fn run(c: &InclinedFlowConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
-    let mut world = datasets::build::inclined_flow(c)?;
-    let length = c.cell_length_diameters * 2.0 * c.grain.radius_mean;
-    let base = c.grain.radius_mean; // top of the rough base (disks centred on y = 0)
-    let d = mean_diameter(&world);
-    let steps = (c.duration / c.dt).round() as u64;
-    let avg_from = ((c.duration - c.average) / c.dt).round() as u64;
-    // Layer height estimate from the grains' area at φ ≈ 0.75, with room for dilation.
-    let area = datasets::build::grain_area(&world);
-    let h_est = area / (0.75 * length);
-    let bins = c.profile_bins;
-    let dy = 1.6 * h_est / bins as f64;
-    let mut prof = Profiles::new(bins, dy);
-    let mut hist = CsvTable::new(&[
-        "time_s",
-        "mean_velocity_m_s",
-        "kinetic_energy_J",
-        "sweeps",
-        "solver_error",
-    ]);
-    let mut vtk = VtkFrames::new(c.duration / c.vtk_frames.max(1) as f64, c.vtk_frames.max(1));
-    let env = ctx.env();
-    let out = &mut ctx.out;
-    let sample_every = ((0.002 / c.dt).round() as u64).max(1);
-    let mut k = 0u64;
-    let stats = run_phase(&env, "flow", &mut world, Stop::Steps(steps), |w, r| {
-        k += 1;
+/// The single phase: the layer flows for `duration`; profiles are averaged over the last
+/// `average` seconds.
+struct Flow<'a> {
+    c: &'a InclinedFlowConfig,
+}
+
+/// What the flow phase collects.
+#[derive(Serialize, Deserialize)]
+struct FlowState {
+    /// Top of the rough base (m).
+    base: f64,
+    prof: Profiles,
+    /// One row per step: `history.csv`.
+    hist: CsvTable,
+    vtk: VtkFrames,
+    /// Steps done.
+    k: u64,
+    stats: PhaseStats,
+}
+
+impl Flow<'_> {
+    fn steps(&self) -> u64 {
+        (self.c.duration / self.c.dt).round() as u64
+    }
+}
+
+impl PhasedRun for Flow<'_> {
+    type State = FlowState;
+
+    fn phase_count(&self) -> usize {
+        1
+    }
+
+    fn enter(
+        &self,
+        _k: usize,
+        _env: &PhaseEnv,
+        _world: &mut dem::World,
+        _st: &mut FlowState,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        Ok(Some(PhasePlan {
+            name: "flow".into(),
+            stop: Stop::Steps(self.steps()),
+        }))
+    }
+
+    fn step(
+        &self,
+        _k: usize,
+        st: &mut FlowState,
+        out: &mut OutputDir,
+        w: &dem::World,
+        r: &dem::StepReport,
+    ) -> Result<()> {
+        let c = self.c;
+        let avg_from = ((c.duration - c.average) / c.dt).round() as u64;
+        let sample_every = ((0.002 / c.dt).round() as u64).max(1);
+        st.k += 1;
         let (mut mv, mut m) = (0.0, 0.0);
         for b in w.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
             mv += b.mass * b.velocity.x;
             m += b.mass;
         }
-        hist.push(vec![
+        st.hist.push(vec![
             w.time,
             mv / m,
             w.kinetic_energy(),
             r.solver.iterations as f64,
             r.solver.error,
         ]);
-        if k > avg_from && k.is_multiple_of(sample_every) {
-            prof.add(&w.snapshot(), base)?;
+        if st.k > avg_from && st.k.is_multiple_of(sample_every) {
+            st.prof.add(&w.snapshot(), st.base)?;
         }
-        vtk.maybe(out, w)
-    })?;
+        st.vtk.maybe(out, w)
+    }
+
+    fn leave(
+        &self,
+        _k: usize,
+        st: &mut FlowState,
+        _out: &mut OutputDir,
+        _world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        st.stats = *stats;
+        Ok(())
+    }
+}
+
+/// Runs the scenario.
+pub fn run(
+    c: &InclinedFlowConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    let length = c.cell_length_diameters * 2.0 * c.grain.radius_mean;
+    let bins = c.profile_bins;
+    let fresh = || -> Result<(dem::World, FlowState)> {
+        let world = datasets::build::inclined_flow(c)?;
+        // Layer height estimate from the grains' area at φ ≈ 0.75, with room for dilation.
+        let area = datasets::build::grain_area(&world);
+        let h_est = area / (0.75 * length);
+        let state = FlowState {
+            base: c.grain.radius_mean, // top of the rough base (disks centred on y = 0)
+            prof: Profiles::new(bins, 1.6 * h_est / bins as f64),
+            hist: CsvTable::new(&[
+                "time_s",
+                "mean_velocity_m_s",
+                "kinetic_energy_J",
+                "sweeps",
+                "solver_error",
+            ]),
+            vtk: VtkFrames::new(c.duration / c.vtk_frames.max(1) as f64, c.vtk_frames.max(1)),
+            k: 0,
+            stats: PhaseStats::default(),
+        };
+        Ok((world, state))
+    };
+    let (
+        world,
+        FlowState {
+            prof,
+            hist,
+            vtk,
+            stats,
+            ..
+        },
+    ) = drive(ctx, ctl, &Flow { c }, fresh)?;
+    let d = mean_diameter(&world);
+    let dy = prof.dy;
     vtk.finish(&mut ctx.out, &world)?;
     let snap = world.snapshot();
     let gs = homogenise::grain_stresses(&snap)?;

@@ -35,12 +35,15 @@ use identify::law::Provenance;
 use identify::{CalibratedLaw, IdentifyError};
 use nalgebra::Vector2;
 
-use super::common::{
-    grain_weight, mean_diameter, run_phase, solver_keys, write_law, Stop, VtkFrames,
-};
-use super::{RunContext, RunOutcome};
+use datasets::phases::PhaseStats;
+use serde::{Deserialize, Serialize};
+
+use super::common::{grain_weight, mean_diameter, solver_keys, write_law, Stop, VtkFrames};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, Summary};
+use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::histogram::{draw_histogram, HistogramPlot};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, Band, LegendAt, Series, Style, XyPlot};
@@ -202,17 +205,176 @@ pub fn fit_band(fit: &JanssenFit, zs: &[f64]) -> Vec<[f64; 7]> {
         .collect()
 }
 
+/// The phases of the column: deposit, relax, release (floor lowered), measure (one step
+/// solved tightly); the release and the measure are skipped when `floor_drop` is 0.
+struct Column<'a> {
+    c: &'a JanssenConfig,
+}
+
+/// What the column's phases collect.
+#[derive(Serialize, Deserialize)]
+struct ColumnState {
+    /// Body index of the floor.
+    bottom: usize,
+    /// Weight of the grains Σ m g (N).
+    weight: f64,
+    /// One row per step: `history.csv`.
+    history: CsvTable,
+    /// VTK frames.
+    vtk: VtkFrames,
+    deposit: PhaseStats,
+    relax: PhaseStats,
+    /// Release and measured step together.
+    release: PhaseStats,
+    /// Floor load over the weight at the end of the deposit and of the relaxation.
+    #[serde(with = "dem::serde_float")]
+    deposit_load: f64,
+    #[serde(with = "dem::serde_float")]
+    relaxed_load: f64,
+}
+
+impl Column<'_> {
+    fn release_steps(&self) -> u64 {
+        let c = self.c;
+        (c.release.floor_drop / (c.release.speed * c.dt)).ceil() as u64
+    }
+
+    fn floor_load(world: &dem::World, st: &ColumnState) -> f64 {
+        -world.contact_force(st.bottom).0.y / st.weight
+    }
+}
+
+const DEPOSIT: usize = 0;
+const RELAX: usize = 1;
+const RELEASE: usize = 2;
+const MEASURE: usize = 3;
+
+impl PhasedRun for Column<'_> {
+    type State = ColumnState;
+
+    fn phase_count(&self) -> usize {
+        4
+    }
+
+    fn enter(
+        &self,
+        k: usize,
+        env: &PhaseEnv,
+        world: &mut dem::World,
+        st: &mut ColumnState,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        let c = self.c;
+        let plan = |name: &str, stop| {
+            Some(PhasePlan {
+                name: name.into(),
+                stop,
+            })
+        };
+        Ok(match k {
+            DEPOSIT => {
+                world.params.solver = c.deposit.solver.params();
+                plan(
+                    "deposit",
+                    Stop::UntilRest(RunUntilRest {
+                        min_time: 0.0,
+                        max_time: c.deposit.max_time,
+                        rest_energy: c.deposit.rest_energy,
+                    }),
+                )
+            }
+            // Relaxation at the scenario's time step, tight tolerance.
+            RELAX => {
+                world.params.dt = c.dt;
+                world.params.solver = c.relax.solver.params();
+                plan(
+                    "relax",
+                    Stop::UntilRest(RunUntilRest {
+                        min_time: c.relax.min_time,
+                        max_time: c.relax.max_time,
+                        rest_energy: c.relax.rest_energy,
+                    }),
+                )
+            }
+            // Release: the floor is lowered slowly so that the column slides along the walls
+            // (Coulomb conditions at the wall contacts).
+            RELEASE if self.release_steps() > 0 => {
+                world.bodies[st.bottom].velocity = Vector2::new(0.0, -c.release.speed);
+                world.params.solver = c.release.solver.params();
+                plan("release", Stop::Steps(self.release_steps()))
+            }
+            // The stresses are measured at the end of the release, on a step solved to the
+            // tight tolerance while the floor still moves.
+            MEASURE if self.release_steps() > 0 => {
+                world.params.solver = dem::SolverParams {
+                    tolerance: c.relax.solver.tolerance,
+                    max_iterations: c.analysis.final_max_iterations,
+                    ..Default::default()
+                };
+                info(
+                    env.verbosity,
+                    &format!(
+                        "     measure: one step solved to {:.0e} (at most {} sweeps)",
+                        c.relax.solver.tolerance, c.analysis.final_max_iterations
+                    ),
+                );
+                plan("measure", Stop::Steps(1))
+            }
+            _ => None,
+        })
+    }
+
+    fn step(
+        &self,
+        k: usize,
+        st: &mut ColumnState,
+        out: &mut OutputDir,
+        w: &dem::World,
+        r: &dem::StepReport,
+    ) -> Result<()> {
+        let load = Self::floor_load(w, st);
+        st.history.push(vec![
+            w.time,
+            k as f64,
+            w.kinetic_energy(),
+            r.active_contacts as f64,
+            r.solver.iterations as f64,
+            r.solver.error,
+            load,
+        ]);
+        st.vtk.maybe(out, w)
+    }
+
+    fn leave(
+        &self,
+        k: usize,
+        st: &mut ColumnState,
+        _out: &mut OutputDir,
+        world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        match k {
+            DEPOSIT => {
+                st.deposit = *stats;
+                st.deposit_load = Self::floor_load(world, st);
+            }
+            RELAX => {
+                st.relax = *stats;
+                st.relaxed_load = Self::floor_load(world, st);
+            }
+            RELEASE => st.release = *stats,
+            _ => {
+                st.release.merge(stats);
+                world.params.solver = self.c.relax.solver.params();
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Runs the scenario.
-pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
+pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
     let width = datasets::build::column_width(&c.grain, c.grains, c.column_aspect);
-    let mut col = datasets::build::column(
-        &c.grain,
-        c.grains,
-        width,
-        &c.friction,
-        c.seed,
-        c.dt / c.deposit.substeps as f64,
-    )?;
     info(
         ctx.verbosity,
         &format!(
@@ -226,98 +388,49 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             c.friction.grain_wall
         ),
     );
-    let world = &mut col.world;
-    world.params.solver = c.deposit.solver.params();
-    let weight = grain_weight(world);
-    let bottom = col.bottom;
-    let mut history = CsvTable::new(&[
-        "time_s",
-        "phase_0deposit_1relax_2release_3measure",
-        "kinetic_energy_J",
-        "contacts",
-        "sweeps",
-        "solver_error",
-        "bottom_load_over_weight",
-    ]);
-    let mut vtk = VtkFrames::new(VTK_INTERVAL, c.analysis.vtk_frames.max(1));
-    let mut record = |w: &dem::World,
-                      r: &dem::StepReport,
-                      phase: f64,
-                      out: &mut crate::output::OutputDir|
-     -> Result<()> {
-        history.push(vec![
-            w.time,
-            phase,
-            w.kinetic_energy(),
-            r.active_contacts as f64,
-            r.solver.iterations as f64,
-            r.solver.error,
-            -w.contact_force(bottom).0.y / weight,
-        ]);
-        vtk.maybe(out, w)
-    };
-    // 1. Deposition.
-    let env = ctx.env();
-    let out = &mut ctx.out;
-    let deposit = run_phase(
-        &env,
-        "deposit",
-        world,
-        Stop::UntilRest(RunUntilRest {
-            min_time: 0.0,
-            max_time: c.deposit.max_time,
-            rest_energy: c.deposit.rest_energy,
-        }),
-        |w, r| record(w, r, 0.0, out),
-    )?;
-    let deposit_load = -world.contact_force(bottom).0.y / weight;
-    // 2. Relaxation at the scenario's time step, tight tolerance.
-    world.params.dt = c.dt;
-    world.params.solver = c.relax.solver.params();
-    let relax = run_phase(
-        &env,
-        "relax",
-        world,
-        Stop::UntilRest(RunUntilRest {
-            min_time: c.relax.min_time,
-            max_time: c.relax.max_time,
-            rest_energy: c.relax.rest_energy,
-        }),
-        |w, r| record(w, r, 1.0, out),
-    )?;
-    let relaxed_load = -world.contact_force(bottom).0.y / weight;
-    // 3. Release: the floor is lowered slowly so that the column slides along the walls
-    //    (Coulomb conditions at the wall contacts); the stresses are measured at the end of the
-    //    release, on a step solved to the tight tolerance while the floor still moves.
-    let release_steps = (c.release.floor_drop / (c.release.speed * c.dt)).ceil() as u64;
-    let mut release = datasets::phases::PhaseStats::default();
-    if release_steps > 0 {
-        world.bodies[bottom].velocity = Vector2::new(0.0, -c.release.speed);
-        world.params.solver = c.release.solver.params();
-        release = run_phase(
-            &env,
-            "release",
-            world,
-            Stop::Steps(release_steps),
-            |w, r| record(w, r, 2.0, out),
+    let fresh = || -> Result<(dem::World, ColumnState)> {
+        let col = datasets::build::column(
+            &c.grain,
+            c.grains,
+            width,
+            &c.friction,
+            c.seed,
+            c.dt / c.deposit.substeps as f64,
         )?;
-        world.params.solver = dem::SolverParams {
-            tolerance: c.relax.solver.tolerance,
-            max_iterations: c.analysis.final_max_iterations,
-            ..Default::default()
+        let state = ColumnState {
+            bottom: col.bottom,
+            weight: grain_weight(&col.world),
+            history: CsvTable::new(&[
+                "time_s",
+                "phase_0deposit_1relax_2release_3measure",
+                "kinetic_energy_J",
+                "contacts",
+                "sweeps",
+                "solver_error",
+                "bottom_load_over_weight",
+            ]),
+            vtk: VtkFrames::new(VTK_INTERVAL, c.analysis.vtk_frames.max(1)),
+            deposit: PhaseStats::default(),
+            relax: PhaseStats::default(),
+            release: PhaseStats::default(),
+            deposit_load: f64::NAN,
+            relaxed_load: f64::NAN,
         };
-        info(
-            env.verbosity,
-            &format!(
-                "     measure: one step solved to {:.0e} (at most {} sweeps)",
-                c.relax.solver.tolerance, c.analysis.final_max_iterations
-            ),
-        );
-        let r = world.step()?;
-        record(world, &r, 3.0, out)?;
-        release.record(&r, c.dt);
-        world.params.solver = c.relax.solver.params();
-    }
+        Ok((col.world, state))
+    };
+    let (world, st) = drive(ctx, ctl, &Column { c }, fresh)?;
+    let world = &world;
+    let ColumnState {
+        bottom,
+        weight,
+        history,
+        vtk,
+        deposit,
+        relax,
+        release,
+        deposit_load,
+        relaxed_load,
+    } = st;
     let final_report = world.last_report();
     if !final_report.solver.converged {
         warn(&format!(

@@ -1,10 +1,12 @@
 //! Running a scenario end to end: simulation phases with progress, homogenisation, fits,
-//! figures, CSV, VTK and `summary.json` (written last).
+//! figures, CSV, VTK and `summary.json` (written last). Every runner is a [`phased::PhasedRun`]:
+//! its simulation can be checkpointed, stopped and resumed ([`run_controlled`]).
 
 pub mod arrangements;
 pub mod common;
 pub mod inclined_flow;
 pub mod janssen;
+pub mod phased;
 pub mod rolling;
 pub mod shear_cell;
 pub mod stick_slip;
@@ -17,6 +19,7 @@ use datasets::{LoadedScenario, Scenario};
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
 use crate::progress::Verbosity;
+pub use phased::{CheckpointPolicy, RunControl};
 
 /// What a scenario run gets.
 pub struct RunContext {
@@ -26,7 +29,7 @@ pub struct RunContext {
     pub verbosity: Verbosity,
     /// The scenario as loaded.
     pub loaded: LoadedScenario,
-    /// Set by Ctrl-C: phases stop and the run fails without writing `summary.json`.
+    /// Set by Ctrl-C: the run writes a checkpoint and stops without writing `summary.json`.
     pub interrupted: Arc<AtomicBool>,
 }
 
@@ -58,19 +61,30 @@ pub struct RunOutcome {
     pub headline: Vec<String>,
 }
 
-/// Runs the loaded scenario, writes every output and `summary.json` last.
+/// Runs the loaded scenario, writes every output and `summary.json` last, with the default
+/// checkpoint policy ([`run_controlled`] with [`RunControl::default`]).
 pub fn run(ctx: &mut RunContext) -> Result<RunOutcome> {
-    let start = std::time::Instant::now();
+    run_controlled(ctx, &mut RunControl::default())
+}
+
+/// Runs the loaded scenario under `ctl`: a new run removes a stale checkpoint directory first;
+/// with `ctl.resume` the run continues from the checkpoint in the output directory. Checkpoints
+/// are written as `ctl.policy` says and when the user stops the run; `summary.json` is written
+/// last, then the checkpoint directory is removed.
+pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    if !ctl.resume {
+        crate::checkpoint::remove(ctx.out.path())?;
+    }
     ctx.out
         .write("scenario.toml", ctx.loaded.effective_toml.as_bytes())?;
     let scenario = ctx.loaded.scenario.clone();
     let mut outcome = match &scenario {
-        Scenario::Janssen(c) => janssen::run(c, ctx)?,
-        Scenario::Rolling(c) => rolling::run(c, ctx)?,
-        Scenario::Arrangements(c) => arrangements::run(c, ctx)?,
-        Scenario::StickSlip(c) => stick_slip::run(c, ctx)?,
-        Scenario::InclinedFlow(c) => inclined_flow::run(c, ctx)?,
-        Scenario::ShearCell(c) => shear_cell::run(c, ctx)?,
+        Scenario::Janssen(c) => janssen::run(c, ctx, ctl)?,
+        Scenario::Rolling(c) => rolling::run(c, ctx, ctl)?,
+        Scenario::Arrangements(c) => arrangements::run(c, ctx, ctl)?,
+        Scenario::StickSlip(c) => stick_slip::run(c, ctx, ctl)?,
+        Scenario::InclinedFlow(c) => inclined_flow::run(c, ctx, ctl)?,
+        Scenario::ShearCell(c) => shear_cell::run(c, ctx, ctl)?,
     };
     let mut head = Summary::new();
     head.text("scenario", scenario.kind())
@@ -80,10 +94,11 @@ pub fn run(ctx: &mut RunContext) -> Result<RunOutcome> {
     for (k, v) in outcome.summary.entries() {
         summary.set(k, v.clone());
     }
-    summary.num("wall_seconds", start.elapsed().as_secs_f64());
+    summary.num("wall_seconds", ctl.wall_seconds());
     summary.text("grainlaw_version", env!("CARGO_PKG_VERSION"));
     ctx.out
         .write("summary.json", summary.to_json().as_bytes())?;
+    crate::checkpoint::remove(ctx.out.path())?;
     outcome.summary = summary;
     Ok(outcome)
 }

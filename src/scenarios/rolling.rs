@@ -14,10 +14,15 @@ use datasets::config::RollingConfig;
 use homogenise::tensor::{frobenius, in_frame, skew_ratio, Tensor2};
 use nalgebra::Vector2;
 
-use super::common::{run_phase, solver_keys, Stop, VtkFrames};
-use super::{RunContext, RunOutcome};
+use datasets::phases::PhaseStats;
+use serde::{Deserialize, Serialize};
+
+use super::common::{solver_keys, Stop, VtkFrames};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
 use crate::error::{CliError, Result};
-use crate::output::{CsvTable, Summary};
+use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 
@@ -58,47 +63,71 @@ pub fn exact_stress(
     (contact + inertia, contact)
 }
 
-/// Runs the scenario.
-pub fn run(c: &RollingConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
-    let (mut world, e1, e2) = datasets::build::rolling(c)?;
-    let phi = c.slope_deg.to_radians();
-    let g = world.params.gravity.norm();
-    let c0 = world.bodies[1].position;
-    let steps = (c.duration / c.dt).round().max(1.0) as u64;
-    let mut hist = CsvTable::new(&[
-        "time_s",
-        "travelled_m",
-        "velocity_m_s",
-        "omega_rad_s",
-        "slip_velocity_m_s",
-        "stress_xx_Pa",
-        "stress_xy_Pa",
-        "stress_yx_Pa",
-        "stress_yy_Pa",
-        "contact_stress_xx_Pa",
-        "contact_stress_xy_Pa",
-        "contact_stress_yx_Pa",
-        "contact_stress_yy_Pa",
-    ]);
-    let mut vtk = VtkFrames::new(c.duration / 20.0, 21);
-    let env = ctx.env();
-    let out = &mut ctx.out;
-    let stats = run_phase(&env, "roll", &mut world, Stop::Steps(steps), |w, _| {
+/// The single phase: the disk rolls for `duration`.
+struct Roll<'a> {
+    c: &'a RollingConfig,
+}
+
+/// What the rolling phase collects.
+#[derive(Serialize, Deserialize)]
+struct RollState {
+    /// Slope frame: down the slope, outward normal.
+    e1: Vector2<f64>,
+    e2: Vector2<f64>,
+    /// Initial centre (m).
+    c0: Vector2<f64>,
+    /// One row per step: `history.csv`.
+    hist: CsvTable,
+    vtk: VtkFrames,
+    stats: PhaseStats,
+}
+
+impl PhasedRun for Roll<'_> {
+    type State = RollState;
+
+    fn phase_count(&self) -> usize {
+        1
+    }
+
+    fn enter(
+        &self,
+        _k: usize,
+        _env: &PhaseEnv,
+        _world: &mut dem::World,
+        _st: &mut RollState,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        let c = self.c;
+        Ok(Some(PhasePlan {
+            name: "roll".into(),
+            stop: Stop::Steps((c.duration / c.dt).round().max(1.0) as u64),
+        }))
+    }
+
+    fn step(
+        &self,
+        _k: usize,
+        st: &mut RollState,
+        out: &mut OutputDir,
+        w: &dem::World,
+        _r: &dem::StepReport,
+    ) -> Result<()> {
         let snap = w.snapshot();
         let gs = homogenise::grain_stresses(&snap)?;
         let gr = gs
             .first()
             .ok_or_else(|| CliError::Usage("no grain".into()))?;
+        let (e1, e2) = (st.e1, st.e2);
         let tot = in_frame(&gr.total, &e1, &e2);
         let con = in_frame(&gr.contact, &e1, &e2);
         let b = &w.bodies[1];
         let v = b.velocity.dot(&e1);
         // Slip velocity of the contact point along e₁: v + ω a (ω counter-clockwise, the
         // contact point is at −a e₂ from the centre: ω e_z × (−a e₂) = ω a e₁).
-        let slip = v + b.omega * c.radius;
-        hist.push(vec![
+        let slip = v + b.omega * self.c.radius;
+        st.hist.push(vec![
             w.time,
-            (b.position - c0).dot(&e1),
+            (b.position - st.c0).dot(&e1),
             v,
             b.omega,
             slip,
@@ -111,8 +140,59 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             con[(1, 0)],
             con[(1, 1)],
         ]);
-        vtk.maybe(out, w)
-    })?;
+        st.vtk.maybe(out, w)
+    }
+
+    fn leave(
+        &self,
+        _k: usize,
+        st: &mut RollState,
+        _out: &mut OutputDir,
+        _world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        st.stats = *stats;
+        Ok(())
+    }
+}
+
+/// Runs the scenario.
+pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    let phi = c.slope_deg.to_radians();
+    let fresh = || -> Result<(dem::World, RollState)> {
+        let (world, e1, e2) = datasets::build::rolling(c)?;
+        let c0 = world.bodies[1].position;
+        let state = RollState {
+            e1,
+            e2,
+            c0,
+            hist: CsvTable::new(&[
+                "time_s",
+                "travelled_m",
+                "velocity_m_s",
+                "omega_rad_s",
+                "slip_velocity_m_s",
+                "stress_xx_Pa",
+                "stress_xy_Pa",
+                "stress_yx_Pa",
+                "stress_yy_Pa",
+                "contact_stress_xx_Pa",
+                "contact_stress_xy_Pa",
+                "contact_stress_yx_Pa",
+                "contact_stress_yy_Pa",
+            ]),
+            vtk: VtkFrames::new(c.duration / 20.0, 21),
+            stats: PhaseStats::default(),
+        };
+        Ok((world, state))
+    };
+    let (
+        world,
+        RollState {
+            hist, vtk, stats, ..
+        },
+    ) = drive(ctx, ctl, &Roll { c }, fresh)?;
+    let g = world.params.gravity.norm();
     let frames = vtk.finish(&mut ctx.out, &world)?;
     let last = hist.rows.last().cloned().unwrap_or_default();
     // Measured acceleration: least squares of v(t) = a t.
@@ -327,7 +407,6 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             con[(0, 0)], con[(0, 1)], con[(1, 0)], con[(1, 1)], skew_ratio(&tot)
         ),
     ];
-    let _ = Vector2::<f64>::zeros();
     Ok(RunOutcome {
         summary: s,
         headline,

@@ -11,7 +11,6 @@
 //! best of three forms by AIC).
 
 use datasets::config::ShearCellConfig;
-use dem::BodyKind;
 use homogenise::kinematics::{velocity_gradient, VelocityWeight};
 use homogenise::state::solid_fraction;
 use homogenise::walls::{near_wall_profile, NearWallSpec};
@@ -22,20 +21,24 @@ use identify::wall_law::{select_wall_law, WallSlipSeries};
 use identify::{CalibratedLaw, FitOptions};
 use nalgebra::Vector2;
 
+use datasets::phases::PhaseStats;
+use serde::{Deserialize, Serialize};
+
 use super::common::{
-    add_fitted_curve, delta_band, fit_keys, mean_diameter, run_phase, solver_keys, write_law, Stop,
-    VtkFrames,
+    add_fitted_curve, delta_band, fit_keys, mean_diameter, solver_keys, write_law, Stop, VtkFrames,
 };
-use super::{RunContext, RunOutcome};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, Summary};
+use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::warn;
 
-/// Averages of one run.
-#[derive(Debug, Clone, Default)]
+/// Averages of one run (sums of finite samples).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 struct RunAverages {
     sxy: f64,
     syy: f64,
@@ -46,58 +49,144 @@ struct RunAverages {
     profile: Vec<(f64, f64, f64)>,
 }
 
-/// Runs the scenario.
-pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
-    let (mut world, length) = datasets::build::shear_cell(c)?;
-    let r = c.grain.radius_mean;
-    let d = mean_diameter(&world);
-    let rho = c.grain.density;
-    let top = 1usize;
-    let env = ctx.env();
-    let mut all = datasets::phases::PhaseStats::default();
-    // Compression at zero shear.
-    world.params.dt = c.dt_max;
-    let comp = run_phase(
-        &env,
-        "compress",
-        &mut world,
-        Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
-        |_, _| Ok(()),
-    )?;
-    all.merge(&comp);
-    let mut rows = Vec::new();
-    let mut mean_profiles = Vec::new();
-    let mut targets = c.inertial_numbers.clone();
-    targets.sort_by(f64::total_cmp);
-    let mut vtk = VtkFrames::new(f64::INFINITY, 1);
-    for (k, &i_target) in targets.iter().enumerate() {
-        let h = world.bodies[top].position.y - 2.0 * r;
-        let gamma_target = i_target * (c.pressure / rho).sqrt() / d;
+/// The phases: compression at zero shear, then one steady shear run per inertial number
+/// (lowest first, each from the previous steady state).
+struct Shear<'a> {
+    c: &'a ShearCellConfig,
+    /// Target inertial numbers, sorted.
+    targets: Vec<f64>,
+}
+
+/// The plan of the current shear run, fixed when it starts.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+struct ShearRun {
+    /// Wall velocity V (m/s), gap H (m), time step (s).
+    v: f64,
+    h: f64,
+    dt: f64,
+    steps: u64,
+    avg_steps: u64,
+    /// Samples every this many steps over the last `avg_steps`.
+    every: u64,
+    /// Steps done.
+    n: u64,
+}
+
+/// A run's mean velocity profile: heights above the bottom wall (m) and mean velocity (m/s,
+/// NaN in an empty bin).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct MeanProfile {
+    #[serde(with = "dem::serde_float")]
+    i: f64,
+    #[serde(with = "crate::floats::vec")]
+    y: Vec<f64>,
+    #[serde(with = "crate::floats::vec")]
+    velocity: Vec<f64>,
+    v: f64,
+    h: f64,
+}
+
+/// What the phases collect.
+#[derive(Serialize, Deserialize)]
+struct ShearState {
+    all: PhaseStats,
+    /// One row per run: `rheology.csv`.
+    #[serde(with = "crate::floats::table")]
+    rows: Vec<Vec<f64>>,
+    profiles: Vec<MeanProfile>,
+    run: ShearRun,
+    acc: RunAverages,
+}
+
+const TOP: usize = 1;
+
+impl PhasedRun for Shear<'_> {
+    type State = ShearState;
+
+    fn phase_count(&self) -> usize {
+        1 + self.targets.len()
+    }
+
+    fn enter(
+        &self,
+        k: usize,
+        _env: &PhaseEnv,
+        world: &mut dem::World,
+        st: &mut ShearState,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        let c = self.c;
+        if k == 0 {
+            world.params.dt = c.dt_max;
+            return Ok(Some(PhasePlan {
+                name: "compress".into(),
+                stop: Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
+            }));
+        }
+        let i_target = self.targets[k - 1];
+        let r = c.grain.radius_mean;
+        let d = mean_diameter(world);
+        let h = world.bodies[TOP].position.y - 2.0 * r;
+        let gamma_target = i_target * (c.pressure / c.grain.density).sqrt() / d;
         let v = gamma_target * h;
         let dt = c.dt_max.min(c.travel_per_step * r / v);
         let steps = (c.strain * h / (v * dt)).ceil() as u64;
         let avg_steps = (c.average_strain * h / (v * dt)).ceil() as u64;
         world.params.dt = dt;
-        world.bodies[top].velocity.x = v;
-        let every = (avg_steps / 40).max(1);
-        let mut acc = RunAverages::default();
-        let mut n = 0u64;
-        let out = &mut ctx.out;
-        let _ = out;
-        let stats = run_phase(
-            &env,
-            &format!("I={i_target}"),
-            &mut world,
-            Stop::Steps(steps),
-            |w, _| {
-                n += 1;
-                if n + avg_steps > steps && n.is_multiple_of(every) {
-                    sample(w, &mut acc, r, d, length)?;
-                }
-                Ok(())
-            },
-        )?;
-        all.merge(&stats);
+        world.bodies[TOP].velocity.x = v;
+        st.run = ShearRun {
+            v,
+            h,
+            dt,
+            steps,
+            avg_steps,
+            every: (avg_steps / 40).max(1),
+            n: 0,
+        };
+        st.acc = RunAverages::default();
+        Ok(Some(PhasePlan {
+            name: format!("I={i_target}"),
+            stop: Stop::Steps(steps),
+        }))
+    }
+
+    fn step(
+        &self,
+        k: usize,
+        st: &mut ShearState,
+        _out: &mut OutputDir,
+        w: &dem::World,
+        _r: &dem::StepReport,
+    ) -> Result<()> {
+        if k == 0 {
+            return Ok(());
+        }
+        let run = &mut st.run;
+        run.n += 1;
+        if run.n + run.avg_steps > run.steps && run.n.is_multiple_of(run.every) {
+            let d = mean_diameter(w);
+            sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
+        }
+        Ok(())
+    }
+
+    fn leave(
+        &self,
+        k: usize,
+        st: &mut ShearState,
+        _out: &mut OutputDir,
+        world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        st.all.merge(stats);
+        if k == 0 {
+            return Ok(());
+        }
+        let i_target = self.targets[k - 1];
+        let rho = self.c.grain.density;
+        let d = mean_diameter(world);
+        let ShearRun { v, h, dt, .. } = st.run;
+        let acc = std::mem::take(&mut st.acc);
         let m = acc.samples.max(1) as f64;
         let (sxy, syy, phi, gd) = (acc.sxy / m, acc.syy / m, acc.phi / m, acc.gamma_dot / m);
         let p = -syy;
@@ -110,7 +199,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         };
         let (vb, mub) = wall(0);
         let (vt, mut_) = wall(1);
-        rows.push(vec![
+        st.rows.push(vec![
             i_target,
             i_meas,
             mu,
@@ -126,20 +215,48 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             mut_,
             acc.samples as f64,
         ]);
-        mean_profiles.push((
-            i_meas,
-            acc.profile
+        st.profiles.push(MeanProfile {
+            i: i_meas,
+            y: acc.profile.iter().map(|p| p.0).collect(),
+            velocity: acc
+                .profile
                 .iter()
-                .map(|&(y, s, c)| (y, if c > 0.0 { s / c } else { f64::NAN }))
-                .collect::<Vec<_>>(),
+                .map(|&(_, s, c)| if c > 0.0 { s / c } else { f64::NAN })
+                .collect(),
             v,
             h,
-        ));
-        if k + 1 == targets.len() {
-            vtk = VtkFrames::new(f64::INFINITY, 1);
-        }
+        });
+        Ok(())
     }
-    vtk.finish(&mut ctx.out, &world)?;
+}
+
+/// Runs the scenario.
+pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    let mut targets = c.inertial_numbers.clone();
+    targets.sort_by(f64::total_cmp);
+    let shear = Shear { c, targets };
+    let fresh = || -> Result<(dem::World, ShearState)> {
+        let (world, _) = datasets::build::shear_cell(c)?;
+        let state = ShearState {
+            all: PhaseStats::default(),
+            rows: Vec::new(),
+            profiles: Vec::new(),
+            run: ShearRun::default(),
+            acc: RunAverages::default(),
+        };
+        Ok((world, state))
+    };
+    let (
+        world,
+        ShearState {
+            all,
+            rows,
+            profiles,
+            ..
+        },
+    ) = drive(ctx, ctl, &shear, fresh)?;
+    let d = mean_diameter(&world);
+    VtkFrames::new(f64::INFINITY, 1).finish(&mut ctx.out, &world)?;
     let headers = [
         "I_target",
         "I",
@@ -406,14 +523,15 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
         Axis::new("velocity / wall velocity v_x / V"),
         Axis::new("height / gap y / H"),
     );
-    for (k, (i, prof, v, h)) in mean_profiles.iter().enumerate() {
+    for (k, mp) in profiles.iter().enumerate() {
         pv.series.push(Series::new(
-            &format!("I = {i:.3}"),
+            &format!("I = {:.3}", mp.i),
             Style::LinePoints,
             PALETTE[k % PALETTE.len()],
-            prof.iter()
+            mp.y.iter()
+                .zip(&mp.velocity)
                 .filter(|p| p.1.is_finite())
-                .map(|p| (p.1 / v, p.0 / h))
+                .map(|(y, u)| (u / mp.v, y / mp.h))
                 .collect(),
         ));
     }
@@ -443,7 +561,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
 }
 
 /// Adds one sample of the bulk and wall quantities to `acc`.
-fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64, length: f64) -> Result<()> {
+fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<()> {
     let snap = w.snapshot();
     let top_y = w.bodies[1].position.y;
     let (lo, hi) = (r + 2.0 * d, top_y - r - 2.0 * d);
@@ -487,7 +605,6 @@ fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64, length: f64) ->
             }
         }
     }
-    let _ = (length, BodyKind::Grain);
     acc.samples += 1;
     Ok(())
 }

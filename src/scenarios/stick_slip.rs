@@ -8,10 +8,15 @@ use datasets::config::StickSlipConfig;
 use datasets::phases::RunUntilRest;
 use nalgebra::Vector2;
 
-use super::common::{grain_weight, run_phase, solver_keys, Stop, VtkFrames};
-use super::{RunContext, RunOutcome};
+use datasets::phases::PhaseStats;
+use serde::{Deserialize, Serialize};
+
+use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, Summary};
+use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_column, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
@@ -24,8 +29,171 @@ pub fn mean_std(v: &[f64]) -> (f64, f64) {
     (m, var.sqrt())
 }
 
+/// Two phases per friction case: deposit (a new column), then push the floor up.
+struct Push<'a> {
+    c: &'a StickSlipConfig,
+}
+
+/// What the phases collect.
+#[derive(Serialize, Deserialize)]
+struct PushState {
+    /// Summary entries so far.
+    s: Summary,
+    /// Force on the moving wall per step and case: `wall_force.csv`.
+    table: CsvTable,
+    headline: Vec<String>,
+    all: PhaseStats,
+    /// Weight of each case's grains (N).
+    weights: Vec<f64>,
+    /// Body index of the current floor.
+    bottom: usize,
+    /// Force on the moving wall in the current push, per step (N).
+    #[serde(with = "crate::floats::vec")]
+    force: Vec<f64>,
+    /// VTK frames of the current push.
+    vtk: VtkFrames,
+}
+
+impl Push<'_> {
+    fn steps(&self) -> u64 {
+        (self.c.push_duration / self.c.dt).round().max(1.0) as u64
+    }
+}
+
+impl PhasedRun for Push<'_> {
+    type State = PushState;
+
+    fn phase_count(&self) -> usize {
+        2 * self.c.cases.list().len()
+    }
+
+    fn enter(
+        &self,
+        k: usize,
+        _env: &PhaseEnv,
+        world: &mut dem::World,
+        st: &mut PushState,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        let c = self.c;
+        let case = k / 2;
+        let (name, friction) = &c.cases.list()[case];
+        let width = c.width_diameters * 2.0 * c.grain.radius_mean;
+        if k % 2 == 0 {
+            let col = datasets::build::column(
+                &c.grain,
+                c.grains,
+                width,
+                friction,
+                c.seed,
+                c.dt / c.deposit.substeps as f64,
+            )?;
+            *world = col.world;
+            world.params.solver = c.deposit.solver.params();
+            st.bottom = col.bottom;
+            st.weights.push(grain_weight(world));
+            Ok(Some(PhasePlan {
+                name: format!("deposit {case}"),
+                stop: Stop::UntilRest(RunUntilRest {
+                    min_time: 0.0,
+                    max_time: c.deposit.max_time,
+                    rest_energy: c.deposit.rest_energy,
+                }),
+            }))
+        } else {
+            world.params.dt = c.dt;
+            world.params.solver = c.solver.params();
+            world.bodies[st.bottom].velocity = Vector2::new(0.0, c.push_velocity);
+            st.force = Vec::with_capacity(self.steps() as usize);
+            st.vtk = VtkFrames::with_prefix(&format!("{name}_"), c.push_duration / 20.0, 21);
+            Ok(Some(PhasePlan {
+                name: format!("push {case}"),
+                stop: Stop::Steps(self.steps()),
+            }))
+        }
+    }
+
+    fn step(
+        &self,
+        k: usize,
+        st: &mut PushState,
+        out: &mut OutputDir,
+        w: &dem::World,
+        _r: &dem::StepReport,
+    ) -> Result<()> {
+        if k % 2 == 1 {
+            st.force.push(-w.contact_force(st.bottom).0.y);
+            st.vtk.maybe(out, w)?;
+        }
+        Ok(())
+    }
+
+    fn leave(
+        &self,
+        k: usize,
+        st: &mut PushState,
+        out: &mut OutputDir,
+        world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        st.all.merge(stats);
+        if k % 2 == 0 {
+            return Ok(());
+        }
+        let case = k / 2;
+        let (name, friction) = &self.c.cases.list()[case];
+        let weight = st.weights[case];
+        std::mem::replace(&mut st.vtk, VtkFrames::new(f64::INFINITY, 1)).finish(out, world)?;
+        let force = std::mem::take(&mut st.force);
+        for (i, f) in force.iter().enumerate() {
+            st.table.rows[i][case + 1] = *f;
+        }
+        // Statistics over the second half (after the start-up transient).
+        let half = &force[force.len() / 2..];
+        let (m, sd) = mean_std(half);
+        let (fmin, fmax) = half
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+        st.s.num(
+            &format!("friction_grain_grain_{name}"),
+            friction.grain_grain,
+        )
+        .num(&format!("friction_grain_wall_{name}"), friction.grain_wall)
+        .num(&format!("weight_N_{name}"), weight)
+        .num(&format!("force_mean_N_{name}"), m)
+        .num(&format!("force_std_N_{name}"), sd)
+        .num(
+            &format!("force_fluctuation_{name}"),
+            sd / m.abs().max(1e-300),
+        )
+        .num(&format!("force_min_N_{name}"), fmin)
+        .num(&format!("force_max_N_{name}"), fmax)
+        .num(&format!("force_mean_over_weight_{name}"), m / weight);
+        st.headline.push(format!(
+            "{name:<17}: force on the moving wall {m:.3} N ± {sd:.3} N (weight {weight:.3} N; relative fluctuation {:.3})",
+            sd / m.abs().max(1e-300)
+        ));
+        let snap = world.snapshot();
+        draw_particles(
+            out,
+            &format!("force_chains_{name}.png"),
+            &ParticleView {
+                snap: &snap,
+                title: format!(
+                    "{}: normal forces at the end of the push",
+                    name.replace('_', " ")
+                ),
+                fill: GrainFill::Plain,
+                forces: true,
+                axis_labels: ("x (m)".into(), "y (m)".into()),
+                width_px: 420,
+            },
+        )
+    }
+}
+
 /// Runs the scenario.
-pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
+pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
     let width = c.width_diameters * 2.0 * c.grain.radius_mean;
     let steps = (c.push_duration / c.dt).round().max(1.0) as u64;
     let mut s = Summary::new();
@@ -42,82 +210,30 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
     for k in 0..steps {
         table.push(vec![(k + 1) as f64 * c.dt, f64::NAN, f64::NAN, f64::NAN]);
     }
+    let state = PushState {
+        s,
+        table,
+        headline: vec![format!("report: {}/", ctx.out.path().display())],
+        all: PhaseStats::default(),
+        weights: Vec::new(),
+        bottom: 0,
+        force: Vec::new(),
+        vtk: VtkFrames::new(f64::INFINITY, 1),
+    };
+    // Each deposit phase builds its own column; the initial world is a placeholder.
+    let empty = dem::World::new(dem::WorldParams::default(), dem::ContactLaws::new(&[], 0.0));
+    let (_, st) = drive(ctx, ctl, &Push { c }, || Ok((empty, state)))?;
+    let PushState {
+        mut s,
+        mut table,
+        headline,
+        all,
+        weights,
+        ..
+    } = st;
     let mut plots = Vec::new();
-    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
-    let mut all = datasets::phases::PhaseStats::default();
-    let env = ctx.env();
     for (k, (name, friction)) in c.cases.list().iter().enumerate() {
-        let mut col = datasets::build::column(
-            &c.grain,
-            c.grains,
-            width,
-            friction,
-            c.seed,
-            c.dt / c.deposit.substeps as f64,
-        )?;
-        let world = &mut col.world;
-        world.params.solver = c.deposit.solver.params();
-        let weight = grain_weight(world);
-        let dep = run_phase(
-            &env,
-            &format!("deposit {k}"),
-            world,
-            Stop::UntilRest(RunUntilRest {
-                min_time: 0.0,
-                max_time: c.deposit.max_time,
-                rest_energy: c.deposit.rest_energy,
-            }),
-            |_, _| Ok(()),
-        )?;
-        all.merge(&dep);
-        world.params.dt = c.dt;
-        world.params.solver = c.solver.params();
-        world.bodies[col.bottom].velocity = Vector2::new(0.0, c.push_velocity);
-        let t0 = world.time;
-        let mut force = Vec::with_capacity(steps as usize);
-        let mut vtk = VtkFrames::with_prefix(&format!("{name}_"), c.push_duration / 20.0, 21);
-        let out = &mut ctx.out;
-        let bottom = col.bottom;
-        let push = run_phase(
-            &env,
-            &format!("push {k}"),
-            world,
-            Stop::Steps(steps),
-            |w, _| {
-                force.push(-w.contact_force(bottom).0.y);
-                vtk.maybe(out, w)
-            },
-        )?;
-        all.merge(&push);
-        vtk.finish(&mut ctx.out, world)?;
-        for (i, f) in force.iter().enumerate() {
-            table.rows[i][k + 1] = *f;
-        }
-        // Statistics over the second half (after the start-up transient).
-        let half = &force[force.len() / 2..];
-        let (m, sd) = mean_std(half);
-        let (fmin, fmax) = half
-            .iter()
-            .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-        s.num(
-            &format!("friction_grain_grain_{name}"),
-            friction.grain_grain,
-        )
-        .num(&format!("friction_grain_wall_{name}"), friction.grain_wall)
-        .num(&format!("weight_N_{name}"), weight)
-        .num(&format!("force_mean_N_{name}"), m)
-        .num(&format!("force_std_N_{name}"), sd)
-        .num(
-            &format!("force_fluctuation_{name}"),
-            sd / m.abs().max(1e-300),
-        )
-        .num(&format!("force_min_N_{name}"), fmin)
-        .num(&format!("force_max_N_{name}"), fmax)
-        .num(&format!("force_mean_over_weight_{name}"), m / weight);
-        headline.push(format!(
-            "{name:<17}: force on the moving wall {m:.3} N ± {sd:.3} N (weight {weight:.3} N; relative fluctuation {:.3})",
-            sd / m.abs().max(1e-300)
-        ));
+        let weight = weights.get(k).copied().unwrap_or(f64::NAN);
         let mut p = XyPlot::new(
             &format!(
                 "{}: μ grain–grain = {}, μ grain–wall = {}",
@@ -138,31 +254,15 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext) -> Result<RunOutcome> {
             "",
             Style::Thin,
             PALETTE[k],
-            force
+            table
+                .rows
                 .iter()
                 .enumerate()
-                .map(|(i, f)| ((i + 1) as f64 * c.dt, *f))
+                .map(|(i, r)| ((i + 1) as f64 * c.dt, r[k + 1]))
                 .collect(),
         ));
         p.legend = LegendAt::UpperRight;
         plots.push(p);
-        let _ = t0;
-        let snap = world.snapshot();
-        draw_particles(
-            &mut ctx.out,
-            &format!("force_chains_{name}.png"),
-            &ParticleView {
-                snap: &snap,
-                title: format!(
-                    "{}: normal forces at the end of the push",
-                    name.replace('_', " ")
-                ),
-                fill: GrainFill::Plain,
-                forces: true,
-                axis_labels: ("x (m)".into(), "y (m)".into()),
-                width_px: 420,
-            },
-        )?;
     }
     solver_keys(&mut s, &all);
     table.comments.push(

@@ -1,0 +1,193 @@
+//! Run checkpoints: everything `grainlaw run --resume DIR` needs to finish an interrupted run
+//! with the same output files, byte for byte, as a run never interrupted (`wall_seconds`
+//! aside).
+//!
+//! One file, `DIR/checkpoint/run.json.gz` (gzip JSON, floats as their shortest round-trip
+//! decimal, non-finite ones as strings), written atomically (temporary file, then rename): an
+//! interruption while it is written leaves the previous checkpoint whole, so only the last one
+//! is kept. It holds
+//! - the scenario as run: name, source, effective TOML (overrides applied) and the `--set`
+//!   overrides, so that a resume cannot mix two scenarios;
+//! - the cursor: which phase (index and plan: name, stop rule) and where in it
+//!   ([`PhaseProgress`]: the phase's statistics and loop counters);
+//! - the world ([`dem::checkpoint::WorldState`]: bodies, contacts with their impulses, time);
+//! - the scenario's own state, collected step by step (histories, VTK frame lists, earlier
+//!   phases' statistics...), whatever its runner declares (`PhasedRun::State`);
+//! - the steps and wall-clock seconds spent so far.
+//!
+//! A successful run removes the checkpoint directory after writing `summary.json`; a new run
+//! (without `--resume`) removes a stale one when it starts.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use datasets::phases::PhaseProgress;
+use dem::checkpoint::WorldState;
+use flate2::read::GzDecoder;
+use flate2::write::GzEncoder;
+use flate2::Compression;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{CliError, Result};
+use crate::scenarios::common::Stop;
+
+/// Format tag of run checkpoints.
+pub const FORMAT: &str = "grainlaw-run-checkpoint-v1";
+
+/// Checkpoint directory inside the output directory.
+pub const DIR: &str = "checkpoint";
+
+/// Checkpoint file inside [`DIR`].
+pub const FILE: &str = "run.json.gz";
+
+/// The checkpoint directory of output directory `out`.
+pub fn dir_of(out: &Path) -> PathBuf {
+    out.join(DIR)
+}
+
+/// The checkpoint file of output directory `out`.
+pub fn file_of(out: &Path) -> PathBuf {
+    dir_of(out).join(FILE)
+}
+
+/// The scenario a run was started with.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ScenarioRecord {
+    /// Name (built-in's, or the file stem).
+    pub name: String,
+    /// `builtin:NAME` or the TOML file path.
+    pub source: String,
+    /// The TOML actually run, overrides applied (as written to `scenario.toml`).
+    pub effective_toml: String,
+    /// The `--set KEY=VALUE` overrides given.
+    pub sets: Vec<String>,
+}
+
+impl ScenarioRecord {
+    /// `SOURCE --set A --set B`, for messages.
+    pub fn describe(&self) -> String {
+        let mut s = self.source.clone();
+        for o in &self.sets {
+            s.push_str(" --set ");
+            s.push_str(o);
+        }
+        s
+    }
+}
+
+/// One phase as planned when it started.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhasePlan {
+    /// Name shown in progress lines and messages.
+    pub name: String,
+    /// When it stops.
+    pub stop: Stop,
+}
+
+/// Where a run stands: inside phase `phase`, planned as `plan`, with `progress`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Cursor {
+    /// Index of the phase in the scenario's sequence.
+    pub phase: usize,
+    /// The phase's plan.
+    pub plan: PhasePlan,
+    /// Steps, statistics and loop counters of the phase so far.
+    pub progress: PhaseProgress,
+}
+
+/// A run checkpoint; `S` is the scenario's state (or [`serde::de::IgnoredAny`] to read the
+/// rest without it).
+#[derive(Debug, Serialize, Deserialize)]
+pub struct RunCheckpoint<S> {
+    /// [`FORMAT`].
+    pub format: String,
+    /// Version of the grainlaw that wrote it (a resume needs the same code to be exact).
+    pub grainlaw_version: String,
+    /// The scenario.
+    pub scenario: ScenarioRecord,
+    /// Where the run stands.
+    pub cursor: Cursor,
+    /// Steps done over the whole run, all phases (and worlds) together.
+    pub steps_total: u64,
+    /// Wall-clock seconds spent by the run so far, over every invocation (s).
+    pub wall_seconds: f64,
+    /// The world.
+    pub world: WorldState,
+    /// The scenario's state.
+    pub state: S,
+}
+
+fn bad(path: &Path, reason: impl std::fmt::Display) -> CliError {
+    CliError::Checkpoint {
+        path: path.display().to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+/// Writes `cp` to `path` atomically (gzip JSON; temporary file in the same directory, then
+/// rename), creating the directory.
+pub fn write<S: Serialize>(path: &Path, cp: &RunCheckpoint<S>) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
+    }
+    dem::atomic::write_atomic(path, |w| {
+        let mut gz = GzEncoder::new(w, Compression::fast());
+        serde_json::to_writer(&mut gz, cp).map_err(std::io::Error::other)?;
+        gz.finish().map(|_| ())
+    })
+    .map_err(|e| bad(path, format!("cannot write the checkpoint ({e})")))
+}
+
+/// Reads the checkpoint of output directory `out`, refusing a missing file, one that is not a
+/// readable checkpoint (truncated, not gzip JSON, not this scenario's state) and one written
+/// by another format or grainlaw version.
+pub fn read<S: DeserializeOwned>(out: &Path) -> Result<RunCheckpoint<S>> {
+    let path = file_of(out);
+    let f = File::open(&path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::NotFound {
+            let done = if out.join("summary.json").exists() {
+                " (the run there finished: summary.json is written)"
+            } else {
+                ""
+            };
+            bad(
+                &path,
+                format!("no checkpoint to resume from{done}; run the scenario without --resume"),
+            )
+        } else {
+            bad(&path, e)
+        }
+    })?;
+    let cp: RunCheckpoint<S> = serde_json::from_reader(GzDecoder::new(BufReader::new(f)))
+        .map_err(|e| bad(&path, format!("not a readable checkpoint ({e})")))?;
+    if cp.format != FORMAT {
+        return Err(bad(
+            &path,
+            format!("format `{}` is not `{FORMAT}`", cp.format),
+        ));
+    }
+    let version = env!("CARGO_PKG_VERSION");
+    if cp.grainlaw_version != version {
+        return Err(bad(
+            &path,
+            format!(
+                "written by grainlaw {}, this is {version}: a resume would not be exact; run the scenario again",
+                cp.grainlaw_version
+            ),
+        ));
+    }
+    Ok(cp)
+}
+
+/// Removes the checkpoint directory of `out` (after a finished run, or a stale one before a
+/// new run); a missing directory is not an error.
+pub fn remove(out: &Path) -> Result<()> {
+    let dir = dir_of(out);
+    match std::fs::remove_dir_all(&dir) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(CliError::io(&dir, e)),
+    }
+}
