@@ -69,11 +69,50 @@ impl Default for CsvFitOptions {
 }
 
 /// Reads `path` and fits `law` (one of [`LAW_NAMES`]); returns the calibrated law for export.
-/// Errors: [`IdentifyError::UnknownLaw`], the file errors of [`crate::data`], and the fit's.
+/// Errors: [`IdentifyError::UnknownLaw`], the file errors of [`crate::data`], a header that
+/// names a column twice ([`IdentifyError::Csv`] on the header line: which of the two would be
+/// read is ambiguous), and the fit's.
 pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<CalibratedLaw> {
     check_law_name(law)?;
-    let table = Table::read_csv(path)?;
+    let source = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| IdentifyError::Io {
+        path: source.clone(),
+        source: e,
+    })?;
+    let table = Table::parse_csv(&text, &source)?;
+    check_unique_headers(&table, header_line(&text))?;
     fit_table(law, &table, options)
+}
+
+/// 1-based line of the header: the first line that is neither blank nor a `#` comment.
+fn header_line(text: &str) -> u64 {
+    text.lines()
+        .position(|l| {
+            let l = l.trim();
+            !l.is_empty() && !l.starts_with('#')
+        })
+        .map_or(0, |i| i as u64 + 1)
+}
+
+/// Refuses a header with the same column twice (headers are matched case-insensitively).
+fn check_unique_headers(table: &Table, line: u64) -> Result<()> {
+    for (j, h) in table.headers.iter().enumerate() {
+        if let Some(k) = table.headers[..j]
+            .iter()
+            .position(|g| g.eq_ignore_ascii_case(h))
+        {
+            return Err(IdentifyError::Csv {
+                file: table.source.clone(),
+                line,
+                message: format!(
+                    "column '{h}' appears twice (fields {} and {})",
+                    k + 1,
+                    j + 1
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 fn check_law_name(law: &str) -> Result<()> {
