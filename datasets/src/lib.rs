@@ -14,6 +14,7 @@
 //! Units: SI throughout (m, kg, s, N, Pa). Every scenario has a `seed`; the same seed gives the
 //! same numbers.
 
+pub mod benchmarks;
 pub mod build;
 pub mod builtin;
 pub mod config;

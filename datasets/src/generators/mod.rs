@@ -1,10 +1,13 @@
 //! Packing generators: seeded polydisperse radii, grains rained without overlap above a floor
-//! (then settled by gravity in the engine, see [`crate::phases`]), and regular stacks.
+//! (then settled by gravity in the engine, see [`crate::phases`]), regular stacks, and dense
+//! packings by sequential geometric deposition.
 
+pub mod deposition;
 pub mod lattice;
 pub mod radii;
 pub mod rain;
 
+pub use deposition::deposit;
 pub use lattice::{lattice, Arrangement};
 pub use radii::{total_area, uniform_radii};
 pub use rain::{rain, RainBox};

@@ -1,0 +1,369 @@
+//! Benchmark worlds: the settled Janssen column of the performance targets.
+//!
+//! `n` disks of radius uniform in [1, 2] mm (density 2500 kg/m³, seeded), μ = 0.5 between grains
+//! and with the walls, e = 0, in a box 40 mean diameters wide (0.12 m), settled under gravity
+//! until kinetic / potential energy < 10⁻⁸ (`KE = Σ ½ m |v|² + ½ I ω²`, `PE = Σ m g y` above the
+//! floor). Two preparations:
+//!
+//! - [`Preparation::Pour`]: the grains start on loose rows ([`crate::generators::rain`]) and
+//!   fall: the whole column compacts (the protocol of a soft-contact code's pour);
+//! - [`Preparation::Deposit`]: sequential geometric deposition
+//!   ([`crate::generators::deposition`]), then the engine relaxes the packing under gravity.
+//!
+//! The engine settings of each are in [`ColumnRun`]; [`settle_column`] returns the timing and
+//! the checks of the final state.
+
+use std::time::Instant;
+
+use dem::bench::{energy_ratio, settle, SettleReport};
+use dem::World;
+use nalgebra::Vector2;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::build::{GRAIN, WALL};
+use crate::config::{FrictionSpec, GrainSpec};
+use crate::error::Result;
+use crate::generators::{deposit, rain, uniform_radii, RainBox};
+
+/// How the column is prepared before it settles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Preparation {
+    /// Loose rows that fall and compact.
+    Pour,
+    /// Geometric sequential deposition, then relaxation.
+    Deposit,
+}
+
+/// Engine settings of a settling run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ColumnRun {
+    /// Time step (s).
+    pub dt: f64,
+    /// Solver tolerance (error measure of `formats/frictional-contact.md`).
+    pub tolerance: f64,
+    /// Sweep cap per step: a step that reaches it continues with its best iterate (counted).
+    pub max_sweeps: usize,
+    /// Colour-ordered parallel sweeps.
+    pub parallel: bool,
+    /// Longest simulated time (s).
+    pub max_time: f64,
+}
+
+impl ColumnRun {
+    /// The settings used for `preparation`: pouring needs a smaller step during the collapse
+    /// (0.5 ms, at most 100 sweeps per step); relaxing a deposited packing takes 1 ms steps.
+    pub fn for_preparation(preparation: Preparation) -> Self {
+        match preparation {
+            Preparation::Pour => ColumnRun {
+                dt: 5e-4,
+                tolerance: 1e-4,
+                max_sweeps: 100,
+                parallel: true,
+                max_time: 5.0,
+            },
+            Preparation::Deposit => ColumnRun {
+                dt: 1e-3,
+                tolerance: 1e-4,
+                max_sweeps: 100,
+                parallel: true,
+                max_time: 5.0,
+            },
+        }
+    }
+}
+
+/// What settling a column measured.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ColumnReport {
+    /// The preparation.
+    pub preparation: Preparation,
+    /// Engine settings.
+    pub run: ColumnRun,
+    /// Seconds spent preparing the grains' positions (generator).
+    pub prepare_seconds: f64,
+    /// The settling run (its `wall_seconds` excludes the preparation).
+    pub settle: SettleReport,
+    /// Largest overlap in the final state relative to the smallest radius.
+    pub final_overlap_ratio: f64,
+    /// Solid fraction of the settled column: area of the grains whose centre lies between
+    /// 2 R_max above the floor and 4 R_max below the top, over that band's area.
+    pub solid_fraction: f64,
+}
+
+impl ColumnReport {
+    /// Total wall seconds: preparation + settling.
+    pub fn total_seconds(&self) -> f64 {
+        self.prepare_seconds + self.settle.wall_seconds
+    }
+}
+
+const R_MIN: f64 = 1e-3;
+const R_MAX: f64 = 2e-3;
+/// Box width: 40 mean diameters (m).
+pub const COLUMN_WIDTH: f64 = 40.0 * (R_MIN + R_MAX);
+
+/// The benchmark column of `n` grains prepared as asked, with the engine settings of `run`.
+pub fn janssen_column(
+    n: usize,
+    preparation: Preparation,
+    run: &ColumnRun,
+    seed: u64,
+) -> Result<World> {
+    let grain = GrainSpec {
+        density: 2500.0,
+        radius_mean: 0.5 * (R_MIN + R_MAX),
+        radius_spread: 0.5 * (R_MAX - R_MIN),
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let radii = uniform_radii(&mut rng, n, &grain);
+    let centres = match preparation {
+        Preparation::Pour => rain(
+            &mut rng,
+            &radii,
+            &RainBox {
+                x_min: 0.0,
+                x_max: COLUMN_WIDTH,
+                y_min: 0.0,
+                gap: 0.02 * R_MIN,
+                periodic: false,
+            },
+        )?,
+        Preparation::Deposit => deposit(&mut rng, &radii, COLUMN_WIDTH, 1e-6 * R_MIN)?,
+    };
+    let friction = FrictionSpec {
+        grain_grain: 0.5,
+        grain_wall: 0.5,
+    };
+    let params = dem::WorldParams {
+        dt: run.dt,
+        detection_gap: 0.1 * R_MIN,
+        solver: dem::SolverParams {
+            tolerance: run.tolerance,
+            max_iterations: run.max_sweeps,
+            parallel: run.parallel,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut w = World::new(params, friction.laws());
+    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL);
+    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL);
+    w.add_line_wall(
+        "right",
+        Vector2::new(COLUMN_WIDTH, 0.0),
+        Vector2::new(-1.0, 0.0),
+        WALL,
+    );
+    for (c, r) in centres.iter().zip(&radii) {
+        w.add_grain(*c, *r, grain.density, GRAIN);
+    }
+    w.validate(1e-12)?;
+    Ok(w)
+}
+
+/// Prepares and settles the benchmark column (KE/PE < 10⁻⁸), timed.
+pub fn settle_column(
+    n: usize,
+    preparation: Preparation,
+    run: &ColumnRun,
+    seed: u64,
+) -> Result<ColumnReport> {
+    let t0 = Instant::now();
+    let mut w = janssen_column(n, preparation, run, seed)?;
+    let prepare_seconds = t0.elapsed().as_secs_f64();
+    let mut settle = settle(&mut w, 1e-8, run.max_time);
+    settle.width = COLUMN_WIDTH;
+    debug_assert!(energy_ratio(&w) == settle.energy_ratio);
+    let overlap = w
+        .contacts()
+        .geometry
+        .iter()
+        .map(|g| -g.gap)
+        .fold(0.0, f64::max);
+    // grains whose centre lies in the band [2 R_max, H − 4 R_max] (away from the floor layer
+    // and the rough top) over the band's area: unbiased on average for a uniform packing
+    let (y0, y1) = (2.0 * R_MAX, settle.height - 4.0 * R_MAX);
+    let area: f64 = w
+        .bodies
+        .iter()
+        .filter(|b| b.kind == dem::BodyKind::Grain && b.position.y >= y0 && b.position.y < y1)
+        .map(|b| std::f64::consts::PI * b.radius * b.radius)
+        .sum();
+    Ok(ColumnReport {
+        preparation,
+        run: *run,
+        prepare_seconds,
+        settle,
+        final_overlap_ratio: overlap / R_MIN,
+        solid_fraction: area / (COLUMN_WIDTH * (y1 - y0).max(f64::MIN_POSITIVE)),
+    })
+}
+
+/// One row of the engine scaling benchmark.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ScalingRow {
+    /// Grains.
+    pub grains: usize,
+    /// Threads of the rayon pool the steps ran on.
+    pub threads: usize,
+    /// Mean contacts per timed step.
+    pub contacts: f64,
+    /// Mean sweeps per timed step.
+    pub sweeps: f64,
+    /// Wall seconds per timed step (detection + solve + update).
+    pub seconds_per_step: f64,
+    /// Contact updates per second over the whole step (contacts × sweeps / step time).
+    pub updates_per_second: f64,
+    /// Timed steps that reached the sweep cap.
+    pub unconverged_steps: usize,
+}
+
+/// Rows of grains in the scaling deposit (the box widens with `n`, so the depth, hence the
+/// sweeps a warm-started step needs, stays the same).
+pub const SCALING_ROWS: f64 = 25.0;
+
+/// A dense deposit of `n` grains (radius 1–2 mm, μ = 0.5, 2500 kg/m³) about [`SCALING_ROWS`]
+/// grains deep in a box as wide as needed, made by geometric deposition and relaxed for
+/// `relax_steps` steps of 1 ms (tolerance 10⁻⁴, at most 200 sweeps per step).
+pub fn scaling_deposit(n: usize, relax_steps: usize, parallel: bool, seed: u64) -> Result<World> {
+    let mean_area = std::f64::consts::PI * (R_MIN * R_MIN + R_MIN * R_MAX + R_MAX * R_MAX) / 3.0;
+    let height = SCALING_ROWS * (R_MIN + R_MAX);
+    let width = (n as f64 * mean_area / (0.8 * height)).max(4.0 * R_MAX);
+    let grain = GrainSpec {
+        density: 2500.0,
+        radius_mean: 0.5 * (R_MIN + R_MAX),
+        radius_spread: 0.5 * (R_MAX - R_MIN),
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let radii = uniform_radii(&mut rng, n, &grain);
+    let centres = deposit(&mut rng, &radii, width, 1e-6 * R_MIN)?;
+    let friction = FrictionSpec {
+        grain_grain: 0.5,
+        grain_wall: 0.5,
+    };
+    let params = dem::WorldParams {
+        dt: 1e-3,
+        detection_gap: 0.1 * R_MIN,
+        solver: dem::SolverParams {
+            tolerance: 1e-4,
+            max_iterations: 200,
+            parallel,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut w = World::new(params, friction.laws());
+    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL);
+    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL);
+    w.add_line_wall(
+        "right",
+        Vector2::new(width, 0.0),
+        Vector2::new(-1.0, 0.0),
+        WALL,
+    );
+    for (c, r) in centres.iter().zip(&radii) {
+        w.add_grain(*c, *r, grain.density, GRAIN);
+    }
+    for _ in 0..relax_steps {
+        w.step()?;
+    }
+    Ok(w)
+}
+
+/// Times `steps` steps of `w` on a rayon pool of `threads` threads.
+pub fn time_steps(w: &mut World, steps: usize, threads: usize) -> Result<ScalingRow> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| crate::DatasetError::Generator(format!("thread pool: {e}")))?;
+    pool.install(|| {
+        let (mut contacts, mut sweeps, mut unconverged, mut updates) =
+            (0usize, 0usize, 0usize, 0f64);
+        let t0 = Instant::now();
+        for _ in 0..steps {
+            let r = w.step()?;
+            contacts += r.contacts;
+            sweeps += r.solver.iterations;
+            updates += (r.contacts * r.solver.iterations.max(1)) as f64;
+            unconverged += usize::from(!r.solver.converged);
+        }
+        let secs = t0.elapsed().as_secs_f64();
+        let k = steps.max(1) as f64;
+        let grains = w
+            .bodies
+            .iter()
+            .filter(|b| b.kind == dem::BodyKind::Grain)
+            .count();
+        Ok(ScalingRow {
+            grains,
+            threads,
+            contacts: contacts as f64 / k,
+            sweeps: sweeps as f64 / k,
+            seconds_per_step: secs / k,
+            updates_per_second: updates / secs.max(1e-12),
+            unconverged_steps: unconverged,
+        })
+    })
+}
+
+/// Least-squares exponent `a` of `t = c · nᵃ` through the rows (log–log fit).
+pub fn scaling_exponent(rows: &[ScalingRow]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.grains > 0 && r.seconds_per_step > 0.0)
+        .map(|r| ((r.grains as f64).ln(), r.seconds_per_step.ln()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let k = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / k,
+        pts.iter().map(|p| p.1).sum::<f64>() / k,
+    );
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deposited column settles: at rest (KE/PE < 1e-8), overlaps below 1 % of the
+    /// smallest radius, dense (0.75 < φ < 0.9).
+    #[test]
+    fn a_deposited_column_of_300_grains_settles() {
+        let run = ColumnRun::for_preparation(Preparation::Deposit);
+        let r = settle_column(300, Preparation::Deposit, &run, 3).unwrap();
+        assert!(r.settle.settled, "{r:?}");
+        assert!(r.final_overlap_ratio < 0.01, "{r:?}");
+        assert!(r.solid_fraction > 0.75 && r.solid_fraction < 0.9, "{r:?}");
+    }
+
+    #[test]
+    fn exponent_of_exact_power_laws() {
+        let row = |n: usize, t: f64| ScalingRow {
+            grains: n,
+            threads: 1,
+            contacts: 0.0,
+            sweeps: 0.0,
+            seconds_per_step: t,
+            updates_per_second: 0.0,
+            unconverged_steps: 0,
+        };
+        let lin: Vec<_> = [1e3, 1e4, 1e5]
+            .iter()
+            .map(|&n| row(n as usize, 2e-6 * n))
+            .collect();
+        assert!((scaling_exponent(&lin).unwrap() - 1.0).abs() < 1e-12);
+        let quad: Vec<_> = [1e3, 1e4]
+            .iter()
+            .map(|&n| row(n as usize, 1e-9 * n * n))
+            .collect();
+        assert!((scaling_exponent(&quad).unwrap() - 2.0).abs() < 1e-12);
+        assert!(scaling_exponent(&lin[..1]).is_none());
+    }
+}
