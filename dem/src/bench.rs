@@ -152,29 +152,6 @@ pub fn energy_ratio(w: &World) -> f64 {
     }
 }
 
-/// A Janssen column: `n` disks of radius uniform in [1, 2] mm (density 2500 kg/m³) on a loose
-/// seeded grid between two vertical walls 40 mean diameters (0.12 m) apart, μ = 0.5 between
-/// grains and with the walls, e = 0; settled under gravity with time step `dt` and solver
-/// tolerance `tolerance` until kinetic / potential energy < `target` (or `max_time` s).
-pub fn janssen_settle(
-    n: usize,
-    dt: f64,
-    tolerance: f64,
-    parallel: bool,
-    seed: u64,
-) -> SettleReport {
-    let width = 40.0 * 3e-3;
-    let mut w = grid_world(n, width, 0.5, seed);
-    w.params.dt = dt;
-    w.params.solver.tolerance = tolerance;
-    w.params.solver.max_iterations = 2000;
-    w.params.solver.parallel = parallel;
-    SettleReport {
-        width,
-        ..settle(&mut w, 1e-8, 10.0)
-    }
-}
-
 /// Steps `w` until [`energy_ratio`] < `target` (or `max_time` simulated seconds), timed.
 pub fn settle(w: &mut World, target: f64, max_time: f64) -> SettleReport {
     let t0 = Instant::now();
