@@ -70,8 +70,8 @@ impl Default for CsvFitOptions {
 
 /// Reads `path` and fits `law` (one of [`LAW_NAMES`]); returns the calibrated law for export.
 /// Errors: [`IdentifyError::UnknownLaw`], the file errors of [`crate::data`], a header that
-/// names a column twice ([`IdentifyError::Csv`] on the header line: which of the two would be
-/// read is ambiguous), and the fit's.
+/// names a column twice or is followed by no data row ([`IdentifyError::Csv`] on the header
+/// line; with a column twice, which of the two would be read is ambiguous), and the fit's.
 pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<CalibratedLaw> {
     check_law_name(law)?;
     let source = path.display().to_string();
@@ -80,7 +80,15 @@ pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<C
         source: e,
     })?;
     let table = Table::parse_csv(&text, &source)?;
-    check_unique_headers(&table, header_line(&text))?;
+    let header = header_line(&text);
+    check_unique_headers(&table, header)?;
+    if table.rows() == 0 {
+        return Err(IdentifyError::Csv {
+            file: source,
+            line: header,
+            message: "no data rows after the header".into(),
+        });
+    }
     fit_table(law, &table, options)
 }
 
