@@ -2,13 +2,24 @@
 //!
 //! ```text
 //! grainlaw [run [SCENARIO] [--out DIR] [--set KEY=VALUE ...] [--quiet]]   (default: run janssen)
+//!          [--checkpoint-every STEPS] [--checkpoint-seconds S]
+//! grainlaw run --resume DIR [--checkpoint-every STEPS] [--checkpoint-seconds S] [--quiet]
 //! grainlaw scenarios [--show NAME]
 //! grainlaw fit LAW DATA.csv [--out law.json]
 //! grainlaw solve-fc PROBLEM.json [--tol T] [--out SOLUTION.json]
-//! grainlaw bench [--dir DIR] [--tol T]
+//! grainlaw bench [--dir DIR] [--engine-grains N ...]
 //! ```
 //!
 //! Every error is one line on stderr and exit code 2.
+//!
+//! `run` writes a checkpoint (`OUT/checkpoint/run.json.gz`, [`crate::checkpoint`]) every
+//! `--checkpoint-seconds` (default 60 s of wall-clock time) and every `--checkpoint-every` steps
+//! (default: not by steps; 0 turns either off). Ctrl-C stops the run after the current step with
+//! a checkpoint there, no `summary.json`, one line saying how to resume, and exit code 130 (the
+//! shells' code for SIGINT, so that scripts tell "stopped, resumable" from "failed"); a second
+//! Ctrl-C quits at once. `run --resume DIR` continues the run in DIR with the checkpoint's
+//! scenario and overrides (a SCENARIO or `--set` given as well must be the same) and gives the
+//! same files as an uninterrupted run, `wall_seconds` aside.
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};

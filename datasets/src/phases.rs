@@ -50,6 +50,8 @@ pub struct PhaseStats {
     pub simulated_time: f64,
     /// Steps whose contact solve stopped at the sweep cap above its tolerance.
     pub unconverged_steps: u64,
+    /// World step index of the first such step.
+    pub first_unconverged_step: Option<u64>,
     /// Largest error measure at the end of a step's solve (1).
     #[serde(with = "dem::serde_float")]
     pub worst_error: f64,
@@ -97,6 +99,7 @@ impl PhaseStats {
         self.simulated_time += dt;
         if !r.solver.converged {
             self.unconverged_steps += 1;
+            self.first_unconverged_step = earliest(self.first_unconverged_step, Some(r.step));
         }
         self.worst_error = self.worst_error.max(r.solver.error);
         self.max_sweeps = self.max_sweeps.max(r.solver.iterations);
@@ -131,6 +134,8 @@ impl PhaseStats {
         self.steps += o.steps;
         self.simulated_time += o.simulated_time;
         self.unconverged_steps += o.unconverged_steps;
+        self.first_unconverged_step =
+            earliest(self.first_unconverged_step, o.first_unconverged_step);
         self.worst_error = self.worst_error.max(o.worst_error);
         self.max_sweeps = self.max_sweeps.max(o.max_sweeps);
         self.total_sweeps += o.total_sweeps;
@@ -190,7 +195,7 @@ pub fn load_energy_scale(world: &World) -> f64 {
     }
     let dmean = if n > 0 { dsum / n as f64 } else { 0.0 };
     for b in &world.bodies {
-        if b.dofs.iter().any(|d| *d == Dof::Free) {
+        if b.dofs.contains(&Dof::Free) {
             s += (b.applied_force.norm() + b.applied_torque.abs() / dmean.max(1e-300)) * dmean;
         }
     }
@@ -550,7 +555,7 @@ mod tests {
         );
         assert!(s
             .first_energy_growth_step
-            .is_some_and(|k| k >= 1 && k <= 400));
+            .is_some_and(|k| (1..=400).contains(&k)));
         assert!(s.penetration_flagged_steps > 0 && s.max_penetration_ratio > PENETRATION_LIMIT);
         let mut one = stack(6, 1e-3, 2e-4, 0.3, 1.0);
         let s = run_steps(&mut one, 400, |_, _| true).unwrap();

@@ -96,13 +96,18 @@ pub fn phase_warnings(
 ) -> Vec<String> {
     let mut lines = Vec::new();
     let solver = &world.params.solver;
+    let first = |s: Option<u64>| s.map_or_else(|| "?".to_string(), |s| s.to_string());
     if stats.unconverged_steps > 0 {
         lines.push(format!(
-            "{name}: {} of {} steps stopped at the sweep cap ({}) above the tolerance {:.0e}; worst error {:.2e}",
-            stats.unconverged_steps, stats.steps, solver.max_iterations, solver.tolerance, stats.worst_error
+            "{name}: {} of {} steps stopped at the sweep cap ({}) above the tolerance {:.0e}, first at step {}; worst error {:.2e}",
+            stats.unconverged_steps,
+            stats.steps,
+            solver.max_iterations,
+            solver.tolerance,
+            first(stats.first_unconverged_step),
+            stats.worst_error
         ));
     }
-    let first = |s: Option<u64>| s.map_or_else(|| "?".to_string(), |s| s.to_string());
     if stats.energy_growth_steps > 0 {
         lines.push(format!(
             "{name}: the mechanical energy grew in {} of {} steps, first at step {}; worst growth {:.2e} of Σ m g d (tolerance {ENERGY_GROWTH_TOLERANCE:.0e})",
@@ -133,7 +138,7 @@ pub fn phase_warnings(
 }
 
 /// Solver and numerics keys of `summary.json`: `solver_steps`, `solver_unconverged_steps`,
-/// `solver_worst_error`, `solver_mean_sweeps`, `solver_max_sweeps`; `max_penetration_m`,
+/// `solver_first_unconverged_step`, `solver_worst_error`, `solver_mean_sweeps`, `solver_max_sweeps`; `max_penetration_m`,
 /// `max_penetration_over_radius` (over the smallest grain radius), `penetration_flagged_steps`
 /// (overlap above [`PENETRATION_LIMIT`] of it) and `penetration_first_step`;
 /// `energy_growth_steps` (energy residual above [`ENERGY_GROWTH_TOLERANCE`] of the load energy
@@ -143,6 +148,10 @@ pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
     let step = |v: Option<u64>| v.map_or(serde_json::Value::Null, serde_json::Value::from);
     s.int("solver_steps", stats.steps)
         .int("solver_unconverged_steps", stats.unconverged_steps)
+        .set(
+            "solver_first_unconverged_step",
+            step(stats.first_unconverged_step),
+        )
         .num("solver_worst_error", stats.worst_error)
         .num("solver_mean_sweeps", stats.mean_sweeps())
         .int("solver_max_sweeps", stats.max_sweeps as u64)

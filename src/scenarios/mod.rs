@@ -72,6 +72,12 @@ pub fn run(ctx: &mut RunContext) -> Result<RunOutcome> {
 /// are written as `ctl.policy` says and when the user stops the run; `summary.json` is written
 /// last, then the checkpoint directory is removed.
 pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    if !ctl.resume && crate::checkpoint::file_of(ctx.out.path()).exists() {
+        crate::progress::warn(&format!(
+            "{}: removed the checkpoint of an earlier, interrupted run (a new run starts here; `--resume` continues one)",
+            ctx.out.path().display()
+        ));
+    }
     if !ctl.resume {
         crate::checkpoint::remove(ctx.out.path())?;
     }

@@ -79,7 +79,7 @@ impl PhasedRun for Push<'_> {
         let case = k / 2;
         let (name, friction) = &c.cases.list()[case];
         let width = c.width_diameters * 2.0 * c.grain.radius_mean;
-        if k % 2 == 0 {
+        if k.is_multiple_of(2) {
             let col = datasets::build::column(
                 &c.grain,
                 c.grains,
@@ -121,7 +121,7 @@ impl PhasedRun for Push<'_> {
         w: &dem::World,
         _r: &dem::StepReport,
     ) -> Result<()> {
-        if k % 2 == 1 {
+        if !k.is_multiple_of(2) {
             st.force.push(-w.contact_force(st.bottom).0.y);
             st.vtk.maybe(out, w)?;
         }
@@ -137,7 +137,7 @@ impl PhasedRun for Push<'_> {
         stats: &PhaseStats,
     ) -> Result<()> {
         st.all.merge(stats);
-        if k % 2 == 0 {
+        if k.is_multiple_of(2) {
             return Ok(());
         }
         let case = k / 2;

@@ -1,0 +1,296 @@
+//! Interrupted runs: `grainlaw run` stopped (the hidden `--stop-after-steps`, which behaves as
+//! Ctrl-C, or a real SIGINT) writes a checkpoint and no `summary.json`; `grainlaw run --resume
+//! DIR` finishes it with every output file byte for byte equal to an uninterrupted run's
+//! (`wall_seconds` aside); resuming from a missing, corrupt or foreign checkpoint is refused
+//! with one line and exit code 2. The numerics keys of `summary.json` are there, and a normal
+//! deposit flags no energy growth.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+/// A short multi-phase scenario: Janssen column of 60 grains (deposit, relax, release,
+/// measure: about 900 steps, half a second).
+const SCENARIO: &[&str] = &["run", "janssen", "--set", "grains=60", "-q"];
+
+fn grainlaw(args: &[&str], extra: &[&Path]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_grainlaw"));
+    cmd.args(args);
+    for p in extra {
+        cmd.arg(p);
+    }
+    cmd.output().expect("grainlaw runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// The error line of a failed command (the last line of stderr; warnings come before it).
+fn error_line(o: &Output) -> String {
+    stderr(o)
+        .lines()
+        .rfind(|l| l.starts_with("error:"))
+        .unwrap_or_default()
+        .to_string()
+}
+
+/// Every file under `dir` (relative path → bytes).
+fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(
+                    p.strip_prefix(dir).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// `a` and `b` hold the same files with the same bytes; `summary.json` the same keys and
+/// values in the same order, `wall_seconds` aside.
+fn assert_same_outputs(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    let names = |f: &BTreeMap<PathBuf, Vec<u8>>| f.keys().cloned().collect::<Vec<_>>();
+    assert_eq!(names(&fa), names(&fb), "different files");
+    for (name, bytes) in &fa {
+        if name == Path::new("summary.json") {
+            continue;
+        }
+        assert!(bytes == &fb[name], "{} differs", name.display());
+    }
+    let summary = |f: &BTreeMap<PathBuf, Vec<u8>>| -> Vec<(String, Value)> {
+        let v: serde_json::Map<String, Value> =
+            serde_json::from_slice(&f[Path::new("summary.json")]).unwrap();
+        v.into_iter().filter(|(k, _)| k != "wall_seconds").collect()
+    };
+    let (sa, sb) = (summary(&fa), summary(&fb));
+    assert_eq!(sa.len(), sb.len());
+    for ((ka, va), (kb, vb)) in sa.iter().zip(&sb) {
+        assert_eq!(ka, kb, "keys in another order");
+        assert_eq!(va, vb, "summary key {ka} differs");
+    }
+}
+
+/// An uninterrupted run of [`SCENARIO`] into `dir`.
+fn reference(dir: &Path) -> Value {
+    let o = grainlaw(&[SCENARIO, &["--out"]].concat(), &[dir]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Checks the state a stopped run leaves: exit 130, one error line that says how to resume,
+/// a checkpoint, no `summary.json`.
+fn assert_stopped(o: &Output, dir: &Path) {
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(o));
+    let line = error_line(o);
+    assert!(
+        line.contains("interrupted at step")
+            && line.contains(&format!("grainlaw run --resume {}", dir.display())),
+        "{line}"
+    );
+    assert!(dir.join("checkpoint/run.json.gz").is_file());
+    assert!(!dir.join("summary.json").exists());
+}
+
+/// Stopped twice (in the deposit, then later in the relaxation or release), resumed twice:
+/// the same files, byte for byte, as the uninterrupted run. A stale `summary.json` left in the
+/// directory is removed as the run starts; the checkpoint directory is removed at the end.
+#[test]
+fn stopped_and_resumed_runs_give_the_same_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    let s = reference(&a);
+    assert!(
+        !a.join("checkpoint").exists(),
+        "a finished run keeps no checkpoint"
+    );
+    std::fs::create_dir_all(&b).unwrap();
+    std::fs::write(b.join("summary.json"), "{\"stale\": true}\n").unwrap();
+    let o = grainlaw(
+        &[SCENARIO, &["--stop-after-steps", "150", "--out"]].concat(),
+        &[&b],
+    );
+    assert_stopped(&o, &b);
+    assert!(
+        error_line(&o).contains("phase `deposit`"),
+        "{}",
+        error_line(&o)
+    );
+    // Second leg: periodic checkpoints every 40 steps, stopped again 450 steps later.
+    let o = grainlaw(
+        &[
+            "run",
+            "-q",
+            "--checkpoint-every",
+            "40",
+            "--stop-after-steps",
+            "450",
+            "--resume",
+        ],
+        &[&b],
+    );
+    assert_stopped(&o, &b);
+    let o = grainlaw(&["run", "-q", "--resume"], &[&b]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!b.join("checkpoint").exists());
+    assert_same_outputs(&a, &b);
+    // The numerics keys; the deposit and the relaxation (converged solves at θ = 1) never
+    // gain energy.
+    for k in [
+        "solver_unconverged_steps",
+        "solver_first_unconverged_step",
+        "solver_worst_error",
+        "max_penetration_m",
+        "max_penetration_over_radius",
+        "penetration_flagged_steps",
+        "penetration_first_step",
+        "energy_growth_steps",
+        "energy_growth_first_step",
+        "energy_growth_worst",
+    ] {
+        assert!(s.get(k).is_some(), "summary.json lacks {k}");
+    }
+    assert_eq!(s["deposit_energy_growth_steps"], 0);
+    assert_eq!(s["relax_energy_growth_steps"], 0);
+    let total = s["energy_growth_steps"].as_u64().unwrap();
+    assert_eq!(s["energy_growth_first_step"].is_null(), total == 0);
+}
+
+/// A real SIGINT (Ctrl-C) while the run steps: a checkpoint, exit 130, no summary.json; the
+/// resumed run gives the uninterrupted run's files.
+#[cfg(unix)]
+#[test]
+fn sigint_stops_cleanly_and_the_run_resumes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    reference(&a);
+    // Checkpoints every 20 steps: the first one shows that the run is stepping (the Ctrl-C
+    // handler is installed before the first step).
+    let mut child = Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .args(SCENARIO)
+        .args(["--checkpoint-every", "20", "--out"])
+        .arg(&b)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !b.join("checkpoint/run.json.gz").exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "no checkpoint after 30 s"
+        );
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before it was interrupted"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    assert_stopped(&o, &b);
+    let o = grainlaw(&["run", "-q", "--resume"], &[&b]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_same_outputs(&a, &b);
+}
+
+/// Refused resumes, each one line and exit code 2, the checkpoint left as it was: no
+/// checkpoint, a finished run, a corrupt checkpoint, another scenario, other overrides,
+/// `--out` with `--resume`. A new run in the directory then removes the stale checkpoint.
+#[test]
+fn bad_resumes_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    let refused = |args: &[&str], extra: &[&Path], needle: &str| {
+        let o = grainlaw(args, extra);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let text = stderr(&o);
+        assert_eq!(text.lines().count(), 1, "{args:?}: not one line: {text}");
+        assert!(text.contains(needle), "{args:?}: `{needle}` not in {text}");
+    };
+    std::fs::create_dir_all(&dir).unwrap();
+    refused(
+        &["run", "--resume"],
+        &[&dir],
+        "no checkpoint to resume from",
+    );
+    let finished = tmp.path().join("finished");
+    reference(&finished);
+    refused(&["run", "--resume"], &[&finished], "the run there finished");
+
+    let o = grainlaw(
+        &[SCENARIO, &["--stop-after-steps", "30", "--out"]].concat(),
+        &[&dir],
+    );
+    assert_stopped(&o, &dir);
+    let cp = dir.join("checkpoint/run.json.gz");
+    let saved = std::fs::read(&cp).unwrap();
+    refused(
+        &["run", "rolling", "--resume"],
+        &[&dir],
+        "resume it with `grainlaw run --resume",
+    );
+    refused(
+        &["run", "janssen", "--set", "grains=61", "--resume"],
+        &[&dir],
+        "not `builtin:janssen --set grains=61`",
+    );
+    refused(
+        &["run", "--set", "grains=70", "--resume"],
+        &[&dir],
+        "builtin:janssen --set grains=60",
+    );
+    refused(
+        &["run", "--out", "elsewhere", "--resume"],
+        &[&dir],
+        "cannot be used with",
+    );
+    assert_eq!(
+        std::fs::read(&cp).unwrap(),
+        saved,
+        "a refusal changed the checkpoint"
+    );
+    // The same scenario and overrides given again are accepted.
+    let o = grainlaw(
+        &[
+            "run",
+            "janssen",
+            "--set",
+            "grains=60",
+            "-q",
+            "--stop-after-steps",
+            "1",
+            "--resume",
+        ],
+        &[&dir],
+    );
+    assert_stopped(&o, &dir);
+    // Truncated, then not gzip at all.
+    let saved = std::fs::read(&cp).unwrap();
+    std::fs::write(&cp, &saved[..saved.len() / 2]).unwrap();
+    refused(&["run", "--resume"], &[&dir], "not a readable checkpoint");
+    std::fs::write(&cp, b"{\"format\": 1}").unwrap();
+    refused(&["run", "--resume"], &[&dir], "not a readable checkpoint");
+    assert!(!dir.join("summary.json").exists());
+    // A new run in the directory says it removes the old checkpoint, and finishes without one.
+    let o = grainlaw(&[SCENARIO, &["--out"]].concat(), &[&dir]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("removed the checkpoint of an earlier, interrupted run"));
+    assert!(!dir.join("checkpoint").exists() && dir.join("summary.json").is_file());
+}
