@@ -23,7 +23,7 @@ use toml::{Table, Value};
 const MAX_MESSAGE: usize = 600;
 
 /// Cases per property when `PROPTEST_CASES` is not set.
-const DEFAULT_CASES: u32 = 300;
+const DEFAULT_CASES: u32 = 2000;
 
 /// Worlds are built only up to this many grains (time of the suite).
 const BUILD_GRAINS: usize = 3_000;

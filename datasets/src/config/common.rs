@@ -129,18 +129,20 @@ impl SolverSpec {
 }
 
 /// A periodic cell `cell_length_diameters · 2 R̄` long must hold three cells of the engine's
-/// contact-detection grid in its worst case, `L ≥ 3 (3 d_max + g)`: a grid cell is the largest
-/// diameter `d_max = 2 R_max` plus the detection gap `g = R_min / 10` plus twice a swept margin
-/// of at most one diameter. `key` names the length in the error.
+/// contact-detection grid, `L ≥ 3 (1.5 d_max + g)`: a grid cell is the largest diameter
+/// `d_max = 2 R_max` plus the detection gap `g = R_min / 10` plus twice the swept margin (the
+/// distance a grain moves in one step), here allowed up to a quarter of `d_max`. `key` names the
+/// length in the error.
 pub fn check_periodic_cell(key: &str, cell_length_diameters: f64, grain: &GrainSpec) -> Result<()> {
     let length = cell_length_diameters * 2.0 * grain.radius_mean;
-    let needed = 3.0 * (3.0 * 2.0 * grain.radius_max() + 0.1 * grain.radius_min());
+    let needed = 3.0 * (1.5 * 2.0 * grain.radius_max() + 0.1 * grain.radius_min());
     if length < needed {
         return Err(DatasetError::invalid(
             key,
             format!(
                 "{} gives a periodic cell {length:.3e} m long, shorter than the {needed:.3e} m \
-                 (9 largest diameters and 3 detection gaps) the contact detection needs",
+                 (3 contact-detection cells of 1.5 largest diameters and a detection gap) the \
+                 engine needs",
                 num(cell_length_diameters)
             ),
         ));
