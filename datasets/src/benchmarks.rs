@@ -130,7 +130,7 @@ pub fn janssen_column(
                 periodic: false,
             },
         )?,
-        Preparation::Deposit => deposit(&mut rng, &radii, COLUMN_WIDTH, 1e-6 * R_MIN)?,
+        Preparation::Deposit => deposit(&mut rng, &radii, COLUMN_WIDTH, 1e-6 * R_MIN)?.centres,
     };
     let friction = FrictionSpec {
         grain_grain: 0.5,
@@ -238,7 +238,7 @@ pub fn scaling_deposit(n: usize, relax_steps: usize, parallel: bool, seed: u64) 
     };
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let radii = uniform_radii(&mut rng, n, &grain);
-    let centres = deposit(&mut rng, &radii, width, 1e-6 * R_MIN)?;
+    let centres = deposit(&mut rng, &radii, width, 1e-6 * R_MIN)?.centres;
     let friction = FrictionSpec {
         grain_grain: 0.5,
         grain_wall: 0.5,

@@ -19,11 +19,11 @@ use crate::local::{project_on_cone, solve_local};
 
 /// Contacts per chunk of the fixed-partition reductions.
 pub const CHUNK: usize = 4096;
-/// Contacts per parallel task inside a colour class.
-pub const TASK: usize = 512;
+/// Fewest contacts per parallel task inside a colour class (rayon splits adaptively above).
+pub const TASK: usize = 256;
 /// Classes with fewer contacts than this are swept on the calling thread (the same numbers, no
 /// fork–join overhead).
-pub const PARALLEL_MIN: usize = 2 * TASK;
+pub const PARALLEL_MIN: usize = 4 * TASK;
 
 /// A raw pointer shared between the tasks of one colour class.
 #[derive(Clone, Copy)]
@@ -115,11 +115,10 @@ fn for_each_coloured(colouring: &ContactColouring, f: impl Fn(usize) + Sync) {
                 f(i as usize);
             }
         } else {
-            class.par_chunks(TASK).for_each(|chunk| {
-                for &i in chunk {
-                    f(i as usize);
-                }
-            });
+            class
+                .par_iter()
+                .with_min_len(TASK)
+                .for_each(|&i| f(i as usize));
         }
     }
 }

@@ -18,13 +18,27 @@ use crate::error::{DatasetError, Result};
 /// Rolls allowed per grain before it is left where it is (a non-overlapping position).
 const MAX_MOVES: usize = 10_000;
 
-/// A support of a grain.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Support {
+/// What a deposited grain rests on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Support {
+    /// The floor `y = 0`.
     Floor,
+    /// The wall `x = 0`.
     LeftWall,
+    /// The wall `x = W`.
     RightWall,
+    /// Another grain (its index; always an earlier one).
     Grain(usize),
+}
+
+/// A deposited packing: centres (m) and, for each grain, its one or two supports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Deposition {
+    /// Centres (m), in the order of the radii.
+    pub centres: Vec<Vector2<f64>>,
+    /// Supports of each grain: the floor alone, or the grain it rolled over and the one (or the
+    /// wall) that stopped it. A grain left after [`MAX_MOVES`] rolls keeps its last pivot only.
+    pub supports: Vec<[Option<Support>; 2]>,
 }
 
 /// Grid of placed grains (cells of side `cell`, rows growing upwards).
@@ -72,12 +86,7 @@ impl Grid {
 
 /// Centres (m) of grains of the given radii (in order) deposited into `[0, width]` above the
 /// floor `y = 0` (see the module documentation). Fails when a grain is wider than the box.
-pub fn deposit(
-    rng: &mut ChaCha8Rng,
-    radii: &[f64],
-    width: f64,
-    gap: f64,
-) -> Result<Vec<Vector2<f64>>> {
+pub fn deposit(rng: &mut ChaCha8Rng, radii: &[f64], width: f64, gap: f64) -> Result<Deposition> {
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
     if width.is_nan() || width <= 2.0 * r_max + 2.0 * gap {
         return Err(DatasetError::Generator(format!(
@@ -90,23 +99,27 @@ pub fn deposit(
         cells: Vec::new(),
     };
     let mut centres: Vec<Vector2<f64>> = Vec::with_capacity(radii.len());
+    let mut supports = Vec::with_capacity(radii.len());
     let mut near = Vec::new();
     let mut top = 0.0f64; // highest grain top so far
     for (i, &r) in radii.iter().enumerate() {
         let (xl, xr) = (r + gap, width - r - gap);
         let mut c = Vector2::new(rng.random_range(xl..=xr), top + 2.0 * r + 2.0 * gap);
         let mut moves = 0;
+        let rests: [Option<Support>; 2];
         'grain: loop {
             // Fall vertically from c.
             let (y_land, support) = fall(&grid, &centres, radii, c, r, gap, &mut near);
             c.y = y_land;
             let Support::Grain(mut pivot) = support else {
+                rests = [Some(Support::Floor), None];
                 break 'grain; // on the floor
             };
             // Roll over the pivot (direction: away from it), until stable or rolled off.
             loop {
                 moves += 1;
                 if moves > MAX_MOVES {
+                    rests = [Some(Support::Grain(pivot)), None];
                     break 'grain;
                 }
                 let p = centres[pivot];
@@ -129,12 +142,16 @@ pub fn deposit(
                             Support::Grain(k) => (centres[k].x > c.x) == right,
                         };
                         if stable {
+                            rests = [Some(Support::Grain(pivot)), Some(s)];
                             break 'grain;
                         }
                         match s {
                             Support::Grain(k) => pivot = k,
                             // a wall on the pivot's side: cannot happen while rolling away
-                            _ => break 'grain,
+                            _ => {
+                                rests = [Some(Support::Grain(pivot)), Some(s)];
+                                break 'grain;
+                            }
                         }
                     }
                     None => {
@@ -151,8 +168,9 @@ pub fn deposit(
         top = top.max(c.y + r);
         grid.insert(i, c);
         centres.push(c);
+        supports.push(rests);
     }
-    Ok(centres)
+    Ok(Deposition { centres, supports })
 }
 
 /// Highest landing height of a grain of radius `r` falling from `c`, and its support.
@@ -311,7 +329,7 @@ mod tests {
     fn equal_disks_in_a_box_width_of_one_disk_stack_vertically() {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let radii = vec![1e-3; 5];
-        let c = deposit(&mut rng, &radii, 2.5e-3, 1e-9).unwrap();
+        let c = deposit(&mut rng, &radii, 2.5e-3, 1e-9).unwrap().centres;
         for (k, ck) in c.iter().enumerate() {
             // box too narrow for two side by side: a vertical stack touching each other
             if k > 0 {
@@ -327,7 +345,8 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let radii: Vec<f64> = (0..800).map(|_| rng.random_range(1e-3..2e-3)).collect();
         let (width, gap) = (0.06, 1e-8);
-        let c = deposit(&mut rng, &radii, width, gap).unwrap();
+        let dep = deposit(&mut rng, &radii, width, gap).unwrap();
+        let c = dep.centres.clone();
         let phi = check(&c, &radii, width, gap);
         // dense random deposit (the top row's roughness counts as void): 0.7–0.85
         assert!(phi > 0.7 && phi < 0.86, "solid fraction {phi}");
@@ -350,6 +369,19 @@ mod tests {
                 left && right && below,
                 "grain {i} unsupported: {touching:?}"
             );
+        }
+        // the recorded supports touch their grain (contact distance r_i + r_j + gap)
+        for (i, sup) in dep.supports.iter().enumerate() {
+            assert!(sup[0].is_some(), "grain {i} without support");
+            for s in sup.iter().flatten() {
+                let d = match *s {
+                    Support::Grain(j) => (c[i] - c[j]).norm() - radii[i] - radii[j],
+                    Support::Floor => c[i].y - radii[i],
+                    Support::LeftWall => c[i].x - radii[i],
+                    Support::RightWall => width - c[i].x - radii[i],
+                };
+                assert!((d - gap).abs() < 1e-9, "grain {i} support {s:?} at {d}");
+            }
         }
     }
 }

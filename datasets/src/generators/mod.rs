@@ -7,7 +7,7 @@ pub mod lattice;
 pub mod radii;
 pub mod rain;
 
-pub use deposition::deposit;
+pub use deposition::{deposit, Deposition, Support};
 pub use lattice::{lattice, Arrangement};
 pub use radii::{total_area, uniform_radii};
 pub use rain::{rain, RainBox};
