@@ -112,8 +112,17 @@ pub enum Command {
         #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
         /// Grain counts of the engine benchmark (settled deposits); none to skip it.
-        #[arg(long, value_name = "N", num_args = 0.., default_values_t = [1000usize])]
+        #[arg(long, value_name = "N", num_args = 0.., default_values_t = [1000usize, 10000])]
         engine_grains: Vec<usize>,
+        /// Thread counts of the engine rows (the first is the reference of the speed-up).
+        #[arg(long, value_name = "T", num_args = 1.., default_values_t = [1usize, 2])]
+        threads: Vec<usize>,
+        /// Grain counts of the deposited Janssen columns settled to KE/PE < 1e-8; none to skip.
+        #[arg(long, value_name = "N", num_args = 0.., default_values_t = [2000usize])]
+        columns: Vec<usize>,
+        /// Grain counts of the poured Janssen columns (slower); none by default.
+        #[arg(long, value_name = "N", num_args = 0..)]
+        pour: Vec<usize>,
     },
 }
 
@@ -212,9 +221,19 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             max_iterations,
             out,
         } => crate::fc_cmd::solve_fc(&problem, tol, max_iterations, out.as_deref()),
-        Command::Bench { dir, engine_grains } => {
-            crate::fc_cmd::bench(dir.as_deref(), &engine_grains)
-        }
+        Command::Bench {
+            dir,
+            engine_grains,
+            threads,
+            columns,
+            pour,
+        } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
+            fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
+            engine_grains,
+            threads,
+            columns,
+            pour,
+        }),
     }
 }
 

@@ -111,6 +111,30 @@ pub fn deposit_benchmark(n: usize, settle_steps: usize, steps: usize) -> EngineB
     }
 }
 
+/// Contact updates per second of bare Gauss–Seidel sweeps (natural order, one thread, no error
+/// evaluation, no acceleration) over the contacts of the last step of `w`, from its impulses:
+/// `contacts × sweeps / seconds`. Measures the O(1) contact update itself.
+pub fn sweep_rate(w: &World, sweeps: usize) -> f64 {
+    let mut rows = w.contacts().rows.clone();
+    if rows.is_empty() || sweeps == 0 {
+        return 0.0;
+    }
+    let inv: Vec<[f64; 3]> = w.bodies.iter().map(crate::Body::inverse_mass).collect();
+    let mut vel: Vec<[f64; 3]> = w
+        .bodies
+        .iter()
+        .map(|b| [b.velocity.x, b.velocity.y, b.omega])
+        .collect();
+    let order: Vec<u32> = (0..rows.len() as u32).collect();
+    let t0 = Instant::now();
+    for _ in 0..sweeps {
+        crate::solver::sweep(&mut rows, &order, &mut vel, &inv, 1.0);
+    }
+    let secs = t0.elapsed().as_secs_f64();
+    std::hint::black_box(&rows);
+    (rows.len() * sweeps) as f64 / secs.max(1e-12)
+}
+
 /// Outcome of settling a column to rest.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SettleReport {

@@ -1,0 +1,199 @@
+//! `grainlaw bench`: the performance figures of the project in one table.
+//!
+//! 1. Frictional-contact problems of `formats/frictional-contact.md` solved to 10⁻⁶ against the
+//!    Siconos fc2d NSGS times ([`dem::fc::bench`]).
+//! 2. Bare Gauss–Seidel sweep throughput (contact updates per second, one core).
+//! 3. Engine time per step of a settled deposit about 25 grains deep in a box that widens with
+//!    N ([`datasets::benchmarks::scaling_deposit`]), on 1 and 2 threads (colour-ordered parallel
+//!    solve, the same numbers on both), with the fitted exponent of `t ∝ Nᵃ`.
+//! 4. Janssen columns settled to kinetic / potential energy < 10⁻⁸
+//!    ([`datasets::benchmarks::settle_column`]) against the reference times of a soft-contact
+//!    code (LAMMPS, Hookean with history, one core).
+//! 5. Memory per grain and per contact ([`dem::bench::MemoryFootprint`]).
+
+use std::path::Path;
+
+use datasets::benchmarks::{
+    scaling_deposit, scaling_exponent, settle_column, time_steps, ColumnRun, Preparation,
+    ScalingRow,
+};
+
+use crate::error::{CliError, Result};
+
+/// What to run.
+#[derive(Debug, Clone)]
+pub struct BenchPlan {
+    /// Directory of the frictional-contact problems.
+    pub fc_dir: std::path::PathBuf,
+    /// Grain counts of the engine scaling rows.
+    pub engine_grains: Vec<usize>,
+    /// Thread counts of the engine rows.
+    pub threads: Vec<usize>,
+    /// Grain counts of deposited columns.
+    pub columns: Vec<usize>,
+    /// Grain counts of poured columns.
+    pub pour: Vec<usize>,
+}
+
+/// Reference wall seconds (range) of a soft-contact DEM code for a settled column of `n` grains
+/// (issue 6: LAMMPS, Hookean with history, one core).
+fn lammps_reference(n: usize) -> Option<(f64, f64)> {
+    match n {
+        2000 => Some((15.0, 25.0)),
+        10000 => Some((190.0, 340.0)),
+        _ => None,
+    }
+}
+
+fn engine_rows(plan: &BenchPlan) -> Result<Vec<ScalingRow>> {
+    if plan.engine_grains.is_empty() {
+        return Ok(Vec::new());
+    }
+    println!(
+        "\nengine, settled deposit ~25 grains deep (radius 1–2 mm, μ = 0.5, h = 1 ms, tolerance 1e-4, colour-ordered):"
+    );
+    println!(
+        "{:>9} {:>7} {:>9} {:>7} {:>11} {:>11} {:>8} {:>11}",
+        "grains", "threads", "contacts", "sweeps", "s/step", "updates/s", "speed-up", "sweep upd/s"
+    );
+    let mut one_thread = Vec::new();
+    for &n in &plan.engine_grains {
+        let w0 = scaling_deposit(n, 100, true, 1)?;
+        let rate = dem::bench::sweep_rate(&w0, 20);
+        let steps = if n >= 200_000 { 5 } else { 20 };
+        let mut base = None;
+        for &t in &plan.threads {
+            let mut w = w0.clone();
+            let r = time_steps(&mut w, steps, t)?;
+            let speedup = base.map_or(1.0, |b: f64| b / r.seconds_per_step);
+            if base.is_none() {
+                base = Some(r.seconds_per_step);
+            }
+            println!(
+                "{:>9} {:>7} {:>9.0} {:>7.1} {:>11.3e} {:>11.3e} {:>8.2} {:>11.3e}",
+                r.grains,
+                r.threads,
+                r.contacts,
+                r.sweeps,
+                r.seconds_per_step,
+                r.updates_per_second,
+                speedup,
+                rate
+            );
+            if t == plan.threads[0] {
+                one_thread.push(r);
+            }
+        }
+    }
+    if let Some(a) = scaling_exponent(&one_thread) {
+        println!(
+            "time per step ∝ N^{a:.2} on {} thread(s) (least squares in log–log)",
+            plan.threads[0]
+        );
+    }
+    Ok(one_thread)
+}
+
+fn columns(plan: &BenchPlan) -> Result<()> {
+    let jobs: Vec<(usize, Preparation)> = plan
+        .columns
+        .iter()
+        .map(|&n| (n, Preparation::Deposit))
+        .chain(plan.pour.iter().map(|&n| (n, Preparation::Pour)))
+        .collect();
+    if jobs.is_empty() {
+        return Ok(());
+    }
+    println!(
+        "\nJanssen column settled to KE/PE < 1e-8 (radius 1–2 mm, μ = 0.5, box 40 mean diameters, all threads):"
+    );
+    println!(
+        "{:>7} {:>8} {:>6} {:>7} {:>7} {:>9} {:>10} {:>6} {:>9} {:>14} {:>9}",
+        "grains",
+        "prepare",
+        "steps",
+        "sweeps",
+        "capped",
+        "overlap/r",
+        "φ",
+        "h (ms)",
+        "wall (s)",
+        "LAMMPS (s)",
+        "ratio"
+    );
+    for (n, prep) in jobs {
+        let run = ColumnRun::for_preparation(prep);
+        let r = settle_column(n, prep, &run, 1)?;
+        let total = r.total_seconds();
+        let (reference, ratio) = match lammps_reference(n) {
+            Some((lo, hi)) => (
+                format!("{lo:.0}–{hi:.0}"),
+                format!("{:.1}–{:.1}×", lo / total, hi / total),
+            ),
+            None => ("–".into(), "–".into()),
+        };
+        println!(
+            "{:>7} {:>8} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>6.2} {:>9.2} {:>14} {:>9}{}",
+            n,
+            match prep {
+                Preparation::Pour => "pour",
+                Preparation::Deposit => "deposit",
+            },
+            r.settle.steps,
+            r.settle.mean_sweeps,
+            r.settle.unconverged_steps,
+            r.final_overlap_ratio,
+            r.solid_fraction,
+            run.dt * 1e3,
+            total,
+            reference,
+            ratio,
+            if r.settle.settled {
+                ""
+            } else {
+                "  NOT settled"
+            }
+        );
+    }
+    println!(
+        "(capped: steps that stopped at the cap of {} sweeps with their best iterate; overlap/r: largest overlap over the smallest radius)",
+        ColumnRun::for_preparation(Preparation::Deposit).max_sweeps
+    );
+    Ok(())
+}
+
+/// Runs the benchmark plan and prints the tables.
+pub fn bench(plan: &BenchPlan) -> Result<()> {
+    if plan.threads.is_empty() || plan.threads.contains(&0) {
+        return Err(CliError::Usage("--threads must list counts ≥ 1".into()));
+    }
+    run_fc(&plan.fc_dir)?;
+    engine_rows(plan)?;
+    columns(plan)?;
+    let mem = dem::bench::MemoryFootprint::current(4);
+    println!(
+        "\nmemory: {} B per grain, {} B per contact; at 2 contacts per grain, 24 GiB hold about {:.1e} grains",
+        mem.per_grain,
+        mem.per_contact,
+        mem.largest_sample(24 << 30, 2.0) as f64
+    );
+    Ok(())
+}
+
+fn run_fc(dir: &Path) -> Result<()> {
+    // one thread: the comparison with Siconos is per core
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| CliError::Usage(format!("cannot start a thread pool: {e}")))?;
+    let rows = pool.install(|| dem::fc::bench::run_reference_benchmarks(dir))?;
+    if rows.is_empty() {
+        return Err(CliError::io(dir, "no .json or .json.gz problems found"));
+    }
+    println!(
+        "frictional-contact problems ({}), one thread:",
+        dir.display()
+    );
+    print!("{}", dem::fc::bench::format_table(&rows));
+    Ok(())
+}
