@@ -2,8 +2,9 @@
 //!
 //! A fit that cannot identify its law returns one of these instead of numbers: too few points,
 //! non-finite values, zero variance, negative pressure, an inertial-number range far below (or
-//! above) `I₀`, a parameter ending at its bound, a rank-deficient Jacobian. Reading a user's CSV
-//! gives errors that name the file, the line and the column.
+//! above) `I₀`, a parameter ending at its bound, a parameter whose standard error exceeds its
+//! value, a rank-deficient Jacobian. Reading a user's CSV gives errors that name the file, the
+//! line and the column. Computed numbers in messages are printed short ([`short`]).
 
 use crate::report::FitReport;
 
@@ -146,7 +147,8 @@ pub enum IdentifyError {
     },
     /// A parameter ended on a bound of its admissible box. The constrained fit is attached so the
     /// caller can inspect it, but its numbers are not an estimate with a valid interval.
-    #[error("parameter {name} ended at its {side} bound {bound} (value {value}): the data push it outside its physical range")]
+    /// The message shows `bound` and `value` with six significant digits ([`short`]).
+    #[error("parameter {name} ended at its {side} bound {b} (value {v}): the data push it outside its physical range", b = short(*.bound), v = short(*.value))]
     ParameterAtBound {
         /// Parameter name.
         name: String,
@@ -157,6 +159,32 @@ pub enum IdentifyError {
         /// Which bound.
         side: BoundSide,
         /// The constrained fit, for inspection only.
+        report: Box<FitReport>,
+    },
+    /// A parameter the law's shape rests on is not determined by the data: its standard error
+    /// exceeds its magnitude, `se(θ) > |θ|`, so its confidence interval `θ ∓ t·se` spans zero
+    /// and reaches beyond it by more than `(t − 1)|θ|` (`t ≈ 2–2.8` at 95 %): not even the
+    /// sign or order of magnitude of `θ` is fixed (criterion of
+    /// [`crate::fit::check_identified`]). The fit is attached for inspection only.
+    #[error("{law}: not identifiable: {name} = {v} has standard error {se} > |{name}|, its {level} % CI [{lo}, {hi}] spans zero: the data do not determine it",
+        v = short(*.value), se = short(*.std_error), level = short(100.0 * *.confidence),
+        lo = short(*.ci_low), hi = short(*.ci_high))]
+    ParameterNotIdentified {
+        /// Law or fit (`wall-law-power`, ...).
+        law: String,
+        /// Parameter name.
+        name: String,
+        /// Its estimate.
+        value: f64,
+        /// Its standard error.
+        std_error: f64,
+        /// Lower end of its confidence interval.
+        ci_low: f64,
+        /// Upper end of its confidence interval.
+        ci_high: f64,
+        /// Confidence level of the interval (0.95 by default).
+        confidence: f64,
+        /// The fit, for inspection only.
         report: Box<FitReport>,
     },
     /// The Jacobian at the optimum is rank deficient (or the fit is otherwise degenerate).
@@ -272,6 +300,34 @@ pub enum IdentifyError {
     },
 }
 
+/// A number with six significant digits for messages (the `%g` of C): plain notation for
+/// `10⁻⁴ ≤ |x| < 10⁶`, else `d.ddddde±x`; trailing zeros dropped. `0`, `10`, `1.5708`,
+/// `9.9e-7`, `1.1897e-17`. Non-finite values as Rust prints them (`NaN`, `inf`).
+pub fn short(x: f64) -> String {
+    if !x.is_finite() || x == 0.0 {
+        return format!("{x}");
+    }
+    // Round to six significant digits first, so that 9.9999999 becomes 10 (exponent 1).
+    let e = format!("{x:.5e}");
+    let (mantissa, exp) = e.split_once('e').unwrap_or((&e, "0"));
+    let exp: i32 = exp.parse().unwrap_or(0);
+    if (-4..6).contains(&exp) {
+        let decimals = (5 - exp).max(0) as usize;
+        trim_zeros(&format!("{x:.decimals$}"))
+    } else {
+        format!("{}e{exp}", trim_zeros(mantissa))
+    }
+}
+
+/// Drops trailing zeros after a decimal point (and the point itself if nothing is left).
+fn trim_zeros(s: &str) -> String {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s.to_string()
+    }
+}
+
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, IdentifyError>;
 
@@ -344,4 +400,23 @@ pub(crate) fn min_max(values: &[f64]) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
             (lo.min(v), hi.max(v))
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short;
+
+    #[test]
+    fn short_numbers_have_six_significant_digits() {
+        assert_eq!(short(0.0), "0");
+        assert_eq!(short(10.0), "10");
+        assert_eq!(short(9.99999998), "10");
+        assert_eq!(short(std::f64::consts::FRAC_PI_2), "1.5708");
+        assert_eq!(short(0.25), "0.25");
+        assert_eq!(short(-0.01), "-0.01");
+        assert_eq!(short(1.1897e-17), "1.1897e-17");
+        assert_eq!(short(123456789.0), "1.23457e8");
+        assert_eq!(short(0.000123), "0.000123");
+        assert_eq!(short(f64::NAN), "NaN");
+    }
 }

@@ -19,7 +19,8 @@
 //!
 //! A parameter that ends on its bound is an error, [`IdentifyError::ParameterAtBound`], carrying
 //! the constrained fit for inspection; a rank-deficient Jacobian is
-//! [`IdentifyError::NotIdentifiable`].
+//! [`IdentifyError::NotIdentifiable`]. [`check_identified`] refuses a fit whose named parameters
+//! have a standard error larger than their value ([`IdentifyError::ParameterNotIdentified`]).
 
 use argmin::core::{Error as ArgminError, Jacobian, Operator};
 use nalgebra::{DMatrix, DVector};
@@ -243,6 +244,38 @@ fn run<M: LeastSquaresModel>(
         solver: format!("Levenberg-Marquardt ({})", model.name()),
         reason,
     })
+}
+
+/// Checks that each parameter of `names` is determined by the data, else returns
+/// [`IdentifyError::ParameterNotIdentified`] for the first that is not.
+///
+/// Criterion: a parameter `θ` with standard error `se` is not identified when `se > |θ|`
+/// (or `se` is not finite). Its interval `θ ∓ t·se` then spans zero and reaches beyond it by
+/// more than `(t − 1)|θ|` (`t ≈ 2.0–2.8` at 95 %, so the interval is several times wider than
+/// the value): the data fix neither the sign nor the order of magnitude of `θ`. A merely
+/// insignificant parameter (`|θ| < t·se`, interval spanning zero by less) is kept. Use it on the
+/// parameters the law's shape rests on (an exponent, a velocity scale), not on an offset that may
+/// rightly be close to zero.
+pub fn check_identified(report: &FitReport, names: &[&str]) -> Result<()> {
+    for name in names {
+        let Some(p) = report.parameter(name) else {
+            continue;
+        };
+        let identified = p.std_error.is_finite() && p.std_error <= p.value.abs();
+        if !identified {
+            return Err(IdentifyError::ParameterNotIdentified {
+                law: report.model.clone(),
+                name: p.name.clone(),
+                value: p.value,
+                std_error: p.std_error,
+                ci_low: p.ci_low,
+                ci_high: p.ci_high,
+                confidence: report.confidence,
+                report: Box::new(report.clone()),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Minimum number of observations for `p` parameters: `p + 2`.

@@ -11,7 +11,12 @@
 //! [`select_wall_law`] fits all three, ranks them by AIC and reports `ΔAIC` and Akaike weights.
 //! Bounds: `0 ≤ μ_0, μ_∞ ≤ 10`, `V* > 0`, `|k| ≤ 10`, `0 < n ≤ 5`. A velocity scale `V*`
 //! outside `[V_min⁺/10, 10 V_max]` (`V_min⁺` the smallest positive `V`) is
-//! [`IdentifyError::ScaleNotResolved`]: the data do not see the law's curvature.
+//! [`IdentifyError::ScaleNotResolved`]: the data do not see the law's curvature. A form whose
+//! shape parameters ([`WallLawForm::shape_parameters`]: `V*`, or `k` and `n`) have a standard
+//! error above their value is [`IdentifyError::ParameterNotIdentified`]
+//! ([`crate::fit::check_identified`]): e.g. μ_eff falling like `a − b ln V` is fitted by the
+//! power law only as `n → 0`, `μ_0 → +∞`, `k → −∞`, with intervals spanning zero by orders of
+//! magnitude; such a form is left out of the AIC ranking (listed as failed with the reason).
 //!
 //! [`fit_boundary_layer`] fits `u(y) = u_b − (u_b − u_s) exp(−y/δ)` to a velocity profile
 //! (`y` distance from the wall, m) and reports `δ` in metres and in grain diameters.
@@ -24,8 +29,8 @@ use crate::error::{
     Result,
 };
 use crate::fit::{
-    fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel, Observations,
-    ParameterSpec,
+    check_identified, fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel,
+    Observations, ParameterSpec,
 };
 use crate::laws::boundary_layer::VelocityBoundaryLayer;
 use crate::laws::janssen::STANDARD_GRAVITY;
@@ -90,6 +95,17 @@ impl WallLawForm {
             WallLawForm::Exponential => "wall-law-exponential",
             WallLawForm::Hyperbolic => "wall-law-hyperbolic",
             WallLawForm::PowerLaw => "wall-law-power",
+        }
+    }
+
+    /// The parameters the velocity dependence rests on, which must be identified
+    /// ([`check_identified`]): `V_star` for the saturating forms, `k` and `n` for the power law
+    /// (with `k → 0` or `n → 0` the law is a constant). `mu_0` is an offset that may rightly be
+    /// close to zero and is not checked.
+    pub fn shape_parameters(&self) -> &'static [&'static str] {
+        match self {
+            WallLawForm::Exponential | WallLawForm::Hyperbolic => &["V_star"],
+            WallLawForm::PowerLaw => &["k", "n"],
         }
     }
 
@@ -230,7 +246,9 @@ fn checked_series(series: &WallSlipSeries) -> Result<Vec<f64>> {
 }
 
 /// Fits one wall-law form. Errors: data checks (≥ 5 points, finite, non-negative, spread),
-/// [`IdentifyError::ScaleNotResolved`] for `V*`, [`IdentifyError::ParameterAtBound`].
+/// [`IdentifyError::ScaleNotResolved`] for `V*`, [`IdentifyError::ParameterAtBound`],
+/// [`IdentifyError::ParameterNotIdentified`] for a shape parameter whose standard error exceeds
+/// its value.
 pub fn fit_wall_law(
     series: &WallSlipSeries,
     form: WallLawForm,
@@ -327,6 +345,7 @@ pub fn fit_wall_law(
     if form != WallLawForm::PowerLaw {
         check_scale("V_star", report.parameters[2].value, &v)?;
     }
+    check_identified(&report, form.shape_parameters())?;
     Ok(WallLawFit {
         form,
         law: form.build(&report.values()),

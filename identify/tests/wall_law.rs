@@ -154,3 +154,105 @@ fn boundary_layer_thickness_in_grain_diameters() {
     assert!((fit.thickness_m.value / D - t.value).abs() < 1e-12);
     assert!((fit.law.u_slip - 0.05).abs() < 0.01);
 }
+
+/// μ_eff falling like `0.45 − 0.005 ln V` over V ∈ [0.01, 10] (12 points, ±0.001 alternating):
+/// the power law reaches it only as `n → 0`, `μ_0 → 10`, `k → −10`, with standard errors of
+/// hundreds and intervals spanning zero. Without the identifiability check it was returned
+/// (and won the AIC ranking) with every interval spanning zero.
+fn log_falling() -> WallSlipSeries {
+    let scale = (9.81 * D).sqrt();
+    let v: Vec<f64> = (0..12)
+        .map(|k| 10f64.powf(-2.0 + 3.0 * k as f64 / 11.0))
+        .collect();
+    let wiggle = |k: usize| if k.is_multiple_of(2) { 0.001 } else { -0.001 };
+    WallSlipSeries::new(
+        v.iter().map(|v| v * scale).collect(),
+        v.iter()
+            .enumerate()
+            .map(|(k, v)| 0.45 - 0.005 * v.ln() + wiggle(k))
+            .collect(),
+        D,
+    )
+}
+
+#[test]
+fn a_power_law_with_unresolved_exponent_is_not_identifiable() {
+    let o = FitOptions::default();
+    let err = fit_wall_law(&log_falling(), WallLawForm::PowerLaw, &o).unwrap_err();
+    let IdentifyError::ParameterNotIdentified {
+        law,
+        name,
+        value,
+        std_error,
+        ci_low,
+        ci_high,
+        ..
+    } = &err
+    else {
+        panic!("expected ParameterNotIdentified, got {err:?}");
+    };
+    assert_eq!(law, "wall-law-power");
+    assert!(name == "k" || name == "n", "{name}");
+    // The criterion: standard error above the magnitude, interval across zero.
+    assert!(
+        *std_error > value.abs() && *ci_low < 0.0 && *ci_high > 0.0,
+        "{err}"
+    );
+    let m = err.to_string();
+    assert!(m.contains("not identifiable") && !m.contains('\n'), "{m}");
+    // The selection keeps the identified saturating forms and lists the power law as failed.
+    let sel = select_wall_law(&log_falling(), &o).unwrap();
+    assert_ne!(sel.best().form, WallLawForm::PowerLaw);
+    assert!(
+        sel.comparison
+            .failed
+            .iter()
+            .any(|(f, why)| f == "wall-law-power" && why.contains("not identifiable")),
+        "{:?}",
+        sel.comparison
+    );
+    for f in &sel.fits {
+        let v_star = f.report.parameter("V_star").unwrap();
+        assert!(v_star.std_error < v_star.value, "{v_star:?}");
+    }
+}
+
+#[test]
+fn a_true_power_law_is_identified() {
+    let truth = WallFrictionLaw::PowerLaw {
+        mu_0: 0.2,
+        k: 0.1,
+        n: 0.5,
+    };
+    let sel = select_wall_law(&series(&truth, 5, 0.002), &FitOptions::default()).unwrap();
+    assert_eq!(
+        sel.best().form,
+        WallLawForm::PowerLaw,
+        "{:?}",
+        sel.comparison
+    );
+    for (p, t) in sel.best().report.parameters.iter().zip([0.2, 0.1, 0.5]) {
+        assert!((p.value - t).abs() < 3.0 * p.std_error, "{p:?}");
+        assert!(p.std_error < 0.1 * p.value, "{p:?}");
+    }
+}
+
+/// μ_eff scattered around 0.44 with a slight fall: the exponential's `V*` has a standard error
+/// above its value, the hyperbolic's `V*` is below the data range, the power law's `μ_0` runs to
+/// its bound: no form is identified, the selection is an error.
+#[test]
+fn scattered_friction_without_velocity_dependence_is_not_identifiable() {
+    let scale = (9.81 * 0.002f64).sqrt();
+    let v = [0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0];
+    let series = WallSlipSeries::new(
+        v.to_vec(),
+        vec![0.47, 0.44, 0.45, 0.43, 0.44, 0.42, 0.43],
+        0.002,
+    );
+    assert!((series.normalised_velocity()[0] - 0.01 / scale).abs() < 1e-15);
+    let err = select_wall_law(&series, &FitOptions::default()).unwrap_err();
+    assert!(
+        matches!(&err, IdentifyError::ParameterNotIdentified { name, .. } if name == "V_star"),
+        "{err}"
+    );
+}
