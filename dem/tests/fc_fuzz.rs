@@ -212,11 +212,13 @@ proptest! {
         prop_assert!(e.is_err(), "a gzip file cut at {cut} of {} bytes was read", gz.len());
         let m = e.unwrap_err().to_string();
         prop_assert!(!m.contains('\n') && !m.is_empty(), "{m}");
+        prop_assert!(m.contains("p.json.gz"), "the message does not name the file: {m}");
     }
 }
 
 /// Every file of `tests/corpus/` (inputs that once broke a rule of this file) is refused with
-/// one line containing the text given for it in `tests/corpus/EXPECT` (`FILE<TAB>TEXT`).
+/// one line naming the file and containing the text given for it in `tests/corpus/EXPECT`
+/// (`FILE<TAB>TEXT`).
 #[test]
 fn corpus_inputs_are_refused_with_their_message() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus");
@@ -234,6 +236,10 @@ fn corpus_inputs_are_refused_with_their_message() {
             Err(e) => e.to_string(),
         };
         assert!(e.contains(expect), "{file}: `{expect}` not in `{e}`");
+        assert!(
+            e.contains(file),
+            "{file}: the message does not name the file: `{e}`"
+        );
         assert!(!e.contains('\n') && e.len() <= MAX_MESSAGE, "{file}: {e}");
         n += 1;
     }

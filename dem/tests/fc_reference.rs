@@ -443,6 +443,44 @@ fn reader_errors_name_the_key() {
     ));
 }
 
+/// A content error read from a file names the file first, then the key; the inner error is
+/// still matched through `FcError::kind`. A valid file reads with no wrapping.
+#[test]
+fn file_errors_name_the_file_then_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad-mu.json");
+    std::fs::write(&path, GOOD.replace("[0.3, 0.5]", "[0.3, -0.5]")).unwrap();
+    let e = read_problem(&path).unwrap_err();
+    let msg = e.to_string();
+    let shown = path.display().to_string();
+    assert!(
+        msg.starts_with(&format!("{shown}: key `mu[1]`")),
+        "message {msg:?} does not start with the file then the key"
+    );
+    assert!(matches!(
+        e.kind(),
+        FcError::NegativeFriction { contact: 1, value } if *value == -0.5
+    ));
+    let path3 = dir.path().join("three-d.json");
+    std::fs::write(
+        &path3,
+        GOOD.replace(r#""dimension": 2"#, r#""dimension": 3"#),
+    )
+    .unwrap();
+    let e = read_problem(&path3).unwrap_err();
+    assert!(
+        e.to_string().contains("three-d.json: key `dimension`"),
+        "{e}"
+    );
+    assert!(matches!(e.kind(), FcError::Unsupported3D { dimension: 3 }));
+    // Parsing text (no file) gives the bare error, not wrapped.
+    let bare = parse(&GOOD.replace("[0.3, 0.5]", "[0.3, -0.5]")).unwrap_err();
+    assert!(matches!(bare, FcError::NegativeFriction { .. }), "{bare:?}");
+    let ok = dir.path().join("good.json");
+    std::fs::write(&ok, GOOD).unwrap();
+    assert_eq!(read_problem(&ok).unwrap().contacts(), 2);
+}
+
 #[test]
 fn an_empty_problem_is_solved_by_r_empty() {
     let p = parse(r#"{"dimension": 2, "nc": 0, "mu": [], "q": [], "W": {"shape": [0, 0], "row": [], "col": [], "val": []}}"#)

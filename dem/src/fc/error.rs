@@ -4,9 +4,20 @@ use thiserror::Error;
 
 /// What can go wrong when reading, building or writing a frictional-contact problem.
 ///
-/// Every variant that comes from the file names the JSON key it is about (`q`, `W.row`, ...).
+/// Every variant that comes from the file names the JSON key it is about (`q`, `W.row`, ...);
+/// [`crate::fc::read_problem`] wraps them in [`FcError::InFile`] so that the message also names
+/// the file (`path: key `mu[1]`: …`).
 #[derive(Debug, Error)]
 pub enum FcError {
+    /// An error in the content of a problem file, with the file's path in front.
+    #[error("{path}: {source}")]
+    InFile {
+        /// File path.
+        path: String,
+        /// What is wrong in it (a variant naming the key, or a JSON syntax error).
+        #[source]
+        source: Box<FcError>,
+    },
     /// The file could not be opened, read or written.
     #[error("{path}: {source}")]
     Io {
@@ -118,4 +129,15 @@ pub enum FcError {
         /// What is wrong.
         reason: String,
     },
+}
+
+impl FcError {
+    /// The error without its file context: the inner error of [`FcError::InFile`] (recursively),
+    /// `self` otherwise. Lets callers match on the kind of error whatever the source.
+    pub fn kind(&self) -> &FcError {
+        match self {
+            FcError::InFile { source, .. } => source.kind(),
+            other => other,
+        }
+    }
 }

@@ -23,6 +23,11 @@ use super::problem::FcProblem;
 
 /// Reads a problem from a file; gzip-compressed content (`.json.gz`) is recognised by its magic
 /// bytes, whatever the extension.
+///
+/// Errors: [`FcError::Io`] (unreadable file, cut gzip stream) and, for a content error, the
+/// error of [`parse_problem`] wrapped in [`FcError::InFile`], so that every message names the
+/// file and then the key (`p.json: key `mu[1]`: friction coefficient -0.5 < 0`); use
+/// [`FcError::kind`] to match on the inner error.
 pub fn read_problem(path: impl AsRef<Path>) -> Result<FcProblem, FcError> {
     let path = path.as_ref();
     let io = |source| FcError::Io {
@@ -31,7 +36,10 @@ pub fn read_problem(path: impl AsRef<Path>) -> Result<FcProblem, FcError> {
     };
     let bytes = std::fs::read(path).map_err(io)?;
     let text = decompress_if_gzip(bytes).map_err(io)?;
-    parse_problem(&text)
+    parse_problem(&text).map_err(|e| FcError::InFile {
+        path: path.display().to_string(),
+        source: Box::new(e),
+    })
 }
 
 /// Returns the bytes unchanged, or their gzip-decompressed content if they start with the gzip
