@@ -22,6 +22,15 @@ pub enum CliError {
     /// Frictional-contact problems.
     #[error("{0}")]
     Fc(#[from] dem::fc::FcError),
+    /// A data file the command read is wrong (a fit that cannot be done on its content, a value
+    /// out of its domain, too few rows, ...): the message names the file first.
+    #[error("{path}: {reason}")]
+    Input {
+        /// The data file.
+        path: String,
+        /// What is wrong with it (one line).
+        reason: String,
+    },
     /// Reading or writing a file.
     #[error("{path}: {reason}")]
     Io {

@@ -169,13 +169,13 @@ fn bad_files_for_fit_and_solve_fc_are_one_line_exit_2() {
     let cases: &[(&[&str], &[&str])] = &[
         (&["fit", "mu-i", "absent.csv"], &["absent.csv"]),
         (&["fit", "mu-i", "text.csv"], &["text.csv", "3"]),
-        (&["fit", "mu-i", "short.csv"], &["too few"]),
+        (&["fit", "mu-i", "short.csv"], &["short.csv", "too few"]),
         (&["fit", "mu-i", "nocol.csv"], &["nocol.csv"]),
         (&["fit", "no-such-law", "text.csv"], &["no-such-law"]),
         (&["solve-fc", "absent.json"], &["absent.json"]),
-        (&["solve-fc", "trunc.json"], &["line 1"]),
-        (&["solve-fc", "negmu.json"], &["mu"]),
-        (&["solve-fc", "size.json"], &["q"]),
+        (&["solve-fc", "trunc.json"], &["trunc.json", "line 1"]),
+        (&["solve-fc", "negmu.json"], &["negmu.json", "key `mu[0]`"]),
+        (&["solve-fc", "size.json"], &["size.json", "key `q`"]),
         (&["solve-fc", "negmu.json", "--tol", "-1"], &["--tol"]),
     ];
     for (args, needles) in cases {
