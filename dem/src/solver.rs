@@ -84,8 +84,12 @@ pub struct SolveReport {
     pub iterations: usize,
     /// Error measure at the returned impulses.
     pub error: f64,
-    /// Whether `error ≤ tolerance`.
+    /// Whether `error ≤ tolerance` and the approach speed is within its limit.
     pub converged: bool,
+    /// Largest approach speed of a closed or loaded contact at the returned impulses (m/s),
+    /// see [`approach_speed`].
+    #[serde(default)]
+    pub approach_speed: f64,
 }
 
 /// Sweeps without the error halving after which the sweep order is shuffled.
@@ -123,6 +127,29 @@ pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 
     } else {
         0.0
     }
+}
+
+/// Largest approach speed `max(0, −u_n)` (m/s) over the contacts that are closed (no
+/// gap-closing shift) or loaded (`r_n > 0`): the rate at which the current iterate would make
+/// them overlap. Open contacts closing within the step are not counted (their `u_n` includes the
+/// gap shift, so `u_n ≥ 0` already means "stops at contact").
+pub fn approach_speed(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
+    let [m] = reduce_max(rows, |c| {
+        if c.shift <= 0.0 || c.r[0] > 0.0 {
+            -c.velocity(&vel[c.a as usize], &vel[c.b as usize])[0]
+        } else {
+            0.0
+        }
+    });
+    m.max(0.0)
+}
+
+fn reduce_max(rows: &[ContactRow], f: impl Fn(&ContactRow) -> f64 + Sync) -> [f64; 1] {
+    let parts: Vec<f64> = rows
+        .par_chunks(CHUNK)
+        .map(|ch| ch.iter().map(&f).fold(f64::NEG_INFINITY, f64::max))
+        .collect();
+    [parts.into_iter().fold(f64::NEG_INFINITY, f64::max)]
 }
 
 /// Norm of the free local velocities `‖q‖`, `q_α = H_α v_free + shift_α`, computed from the
@@ -241,7 +268,10 @@ impl SweepOrder<'_> {
 }
 
 /// Solve the contact problem of a step by accelerated NLGS (see the module documentation),
-/// starting from the impulses stored in `rows`. On entry `vel` must equal
+/// starting from the impulses stored in `rows`. Converged means `error ≤ tolerance` and
+/// [`approach_speed`] `≤ approach_limit` (m/s): the relative error alone is normalised by the
+/// largest velocities of the step, so while some grains fall fast it lets resting contacts
+/// approach at up to `tolerance × ‖q‖`, and their overlaps add up over the steps. On entry `vel` must equal
 /// `v_free + M⁻¹ Hᵀ R` for those impulses (see [`apply_impulses`]); `q_norm` is
 /// [`free_velocity_norm`].
 ///
@@ -261,6 +291,7 @@ pub fn solve(
     v_free: &[[f64; 3]],
     inv: &[[f64; 3]],
     q_norm: f64,
+    approach_limit: f64,
     params: &SolverParams,
     work: &mut SolverWork,
 ) -> SolveReport {
@@ -270,15 +301,20 @@ pub fn solve(
             iterations: 0,
             error: 0.0,
             converged: true,
+            approach_speed: 0.0,
         };
     }
     let tol = params.tolerance;
+    let done = |rows: &[ContactRow], vel: &[[f64; 3]], error: f64| {
+        error <= tol && approach_speed(rows, vel) <= approach_limit
+    };
     let mut error = error_measure(rows, vel, q_norm);
-    if error <= tol {
+    if done(rows, vel, error) {
         return SolveReport {
             iterations: 0,
             error,
             converged: true,
+            approach_speed: approach_speed(rows, vel),
         };
     }
     let use_aa = params.anderson_memory > 0;
@@ -328,7 +364,7 @@ pub fn solve(
                 plain_until = it + plain_phase;
                 plain_phase = plain_phase.saturating_mul(2);
             }
-            if error <= tol {
+            if done(rows, vel, error) {
                 break;
             }
             if use_aa {
@@ -369,17 +405,19 @@ pub fn solve(
             }
         }
     }
-    if error > tol && best_error < error {
+    if !done(rows, vel, error) && best_error < error {
         for (c, b) in rows.iter_mut().zip(work.best.iter()) {
             c.r = *b;
         }
         rebuild_velocities(rows, vel, v_free, inv, &order);
         error = error_measure(rows, vel, q_norm);
     }
+    let approach = approach_speed(rows, vel);
     SolveReport {
         iterations: it,
         error,
-        converged: error <= tol,
+        converged: error <= tol && approach <= approach_limit,
+        approach_speed: approach,
     }
 }
 

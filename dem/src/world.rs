@@ -46,6 +46,13 @@ pub struct WorldParams {
     pub periodic_x: Option<[f64; 2]>,
     /// Detection gap (m): pairs closer than this become contacts.
     pub detection_gap: f64,
+    /// Largest overlap growth per step allowed at a converged contact solve, as a fraction of
+    /// the smallest grain radius `R_min`: the solve continues until no closed or loaded contact
+    /// approaches faster than `overlap_rate · R_min / h` (besides the error tolerance). Overlaps
+    /// are never pushed apart (that would inject energy), so this bounds how fast solver
+    /// residuals can let them build up. 0 disables the check.
+    #[serde(default = "default_overlap_rate")]
+    pub overlap_rate: f64,
     /// Contact solver.
     pub solver: SolverParams,
 }
@@ -58,9 +65,14 @@ impl Default for WorldParams {
             gravity: Vector2::new(0.0, -9.81),
             periodic_x: None,
             detection_gap: 1e-4,
+            overlap_rate: default_overlap_rate(),
             solver: SolverParams::default(),
         }
     }
+}
+
+fn default_overlap_rate() -> f64 {
+    1e-5
 }
 
 /// What one step did.
@@ -312,6 +324,15 @@ impl World {
             return Err(perr(
                 "detection_gap",
                 format!("must be ≥ 0 m, got {}", p.detection_gap),
+            ));
+        }
+        if !(p.overlap_rate.is_finite() && p.overlap_rate >= 0.0) {
+            return Err(perr(
+                "overlap_rate",
+                format!(
+                    "must be ≥ 0 (fraction of the smallest radius per step), got {}",
+                    p.overlap_rate
+                ),
             ));
         }
         if let Some([a, b]) = p.periodic_x {
@@ -584,6 +605,7 @@ impl World {
 
         // 3. Contact solve.
         let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
+        let approach_limit = self.approach_limit();
         self.v_free.clear();
         self.v_free.extend_from_slice(&self.vel);
         let order = if self.params.solver.parallel {
@@ -614,6 +636,7 @@ impl World {
             &self.v_free,
             &self.inv,
             q_norm,
+            approach_limit,
             &self.params.solver,
             &mut self.work,
         );
@@ -659,6 +682,22 @@ impl World {
             max_penetration: max_pen,
         };
         Ok(self.last)
+    }
+
+    /// Largest approach speed of a converged solve (m/s): `overlap_rate · R_min / h`, infinite
+    /// when the rate is 0 or there is no grain.
+    fn approach_limit(&self) -> f64 {
+        let r_min = self
+            .bodies
+            .iter()
+            .filter(|b| b.kind == BodyKind::Grain && b.radius > 0.0)
+            .map(|b| b.radius)
+            .fold(f64::INFINITY, f64::min);
+        if self.params.overlap_rate > 0.0 && r_min.is_finite() {
+            self.params.overlap_rate * r_min / self.params.dt
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// Time step (s) of the impulses held in the contact set: forces are impulses divided by it.

@@ -1,0 +1,67 @@
+//! The approach-speed criterion of the contact solve on the janssen deposit.
+
+use datasets::build::{column, column_width};
+use datasets::config::{FrictionSpec, GrainSpec};
+
+/// Steps of the janssen deposit (350 grains, radius 0.5–2.5 mm, μ = 0.25, h = 0.25 ms,
+/// tolerance 1e-4) declared converged while a closed or loaded contact approached faster than
+/// 1e-5 of the smallest radius per step, with the engine's `overlap_rate` set as given; and the
+/// largest overlap over the smallest radius.
+fn fast_approaches(overlap_rate: f64, steps: usize) -> (usize, f64) {
+    let grain = GrainSpec {
+        density: 2500.0,
+        radius_mean: 1.5e-3,
+        radius_spread: 1.0e-3,
+    };
+    let friction = FrictionSpec {
+        grain_grain: 0.25,
+        grain_wall: 0.25,
+    };
+    let width = column_width(&grain, 350, 4.0);
+    let mut w = column(&grain, 350, width, &friction, 1, 2.5e-4)
+        .unwrap()
+        .world;
+    w.params.solver.tolerance = 1e-4;
+    w.params.solver.max_iterations = 1000;
+    w.params.overlap_rate = overlap_rate;
+    let r_min = w
+        .bodies
+        .iter()
+        .filter(|b| b.radius > 0.0)
+        .map(|b| b.radius)
+        .fold(f64::INFINITY, f64::min);
+    let limit = 1e-5 * r_min / w.params.dt;
+    let (mut fast, mut overlap) = (0, 0.0f64);
+    for _ in 0..steps {
+        let r = w.step().unwrap();
+        overlap = overlap.max(r.max_penetration / r_min);
+        if r.solver.converged && r.solver.approach_speed > limit {
+            fast += 1;
+        }
+    }
+    (fast, overlap)
+}
+
+/// The relative error measure is normalised by the step's largest velocities: while grains
+/// still fall it accepts iterates where resting contacts approach at up to 1e-4 of those, and
+/// since overlaps are never pushed apart they add up (here 8 % of the smallest radius after 450
+/// steps). With `overlap_rate` (1e-5 of the smallest radius per step, the default) no step
+/// counts as converged while a contact approaches faster, and the overlaps stay below 1 %.
+#[test]
+fn converged_steps_respect_the_approach_speed_limit() {
+    let steps = 450;
+    let (with, overlap_with) = fast_approaches(1e-5, steps);
+    let (without, overlap_without) = fast_approaches(0.0, steps);
+    eprintln!(
+        "with: {with} fast, overlap {overlap_with:.4}; without: {without}, {overlap_without:.4}"
+    );
+    assert_eq!(
+        with, 0,
+        "{with} of {steps} converged steps approach too fast"
+    );
+    assert!(overlap_with < 0.01, "overlap {overlap_with} of R_min");
+    assert!(
+        without > 0 && overlap_without > 0.02,
+        "the relative error alone: {without} fast steps, overlap {overlap_without}: the test shows nothing"
+    );
+}
