@@ -18,7 +18,10 @@ fn main() {
     let mut rows = Vec::new();
     for n in ns {
         let t = std::time::Instant::now();
-        let w0 = scaling_deposit(n, relax, true, 1).expect("deposit");
+        let mut w0 = scaling_deposit(n, relax, true, 1).expect("deposit");
+        if let Ok(v) = std::env::var("OVERLAP") {
+            w0.params.overlap_rate = v.parse().expect("OVERLAP");
+        }
         eprintln!("prepared {n} in {:.1} s", t.elapsed().as_secs_f64());
         for threads in [1, 2] {
             let mut w = w0.clone();

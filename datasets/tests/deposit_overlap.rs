@@ -3,9 +3,12 @@
 use datasets::build::{column, column_width};
 use datasets::config::{FrictionSpec, GrainSpec};
 
+/// The engine's default `overlap_rate`.
+const RATE: f64 = 1e-4;
+
 /// Steps of the janssen deposit (350 grains, radius 0.5–2.5 mm, μ = 0.25, h = 0.25 ms,
 /// tolerance 1e-4) declared converged while a closed or loaded contact approached faster than
-/// 1e-5 of the smallest radius per step, with the engine's `overlap_rate` set as given; and the
+/// [`RATE`] of the smallest radius per step, with the engine's `overlap_rate` set as given; and the
 /// largest overlap over the smallest radius.
 fn fast_approaches(overlap_rate: f64, steps: usize) -> (usize, f64) {
     let grain = GrainSpec {
@@ -30,7 +33,7 @@ fn fast_approaches(overlap_rate: f64, steps: usize) -> (usize, f64) {
         .filter(|b| b.radius > 0.0)
         .map(|b| b.radius)
         .fold(f64::INFINITY, f64::min);
-    let limit = 1e-5 * r_min / w.params.dt;
+    let limit = RATE * r_min / w.params.dt;
     let (mut fast, mut overlap) = (0, 0.0f64);
     for _ in 0..steps {
         let r = w.step().unwrap();
@@ -45,12 +48,12 @@ fn fast_approaches(overlap_rate: f64, steps: usize) -> (usize, f64) {
 /// The relative error measure is normalised by the step's largest velocities: while grains
 /// still fall it accepts iterates where resting contacts approach at up to 1e-4 of those, and
 /// since overlaps are never pushed apart they add up (here 8 % of the smallest radius after 450
-/// steps). With `overlap_rate` (1e-5 of the smallest radius per step, the default) no step
+/// steps). With `overlap_rate` ([`RATE`] of the smallest radius per step, the default) no step
 /// counts as converged while a contact approaches faster, and the overlaps stay below 1 %.
 #[test]
 fn converged_steps_respect_the_approach_speed_limit() {
     let steps = 450;
-    let (with, overlap_with) = fast_approaches(1e-5, steps);
+    let (with, overlap_with) = fast_approaches(RATE, steps);
     let (without, overlap_without) = fast_approaches(0.0, steps);
     eprintln!(
         "with: {with} fast, overlap {overlap_with:.4}; without: {without}, {overlap_without:.4}"

@@ -45,7 +45,7 @@ pub fn grid_world(n: usize, width: f64, mu: f64, seed: u64) -> World {
         gravity: Vector2::new(0.0, -9.81),
         periodic_x: None,
         detection_gap: 0.1 * r_min,
-        overlap_rate: 1e-5,
+        overlap_rate: 1e-4,
         solver: SolverParams {
             tolerance: 1e-4,
             max_iterations: 1000,

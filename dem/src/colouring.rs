@@ -35,6 +35,12 @@ pub struct ContactColouring {
     /// True when the last class holds contacts that found no free colour among 64 and must be
     /// updated one after the other.
     pub sequential_tail: bool,
+    /// Contacts of each mobile body: `body_contacts[body_offsets[i]..body_offsets[i + 1]]`, each
+    /// `(contact << 1) | side` with side 0 when the body is the contact's `a`, 1 for `b`,
+    /// ascending by contact. Empty for immobile bodies.
+    pub body_contacts: Vec<u32>,
+    /// Offsets into `body_contacts`, `bodies + 1` entries.
+    pub body_offsets: Vec<u32>,
     masks: Vec<u64>,
     colour: Vec<u8>,
     counts: Vec<usize>,
@@ -106,6 +112,33 @@ impl ContactColouring {
             start.push(total);
             total += self.counts[OVERFLOW as usize];
             self.offsets.push(total);
+        }
+        // Body → contacts adjacency (counting sort, ascending contact index per body).
+        self.body_offsets.clear();
+        self.body_offsets.resize(mobile.len() + 1, 0);
+        for c in rows {
+            for (body, m) in [(c.a as usize, mobile[c.a as usize]), (c.b as usize, mobile[c.b as usize])] {
+                if m {
+                    self.body_offsets[body + 1] += 1;
+                }
+            }
+        }
+        for i in 0..mobile.len() {
+            self.body_offsets[i + 1] += self.body_offsets[i];
+        }
+        self.body_contacts.clear();
+        self.body_contacts
+            .resize(self.body_offsets[mobile.len()] as usize, 0);
+        self.masks.clear();
+        self.masks
+            .extend(self.body_offsets[..mobile.len()].iter().map(|&o| o as u64));
+        for (k, c) in rows.iter().enumerate() {
+            for (side, body) in [(0u32, c.a as usize), (1u32, c.b as usize)] {
+                if mobile[body] {
+                    self.body_contacts[self.masks[body] as usize] = ((k as u32) << 1) | side;
+                    self.masks[body] += 1;
+                }
+            }
         }
         self.order.clear();
         self.order.resize(total, 0);

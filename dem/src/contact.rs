@@ -71,6 +71,20 @@ impl ContactRow {
         va[2] -= ia[2] * (self.k[0] * d[0] + self.k[1] * d[1]);
     }
 
+    /// The generalised impulse `H_bᵀ r` (side 1) or `−H_aᵀ r` (side 0) on one body of the
+    /// contact, before the inverse mass: `(F_x, F_y, torque)`·h.
+    #[inline(always)]
+    pub fn impulse_on(&self, side: u32, r: [f64; 2]) -> [f64; 3] {
+        let [nx, ny] = self.n;
+        let fx = r[0] * nx - r[1] * ny;
+        let fy = r[0] * ny + r[1] * nx;
+        if side == 1 {
+            [fx, fy, self.k[2] * r[0] + self.k[3] * r[1]]
+        } else {
+            [-fx, -fy, -(self.k[0] * r[0] + self.k[1] * r[1])]
+        }
+    }
+
     /// The local Delassus block from the inverse masses of both bodies.
     #[inline]
     pub fn delassus(n: [f64; 2], k: [f64; 4], ia: &[f64; 3], ib: &[f64; 3]) -> Delassus2 {

@@ -4,7 +4,7 @@
 //!   [`ContactColouring`] in turn; the contacts of a class share no mobile body, so they are
 //!   updated concurrently on the rayon pool and the numbers are exactly those of the same
 //!   class order swept by one thread.
-//! - [`coloured_apply`]: `v ← v + M⁻¹ Hᵀ R` class by class (the same argument).
+//! - [`gather_velocities`]: `v = v_free + M⁻¹ Hᵀ R` body by body (a gather, no conflicts).
 //! - [`reduce_chunks`]: sums over contacts as partial sums over fixed chunks of [`CHUNK`]
 //!   contacts added in chunk order, so the rounding does not depend on the thread count.
 //!
@@ -147,38 +147,37 @@ pub fn coloured_sweep(
     });
 }
 
-/// `v ← v + M⁻¹ Hᵀ R` with the impulses stored in `rows`, class by class.
-pub fn coloured_apply(
+/// `v ← v_free + M⁻¹ Hᵀ R` for the mobile bodies, gathered body by body over the adjacency of
+/// `colouring` (contributions added in ascending contact order): one parallel pass over the
+/// bodies, the same bits on any thread count. Immobile bodies keep `v_free`.
+pub fn gather_velocities(
     rows: &[ContactRow],
     colouring: &ContactColouring,
     vel: &mut [[f64; 3]],
+    v_free: &[[f64; 3]],
     inv: &[[f64; 3]],
-    mobile: &[bool],
 ) {
-    assert_eq!(colouring.order.len(), rows.len(), "colouring of other rows");
-    let pv = Shared(vel.as_mut_ptr());
-    let n_bodies = inv.len();
-    assert!(vel.len() == n_bodies && mobile.len() == n_bodies);
-    for_each_coloured(colouring, |i| {
-        let c = &rows[i];
-        if c.r == [0.0, 0.0] {
-            return;
-        }
-        let (a, b) = (c.a as usize, c.b as usize);
-        assert!(a < n_bodies && b < n_bodies);
-        // SAFETY: as in `coloured_sweep`: the mobile bodies of a parallel class are distinct.
-        unsafe {
-            let (pa, pb) = (pv.ptr().add(a), pv.ptr().add(b));
-            let (mut va, mut vb) = (*pa, *pb);
-            c.apply(c.r, &mut va, &inv[a], &mut vb, &inv[b]);
-            if mobile[a] {
-                *pa = va;
+    assert!(vel.len() == v_free.len() && vel.len() == inv.len());
+    assert_eq!(colouring.body_offsets.len(), vel.len() + 1, "colouring of other bodies");
+    let offsets = &colouring.body_offsets;
+    let adj = &colouring.body_contacts;
+    vel.par_iter_mut()
+        .with_min_len(TASK)
+        .enumerate()
+        .for_each(|(i, v)| {
+            let mut acc = [0.0f64; 3];
+            for &e in &adj[offsets[i] as usize..offsets[i + 1] as usize] {
+                let c = &rows[(e >> 1) as usize];
+                if c.r != [0.0, 0.0] {
+                    let d = c.impulse_on(e & 1, c.r);
+                    acc[0] += d[0];
+                    acc[1] += d[1];
+                    acc[2] += d[2];
+                }
             }
-            if mobile[b] {
-                *pb = vb;
-            }
-        }
-    });
+            let (f, m) = (v_free[i], inv[i]);
+            *v = [f[0] + m[0] * acc[0], f[1] + m[1] * acc[1], f[2] + m[2] * acc[2]];
+        });
 }
 
 /// `Σ_α f(α)` over the contacts as partial sums over fixed chunks of [`CHUNK`] contacts, added

@@ -34,7 +34,7 @@ use crate::anderson::Anderson;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
 use crate::local::{natural_map_residual, ContactStatus};
-use crate::parallel::{coloured_apply, coloured_sweep, local_update, reduce_chunks, CHUNK};
+use crate::parallel::{coloured_sweep, gather_velocities, local_update, reduce_chunks, CHUNK};
 
 /// Parameters of the NLGS solver.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -206,11 +206,13 @@ pub fn rebuild_velocities(
     inv: &[[f64; 3]],
     order: &SweepOrder,
 ) {
-    vel.copy_from_slice(v_free);
     match order {
-        SweepOrder::Natural(_) => apply_impulses(rows, vel, inv),
-        SweepOrder::Coloured { colouring, mobile } => {
-            coloured_apply(rows, colouring, vel, inv, mobile)
+        SweepOrder::Natural(_) => {
+            vel.copy_from_slice(v_free);
+            apply_impulses(rows, vel, inv)
+        }
+        SweepOrder::Coloured { colouring, .. } => {
+            gather_velocities(rows, colouring, vel, v_free, inv)
         }
     }
 }

@@ -72,7 +72,7 @@ impl Default for WorldParams {
 }
 
 fn default_overlap_rate() -> f64 {
-    1e-5
+    1e-4
 }
 
 /// What one step did.

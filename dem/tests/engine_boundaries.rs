@@ -13,7 +13,7 @@ fn params(dt: f64) -> WorldParams {
         gravity: Vector2::new(0.0, -G),
         periodic_x: None,
         detection_gap: 1e-4,
-        overlap_rate: 1e-5,
+        overlap_rate: 1e-4,
         solver: SolverParams {
             tolerance: 1e-12,
             max_iterations: 10_000,

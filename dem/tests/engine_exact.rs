@@ -14,7 +14,7 @@ fn params(dt: f64, gravity: Vector2<f64>) -> WorldParams {
         gravity,
         periodic_x: None,
         detection_gap: 1e-4,
-        overlap_rate: 1e-5,
+        overlap_rate: 1e-4,
         solver: SolverParams {
             tolerance: 1e-12,
             max_iterations: 100_000,

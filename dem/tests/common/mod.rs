@@ -24,7 +24,7 @@ pub fn random_box(
         gravity: Vector2::new(0.0, -9.81),
         periodic_x: None,
         detection_gap: 0.2 * r_min,
-        overlap_rate: 1e-5,
+        overlap_rate: 1e-4,
         solver: SolverParams {
             tolerance: 1e-10,
             max_iterations: 20_000,
