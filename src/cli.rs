@@ -123,6 +123,9 @@ pub enum Command {
         /// Grain counts of the poured Janssen columns (slower); none by default.
         #[arg(long, value_name = "N", num_args = 0..)]
         pour: Vec<usize>,
+        /// Steps relaxing each engine deposit before the timed steps.
+        #[arg(long, value_name = "STEPS", default_value_t = 30)]
+        relax_steps: usize,
     },
 }
 
@@ -227,12 +230,14 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             threads,
             columns,
             pour,
+            relax_steps,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
             engine_grains,
             threads,
             columns,
             pour,
+            relax_steps,
         }),
     }
 }

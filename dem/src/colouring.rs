@@ -41,13 +41,25 @@ pub struct ContactColouring {
     pub body_contacts: Vec<u32>,
     /// Offsets into `body_contacts`, `bodies + 1` entries.
     pub body_offsets: Vec<u32>,
+    /// Interior contacts of each spatial block (see [`ContactColouring::build_blocked`]):
+    /// `block_order[block_offsets[k]..block_offsets[k + 1]]`, ascending. Empty without blocks.
+    pub block_order: Vec<u32>,
+    /// Offsets into `block_order` (`blocks + 1` entries, or none).
+    pub block_offsets: Vec<usize>,
     masks: Vec<u64>,
+    body_block: Vec<u32>,
+    contact_block: Vec<u32>,
+    sort_buf: Vec<u32>,
     colour: Vec<u8>,
     counts: Vec<usize>,
 }
 
 /// Colour of the contacts that found no free colour (swept sequentially).
 const OVERFLOW: u8 = 64;
+/// Marker of the contacts interior to a block (not coloured).
+const INTERIOR: u8 = 255;
+/// Block of the separator contacts.
+const SEPARATOR: u32 = u32::MAX;
 
 impl ContactColouring {
     /// Number of colour classes.
@@ -65,15 +77,110 @@ impl ContactColouring {
         self.sequential_tail && c + 1 == self.colours()
     }
 
-    /// Colours `rows` greedily; `mobile[i]` tells whether body `i` has a non-zero inverse mass
-    /// component.
+    /// Number of spatial blocks (0 without).
+    pub fn blocks(&self) -> usize {
+        self.block_offsets.len().saturating_sub(1)
+    }
+
+    /// The interior contacts of block `k`.
+    pub fn block(&self, k: usize) -> &[u32] {
+        &self.block_order[self.block_offsets[k]..self.block_offsets[k + 1]]
+    }
+
+    /// Colours all of `rows` greedily (no blocks); `mobile[i]` tells whether body `i` has a
+    /// non-zero inverse mass component.
     pub fn build(&mut self, rows: &[ContactRow], mobile: &[bool]) {
+        self.block_order.clear();
+        self.block_offsets.clear();
+        self.contact_block.clear();
+        self.contact_block.resize(rows.len(), SEPARATOR);
+        self.colour_separator(rows, mobile);
+        self.build_adjacency(rows, mobile);
+    }
+
+    /// Splits the mobile bodies into `blocks` slabs of equal count along the longer side of
+    /// their bounding box (`pos`: body centres, m); a contact whose mobile bodies all lie in one
+    /// slab is interior to it, the others form the separator, coloured greedily. The sweep then
+    /// runs the blocks' interiors concurrently (each in ascending contact order), then the
+    /// separator classes: two synchronisations per sweep plus one per separator class, instead
+    /// of one per colour. The split depends on the positions only, never on the thread count.
+    pub fn build_blocked(
+        &mut self,
+        rows: &[ContactRow],
+        mobile: &[bool],
+        pos: &[[f64; 2]],
+        blocks: usize,
+    ) {
+        let blocks = blocks.max(1);
+        let n = mobile.len();
+        self.sort_buf.clear();
+        self.sort_buf
+            .extend((0..n as u32).filter(|&i| mobile[i as usize]));
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for &i in &self.sort_buf {
+            for d in 0..2 {
+                lo[d] = lo[d].min(pos[i as usize][d]);
+                hi[d] = hi[d].max(pos[i as usize][d]);
+            }
+        }
+        let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
+        self.sort_buf.sort_unstable_by(|&i, &j| {
+            pos[i as usize][axis]
+                .total_cmp(&pos[j as usize][axis])
+                .then(i.cmp(&j))
+        });
+        self.body_block.clear();
+        self.body_block.resize(n, u32::MAX);
+        let m = self.sort_buf.len().max(1);
+        for (rank, &i) in self.sort_buf.iter().enumerate() {
+            self.body_block[i as usize] = (rank * blocks / m) as u32;
+        }
+        self.contact_block.clear();
+        let mut counts = vec![0usize; blocks + 1];
+        for c in rows {
+            let (a, b) = (c.a as usize, c.b as usize);
+            let ba = mobile[a].then(|| self.body_block[a]);
+            let bb = mobile[b].then(|| self.body_block[b]);
+            let k = match (ba, bb) {
+                (Some(x), Some(y)) if x == y => x,
+                (Some(_), Some(_)) => SEPARATOR,
+                (Some(x), None) | (None, Some(x)) => x,
+                (None, None) => 0,
+            };
+            if k != SEPARATOR {
+                counts[k as usize + 1] += 1;
+            }
+            self.contact_block.push(k);
+        }
+        for k in 0..blocks {
+            counts[k + 1] += counts[k];
+        }
+        self.block_offsets.clear();
+        self.block_offsets.extend_from_slice(&counts);
+        self.block_order.clear();
+        self.block_order.resize(counts[blocks], 0);
+        for (i, &k) in self.contact_block.iter().enumerate() {
+            if k != SEPARATOR {
+                self.block_order[counts[k as usize]] = i as u32;
+                counts[k as usize] += 1;
+            }
+        }
+        self.colour_separator(rows, mobile);
+        self.build_adjacency(rows, mobile);
+    }
+
+    /// Greedy first-fit colouring of the separator contacts (all, without blocks).
+    fn colour_separator(&mut self, rows: &[ContactRow], mobile: &[bool]) {
         self.masks.clear();
         self.masks.resize(mobile.len(), 0);
         self.colour.clear();
         self.counts.clear();
         self.counts.resize(OVERFLOW as usize + 1, 0);
-        for c in rows {
+        for (c, &k) in rows.iter().zip(&self.contact_block) {
+            if k != SEPARATOR {
+                self.colour.push(INTERIOR);
+                continue;
+            }
             let (a, b) = (c.a as usize, c.b as usize);
             let (ma, mb) = (mobile[a], mobile[b]);
             let used = if ma { self.masks[a] } else { 0 } | if mb { self.masks[b] } else { 0 };
@@ -113,11 +220,31 @@ impl ContactColouring {
             total += self.counts[OVERFLOW as usize];
             self.offsets.push(total);
         }
-        // Body → contacts adjacency (counting sort, ascending contact index per body).
+        self.order.clear();
+        self.order.resize(total, 0);
+        for (i, &c) in self.colour.iter().enumerate() {
+            if c == INTERIOR {
+                continue;
+            }
+            let slot = if c == OVERFLOW {
+                used_colours
+            } else {
+                c as usize
+            };
+            self.order[start[slot]] = i as u32;
+            start[slot] += 1;
+        }
+    }
+
+    /// Body → contacts adjacency (counting sort, ascending contact index per body).
+    fn build_adjacency(&mut self, rows: &[ContactRow], mobile: &[bool]) {
         self.body_offsets.clear();
         self.body_offsets.resize(mobile.len() + 1, 0);
         for c in rows {
-            for (body, m) in [(c.a as usize, mobile[c.a as usize]), (c.b as usize, mobile[c.b as usize])] {
+            for (body, m) in [
+                (c.a as usize, mobile[c.a as usize]),
+                (c.b as usize, mobile[c.b as usize]),
+            ] {
                 if m {
                     self.body_offsets[body + 1] += 1;
                 }
@@ -140,24 +267,28 @@ impl ContactColouring {
                 }
             }
         }
-        self.order.clear();
-        self.order.resize(total, 0);
-        for (i, &c) in self.colour.iter().enumerate() {
-            let slot = if c == OVERFLOW {
-                used_colours
-            } else {
-                c as usize
-            };
-            self.order[start[slot]] = i as u32;
-            start[slot] += 1;
-        }
     }
 
     /// Checks the defining property: within every parallel class no two contacts share a mobile
     /// body, and every contact appears exactly once. For tests.
     pub fn is_valid(&self, rows: &[ContactRow], mobile: &[bool]) -> bool {
         let mut seen = vec![false; rows.len()];
-        for &i in &self.order {
+        // blocks: no mobile body in two blocks' interiors
+        let mut owner = vec![usize::MAX; mobile.len()];
+        for k in 0..self.blocks() {
+            for &i in self.block(k) {
+                let r = &rows[i as usize];
+                for body in [r.a as usize, r.b as usize] {
+                    if mobile[body] {
+                        if owner[body] != usize::MAX && owner[body] != k {
+                            return false;
+                        }
+                        owner[body] = k;
+                    }
+                }
+            }
+        }
+        for &i in self.order.iter().chain(&self.block_order) {
             if std::mem::replace(&mut seen[i as usize], true) {
                 return false;
             }

@@ -20,6 +20,7 @@
 pub mod anderson;
 pub mod atomic;
 pub mod bench;
+pub mod blocked;
 pub mod body;
 pub mod checkpoint;
 pub mod collider;

@@ -104,10 +104,20 @@ unsafe fn update_shared(
     }
 }
 
-/// Runs `f(i)` for every contact `i` of every class, classes in turn, the contacts of a
-/// parallel class concurrently.
+/// Runs `f(i)` for every contact `i`: first the blocks' interiors (blocks concurrently, each in
+/// ascending order), then the colour classes in turn, the contacts of a parallel class
+/// concurrently.
 #[inline]
 fn for_each_coloured(colouring: &ContactColouring, f: impl Fn(usize) + Sync) {
+    match colouring.blocks() {
+        0 => {}
+        1 => colouring.block(0).iter().for_each(|&i| f(i as usize)),
+        b => (0..b).into_par_iter().for_each(|k| {
+            for &i in colouring.block(k) {
+                f(i as usize);
+            }
+        }),
+    }
     for k in 0..colouring.colours() {
         let class = colouring.class(k);
         if colouring.is_sequential(k) || class.len() < PARALLEL_MIN {
@@ -134,7 +144,11 @@ pub fn coloured_sweep(
     mobile: &[bool],
     omega: f64,
 ) {
-    assert_eq!(colouring.order.len(), rows.len(), "colouring of other rows");
+    assert_eq!(
+        colouring.order.len() + colouring.block_order.len(),
+        rows.len(),
+        "colouring of other rows"
+    );
     assert!(vel.len() == inv.len() && vel.len() == mobile.len());
     let n_rows = rows.len();
     let (pr, pv) = (Shared(rows.as_mut_ptr()), Shared(vel.as_mut_ptr()));
@@ -158,7 +172,11 @@ pub fn gather_velocities(
     inv: &[[f64; 3]],
 ) {
     assert!(vel.len() == v_free.len() && vel.len() == inv.len());
-    assert_eq!(colouring.body_offsets.len(), vel.len() + 1, "colouring of other bodies");
+    assert_eq!(
+        colouring.body_offsets.len(),
+        vel.len() + 1,
+        "colouring of other bodies"
+    );
     let offsets = &colouring.body_offsets;
     let adj = &colouring.body_contacts;
     vel.par_iter_mut()
@@ -176,7 +194,11 @@ pub fn gather_velocities(
                 }
             }
             let (f, m) = (v_free[i], inv[i]);
-            *v = [f[0] + m[0] * acc[0], f[1] + m[1] * acc[1], f[2] + m[2] * acc[2]];
+            *v = [
+                f[0] + m[0] * acc[0],
+                f[1] + m[1] * acc[1],
+                f[2] + m[2] * acc[2],
+            ];
         });
 }
 

@@ -260,6 +260,10 @@ impl SweepOrder<'_> {
         match self {
             SweepOrder::Natural(order) => shuffle(order),
             SweepOrder::Coloured { colouring, .. } => {
+                for k in 0..colouring.blocks() {
+                    let (lo, hi) = (colouring.block_offsets[k], colouring.block_offsets[k + 1]);
+                    shuffle(&mut colouring.block_order[lo..hi]);
+                }
                 for k in 0..colouring.colours() {
                     let (lo, hi) = (colouring.offsets[k], colouring.offsets[k + 1]);
                     shuffle(&mut colouring.order[lo..hi]);

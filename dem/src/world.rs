@@ -20,6 +20,7 @@
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
+use crate::blocked::BlockLayout;
 use crate::body::{Body, Dof};
 use crate::checkpoint::WorldState;
 use crate::collider::{rotate, Collider, Shape};
@@ -71,6 +72,13 @@ impl Default for WorldParams {
     }
 }
 
+/// Spatial blocks of the parallel sweep ([`ContactColouring::build_blocked`]); fixed, so the
+/// numbers do not depend on the thread count.
+pub const SWEEP_BLOCKS: usize = 16;
+/// Below this many contacts the parallel mode sweeps one block (sequentially, same order on any
+/// thread count).
+pub const BLOCKED_MIN_CONTACTS: usize = 4096;
+
 fn default_overlap_rate() -> f64 {
     1e-4
 }
@@ -115,6 +123,8 @@ pub struct World {
     body_force: Vec<[f64; 3]>,
     order: Vec<u32>,
     mobile: Vec<bool>,
+    pos: Vec<[f64; 2]>,
+    layout: BlockLayout,
     colouring: ContactColouring,
     v_free: Vec<[f64; 3]>,
     work: solver::SolverWork,
@@ -139,6 +149,8 @@ impl World {
             body_force: Vec::new(),
             order: Vec::new(),
             mobile: Vec::new(),
+            pos: Vec::new(),
+            layout: BlockLayout::default(),
             colouring: ContactColouring::default(),
             v_free: Vec::new(),
             work: solver::SolverWork::default(),
@@ -608,38 +620,72 @@ impl World {
         let approach_limit = self.approach_limit();
         self.v_free.clear();
         self.v_free.extend_from_slice(&self.vel);
-        let order = if self.params.solver.parallel {
+        let report = if self.params.solver.parallel {
             self.mobile.clear();
             self.mobile
                 .extend(self.inv.iter().map(|i| i.iter().any(|&x| x != 0.0)));
-            self.colouring.build(&self.contacts.rows, &self.mobile);
-            SweepOrder::Coloured {
+            self.pos.clear();
+            self.pos
+                .extend(self.bodies.iter().map(|b| [b.position.x, b.position.y]));
+            let blocks = if self.contacts.len() >= BLOCKED_MIN_CONTACTS {
+                SWEEP_BLOCKS
+            } else {
+                1
+            };
+            // Solve in a block-contiguous copy (no two threads on one cache line).
+            self.layout.gather(
+                &self.contacts.rows,
+                &self.vel,
+                &self.v_free,
+                &self.inv,
+                &self.mobile,
+                &self.pos,
+                blocks,
+            );
+            let l = &mut self.layout;
+            self.colouring
+                .build_blocked(&l.rows, &l.mobile, &l.pos, blocks);
+            let order = SweepOrder::Coloured {
                 colouring: &mut self.colouring,
-                mobile: &self.mobile,
-            }
+                mobile: &l.mobile,
+            };
+            solver::rebuild_velocities(&l.rows, &mut l.vel, &l.v_free, &l.inv, &order);
+            let report = solver::solve(
+                &mut l.rows,
+                order,
+                &mut l.vel,
+                &l.v_free,
+                &l.inv,
+                q_norm,
+                approach_limit,
+                &self.params.solver,
+                &mut self.work,
+            );
+            l.scatter(&mut self.contacts.rows, &mut self.vel);
+            report
         } else {
             self.order.clear();
             self.order.extend(0..self.contacts.len() as u32);
-            SweepOrder::Natural(&mut self.order)
+            let order = SweepOrder::Natural(&mut self.order);
+            solver::rebuild_velocities(
+                &self.contacts.rows,
+                &mut self.vel,
+                &self.v_free,
+                &self.inv,
+                &order,
+            );
+            solver::solve(
+                &mut self.contacts.rows,
+                order,
+                &mut self.vel,
+                &self.v_free,
+                &self.inv,
+                q_norm,
+                approach_limit,
+                &self.params.solver,
+                &mut self.work,
+            )
         };
-        solver::rebuild_velocities(
-            &self.contacts.rows,
-            &mut self.vel,
-            &self.v_free,
-            &self.inv,
-            &order,
-        );
-        let report = solver::solve(
-            &mut self.contacts.rows,
-            order,
-            &mut self.vel,
-            &self.v_free,
-            &self.inv,
-            q_norm,
-            approach_limit,
-            &self.params.solver,
-            &mut self.work,
-        );
         solver::classify(&self.contacts.rows, &mut self.contacts.status);
 
         // 4. Positions, accelerations.
