@@ -194,6 +194,17 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
         mem.per_contact,
         mem.largest_sample(24 << 30, 2.0) as f64
     );
+    let extra = dem::bench::MemoryFootprint::parallel_extra();
+    let both = dem::bench::MemoryFootprint {
+        per_grain: mem.per_grain + extra.per_grain,
+        per_contact: mem.per_contact + extra.per_contact,
+    };
+    println!(
+        "parallel mode adds {} B per grain, {} B per contact: about {:.1e} grains in 24 GiB",
+        extra.per_grain,
+        extra.per_contact,
+        both.largest_sample(24 << 30, 2.0) as f64
+    );
     Ok(())
 }
 

@@ -252,6 +252,26 @@ impl MemoryFootprint {
         }
     }
 
+    /// What the parallel mode ([`crate::SolverParams::parallel`]) adds: the block-contiguous copy
+    /// of the problem ([`crate::blocked::BlockLayout`]: rows, body vectors, permutations) and
+    /// the colouring with its body → contact adjacency.
+    pub fn parallel_extra() -> Self {
+        use std::mem::size_of;
+        let per_grain = 3 * size_of::<[f64; 3]>() // velocities, free velocities, inverse masses
+            + 2 * 16 // centres (world and copy)
+            + 2 // mobility flags
+            + 4 + 4 // permutation both ways
+            + 8 + 4 + 4 + 4; // colouring: masks, slab, sort buffer, adjacency offsets
+        let per_contact = size_of::<crate::contact::ContactRow>() // the copy
+            + 8 + 4 // sort keys, permutation
+            + 1 + 4 + 4 // colour, slab, class or slab order
+            + 2 * 4; // adjacency entries
+        MemoryFootprint {
+            per_grain,
+            per_contact,
+        }
+    }
+
     /// The largest number of grains that fits in `bytes` with `contacts_per_grain` contacts each
     /// (about 2 in a dense 2D packing).
     pub fn largest_sample(&self, bytes: usize, contacts_per_grain: f64) -> usize {

@@ -1,4 +1,8 @@
-//! Colouring of the contact graph for the parallel Gauss–Seidel sweep.
+//! Colouring of the contact graph for the parallel Gauss–Seidel sweep, with spatial blocks.
+//!
+//! With blocks ([`ContactColouring::build_blocked`], used by the world), the mobile bodies are
+//! split into slabs; contacts inside one slab are swept slab by slab concurrently, and only the
+//! contacts across slabs (the separator, a few percent) are coloured as below.
 //!
 //! Two contacts conflict when they act on a common *mobile* body (one with a non-zero inverse
 //! mass component): updating both at once would race on that body's velocity. Contacts that

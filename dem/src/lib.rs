@@ -10,9 +10,9 @@
 //!
 //! Algorithms, in the order of one step ([`world::World::step`]):
 //! [`detection`] (cell grid, O(N)) → free velocities → [`solver`] (NLGS, O(1) per contact
-//! update, local law in [`local`]; optionally in colour order on several threads,
-//! [`colouring`] and [`parallel`], with the same numbers on any thread count) → θ-method
-//! position update.
+//! update, local law in [`local`]; optionally on several threads by spatial slabs and a
+//! coloured separator, [`colouring`], [`blocked`] and [`parallel`], with the same numbers on any
+//! thread count) → θ-method position update.
 //!
 //! The same local law solves standalone frictional-contact problems given by `W`, `q`, `μ`
 //! ([`fc`]).
