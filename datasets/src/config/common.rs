@@ -103,6 +103,10 @@ pub struct SolverSpec {
     pub tolerance: f64,
     /// Largest number of Gauss–Seidel sweeps per step, ≥ 1.
     pub max_iterations: usize,
+    /// Solve on all threads ([`dem::SolverParams::parallel`]); the numbers do not depend on the
+    /// thread count. Default false.
+    #[serde(default)]
+    pub parallel: bool,
 }
 
 impl SolverSpec {
@@ -123,6 +127,7 @@ impl SolverSpec {
         dem::SolverParams {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
+            parallel: self.parallel,
             ..Default::default()
         }
     }
