@@ -132,6 +132,21 @@ pub fn janssen_column(
         )?,
         Preparation::Deposit => deposit(&mut rng, &radii, COLUMN_WIDTH, 1e-6 * R_MIN)?.centres,
     };
+    let mut w = box_world(COLUMN_WIDTH, run, &centres, &radii, grain.density);
+    w.validate(1e-12)?;
+    Ok(w)
+}
+
+/// A box `width` wide (floor `y = 0`, walls `x = 0` and `x = width`), μ = 0.5 between grains
+/// and with the walls, holding grains of the given centres and radii, with the engine settings
+/// of `run`.
+fn box_world(
+    width: f64,
+    run: &ColumnRun,
+    centres: &[Vector2<f64>],
+    radii: &[f64],
+    density: f64,
+) -> World {
     let friction = FrictionSpec {
         grain_grain: 0.5,
         grain_wall: 0.5,
@@ -152,15 +167,14 @@ pub fn janssen_column(
     w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL);
     w.add_line_wall(
         "right",
-        Vector2::new(COLUMN_WIDTH, 0.0),
+        Vector2::new(width, 0.0),
         Vector2::new(-1.0, 0.0),
         WALL,
     );
-    for (c, r) in centres.iter().zip(&radii) {
-        w.add_grain(*c, *r, grain.density, GRAIN);
+    for (c, r) in centres.iter().zip(radii) {
+        w.add_grain(*c, *r, density, GRAIN);
     }
-    w.validate(1e-12)?;
-    Ok(w)
+    w
 }
 
 /// Prepares and settles the benchmark column (KE/PE < 10⁻⁸), timed.
@@ -239,33 +253,14 @@ pub fn scaling_deposit(n: usize, relax_steps: usize, parallel: bool, seed: u64) 
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let radii = uniform_radii(&mut rng, n, &grain);
     let centres = deposit(&mut rng, &radii, width, 1e-6 * R_MIN)?.centres;
-    let friction = FrictionSpec {
-        grain_grain: 0.5,
-        grain_wall: 0.5,
-    };
-    let params = dem::WorldParams {
+    let run = ColumnRun {
         dt: 1e-3,
-        detection_gap: 0.1 * R_MIN,
-        solver: dem::SolverParams {
-            tolerance: 1e-4,
-            max_iterations: 200,
-            parallel,
-            ..Default::default()
-        },
-        ..Default::default()
+        tolerance: 1e-4,
+        max_sweeps: 200,
+        parallel,
+        max_time: f64::INFINITY,
     };
-    let mut w = World::new(params, friction.laws());
-    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        WALL,
-    );
-    for (c, r) in centres.iter().zip(&radii) {
-        w.add_grain(*c, *r, grain.density, GRAIN);
-    }
+    let mut w = box_world(width, &run, &centres, &radii, grain.density);
     for _ in 0..relax_steps {
         w.step()?;
     }

@@ -10,6 +10,7 @@
 //! (separator last), then by their index. The solve runs on the copy; impulses and velocities
 //! are copied back. O(N log N + contacts) per step, a few percent of a solve.
 
+use crate::colouring::slab_order;
 use crate::contact::ContactRow;
 
 /// A block-contiguous copy of a contact problem (see the module documentation).
@@ -51,22 +52,7 @@ impl BlockLayout {
     ) {
         let n = mobile.len();
         let blocks = blocks.max(1);
-        self.body_old.clear();
-        self.body_old
-            .extend((0..n as u32).filter(|&i| mobile[i as usize]));
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for &i in &self.body_old {
-            for d in 0..2 {
-                lo[d] = lo[d].min(pos[i as usize][d]);
-                hi[d] = hi[d].max(pos[i as usize][d]);
-            }
-        }
-        let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
-        self.body_old.sort_unstable_by(|&i, &j| {
-            pos[i as usize][axis]
-                .total_cmp(&pos[j as usize][axis])
-                .then(i.cmp(&j))
-        });
+        slab_order(mobile, pos, &mut self.body_old);
         let m = self.body_old.len().max(1);
         self.body_old
             .extend((0..n as u32).filter(|&i| !mobile[i as usize]));

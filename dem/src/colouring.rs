@@ -58,6 +58,26 @@ pub struct ContactColouring {
     counts: Vec<usize>,
 }
 
+/// The mobile bodies sorted along the longer side of their bounding box (ties by index), into
+/// `out`: the order that cuts them into slabs of equal count.
+pub fn slab_order(mobile: &[bool], pos: &[[f64; 2]], out: &mut Vec<u32>) {
+    out.clear();
+    out.extend((0..mobile.len() as u32).filter(|&i| mobile[i as usize]));
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for &i in out.iter() {
+        for d in 0..2 {
+            lo[d] = lo[d].min(pos[i as usize][d]);
+            hi[d] = hi[d].max(pos[i as usize][d]);
+        }
+    }
+    let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
+    out.sort_unstable_by(|&i, &j| {
+        pos[i as usize][axis]
+            .total_cmp(&pos[j as usize][axis])
+            .then(i.cmp(&j))
+    });
+}
+
 /// Colour of the contacts that found no free colour (swept sequentially).
 const OVERFLOW: u8 = 64;
 /// Marker of the contacts interior to a block (not coloured).
@@ -117,22 +137,7 @@ impl ContactColouring {
     ) {
         let blocks = blocks.max(1);
         let n = mobile.len();
-        self.sort_buf.clear();
-        self.sort_buf
-            .extend((0..n as u32).filter(|&i| mobile[i as usize]));
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for &i in &self.sort_buf {
-            for d in 0..2 {
-                lo[d] = lo[d].min(pos[i as usize][d]);
-                hi[d] = hi[d].max(pos[i as usize][d]);
-            }
-        }
-        let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
-        self.sort_buf.sort_unstable_by(|&i, &j| {
-            pos[i as usize][axis]
-                .total_cmp(&pos[j as usize][axis])
-                .then(i.cmp(&j))
-        });
+        slab_order(mobile, pos, &mut self.sort_buf);
         self.body_block.clear();
         self.body_block.resize(n, u32::MAX);
         let m = self.sort_buf.len().max(1);
