@@ -42,7 +42,8 @@ impl<T> Shared<T> {
 }
 
 /// The exact local update of one contact on given body velocities: `r ← solve_local(W, u − W r)`,
-/// optionally relaxed and projected back on the cone; returns the impulse increment.
+/// optionally relaxed and projected back on the cone; returns whether the impulse changed
+/// (then `va`, `vb` hold the updated velocities).
 #[inline(always)]
 pub(crate) fn local_update(
     c: &mut ContactRow,
@@ -200,6 +201,13 @@ pub fn gather_velocities(
                 f[2] + m[2] * acc[2],
             ];
         });
+}
+
+/// `max_α f(α)` over the contacts, chunk by chunk on the rayon pool (−∞ when there is none).
+pub fn max_over(rows: &[ContactRow], f: impl Fn(&ContactRow) -> f64 + Sync) -> f64 {
+    rows.par_chunks(CHUNK)
+        .map(|ch| ch.iter().map(&f).fold(f64::NEG_INFINITY, f64::max))
+        .reduce(|| f64::NEG_INFINITY, f64::max)
 }
 
 /// `Σ_α f(α)` over the contacts as partial sums over fixed chunks of [`CHUNK`] contacts, added

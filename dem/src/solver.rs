@@ -34,7 +34,9 @@ use crate::anderson::Anderson;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
 use crate::local::{natural_map_residual, ContactStatus};
-use crate::parallel::{coloured_sweep, gather_velocities, local_update, reduce_chunks, CHUNK};
+use crate::parallel::{
+    coloured_sweep, gather_velocities, local_update, max_over, reduce_chunks, CHUNK,
+};
 
 /// Parameters of the NLGS solver.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -134,22 +136,14 @@ pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 
 /// them overlap. Open contacts closing within the step are not counted (their `u_n` includes the
 /// gap shift, so `u_n ≥ 0` already means "stops at contact").
 pub fn approach_speed(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
-    let [m] = reduce_max(rows, |c| {
+    max_over(rows, |c| {
         if c.shift <= 0.0 || c.r[0] > 0.0 {
             -c.velocity(&vel[c.a as usize], &vel[c.b as usize])[0]
         } else {
             0.0
         }
-    });
-    m.max(0.0)
-}
-
-fn reduce_max(rows: &[ContactRow], f: impl Fn(&ContactRow) -> f64 + Sync) -> [f64; 1] {
-    let parts: Vec<f64> = rows
-        .par_chunks(CHUNK)
-        .map(|ch| ch.iter().map(&f).fold(f64::NEG_INFINITY, f64::max))
-        .collect();
-    [parts.into_iter().fold(f64::NEG_INFINITY, f64::max)]
+    })
+    .max(0.0)
 }
 
 /// Norm of the free local velocities `‖q‖`, `q_α = H_α v_free + shift_α`, computed from the
