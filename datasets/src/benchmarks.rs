@@ -111,13 +111,7 @@ pub fn janssen_column(
     run: &ColumnRun,
     seed: u64,
 ) -> Result<World> {
-    let grain = GrainSpec {
-        density: 2500.0,
-        radius_mean: 0.5 * (R_MIN + R_MAX),
-        radius_spread: 0.5 * (R_MAX - R_MIN),
-    };
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let radii = uniform_radii(&mut rng, n, &grain);
+    let (grain, mut rng, radii) = benchmark_grains(n, seed);
     let centres = match preparation {
         Preparation::Pour => rain(
             &mut rng,
@@ -135,6 +129,19 @@ pub fn janssen_column(
     let mut w = box_world(COLUMN_WIDTH, run, &centres, &radii, grain.density);
     w.validate(1e-12)?;
     Ok(w)
+}
+
+/// The benchmark grains: `n` seeded radii uniform in [R_MIN, R_MAX], density 2500 kg/m³; the
+/// generator continues to place them.
+fn benchmark_grains(n: usize, seed: u64) -> (GrainSpec, ChaCha8Rng, Vec<f64>) {
+    let grain = GrainSpec {
+        density: 2500.0,
+        radius_mean: 0.5 * (R_MIN + R_MAX),
+        radius_spread: 0.5 * (R_MAX - R_MIN),
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let radii = uniform_radii(&mut rng, n, &grain);
+    (grain, rng, radii)
 }
 
 /// A box `width` wide (floor `y = 0`, walls `x = 0` and `x = width`), μ = 0.5 between grains
@@ -245,13 +252,7 @@ pub fn scaling_deposit(n: usize, relax_steps: usize, parallel: bool, seed: u64) 
     let mean_area = std::f64::consts::PI * (R_MIN * R_MIN + R_MIN * R_MAX + R_MAX * R_MAX) / 3.0;
     let height = SCALING_ROWS * (R_MIN + R_MAX);
     let width = (n as f64 * mean_area / (0.8 * height)).max(4.0 * R_MAX);
-    let grain = GrainSpec {
-        density: 2500.0,
-        radius_mean: 0.5 * (R_MIN + R_MAX),
-        radius_spread: 0.5 * (R_MAX - R_MIN),
-    };
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let radii = uniform_radii(&mut rng, n, &grain);
+    let (grain, mut rng, radii) = benchmark_grains(n, seed);
     let centres = deposit(&mut rng, &radii, width, 1e-6 * R_MIN)?.centres;
     let run = ColumnRun {
         dt: 1e-3,
