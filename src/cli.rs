@@ -48,33 +48,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Run a scenario end to end (simulation, homogenisation, fits, figures, summary.json).
-    Run {
-        /// A built-in scenario name (see `grainlaw scenarios`) or a TOML file path (default
-        /// `janssen`; with `--resume`, the checkpoint's).
-        scenario: Option<String>,
-        /// Output directory (default `grainlaw-out/SCENARIO`).
-        #[arg(long, value_name = "DIR", conflicts_with = "resume")]
-        out: Option<PathBuf>,
-        /// Override a scenario key (dotted keys for tables), e.g. `--set grains=2000`.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// No progress bars and no report on stdout (warnings and errors still go to stderr).
-        #[arg(long, short)]
-        quiet: bool,
-        /// Continue the interrupted run whose output directory is DIR, from its checkpoint
-        /// (scenario and overrides are the checkpoint's; output continues in DIR).
-        #[arg(long, value_name = "DIR")]
-        resume: Option<PathBuf>,
-        /// Write a checkpoint every STEPS steps (all phases together; 0: not by steps).
-        #[arg(long, value_name = "STEPS", default_value_t = 0)]
-        checkpoint_every: u64,
-        /// Write a checkpoint every S seconds of wall-clock time (0: not by time).
-        #[arg(long, value_name = "S", default_value_t = DEFAULT_CHECKPOINT_SECONDS)]
-        checkpoint_seconds: f64,
-        /// Test hook: stop as Ctrl-C does after this many steps of this invocation.
-        #[arg(long, value_name = "STEPS", hide = true)]
-        stop_after_steps: Option<u64>,
-    },
+    Run(RunArgs),
     /// List the built-in scenarios, or print one's full TOML.
     Scenarios {
         /// Print the full TOML of this scenario.
@@ -166,56 +140,55 @@ where
 }
 
 /// The options of `grainlaw run`.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct RunArgs {
-    /// Scenario name or TOML path (`None`: janssen, or the checkpoint's with `resume`).
+    /// A built-in scenario name (see `grainlaw scenarios`) or a TOML file path (default
+    /// `janssen`; with `--resume`, the checkpoint's).
     pub scenario: Option<String>,
-    /// Output directory.
+    /// Output directory (default `grainlaw-out/SCENARIO`).
+    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
     pub out: Option<PathBuf>,
-    /// `KEY=VALUE` overrides.
+    /// Override a scenario key (dotted keys for tables), e.g. `--set grains=2000`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// No progress and no report on stdout.
+    /// No progress bars and no report on stdout (warnings and errors still go to stderr).
+    #[arg(long, short)]
     pub quiet: bool,
-    /// Output directory of the run to resume.
+    /// Continue the interrupted run whose output directory is DIR, from its checkpoint
+    /// (scenario and overrides are the checkpoint's; output continues in DIR).
+    #[arg(long, value_name = "DIR")]
     pub resume: Option<PathBuf>,
-    /// Checkpoint every this many steps (0: not by steps).
+    /// Write a checkpoint every STEPS steps (all phases together; 0: not by steps).
+    #[arg(long, value_name = "STEPS", default_value_t = 0)]
     pub checkpoint_every: u64,
-    /// Checkpoint every this many wall-clock seconds (0: not by time).
+    /// Write a checkpoint every S seconds of wall-clock time (0: not by time).
+    #[arg(long, value_name = "S", default_value_t = DEFAULT_CHECKPOINT_SECONDS)]
     pub checkpoint_seconds: f64,
-    /// Stop as Ctrl-C does after this many steps (tests).
+    /// Test hook: stop as Ctrl-C does after this many steps of this invocation.
+    #[arg(long, value_name = "STEPS", hide = true)]
     pub stop_after_steps: Option<u64>,
 }
 
+impl Default for RunArgs {
+    /// `grainlaw run` with no option: janssen, checkpoints every
+    /// [`DEFAULT_CHECKPOINT_SECONDS`].
+    fn default() -> Self {
+        RunArgs {
+            scenario: None,
+            out: None,
+            set: Vec::new(),
+            quiet: false,
+            resume: None,
+            checkpoint_every: 0,
+            checkpoint_seconds: DEFAULT_CHECKPOINT_SECONDS,
+            stop_after_steps: None,
+        }
+    }
+}
+
 fn dispatch(cmd: Option<Command>) -> Result<()> {
-    match cmd.unwrap_or(Command::Run {
-        scenario: None,
-        out: None,
-        set: Vec::new(),
-        quiet: false,
-        resume: None,
-        checkpoint_every: 0,
-        checkpoint_seconds: DEFAULT_CHECKPOINT_SECONDS,
-        stop_after_steps: None,
-    }) {
-        Command::Run {
-            scenario,
-            out,
-            set,
-            quiet,
-            resume,
-            checkpoint_every,
-            checkpoint_seconds,
-            stop_after_steps,
-        } => run(RunArgs {
-            scenario,
-            out,
-            set,
-            quiet,
-            resume,
-            checkpoint_every,
-            checkpoint_seconds,
-            stop_after_steps,
-        }),
+    match cmd.unwrap_or(Command::Run(RunArgs::default())) {
+        Command::Run(args) => run(args),
         Command::Scenarios { show } => scenarios_cmd(show.as_deref()),
         Command::Fit { law, data, out } => crate::fit_cmd::fit(&law, &data, out.as_deref()),
         Command::SolveFc {

@@ -22,7 +22,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::build::{GRAIN, WALL};
+use crate::build::{box_walls, GRAIN};
 use crate::config::{FrictionSpec, GrainSpec};
 use crate::error::Result;
 use crate::generators::{deposit, rain, uniform_radii, RainBox};
@@ -170,14 +170,7 @@ fn box_world(
         ..Default::default()
     };
     let mut w = World::new(params, friction.laws());
-    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        WALL,
-    );
+    box_walls(&mut w, width);
     for (c, r) in centres.iter().zip(radii) {
         w.add_grain(*c, *r, density, GRAIN);
     }

@@ -43,6 +43,22 @@ fn world(
     World::new(params, friction.laws())
 }
 
+/// Adds the line walls `bottom` (y = 0), `left` (x = 0) and `right` (x = `width`, m) of a box,
+/// material [`WALL`], and returns their body indices.
+pub fn box_walls(w: &mut World, width: f64) -> [usize; 3] {
+    [
+        w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL),
+        w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL),
+        w.add_line_wall(
+            "right",
+            Vector2::new(width, 0.0),
+            Vector2::new(-1.0, 0.0),
+            WALL,
+        ),
+    ]
+    .map(|b| b as usize)
+}
+
 /// A box of two vertical walls and a floor filled with rained grains.
 #[derive(Debug, Clone)]
 pub struct ColumnWorld {
@@ -95,14 +111,7 @@ pub fn column(
         grain.radius_min(),
         friction,
     );
-    let bottom = w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL) as usize;
-    let left = w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL) as usize;
-    let right = w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        WALL,
-    ) as usize;
+    let [bottom, left, right] = box_walls(&mut w, width);
     for (c, r) in centres.iter().zip(&radii) {
         w.add_grain(*c, *r, grain.density, GRAIN);
     }
@@ -146,14 +155,7 @@ pub fn arrangement(c: &ArrangementsConfig, kind: Arrangement) -> Result<World> {
     let top = centres.iter().map(|p| p.y).fold(0.0, f64::max) + 2.0 * r;
     let mut w = world(c.dt, Vector2::new(0.0, -9.81), None, r, &c.friction);
     w.params.solver = c.solver.params();
-    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        WALL,
-    );
+    box_walls(&mut w, width);
     w.add_line_wall("top", Vector2::new(0.0, top), Vector2::new(0.0, -1.0), WALL);
     for p in centres {
         w.add_grain(p, r, c.density, GRAIN);

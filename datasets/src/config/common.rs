@@ -136,9 +136,12 @@ impl SolverSpec {
 /// A periodic cell `cell_length_diameters · 2 R̄` long must hold three cells of the engine's
 /// contact-detection grid, `L ≥ 3 (1.5 d_max + g)`: a grid cell is the largest diameter
 /// `d_max = 2 R_max` plus the detection gap `g = R_min / 10` plus twice the swept margin (the
-/// distance a grain moves in one step), here allowed up to a quarter of `d_max`. `key` names the
-/// length in the error.
+/// distance a grain moves in one step), here allowed up to a quarter of `d_max`. Also checks
+/// `grain` and that the length lies in [4, 10⁴] mean diameters. `key` names the length in the
+/// error.
 pub fn check_periodic_cell(key: &str, cell_length_diameters: f64, grain: &GrainSpec) -> Result<()> {
+    in_range(key, cell_length_diameters, 4.0, 1e4)?;
+    grain.validate("grain")?;
     let length = cell_length_diameters * 2.0 * grain.radius_mean;
     let needed = 3.0 * (1.5 * 2.0 * grain.radius_max() + 0.1 * grain.radius_min());
     if length < needed {

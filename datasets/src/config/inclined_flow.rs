@@ -52,13 +52,6 @@ impl InclinedFlowConfig {
                 format!("must be in (0, 90)°, got {}", num(self.slope_deg)),
             ));
         }
-        in_range(
-            "cell_length_diameters",
-            self.cell_length_diameters,
-            4.0,
-            1e4,
-        )?;
-        self.grain.validate("grain")?;
         check_periodic_cell(
             "cell_length_diameters",
             self.cell_length_diameters,

@@ -54,13 +54,6 @@ impl ShearCellConfig {
     /// [`crate::build::PACKING_GUESS`] (the settled sample is a little looser, so a little higher).
     pub fn validate(&self) -> Result<()> {
         limits::grains("grains", self.grains, 20)?;
-        in_range(
-            "cell_length_diameters",
-            self.cell_length_diameters,
-            4.0,
-            1e4,
-        )?;
-        self.grain.validate("grain")?;
         check_periodic_cell(
             "cell_length_diameters",
             self.cell_length_diameters,
