@@ -542,7 +542,19 @@ impl World {
     /// Advance one time step (see the module documentation). Non-convergence of the contact
     /// solver is reported in the returned [`StepReport`], never hidden; a non-finite state is an
     /// error.
+    ///
+    /// Called from outside the rayon pool, the step runs on one of its workers (one hand-over
+    /// per step), so that the many short parallel kernels of the solve fork and join between
+    /// workers instead of each waking the pool from the outside and blocking on it.
     pub fn step(&mut self) -> Result<StepReport, DemError> {
+        if rayon::current_thread_index().is_none() {
+            rayon::scope(|_| self.step_in_pool())
+        } else {
+            self.step_in_pool()
+        }
+    }
+
+    fn step_in_pool(&mut self) -> Result<StepReport, DemError> {
         let h = self.params.dt;
         let theta = self.params.theta;
         let g = self.params.gravity;
