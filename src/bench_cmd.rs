@@ -125,7 +125,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         "\nJanssen column settled to KE/PE < 1e-8 (radius 1–2 mm, μ = 0.5, box 40 mean diameters, all threads):"
     );
     println!(
-        "{:>7} {:>8} {:>6} {:>7} {:>7} {:>9} {:>10} {:>6} {:>9} {:>14} {:>9}",
+        "{:>7} {:>8} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9} {:>14} {:>9}",
         "grains",
         "prepare",
         "steps",
@@ -150,7 +150,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
             None => ("–".into(), "–".into()),
         };
         println!(
-            "{:>7} {:>8} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>6.2} {:>9.2} {:>14} {:>9}{}",
+            "{:>7} {:>8} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
             n,
             match prep {
                 Preparation::Pour => "pour",
@@ -161,7 +161,14 @@ fn columns(plan: &BenchPlan) -> Result<()> {
             r.settle.unconverged_steps,
             r.final_overlap_ratio,
             r.solid_fraction,
-            run.dt * 1e3,
+            {
+                let [lo, hi] = r.settle.dt_range;
+                if lo < hi {
+                    format!("{:.3}–{:.2}", lo * 1e3, hi * 1e3)
+                } else {
+                    format!("{:.2}", lo * 1e3)
+                }
+            },
             total,
             reference,
             ratio,
@@ -173,7 +180,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         );
     }
     println!(
-        "(capped: steps that stopped at the cap of {} sweeps with their best iterate; overlap/r: largest overlap over the smallest radius)",
+        "(capped: steps that stopped at the cap of {} sweeps with their best iterate; overlap/r: largest overlap over the smallest radius;\n h: the step range used; a deposit starts from the weight-carrying impulses and adapts its step, halved after a capped step)",
         ColumnRun::for_preparation(Preparation::Deposit).max_sweeps
     );
     Ok(())

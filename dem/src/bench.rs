@@ -11,6 +11,7 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
+use crate::step_control::StepControl;
 use crate::{ContactLaws, SolverParams, World, WorldParams};
 
 /// One measured row.
@@ -147,6 +148,8 @@ pub struct SettleReport {
     pub steps: u64,
     /// Simulated time (s).
     pub simulated_seconds: f64,
+    /// Smallest and largest time step used (s).
+    pub dt_range: [f64; 2],
     /// Wall-clock seconds (building excluded).
     pub wall_seconds: f64,
     /// Mean sweeps per step.
@@ -177,20 +180,33 @@ pub fn energy_ratio(w: &World) -> f64 {
     }
 }
 
-/// Steps `w` until [`energy_ratio`] < `target` (or `max_time` simulated seconds), timed.
-pub fn settle(w: &mut World, target: f64, max_time: f64) -> SettleReport {
+/// Steps `w` until [`energy_ratio`] < `target` (or `max_time` simulated seconds), timed; with
+/// `control`, the time step follows [`StepControl`] (starting from `w.params.dt`).
+pub fn settle(
+    w: &mut World,
+    target: f64,
+    max_time: f64,
+    mut control: Option<StepControl>,
+) -> SettleReport {
     let t0 = Instant::now();
     let (mut steps, mut sweeps, mut unconverged) = (0u64, 0u64, 0u64);
-    let max_steps = (max_time / w.params.dt).ceil() as u64;
+    let (mut simulated, mut dt_min, mut dt_max) = (0.0, w.params.dt, w.params.dt);
     let mut ratio = energy_ratio(w);
-    while steps < max_steps {
+    while simulated < max_time {
+        let h = w.params.dt;
         let Ok(rep) = w.step() else { break };
         steps += 1;
+        simulated += h;
         sweeps += rep.solver.iterations as u64;
         unconverged += u64::from(!rep.solver.converged);
         ratio = energy_ratio(w);
         if ratio < target {
             break;
+        }
+        if let Some(c) = control.as_mut() {
+            let h = c.after(w, &rep);
+            dt_min = dt_min.min(h);
+            dt_max = dt_max.max(h);
         }
     }
     let height = w
@@ -208,7 +224,8 @@ pub fn settle(w: &mut World, target: f64, max_time: f64) -> SettleReport {
         grains,
         width: f64::NAN,
         steps,
-        simulated_seconds: steps as f64 * w.params.dt,
+        simulated_seconds: simulated,
+        dt_range: [dt_min, dt_max],
         wall_seconds: t0.elapsed().as_secs_f64(),
         mean_sweeps: sweeps as f64 / steps.max(1) as f64,
         unconverged_steps: unconverged,

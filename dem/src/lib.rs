@@ -14,6 +14,10 @@
 //! coloured separator, [`colouring`], [`blocked`] and [`parallel`], with the same numbers on any
 //! thread count) → θ-method position update.
 //!
+//! Helpers for runs that only want a state: [`hydrostatic`] (a weight-carrying first guess of
+//! the impulses of a packing generated at rest, [`world::World::prime_with_weight`]) and
+//! [`step_control`] (a time step adapted to the solver's convergence).
+//!
 //! The same local law solves standalone frictional-contact problems given by `W`, `q`, `μ`
 //! ([`fc`]).
 
@@ -29,12 +33,14 @@ pub mod contact;
 pub mod detection;
 pub mod error;
 pub mod fc;
+pub mod hydrostatic;
 pub mod local;
 pub mod material;
 pub mod parallel;
 pub mod serde_float;
 pub mod snapshot;
 pub mod solver;
+pub mod step_control;
 pub mod world;
 
 pub use body::{Body, BodyKind, Dof};
