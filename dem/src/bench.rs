@@ -1,10 +1,7 @@
-//! Engine benchmark: a deposit of N disks in a wide box, timed per step.
-//!
-//! Reports the time per step, the contact updates per second of the Gauss–Seidel sweeps
-//! (contacts × sweeps / solve time) and the time spent in detection. The deposit starts as a
-//! loose seeded grid of polydisperse disks (radius 1–2 mm) that first settles for
-//! `settle_steps` steps (not timed), so that the timed steps see a dense, warm-started packing,
-//! the regime of long quasi-static runs.
+//! Measurements behind `grainlaw bench` (the benchmark worlds themselves are built in
+//! `datasets::benchmarks`): bare sweep rate ([`sweep_rate`]), settling to rest with an optional
+//! adaptive step ([`settle`], [`energy_ratio`]) and the memory footprint of the data layout
+//! ([`MemoryFootprint`]); plus a loose-grid deposit ([`deposit_world`]) for profiling.
 
 use std::time::Instant;
 
@@ -13,23 +10,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::step_control::StepControl;
 use crate::{ContactLaws, SolverParams, World, WorldParams};
-
-/// One measured row.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct EngineBenchRow {
-    /// Grains.
-    pub grains: usize,
-    /// Mean contacts per timed step.
-    pub contacts: f64,
-    /// Mean Gauss–Seidel sweeps per timed step.
-    pub sweeps: f64,
-    /// Wall-clock seconds per step (detection + solve + update).
-    pub seconds_per_step: f64,
-    /// Contact updates per second in the whole step (contacts × sweeps / step time).
-    pub contact_updates_per_second: f64,
-    /// Steps that stopped at the sweep limit.
-    pub unconverged_steps: usize,
-}
 
 /// A box `width` wide holding `n` disks of radius in [1, 2] mm on a loose seeded grid, μ = 0.3,
 /// density 2500 kg/m³, time step 2·10⁻⁴ s.
@@ -79,38 +59,6 @@ pub fn grid_world(n: usize, width: f64, mu: f64, seed: u64) -> World {
         w.add_grain(Vector2::new(x, y), r, 2500.0, 0);
     }
     w
-}
-
-/// Settle a deposit of `n` grains (box 1.5·√n diameters wide) for `settle_steps`, then time
-/// `steps` steps.
-pub fn deposit_benchmark(n: usize, settle_steps: usize, steps: usize) -> EngineBenchRow {
-    let width = (1.5 * (n as f64).sqrt()).ceil() * 4.1e-3;
-    let mut w = deposit_world(n, width, 1);
-    for _ in 0..settle_steps {
-        let _ = w.step();
-    }
-    let (mut contacts, mut sweeps, mut unconverged, mut updates) = (0usize, 0usize, 0usize, 0f64);
-    let t0 = Instant::now();
-    for _ in 0..steps {
-        if let Ok(rep) = w.step() {
-            contacts += rep.contacts;
-            sweeps += rep.solver.iterations;
-            updates += (rep.contacts * rep.solver.iterations.max(1)) as f64;
-            if !rep.solver.converged {
-                unconverged += 1;
-            }
-        }
-    }
-    let secs = t0.elapsed().as_secs_f64();
-    let steps_f = steps.max(1) as f64;
-    EngineBenchRow {
-        grains: n,
-        contacts: contacts as f64 / steps_f,
-        sweeps: sweeps as f64 / steps_f,
-        seconds_per_step: secs / steps_f,
-        contact_updates_per_second: updates / secs.max(1e-12),
-        unconverged_steps: unconverged,
-    }
 }
 
 /// Contact updates per second of bare Gauss–Seidel sweeps (natural order, one thread, no error

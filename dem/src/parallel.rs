@@ -18,7 +18,7 @@ use crate::contact::ContactRow;
 use crate::local::{project_on_cone, solve_local};
 
 /// Contacts per chunk of the fixed-partition reductions.
-pub const CHUNK: usize = 4096;
+pub const CHUNK: usize = 1024;
 /// Fewest contacts per parallel task inside a colour class (rayon splits adaptively above).
 pub const TASK: usize = 256;
 /// Classes with fewer contacts than this are swept on the calling thread (the same numbers, no
