@@ -15,7 +15,9 @@ fn main() {
         run.parallel = false;
     }
     if let Ok(v) = std::env::var("DT") {
+        // a fixed step
         run.dt = v.parse().expect("DT");
+        run.dt_range = [run.dt, run.dt];
     }
     if let Ok(v) = std::env::var("CAP") {
         run.max_sweeps = v.parse().expect("CAP");

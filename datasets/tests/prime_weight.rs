@@ -26,12 +26,12 @@ fn column(n: usize, seed: u64) -> dem::World {
 fn primed_impulses_carry_the_weight_to_the_walls() {
     let mut w = column(600, 5);
     w.prime_with_weight().unwrap();
-    let h = w.params.dt;
+    let (h, g) = (w.params.dt, w.params.gravity.norm());
     let weight: f64 = w
         .bodies
         .iter()
         .filter(|b| b.kind == BodyKind::Grain)
-        .map(|b| b.mass * 9.81 * h)
+        .map(|b| b.mass * g * h)
         .sum();
     let mut from_walls = 0.0;
     for c in &w.contacts().rows {

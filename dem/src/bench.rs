@@ -96,7 +96,7 @@ pub struct SettleReport {
     pub steps: u64,
     /// Simulated time (s).
     pub simulated_seconds: f64,
-    /// Smallest and largest time step used (s).
+    /// Smallest and largest time step the steps used (s).
     pub dt_range: [f64; 2],
     /// Wall-clock seconds (building excluded).
     pub wall_seconds: f64,
@@ -138,13 +138,16 @@ pub fn settle(
 ) -> SettleReport {
     let t0 = Instant::now();
     let (mut steps, mut sweeps, mut unconverged) = (0u64, 0u64, 0u64);
-    let (mut simulated, mut dt_min, mut dt_max) = (0.0, w.params.dt, w.params.dt);
+    let (mut simulated, mut dt_min, mut dt_max) = (0.0f64, f64::INFINITY, 0.0f64);
     let mut ratio = energy_ratio(w);
-    while simulated < max_time {
+    // half a step of slack: the sum of the steps must not add a step to a fixed-step run
+    while simulated < max_time - 0.5 * w.params.dt {
         let h = w.params.dt;
         let Ok(rep) = w.step() else { break };
         steps += 1;
         simulated += h;
+        dt_min = dt_min.min(h);
+        dt_max = dt_max.max(h);
         sweeps += rep.solver.iterations as u64;
         unconverged += u64::from(!rep.solver.converged);
         ratio = energy_ratio(w);
@@ -152,9 +155,7 @@ pub fn settle(
             break;
         }
         if let Some(c) = control.as_mut() {
-            let h = c.after(w, &rep);
-            dt_min = dt_min.min(h);
-            dt_max = dt_max.max(h);
+            c.after(w, &rep);
         }
     }
     let height = w
@@ -173,7 +174,11 @@ pub fn settle(
         width: f64::NAN,
         steps,
         simulated_seconds: simulated,
-        dt_range: [dt_min, dt_max],
+        dt_range: if steps > 0 {
+            [dt_min, dt_max]
+        } else {
+            [w.params.dt; 2]
+        },
         wall_seconds: t0.elapsed().as_secs_f64(),
         mean_sweeps: sweeps as f64 / steps.max(1) as f64,
         unconverged_steps: unconverged,

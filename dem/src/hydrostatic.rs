@@ -35,12 +35,18 @@ use crate::contact::ContactRow;
 
 /// Smallest rise `c = −d·ĝ` of a support normal (a contact within about 78° of vertical).
 pub const C_MIN: f64 = 0.2;
-/// Largest normal impulse given to one support, in units of the load it carries.
+/// Largest normal impulse given to one support, in units of the load of the grain it supports.
 pub const P_MAX: f64 = 2.0;
 
-/// Overwrite the normal impulses of `rows` with the weight-carrying estimate (tangential
+/// Overwrite the normal impulses of `rows` (N·s) with the weight-carrying estimate (tangential
 /// impulses set to zero) for time step `h` (s) and gravity `gravity` (m/s²). `inv` holds the
-/// bodies' inverse masses: a body carries load only if it is free along gravity (a grain).
+/// bodies' inverse masses: a body carries and passes on load if gravity acts on it, its mass is
+/// finite and it is free to translate along x or y (grains and clumps; walls only receive).
+///
+/// Bodies are visited by the height of their centre along `−ĝ`, which orders supports below the
+/// grains they carry for disks. For clumps, or for a support across a periodic boundary, a
+/// support can come first; its load is then not passed on (lost, never counted twice), which
+/// only weakens the estimate.
 pub fn weight_impulses(
     rows: &mut [ContactRow],
     bodies: &[Body],
@@ -135,6 +141,45 @@ mod tests {
         let mut b = Body::disk(Vector2::new(x, y), 1.0, 1.0, 1.0);
         b.mass = m;
         b
+    }
+
+    /// A grain resting on two grains at ±30° from the vertical and touching a side wall: the
+    /// side contact (horizontal normal, rise 0 < C_MIN) gets nothing, the two supports
+    /// `P / (2 cos 30°)` each, which balances the grain exactly (statics of a symmetric wedge).
+    #[test]
+    fn a_grain_on_two_slanted_supports_is_balanced() {
+        let wall = Body::wall("side", Vector2::zeros(), Vector2::zeros());
+        let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+        let mut bodies = vec![
+            wall,
+            grain(-s, -c, 1.0),
+            grain(s, -c, 1.0),
+            grain(0.0, 0.0, 2.0),
+        ];
+        // the two supports are held by the wall of the test (immobile)
+        for b in &mut bodies[1..3] {
+            b.dofs = [crate::Dof::Imposed; 3];
+        }
+        let inv: Vec<[f64; 3]> = bodies.iter().map(Body::inverse_mass).collect();
+        let mk = |a: u32, b: u32, n: [f64; 2]| ContactRow {
+            a,
+            b,
+            n,
+            mu: 0.5,
+            ..Default::default()
+        };
+        // normals from a (support) to b (the top grain)
+        let mut rows = vec![mk(1, 3, [s, c]), mk(2, 3, [-s, c]), mk(0, 3, [1.0, 0.0])];
+        let (g, h) = (9.81, 1e-3);
+        weight_impulses(&mut rows, &bodies, &inv, Vector2::new(0.0, -g), h);
+        let p = 2.0 * g * h;
+        for row in &rows[..2] {
+            assert!((row.r[0] - p / (2.0 * c)).abs() <= 1e-12 * p, "{:?}", row.r);
+        }
+        assert_eq!(rows[2].r, [0.0, 0.0]);
+        let fx: f64 = rows.iter().map(|r| r.r[0] * r.n[0]).sum();
+        let fy: f64 = rows.iter().map(|r| r.r[0] * r.n[1]).sum();
+        assert!(fx.abs() <= 1e-12 * p && (fy - p).abs() <= 1e-12 * p);
     }
 
     /// A vertical stack of three grains on a fixed floor: the floor contact carries the weight

@@ -6,7 +6,7 @@
 //! `T / h` steps the overlap left behind scales as `T u_a`, with `u_a` itself of the order of the
 //! unbalanced part of `g h`: halving `h` roughly halves the overlap a transient leaves, and it
 //! makes each step's load change smaller. Once the packing is quiet the step can grow again.
-//! This is the rule of LMGC90's adaptive step on the NLGS iteration count:
+//! A rule in the spirit of LMGC90's adaptive step on the NLGS iteration count:
 //!
 //! ```text
 //! solve not converged                       →  h ← max(h / 2, h_min)

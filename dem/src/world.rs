@@ -510,7 +510,11 @@ impl World {
     /// down to its supports ([`crate::hydrostatic`]); the next step starts its solve from them
     /// instead of from zero. Meant for a packing generated at rest (a geometric deposit): its
     /// first steps otherwise spend of the order of `H²` sweeps (`H` its depth in grains) letting
-    /// the weight reach the floor. Changes only the solver's starting point.
+    /// the weight reach the floor.
+    ///
+    /// The primed impulses replace the contact set that [`World::contacts`], snapshots and
+    /// checkpoints show until the next step (contact forces on bodies are not refreshed). Called
+    /// in the middle of a run it discards the warm start of the previous step.
     pub fn prime_with_weight(&mut self) -> Result<(), DemError> {
         self.refresh_inverse_mass();
         let periodic = self.periodic();

@@ -4,10 +4,12 @@
 
 pub mod deposition;
 pub mod lattice;
+pub mod ordering;
 pub mod radii;
 pub mod rain;
 
 pub use deposition::{deposit, Deposition, Support};
 pub use lattice::{lattice, Arrangement};
+pub use ordering::spatial_order;
 pub use radii::{total_area, uniform_radii};
 pub use rain::{rain, RainBox};
