@@ -43,6 +43,7 @@ pub struct Anderson {
 /// Entries per chunk of the parallel passes; the partial sums of the chunks are added in chunk
 /// order, so the result does not depend on the number of threads.
 const CHUNK: usize = 2 * crate::parallel::CHUNK;
+use crate::parallel::MIN_CHUNKS_PER_TASK;
 
 impl Anderson {
     /// Acceleration with memory `m ≥ 1` for vectors of length `len`.
@@ -124,6 +125,7 @@ impl Anderson {
                 .zip(self.f_prev.par_chunks_mut(CHUNK))
                 .zip(self.g_prev.par_chunks_mut(CHUNK))
                 .zip(partials.par_chunks_mut(2 * m))
+                .with_min_len(MIN_CHUNKS_PER_TASK)
                 .enumerate()
                 .for_each(|(ci, ((((dfc, dgc), fpc), gpc), part))| {
                     let r = ci * CHUNK..ci * CHUNK + dfc.len();
@@ -197,15 +199,18 @@ impl Anderson {
         slots.clear();
         slots.extend((0..c).map(|p| self.slot(p)));
         let (dg, gamma) = (&self.dg, &self.b[..c]);
-        g.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, gc)| {
-            let start = ci * CHUNK;
-            for (p, &gam) in gamma.iter().enumerate() {
-                let dgp = &dg[slots[p]][start..start + gc.len()];
-                for (gi, &a) in gc.iter_mut().zip(dgp) {
-                    *gi -= gam * a;
+        g.par_chunks_mut(CHUNK)
+            .with_min_len(MIN_CHUNKS_PER_TASK)
+            .enumerate()
+            .for_each(|(ci, gc)| {
+                let start = ci * CHUNK;
+                for (p, &gam) in gamma.iter().enumerate() {
+                    let dgp = &dg[slots[p]][start..start + gc.len()];
+                    for (gi, &a) in gc.iter_mut().zip(dgp) {
+                        *gi -= gam * a;
+                    }
                 }
-            }
-        });
+            });
         self.slots = slots;
     }
 

@@ -19,6 +19,10 @@ use crate::local::{project_on_cone, solve_local};
 
 /// Contacts per chunk of the fixed-partition reductions.
 pub const CHUNK: usize = 1024;
+/// Fewest chunks per parallel task of the chunked passes: below `2 × 4 × CHUNK` contacts a pass
+/// runs on the calling thread (the same partial sums in the same order, so the same bits),
+/// where forking would cost more than the pass.
+pub const MIN_CHUNKS_PER_TASK: usize = 4;
 /// Fewest contacts per parallel task inside a colour class (rayon splits adaptively above).
 pub const TASK: usize = 256;
 /// Classes with fewer contacts than this are swept on the calling thread (the same numbers, no
@@ -206,6 +210,7 @@ pub fn gather_velocities(
 /// `max_α f(α)` over the contacts, chunk by chunk on the rayon pool (−∞ when there is none).
 pub fn max_over(rows: &[ContactRow], f: impl Fn(&ContactRow) -> f64 + Sync) -> f64 {
     rows.par_chunks(CHUNK)
+        .with_min_len(MIN_CHUNKS_PER_TASK)
         .map(|ch| ch.iter().map(&f).fold(f64::NEG_INFINITY, f64::max))
         .reduce(|| f64::NEG_INFINITY, f64::max)
 }
@@ -230,7 +235,11 @@ pub fn reduce_chunks<const N: usize>(
     if rows.len() <= CHUNK {
         total = partial(rows);
     } else {
-        let parts: Vec<[f64; N]> = rows.par_chunks(CHUNK).map(partial).collect();
+        let parts: Vec<[f64; N]> = rows
+            .par_chunks(CHUNK)
+            .with_min_len(MIN_CHUNKS_PER_TASK)
+            .map(partial)
+            .collect();
         for p in parts {
             for k in 0..N {
                 total[k] += p[k];

@@ -36,6 +36,7 @@ use crate::contact::ContactRow;
 use crate::local::{natural_map_residual, ContactStatus};
 use crate::parallel::{
     coloured_sweep, gather_velocities, local_update, max_over, reduce_chunks, CHUNK,
+    MIN_CHUNKS_PER_TASK,
 };
 
 /// Parameters of the NLGS solver.
@@ -396,6 +397,7 @@ pub fn solve(
                 aa.step(&work.x, &mut work.g);
                 rows.par_chunks_mut(CHUNK)
                     .zip(work.g.par_chunks(2 * CHUNK))
+                    .with_min_len(MIN_CHUNKS_PER_TASK)
                     .for_each(|(rs, g)| {
                         for (c, r) in rs.iter_mut().zip(g.chunks_exact(2)) {
                             c.r = [r[0], r[1]];
@@ -426,6 +428,7 @@ fn copy_impulses(rows: &[ContactRow], x: &mut Vec<f64>) {
     x.resize(2 * rows.len(), 0.0);
     rows.par_chunks(CHUNK)
         .zip(x.par_chunks_mut(2 * CHUNK))
+        .with_min_len(MIN_CHUNKS_PER_TASK)
         .for_each(|(rs, x)| {
             for (c, x) in rs.iter().zip(x.chunks_exact_mut(2)) {
                 x[0] = c.r[0];

@@ -517,9 +517,17 @@ impl World {
     /// in the middle of a run it discards the warm start of the previous step.
     pub fn prime_with_weight(&mut self) -> Result<(), DemError> {
         self.refresh_inverse_mass();
+        self.detect_step_contacts()?;
+        let (h, g) = (self.params.dt, self.params.gravity);
+        crate::hydrostatic::weight_impulses(&mut self.contacts.rows, &self.bodies, &self.inv, g, h);
+        self.contacts.dt = h;
+        Ok(())
+    }
+
+    /// Detection into `self.contacts` with the step's gap, time step and gravity (the inverse
+    /// masses must be current).
+    fn detect_step_contacts(&mut self) -> Result<(), DemError> {
         let periodic = self.periodic();
-        let h = self.params.dt;
-        let g = self.params.gravity;
         self.detector.detect(
             &self.bodies,
             &self.inv,
@@ -527,13 +535,10 @@ impl World {
             &self.laws,
             periodic,
             self.params.detection_gap,
-            h,
-            g.norm(),
+            self.params.dt,
+            self.params.gravity.norm(),
             &mut self.contacts,
-        )?;
-        crate::hydrostatic::weight_impulses(&mut self.contacts.rows, &self.bodies, &self.inv, g, h);
-        self.contacts.dt = h;
-        Ok(())
+        )
     }
 
     /// Contact forces received by each body during the last step (walls' loads), N and N·m;
@@ -593,17 +598,7 @@ impl World {
 
         // 1. Detection at q⁻, warm start from the previous step.
         std::mem::swap(&mut self.contacts, &mut self.previous);
-        self.detector.detect(
-            &self.bodies,
-            &self.inv,
-            &self.colliders,
-            &self.laws,
-            periodic,
-            self.params.detection_gap,
-            h,
-            g.norm(),
-            &mut self.contacts,
-        )?;
+        self.detect_step_contacts()?;
         // Impulses scale with the time step (R = h r): rescale if it changed.
         let scale = if self.previous.dt > 0.0 {
             h / self.previous.dt
