@@ -231,11 +231,10 @@ impl MemoryFootprint {
             + 2 * 16 // centres (world and copy)
             + 2 // mobility flags
             + 4 + 4 // permutation both ways
-            + 8 + 4 + 4 + 4; // colouring: masks, slab, sort buffer, adjacency offsets
+            + 8 + 4 + 4; // colouring: masks, slab, sort buffer
         let per_contact = size_of::<crate::contact::ContactRow>() // the copy
             + 8 + 4 // sort keys, permutation
-            + 1 + 4 + 4 // colour, slab, class or slab order
-            + 2 * 4; // adjacency entries
+            + 1 + 4 + 4; // colour, slab, class or slab order
         MemoryFootprint {
             per_grain,
             per_contact,

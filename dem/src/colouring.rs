@@ -39,12 +39,6 @@ pub struct ContactColouring {
     /// True when the last class holds contacts that found no free colour among 64 and must be
     /// updated one after the other.
     pub sequential_tail: bool,
-    /// Contacts of each mobile body: `body_contacts[body_offsets[i]..body_offsets[i + 1]]`, each
-    /// `(contact << 1) | side` with side 0 when the body is the contact's `a`, 1 for `b`,
-    /// ascending by contact. Empty for immobile bodies.
-    pub body_contacts: Vec<u32>,
-    /// Offsets into `body_contacts`, `bodies + 1` entries.
-    pub body_offsets: Vec<u32>,
     /// Interior contacts of each spatial block (see [`ContactColouring::build_blocked`]):
     /// `block_order[block_offsets[k]..block_offsets[k + 1]]`, ascending. Empty without blocks.
     pub block_order: Vec<u32>,
@@ -119,7 +113,6 @@ impl ContactColouring {
         self.contact_block.clear();
         self.contact_block.resize(rows.len(), SEPARATOR);
         self.colour_separator(rows, mobile);
-        self.build_adjacency(rows, mobile);
     }
 
     /// Splits the mobile bodies into `blocks` slabs of equal count along the longer side of
@@ -175,7 +168,6 @@ impl ContactColouring {
             }
         }
         self.colour_separator(rows, mobile);
-        self.build_adjacency(rows, mobile);
     }
 
     /// Greedy first-fit colouring of the separator contacts (all, without blocks).
@@ -242,39 +234,6 @@ impl ContactColouring {
             };
             self.order[start[slot]] = i as u32;
             start[slot] += 1;
-        }
-    }
-
-    /// Body → contacts adjacency (counting sort, ascending contact index per body).
-    fn build_adjacency(&mut self, rows: &[ContactRow], mobile: &[bool]) {
-        self.body_offsets.clear();
-        self.body_offsets.resize(mobile.len() + 1, 0);
-        for c in rows {
-            for (body, m) in [
-                (c.a as usize, mobile[c.a as usize]),
-                (c.b as usize, mobile[c.b as usize]),
-            ] {
-                if m {
-                    self.body_offsets[body + 1] += 1;
-                }
-            }
-        }
-        for i in 0..mobile.len() {
-            self.body_offsets[i + 1] += self.body_offsets[i];
-        }
-        self.body_contacts.clear();
-        self.body_contacts
-            .resize(self.body_offsets[mobile.len()] as usize, 0);
-        self.masks.clear();
-        self.masks
-            .extend(self.body_offsets[..mobile.len()].iter().map(|&o| o as u64));
-        for (k, c) in rows.iter().enumerate() {
-            for (side, body) in [(0u32, c.a as usize), (1u32, c.b as usize)] {
-                if mobile[body] {
-                    self.body_contacts[self.masks[body] as usize] = ((k as u32) << 1) | side;
-                    self.masks[body] += 1;
-                }
-            }
         }
     }
 

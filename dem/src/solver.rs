@@ -35,7 +35,7 @@ use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
 use crate::local::{natural_map_residual, ContactStatus};
 use crate::parallel::{
-    coloured_sweep, gather_velocities, local_update, max_over, reduce_chunks, CHUNK,
+    coloured_sweep, local_update, max_over, reduce_chunks, scatter_velocities, CHUNK,
     MIN_CHUNKS_PER_TASK,
 };
 
@@ -206,8 +206,8 @@ pub fn rebuild_velocities(
             vel.copy_from_slice(v_free);
             apply_impulses(rows, vel, inv)
         }
-        SweepOrder::Coloured { colouring, .. } => {
-            gather_velocities(rows, colouring, vel, v_free, inv)
+        SweepOrder::Coloured { colouring, mobile } => {
+            scatter_velocities(rows, colouring, vel, v_free, inv, mobile)
         }
     }
 }
