@@ -122,7 +122,8 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         return Ok(());
     }
     println!(
-        "\nJanssen column settled to KE/PE < 1e-8 (radius 1–2 mm, μ = 0.5, box 40 mean diameters, all threads):"
+        "\nJanssen column settled to KE/PE < 1e-8 (radius 1–2 mm, μ = 0.5, box 40 mean diameters; one thread below {} grains, else all):",
+        datasets::benchmarks::PARALLEL_FROM_GRAINS
     );
     println!(
         "{:>7} {:>8} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9} {:>14} {:>9}",
@@ -139,7 +140,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         "ratio"
     );
     for (n, prep) in jobs {
-        let run = ColumnRun::for_preparation(prep);
+        let run = ColumnRun::for_column(prep, n);
         let r = settle_column(n, prep, &run, 1)?;
         let total = r.total_seconds();
         let (reference, ratio) = match lammps_reference(n) {
