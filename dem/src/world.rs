@@ -474,18 +474,7 @@ impl World {
         // Overlaps and grains behind walls, with the detector at zero gap.
         self.refresh_inverse_mass();
         let mut set = ContactSet::default();
-        let periodic = self.periodic();
-        self.detector.detect(
-            &self.bodies,
-            &self.inv,
-            &self.colliders,
-            &self.laws,
-            periodic,
-            0.0,
-            0.0,
-            0.0,
-            &mut set,
-        )?;
+        self.detect_into(0.0, 0.0, 0.0, &mut set)?;
         for (row, g) in set.rows.iter().zip(&set.geometry) {
             if g.gap < -tolerance {
                 let (a, b) = (row.a as usize, row.b as usize);
@@ -527,6 +516,26 @@ impl World {
     /// Detection into `self.contacts` with the step's gap, time step and gravity (the inverse
     /// masses must be current).
     fn detect_step_contacts(&mut self) -> Result<(), DemError> {
+        let mut set = std::mem::take(&mut self.contacts);
+        let (gap, h, g) = (
+            self.params.detection_gap,
+            self.params.dt,
+            self.params.gravity.norm(),
+        );
+        let found = self.detect_into(gap, h, g, &mut set);
+        self.contacts = set;
+        found
+    }
+
+    /// Detection into `set`: pairs closer than `gap` (m) plus what they can travel in a step of
+    /// `h` (s) under gravity `g` (m/s²).
+    fn detect_into(
+        &mut self,
+        gap: f64,
+        h: f64,
+        g: f64,
+        set: &mut ContactSet,
+    ) -> Result<(), DemError> {
         let periodic = self.periodic();
         self.detector.detect(
             &self.bodies,
@@ -534,10 +543,10 @@ impl World {
             &self.colliders,
             &self.laws,
             periodic,
-            self.params.detection_gap,
-            self.params.dt,
-            self.params.gravity.norm(),
-            &mut self.contacts,
+            gap,
+            h,
+            g,
+            set,
         )
     }
 
