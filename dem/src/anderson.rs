@@ -17,6 +17,8 @@
 
 use rayon::prelude::*;
 
+use crate::parallel::MIN_CHUNKS_PER_TASK;
+
 /// Anderson acceleration state for vectors of a fixed length.
 #[derive(Debug, Clone)]
 pub struct Anderson {
@@ -43,7 +45,6 @@ pub struct Anderson {
 /// Entries per chunk of the parallel passes; the partial sums of the chunks are added in chunk
 /// order, so the result does not depend on the number of threads.
 const CHUNK: usize = 2 * crate::parallel::CHUNK;
-use crate::parallel::MIN_CHUNKS_PER_TASK;
 
 impl Anderson {
     /// Acceleration with memory `m ≥ 1` for vectors of length `len`.
