@@ -6,7 +6,8 @@ use common::gaussian;
 use identify::fit::FitOptions;
 use identify::laws::{VelocityBoundaryLayer, WallFrictionLaw};
 use identify::wall_law::{
-    fit_boundary_layer, fit_wall_law, select_wall_law, VelocityProfile, WallLawForm, WallSlipSeries,
+    fit_boundary_layer, fit_wall_law, select_wall_law, VelocityProfile, WallLawForm,
+    WallLawSelection, WallSlipSeries,
 };
 use identify::IdentifyError;
 
@@ -26,6 +27,25 @@ fn series(law: &WallFrictionLaw, seed: u64, noise: f64) -> WallSlipSeries {
     )
 }
 
+/// Selects a law on `series(truth, seed, noise)` and asserts that `form` wins, with every
+/// parameter within 3 standard errors of `expected`; returns the selection for further checks.
+fn selects(
+    truth: &WallFrictionLaw,
+    seed: u64,
+    noise: f64,
+    form: WallLawForm,
+    expected: &[f64],
+) -> WallLawSelection {
+    let sel = select_wall_law(&series(truth, seed, noise), &FitOptions::default()).unwrap();
+    assert_eq!(sel.best().form, form, "{:?}", sel.comparison);
+    let params = &sel.best().report.parameters;
+    assert_eq!(params.len(), expected.len());
+    for (p, t) in params.iter().zip(expected) {
+        assert!((p.value - t).abs() < 3.0 * p.std_error, "{p:?}");
+    }
+    sel
+}
+
 #[test]
 fn exponential_data_select_the_exponential_law() {
     let truth = WallFrictionLaw::Exponential {
@@ -33,8 +53,13 @@ fn exponential_data_select_the_exponential_law() {
         mu_inf: 0.45,
         v_star: 0.5,
     };
-    let sel = select_wall_law(&series(&truth, 1, 0.003), &FitOptions::default()).unwrap();
-    assert_eq!(sel.best().form, WallLawForm::Exponential);
+    let sel = selects(
+        &truth,
+        1,
+        0.003,
+        WallLawForm::Exponential,
+        &[0.15, 0.45, 0.5],
+    );
     assert_eq!(sel.comparison.best(), Some("wall-law-exponential"));
     assert_eq!(sel.comparison.ranking[0].delta_aic, 0.0);
     assert!(
@@ -44,9 +69,6 @@ fn exponential_data_select_the_exponential_law() {
     );
     let w: f64 = sel.comparison.ranking.iter().map(|c| c.akaike_weight).sum();
     assert!((w - 1.0).abs() < 1e-12);
-    for (p, t) in sel.best().report.parameters.iter().zip([0.15, 0.45, 0.5]) {
-        assert!((p.value - t).abs() < 3.0 * p.std_error, "{p:?}");
-    }
     assert_eq!(sel.best().report.validity[0].variable, "V");
 }
 
@@ -57,16 +79,7 @@ fn hyperbolic_data_select_the_hyperbolic_law() {
         mu_inf: 0.5,
         v_star: 0.3,
     };
-    let sel = select_wall_law(&series(&truth, 2, 0.003), &FitOptions::default()).unwrap();
-    assert_eq!(
-        sel.best().form,
-        WallLawForm::Hyperbolic,
-        "{:?}",
-        sel.comparison
-    );
-    for (p, t) in sel.best().report.parameters.iter().zip([0.1, 0.5, 0.3]) {
-        assert!((p.value - t).abs() < 3.0 * p.std_error, "{p:?}");
-    }
+    selects(&truth, 2, 0.003, WallLawForm::Hyperbolic, &[0.1, 0.5, 0.3]);
 }
 
 #[test]
@@ -224,15 +237,8 @@ fn a_true_power_law_is_identified() {
         k: 0.1,
         n: 0.5,
     };
-    let sel = select_wall_law(&series(&truth, 5, 0.002), &FitOptions::default()).unwrap();
-    assert_eq!(
-        sel.best().form,
-        WallLawForm::PowerLaw,
-        "{:?}",
-        sel.comparison
-    );
-    for (p, t) in sel.best().report.parameters.iter().zip([0.2, 0.1, 0.5]) {
-        assert!((p.value - t).abs() < 3.0 * p.std_error, "{p:?}");
+    let sel = selects(&truth, 5, 0.002, WallLawForm::PowerLaw, &[0.2, 0.1, 0.5]);
+    for p in &sel.best().report.parameters {
         assert!(p.std_error < 0.1 * p.value, "{p:?}");
     }
 }
