@@ -45,7 +45,7 @@ pub struct ColumnRun {
     /// Time step range `[h_min, h_max]` (s) of the adaptive step ([`StepControl`]): halved after
     /// a capped step, doubled after a calm run. `[dt, dt]` keeps the step fixed.
     pub dt_range: [f64; 2],
-    /// Solver tolerance (error measure of `formats/frictional-contact.md`).
+    /// Solver tolerance (error measure of `docs/formats.md` §1.2).
     pub tolerance: f64,
     /// Sweep cap per step: a step that reaches it continues with its best iterate (counted).
     pub max_sweeps: usize,

@@ -1,7 +1,7 @@
 //! # homogenise — from contact-dynamics snapshots to continuum fields
 //!
 //! Reads `dem::snapshot::Snapshot`s (bodies, contacts, walls after a step; forces are the step's
-//! impulses divided by the time step) and computes (DESIGN §2–§3):
+//! impulses divided by the time step) and computes (`docs/physics.md` §2):
 //!
 //! - per-grain mean stress with inertia, `Σ_p = Σ_c + Σ_i`, symmetric, and its region mean
 //!   `Σ = (1/V) Σ_p V_p Σ_p` ([`stress`], regions in [`region`], exact disk–rectangle areas in

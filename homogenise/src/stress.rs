@@ -1,5 +1,5 @@
-//! Mean stress of a grain with inertia (DESIGN §2, the paper's eq. 8–12) and its region mean
-//! (eq. 9).
+//! Mean stress of a grain with inertia (`docs/physics.md` §2.1, the seed paper's eq. 8–12) and
+//! its region mean (eq. 9, `docs/physics.md` §2.2).
 //!
 //! For a grain `p` (volume `V_p`, centre `c_p`) under contact forces `r_α` at points `x_α` and
 //! the body force `ρ (g − ẍ)`:
@@ -80,7 +80,7 @@ pub fn disk_inertia_stress(inertia: f64, volume: f64, omega: f64, omega_dot: f64
 }
 
 /// Per-grain mean stresses `Σ_p` (contact, inertia, total) of every grain of the snapshot, in
-/// body order. Implements DESIGN §2 (see the module documentation).
+/// body order. Implements `docs/physics.md` §2.1 (see the module documentation).
 pub fn grain_stresses(snapshot: &Snapshot) -> Result<Vec<GrainStress>> {
     check_snapshot(snapshot)?;
     let moments = contact_moments(snapshot);

@@ -59,7 +59,7 @@ pub fn in_frame(t: &Tensor2, e1: &Vector2<f64>, e2: &Vector2<f64>) -> Tensor2 {
 
 /// The slope frame of a plane inclined by `angle` (rad) going down towards +x under gravity
 /// along −y: `e1 = (cos φ, −sin φ)` down the slope, `e2 = (sin φ, cos φ)` the outward normal
-/// (right-handed). Use with [`in_frame`] for the rolling disk (DESIGN §2).
+/// (right-handed). Use with [`in_frame`] for the rolling disk (`docs/physics.md` §2.3).
 pub fn slope_frame(angle: f64) -> (Vector2<f64>, Vector2<f64>) {
     let (s, c) = angle.sin_cos();
     (Vector2::new(c, -s), Vector2::new(s, c))

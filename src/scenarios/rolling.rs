@@ -1,5 +1,6 @@
-//! The `rolling` scenario: one homogeneous disk released from rest on a slope (DESIGN §2, the
-//! paper's eq. 13–14), the exact check of the mean stress with inertia.
+//! The `rolling` scenario: one homogeneous disk released from rest on a slope
+//! (`docs/physics.md` §2.3, the seed paper's eq. 13–14), the exact check of the mean stress
+//! with inertia. Its files and `summary.json` keys: `docs/outputs.md` §3.1.
 //!
 //! In the slope frame (e₁ down the slope, e₂ the outward normal), for μ ≥ tan φ / 3 the disk
 //! rolls without slipping with acceleration `(2/3) g sin φ`, and when its centre has travelled L

@@ -1,5 +1,5 @@
-//! The `rolling` scenario (paper §3, DESIGN §2): one homogeneous disk released from rest on a
-//! slope, the exact check of the mean stress with inertia.
+//! The `rolling` scenario (paper §3, `docs/physics.md` §2.3): one homogeneous disk released
+//! from rest on a slope, the exact check of the mean stress with inertia.
 
 use serde::{Deserialize, Serialize};
 
