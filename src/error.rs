@@ -4,7 +4,8 @@ use thiserror::Error;
 
 /// Everything `grainlaw` can fail with. [`CliError::one_line`] is what is printed; the exit code
 /// ([`CliError::exit_code`]) is 2 for all of them (bad input, unreadable file, failed run),
-/// after no partial output that looks complete, except 130 for [`CliError::Interrupted`].
+/// after no partial output that looks complete, except 130 for [`CliError::Interrupted`] and 3
+/// for [`CliError::FitRefused`].
 #[derive(Debug, Error)]
 pub enum CliError {
     /// Scenario loading, validation, generation.
@@ -29,6 +30,15 @@ pub enum CliError {
         /// The data file.
         path: String,
         /// What is wrong with it (one line).
+        reason: String,
+    },
+    /// `grainlaw fit` read the data but refused the fit (not identifiable, an interval crossing a
+    /// physical bound, R² too low, ...): exit code 3. The message names the file first.
+    #[error("{path}: {reason}")]
+    FitRefused {
+        /// The data file.
+        path: String,
+        /// Why the fit was refused (one line), with the simpler form when there is one.
         reason: String,
     },
     /// Reading or writing a file.
@@ -82,10 +92,12 @@ impl CliError {
     }
 
     /// The process exit code: 130 (128 + SIGINT, the shells' convention) for a run stopped by
-    /// the user, which can be resumed; 2 for every error.
+    /// the user, which can be resumed; 3 for a fit refused on valid data; 2 for every other
+    /// error.
     pub fn exit_code(&self) -> i32 {
         match self {
             CliError::Interrupted { .. } => 130,
+            CliError::FitRefused { .. } => 3,
             _ => 2,
         }
     }

@@ -1,28 +1,31 @@
 //! `grainlaw fit LAW DATA.csv [--out law.json]`: fits a law to a user's CSV.
+//!
+//! Exit status: 0 when the law passed every check of `identify::accept` and was written; 2 for
+//! bad input (unreadable or malformed file, missing column or metadata, unknown metadata key,
+//! value out of its domain, too few rows, unknown law); 3 when the data were read but the fit
+//! was refused (not identifiable, a parameter at its bound or with a standard error above its
+//! value, an interval crossing a physical bound, a scale outside the data, R² below the
+//! threshold or below the simpler nested form's). Errors are one line on stderr, naming the file
+//! first; a refusal ends with the simpler form to use when there is one.
 
 use std::path::Path;
 
+use identify::law::{CalibratedLaw, DerivedQuantity, LawParameter};
 use identify::user_fit::{fit_csv_file, CsvFitOptions};
-use identify::{Estimate, IdentifyError};
+use identify::IdentifyError;
 
 use crate::error::{CliError, Result};
 use crate::output::dir::write_atomic;
 
-/// Fits `law` to `data`; prints the parameters with their 95 % intervals (a parameter held at
-/// its bound is printed as such, not as an estimate), and writes the calibrated-law JSON to
-/// `out` (or stdout without it). Every error about the data starts with the file's path.
+/// Fits `law` to `data`; prints every parameter with its 95 % interval (a parameter held at its
+/// bound is printed as such, not as an estimate; angles also in degrees), then the derived
+/// quantities, and writes the calibrated-law JSON to `out`. With `out` the lines go to stdout;
+/// without it the JSON goes to stdout (so that it can be piped) and the lines to stderr.
 pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
     let cal =
         fit_csv_file(law, data, &CsvFitOptions::default()).map_err(|e| naming_file(data, e))?;
     let json = cal.to_json_string()? + "\n";
-    let mut lines = vec![format!(
-        "{} fitted to {} ({} points, R² = {:.4})",
-        cal.law,
-        data.display(),
-        cal.fit.n,
-        cal.fit.r_squared
-    )];
-    lines.extend(cal.parameters.iter().map(parameter_line));
+    let lines = report_lines(&cal, data);
     match out {
         Some(path) => {
             write_atomic(path, json.as_bytes())?;
@@ -41,20 +44,45 @@ pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
-/// One printed parameter: `name = value unit (95 % CI low … high)`; a parameter on its bound
-/// (`at_bound`, e.g. a Mohr–Coulomb cohesion held at `c = 0`, a Janssen `μ_w` fixed at
-/// `μ_wall`) is `name = at its bound (value unit), not an estimate`, followed by the upper end
-/// the data allow when its interval is one-sided and not empty.
-fn parameter_line(p: &Estimate) -> String {
+/// The printed report: a title line, one line per parameter (in the registry's order), one per
+/// derived quantity.
+fn report_lines(cal: &CalibratedLaw, data: &Path) -> Vec<String> {
+    let mut lines = vec![format!(
+        "{} fitted to {} ({} points, R² = {:.4})",
+        cal.law,
+        data.display(),
+        cal.fit.n,
+        cal.fit.r_squared
+    )];
+    for p in &cal.parameters {
+        lines.push(parameter_line(p));
+    }
+    for d in &cal.derived {
+        lines.push(derived_line(d));
+    }
+    lines
+}
+
+/// ` unit` for a unit other than `1`.
+fn unit_suffix(unit: &str) -> String {
+    if unit == "1" {
+        String::new()
+    } else {
+        format!(" {unit}")
+    }
+}
+
+/// One printed parameter: `name = value unit (95 % CI low … high)`, with `= value° (95 % CI
+/// low° … high°)` for an angle; a parameter on its bound (`at_bound`, e.g. a Mohr–Coulomb
+/// cohesion held at `c = 0`, a Janssen `μ_w` fixed at `μ_wall`) is
+/// `name = at its bound (value unit), not an estimate`, followed by the upper end the data allow
+/// when its interval is one-sided and not empty.
+fn parameter_line(p: &LawParameter) -> String {
+    let name = &p.name;
+    let unit = unit_suffix(&p.unit);
     if p.at_bound {
-        let unit = if p.unit == "1" {
-            String::new()
-        } else {
-            format!(" {}", p.unit)
-        };
         let mut l = format!(
-            "  {:<10} = at its bound ({}{unit}), not an estimate",
-            p.name,
+            "  {name:<10} = at its bound ({}{unit}), not an estimate",
             identify::error::short(p.value),
         );
         if p.ci_high > p.value {
@@ -65,18 +93,51 @@ fn parameter_line(p: &Estimate) -> String {
         }
         l
     } else {
+        let mut l = format!(
+            "  {name:<10} = {:.6e}{unit}  (95 % CI {:.6e} … {:.6e})",
+            p.value, p.ci_low, p.ci_high
+        );
+        if let Some(d) = &p.deg {
+            l.push_str(&format!(
+                " = {:.4}°  (95 % CI {:.4}° … {:.4}°)",
+                d.value, d.ci_low, d.ci_high
+            ));
+        }
+        l
+    }
+}
+
+/// One derived quantity: `name = value unit (95 % CI low … high), derived: formula`.
+fn derived_line(d: &DerivedQuantity) -> String {
+    let name = &d.name;
+    let unit = unit_suffix(&d.unit);
+    if d.at_bound {
         format!(
-            "  {:<10} = {:.6e} {}  (95 % CI {:.6e} … {:.6e})",
-            p.name, p.value, p.unit, p.ci_low, p.ci_high
+            "  {name:<10} = {}{unit}, fixed (derived: {})",
+            identify::error::short(d.value),
+            d.formula
+        )
+    } else {
+        format!(
+            "  {name:<10} = {:.6e}{unit}  (95 % CI {:.6e} … {:.6e}; derived: {})",
+            d.value, d.ci_low, d.ci_high, d.formula
         )
     }
 }
 
 /// Puts the data file's path in front of a fit error whose message does not start with it (an
-/// unknown law name is about the argument, not the file, and is left as it is).
+/// unknown law name is about the argument, not the file, and is left as it is); a refusal
+/// ([`IdentifyError::is_refusal`]) becomes [`CliError::FitRefused`] (exit code 3).
 fn naming_file(data: &Path, e: IdentifyError) -> CliError {
     let path = data.display().to_string();
     let message = e.to_string();
+    if e.is_refusal() {
+        let reason = message
+            .strip_prefix(&path)
+            .map(|m| m.trim_start_matches(':').trim_start().to_string())
+            .unwrap_or(message);
+        return CliError::FitRefused { path, reason };
+    }
     if matches!(e, IdentifyError::UnknownLaw { .. }) || message.starts_with(&path) {
         CliError::Identify(e)
     } else {

@@ -1,10 +1,15 @@
 //! Typed errors of the identification stage.
 //!
 //! A fit that cannot identify its law returns one of these instead of numbers: too few points,
-//! non-finite values, zero variance, negative pressure, an inertial-number range far below (or
-//! above) `I₀`, a parameter ending at its bound, a parameter whose standard error exceeds its
-//! value, a rank-deficient Jacobian. Reading a user's CSV gives errors that name the file, the
-//! line and the column. Computed numbers in messages are printed short ([`short`]).
+//! non-finite values, zero variance, negative pressure, a scale parameter (`I₀`, `V*`, `δ`)
+//! outside the range of its variable in the data, a parameter ending at its bound, a 95 %
+//! interval crossing a physical bound, a parameter whose standard error exceeds its value, an R²
+//! below [`crate::accept::MIN_R_SQUARED`] or below that of the law's simpler nested form, a
+//! rank-deficient Jacobian (the checks are in [`crate::accept`]). Where a simpler form is
+//! supported, the refusal carries it as a [`Suggestion`] that ends its message
+//! (`…; use mu-i-linear`). [`IdentifyError::is_refusal`] tells a refused fit (the data were
+//! valid) from bad input. Reading a user's CSV gives errors that name the file, the line and
+//! the column. Computed numbers in messages are printed short ([`short`]).
 
 use crate::report::FitReport;
 
@@ -22,6 +27,55 @@ impl std::fmt::Display for BoundSide {
         match self {
             BoundSide::Lower => write!(f, "lower"),
             BoundSide::Upper => write!(f, "upper"),
+        }
+    }
+}
+
+/// A simpler form to offer in a refusal (`use mu-i-linear`, `fix the cohesion at zero with
+/// '# cohesion = 0'`); shown as `; {text}` at the end of the message, nothing when empty.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Suggestion(pub Option<String>);
+
+impl Suggestion {
+    /// No suggestion.
+    pub fn none() -> Self {
+        Suggestion(None)
+    }
+
+    /// A suggestion with this text.
+    pub fn of(text: &str) -> Self {
+        Suggestion(Some(text.to_string()))
+    }
+
+    /// The text, if any.
+    pub fn text(&self) -> Option<&str> {
+        self.0.as_deref()
+    }
+}
+
+impl std::fmt::Display for Suggestion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.0 {
+            Some(s) => write!(f, "; {s}"),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Where a scale parameter lies with respect to the data range of its variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScaleSide {
+    /// Above the largest value in the data.
+    AboveData,
+    /// Below the smallest (positive) value in the data.
+    BelowData,
+}
+
+impl std::fmt::Display for ScaleSide {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ScaleSide::AboveData => write!(f, "above the largest"),
+            ScaleSide::BelowData => write!(f, "below the smallest"),
         }
     }
 }
@@ -114,41 +168,36 @@ pub enum IdentifyError {
         /// Depths given.
         total: usize,
     },
-    /// All inertial numbers are far below `I₀` (`I_max < I₀/10`): only the slope
-    /// `(μ₂ − μ_s)/I₀` is identified, not `μ₂` and `I₀` separately.
-    #[error("all I ≤ {i_max:.3e} are far below I₀ ≈ {i0:.3e} (I_max < I₀/10): μ₂ and I₀ are not separately identifiable; fit the linear form or extend the I range")]
-    IRangeBelowI0 {
-        /// Largest inertial number in the data.
-        i_max: f64,
-        /// The estimate of `I₀` the fit ran to.
-        i0: f64,
-    },
-    /// All inertial numbers are far above `I₀` (`I_min > 10 I₀`): the data sit on the plateau
-    /// `μ ≈ μ₂` and `μ_s` is not identified.
-    #[error("all I ≥ {i_min:.3e} are far above I₀ ≈ {i0:.3e} (I_min > 10 I₀): μ_s is not identifiable; extend the I range to slower flows")]
-    IRangeAboveI0 {
-        /// Smallest inertial number in the data.
-        i_min: f64,
-        /// The estimate of `I₀` the fit ran to.
-        i0: f64,
-    },
-    /// A characteristic scale of the law (`V*`, `δ`, ...) lies far outside the data range,
-    /// so the law's curvature is not seen by the data.
-    #[error("{parameter} = {value:.3e} lies far outside the data range [{data_min:.3e}, {data_max:.3e}]: not identifiable from these data")]
+    /// A scale parameter of the law (`I₀` of μ(I), `V*` of a wall law, `δ` of a boundary layer)
+    /// lies outside the range of its variable in the data, `[x_min⁺, x_max]` (`x_min⁺` the
+    /// smallest positive value): the law's curvature is not seen, the scale and the asymptote on
+    /// that side are not separately identifiable from these data (criterion of
+    /// [`crate::accept::check_scale`]).
+    #[error("{law}: refused: {parameter} = {v} lies {side} {variable} in the data ({edge}, data range [{lo}, {hi}]): {parameter} and the law's asymptote are not separately identifiable{suggestion}",
+        v = short(*.value), edge = short(match .side { ScaleSide::AboveData => *.data_max, ScaleSide::BelowData => *.data_min }),
+        lo = short(*.data_min), hi = short(*.data_max))]
     ScaleNotResolved {
+        /// Law or fit.
+        law: String,
         /// Parameter name.
         parameter: String,
         /// Its estimate.
         value: f64,
-        /// Smallest abscissa.
+        /// The variable it is a scale of (`I`, `V`, `y`).
+        variable: String,
+        /// Which side of the data it lies on.
+        side: ScaleSide,
+        /// Smallest positive value of the variable.
         data_min: f64,
-        /// Largest abscissa.
+        /// Largest value of the variable.
         data_max: f64,
+        /// A simpler form the data support, if any.
+        suggestion: Suggestion,
     },
     /// A parameter ended on a bound of its admissible box. The constrained fit is attached so the
     /// caller can inspect it, but its numbers are not an estimate with a valid interval.
     /// The message shows `bound` and `value` with six significant digits ([`short`]).
-    #[error("parameter {name} ended at its {side} bound {b} (value {v}): the data push it outside its physical range", b = short(*.bound), v = short(*.value))]
+    #[error("parameter {name} ended at its {side} bound {b} (value {v}): the data push it outside its physical range{suggestion}", b = short(*.bound), v = short(*.value))]
     ParameterAtBound {
         /// Parameter name.
         name: String,
@@ -160,13 +209,15 @@ pub enum IdentifyError {
         side: BoundSide,
         /// The constrained fit, for inspection only.
         report: Box<FitReport>,
+        /// A simpler form the data support, if any.
+        suggestion: Suggestion,
     },
     /// A parameter the law's shape rests on is not determined by the data: its standard error
     /// exceeds its magnitude, `se(θ) > |θ|`, so its confidence interval `θ ∓ t·se` spans zero
     /// and reaches beyond it by more than `(t − 1)|θ|` (`t ≈ 2–2.8` at 95 %): not even the
     /// sign or order of magnitude of `θ` is fixed (criterion of
-    /// [`crate::fit::check_identified`]). The fit is attached for inspection only.
-    #[error("{law}: not identifiable: {name} = {v} has standard error {se} > |{name}|, its {level} % CI [{lo}, {hi}] spans zero: the data do not determine it",
+    /// [`crate::accept::check_identified`]). The fit is attached for inspection only.
+    #[error("{law}: not identifiable: {name} = {v} has standard error {se} > |{name}|, its {level} % CI [{lo}, {hi}] spans zero: the data do not determine it{suggestion}",
         v = short(*.value), se = short(*.std_error), level = short(100.0 * *.confidence),
         lo = short(*.ci_low), hi = short(*.ci_high))]
     ParameterNotIdentified {
@@ -186,6 +237,71 @@ pub enum IdentifyError {
         confidence: f64,
         /// The fit, for inspection only.
         report: Box<FitReport>,
+        /// A simpler form the data support, if any.
+        suggestion: Suggestion,
+    },
+    /// The confidence interval of a parameter reaches beyond its physical range (`I₀ < 0`,
+    /// `c < 0`, `φ_min < 0`, `μ_w > μ_wall`, ...): the data do not exclude unphysical values, so
+    /// the interval is not a statement about the material (criterion of
+    /// [`crate::accept::check_physical_ranges`]). The fit is attached for inspection only.
+    #[error("{law}: refused: the {level} % interval of {name} [{lo}, {hi}] crosses its physical {side} bound {b}{suggestion}",
+        level = short(100.0 * *.confidence), lo = short(*.ci_low), hi = short(*.ci_high), b = short(*.bound))]
+    IntervalCrossesBound {
+        /// Law or fit.
+        law: String,
+        /// Parameter name.
+        name: String,
+        /// Its estimate.
+        value: f64,
+        /// Lower end of its interval.
+        ci_low: f64,
+        /// Upper end of its interval.
+        ci_high: f64,
+        /// The physical bound crossed.
+        bound: f64,
+        /// Which bound.
+        side: BoundSide,
+        /// Confidence level.
+        confidence: f64,
+        /// The fit, for inspection only.
+        report: Box<FitReport>,
+        /// A simpler form the data support, if any.
+        suggestion: Suggestion,
+    },
+    /// The law explains too little of the data's variance: `R²` below the threshold
+    /// ([`crate::accept::MIN_R_SQUARED`] by default, [`crate::FitOptions::min_r_squared`]).
+    #[error("{law}: refused: R² = {r2} is below {min}: the law does not describe these data{suggestion}",
+        r2 = short(*.r_squared), min = short(*.threshold))]
+    RSquaredTooLow {
+        /// Law or fit.
+        law: String,
+        /// R² of the fit.
+        r_squared: f64,
+        /// The threshold.
+        threshold: f64,
+        /// The fit, for inspection only.
+        report: Box<FitReport>,
+        /// A simpler form, if any.
+        suggestion: Suggestion,
+    },
+    /// The law does no better than its simpler nested form on these data: its adjusted
+    /// `R̄² = 1 − (1 − R²)(n − 1)/(n − p)` is below the nested form's, so its extra parameters
+    /// are not supported (criterion of [`crate::accept::check_nested`]).
+    #[error("{law}: refused: adjusted R² = {a} is below {b} of its simpler nested form {nested}: the extra parameters are not supported by the data{suggestion}",
+        a = short(*.adjusted_r_squared), b = short(*.nested_adjusted_r_squared))]
+    WorseThanNested {
+        /// Law or fit.
+        law: String,
+        /// Its adjusted R².
+        adjusted_r_squared: f64,
+        /// The nested form (`mu-i-linear`, `janssen with full mobilisation`, ...).
+        nested: String,
+        /// The nested form's adjusted R².
+        nested_adjusted_r_squared: f64,
+        /// The fit, for inspection only.
+        report: Box<FitReport>,
+        /// The simpler form to use.
+        suggestion: Suggestion,
     },
     /// The Jacobian at the optimum is rank deficient (or the fit is otherwise degenerate).
     #[error("not identifiable: {reason}")]
@@ -208,7 +324,7 @@ pub enum IdentifyError {
         reason: String,
     },
     /// A column required by the law is missing from a CSV header.
-    #[error("{file}: missing column '{column}' (header has: {available})")]
+    #[error("{file}: missing column '{column}' (header has: {available}){hint}")]
     MissingColumn {
         /// File name.
         file: String,
@@ -216,6 +332,8 @@ pub enum IdentifyError {
         column: String,
         /// The header's columns, comma separated.
         available: String,
+        /// What to rename when the column is there in a unit that is not read.
+        hint: Suggestion,
     },
     /// A CSV cell that should be a number is not.
     #[error("{file}:{line}: column '{column}': '{value}' is not a number")]
@@ -249,6 +367,21 @@ pub enum IdentifyError {
         /// What is wrong.
         message: String,
     },
+    /// A `# key = value` line whose key the law does not read: refused rather than ignored, so
+    /// that a misspelt key never leaves a default in place.
+    #[error("{file}:{line}: unknown metadata key '{key}' for {law} (known keys: {known})")]
+    UnknownMetadata {
+        /// File name.
+        file: String,
+        /// 1-based line (0 for a key given by the caller's options).
+        line: u64,
+        /// The key.
+        key: String,
+        /// The law being fitted.
+        law: String,
+        /// The keys the law reads, comma separated.
+        known: String,
+    },
     /// Malformed CSV (ragged rows, bad UTF-8, ...).
     #[error("{file}:{line}: {message}")]
     Csv {
@@ -276,7 +409,7 @@ pub enum IdentifyError {
     },
     /// Calibrated-law JSON of a schema version this build does not read.
     #[error(
-        "calibrated law schema version {found} is not supported (this build reads {supported})"
+        "calibrated law schema version {found} is not supported (this build reads versions 1 to {supported})"
     )]
     UnsupportedSchema {
         /// Version found.
@@ -298,6 +431,62 @@ pub enum IdentifyError {
         /// Solver status.
         status: String,
     },
+}
+
+impl IdentifyError {
+    /// True when the data were valid for the law but the fit was refused: not identifiable, a
+    /// parameter at its bound or not determined, an interval crossing a physical bound, a scale
+    /// outside the data, an R² too low or below the nested form's, no convergence, zero variance
+    /// of a column. False for bad input (unreadable or malformed file, missing column or
+    /// metadata, value out of its domain, too few rows, unknown law or key). `grainlaw fit`
+    /// exits with 3 for a refusal and 2 for bad input.
+    pub fn is_refusal(&self) -> bool {
+        matches!(
+            self,
+            IdentifyError::ZeroVariance { .. }
+                | IdentifyError::ScaleNotResolved { .. }
+                | IdentifyError::ParameterAtBound { .. }
+                | IdentifyError::ParameterNotIdentified { .. }
+                | IdentifyError::IntervalCrossesBound { .. }
+                | IdentifyError::RSquaredTooLow { .. }
+                | IdentifyError::WorseThanNested { .. }
+                | IdentifyError::NotIdentifiable { .. }
+                | IdentifyError::NoConvergence { .. }
+                | IdentifyError::ConicSolver { .. }
+        )
+    }
+
+    /// The simpler form the refusal offers, if any.
+    pub fn suggestion(&self) -> Option<&str> {
+        match self {
+            IdentifyError::ScaleNotResolved { suggestion, .. }
+            | IdentifyError::ParameterAtBound { suggestion, .. }
+            | IdentifyError::ParameterNotIdentified { suggestion, .. }
+            | IdentifyError::IntervalCrossesBound { suggestion, .. }
+            | IdentifyError::RSquaredTooLow { suggestion, .. }
+            | IdentifyError::WorseThanNested { suggestion, .. } => suggestion.text(),
+            _ => None,
+        }
+    }
+
+    /// The same error offering `text` as the simpler form, when it is a refusal that carries a
+    /// suggestion and has none yet (other errors are returned unchanged).
+    pub fn suggesting(mut self, text: &str) -> Self {
+        match &mut self {
+            IdentifyError::ScaleNotResolved { suggestion, .. }
+            | IdentifyError::ParameterAtBound { suggestion, .. }
+            | IdentifyError::ParameterNotIdentified { suggestion, .. }
+            | IdentifyError::IntervalCrossesBound { suggestion, .. }
+            | IdentifyError::RSquaredTooLow { suggestion, .. }
+            | IdentifyError::WorseThanNested { suggestion, .. }
+                if suggestion.0.is_none() =>
+            {
+                *suggestion = Suggestion::of(text);
+            }
+            _ => {}
+        }
+        self
+    }
 }
 
 /// A number with six significant digits for messages (the `%g` of C): plain notation for

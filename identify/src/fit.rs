@@ -19,8 +19,9 @@
 //!
 //! A parameter that ends on its bound is an error, [`IdentifyError::ParameterAtBound`], carrying
 //! the constrained fit for inspection; a rank-deficient Jacobian is
-//! [`IdentifyError::NotIdentifiable`]. [`check_identified`] refuses a fit whose named parameters
-//! have a standard error larger than their value ([`IdentifyError::ParameterNotIdentified`]).
+//! [`IdentifyError::NotIdentifiable`]. What a law's fit must pass on top of this (scales in the
+//! data, intervals inside the physical ranges, standard errors below the values, R², the nested
+//! form) is in [`crate::accept`].
 
 use argmin::core::{Error as ArgminError, Jacobian, Operator};
 use nalgebra::{DMatrix, DVector};
@@ -168,6 +169,9 @@ pub struct FitOptions {
     pub reweight_groups: bool,
     /// Seeded bootstrap (default none).
     pub bootstrap: Option<BootstrapOptions>,
+    /// A law whose `R²` is below this is refused (default [`crate::accept::MIN_R_SQUARED`],
+    /// 0.5; see [`crate::accept::check_r_squared`]).
+    pub min_r_squared: f64,
 }
 
 impl Default for FitOptions {
@@ -177,6 +181,7 @@ impl Default for FitOptions {
             max_iters: 500,
             reweight_groups: true,
             bootstrap: None,
+            min_r_squared: crate::accept::MIN_R_SQUARED,
         }
     }
 }
@@ -246,37 +251,7 @@ fn run<M: LeastSquaresModel>(
     })
 }
 
-/// Checks that each parameter of `names` is determined by the data, else returns
-/// [`IdentifyError::ParameterNotIdentified`] for the first that is not.
-///
-/// Criterion: a parameter `θ` with standard error `se` is not identified when `se > |θ|`
-/// (or `se` is not finite). Its interval `θ ∓ t·se` then spans zero and reaches beyond it by
-/// more than `(t − 1)|θ|` (`t ≈ 2.0–2.8` at 95 %, so the interval is several times wider than
-/// the value): the data fix neither the sign nor the order of magnitude of `θ`. A merely
-/// insignificant parameter (`|θ| < t·se`, interval spanning zero by less) is kept. Use it on the
-/// parameters the law's shape rests on (an exponent, a velocity scale), not on an offset that may
-/// rightly be close to zero.
-pub fn check_identified(report: &FitReport, names: &[&str]) -> Result<()> {
-    for name in names {
-        let Some(p) = report.parameter(name) else {
-            continue;
-        };
-        let identified = p.std_error.is_finite() && p.std_error <= p.value.abs();
-        if !identified {
-            return Err(IdentifyError::ParameterNotIdentified {
-                law: report.model.clone(),
-                name: p.name.clone(),
-                value: p.value,
-                std_error: p.std_error,
-                ci_low: p.ci_low,
-                ci_high: p.ci_high,
-                confidence: report.confidence,
-                report: Box::new(report.clone()),
-            });
-        }
-    }
-    Ok(())
-}
+pub use crate::accept::check_identified;
 
 /// Minimum number of observations for `p` parameters: `p + 2`.
 pub fn min_points(p: usize) -> usize {
@@ -449,6 +424,7 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
                 bound,
                 side,
                 report: Box::new(report),
+                suggestion: crate::error::Suggestion::none(),
             });
         }
     }

@@ -10,6 +10,12 @@
 //!   every wall contact sliding), fitting `K` only. The documented fallback when the joint fit
 //!   returns [`IdentifyError::ParameterAtBound`] for `mu_w` at its upper bound.
 //!
+//! Every fit passes the checks of [`crate::accept`] or is refused: intervals of `K`, `K μ_w`
+//! non-negative and of `μ_w` inside `[0, μ_wall]` (crossing `μ_wall` offers full
+//! mobilisation), standard errors below the values, `R²` above the threshold, and an adjusted
+//! `R²` not below that of the nested form (full mobilisation for the joint fit, the hydrostatic
+//! line `ρ_b g z` for `K μ_w`).
+//!
 //! Each result reports `K`, `μ_w`, `K μ_w`, the saturation length `λ = W/(2Kμ_w)` and the
 //! mobilisation `μ_w/μ_wall` with 95 % intervals (delta method for derived quantities), the
 //! residuals by depth with the hydrostatic line `ρ_b g z`, and the depth range used.
@@ -19,9 +25,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::accept::{r_squared_of, Acceptance, NestedForm, PhysicalRange};
 use crate::error::{
     check_finite, check_non_negative_pressure, check_same_len, check_setup_positive, check_spread,
-    min_max, IdentifyError, Result,
+    min_max, BoundSide, IdentifyError, Result,
 };
 use crate::fit::{
     fit_least_squares, log_grid, FitOptions, LeastSquaresModel, Observations, ParameterSpec,
@@ -29,6 +36,10 @@ use crate::fit::{
 use crate::laws::janssen::{janssen_shape, JanssenLaw, JanssenVerticalLaw, STANDARD_GRAVITY};
 use crate::report::{Estimate, FitReport, ValidityRange};
 use nalgebra::DMatrix;
+
+/// What a refusal of the joint fit offers when `μ_w` reaches the wall friction.
+const FULL_MOBILISATION: &str =
+    "use full mobilisation, mu_w = mu_wall (janssen with '# full_mobilisation = 1')";
 
 /// A measured stress profile down a column (data).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -432,7 +443,7 @@ fn residual_rows(sel: &Selected, report: &FitReport, setup: &JanssenSetup) -> Ve
 /// Errors: the data checks of [`crate::fit::fit_least_squares`]; [`IdentifyError::NotIdentifiable`]
 /// without `σ_h`; [`IdentifyError::NegativePressure`]; [`IdentifyError::EmptyDepthWindow`];
 /// [`IdentifyError::ParameterAtBound`] when `K → 0`, `μ_w → 0` or `μ_w → μ_wall` (for the last,
-/// see [`fit_janssen_full_mobilisation`]).
+/// see [`fit_janssen_full_mobilisation`]); the refusals of the module documentation.
 pub fn fit_janssen(
     profile: &JanssenProfile,
     setup: &JanssenSetup,
@@ -502,7 +513,36 @@ fn fit_joint(
             vec![k0, mu0]
         }
     };
-    let report = fit_least_squares(&model, &obs, &theta0, &options.fit, validity(&sel))?;
+    let report = fit_least_squares(&model, &obs, &theta0, &options.fit, validity(&sel)).map_err(
+        |e| match &e {
+            IdentifyError::ParameterAtBound {
+                name,
+                side: BoundSide::Upper,
+                ..
+            } if name == "mu_w" => e.suggesting(FULL_MOBILISATION),
+            _ => e,
+        },
+    )?;
+    let acceptance = Acceptance::new(&model.name(), options.fit.min_r_squared).non_negative(&["K"]);
+    match mu_fixed {
+        Some(_) => acceptance,
+        None => {
+            let nested = fit_joint(profile, setup, options, Some(setup.wall_friction))
+                .ok()
+                .map(|f| NestedForm {
+                    name: "janssen with full mobilisation (# full_mobilisation = 1)".into(),
+                    r_squared: f.report.r_squared,
+                    parameters: 1,
+                });
+            acceptance
+                .range(
+                    PhysicalRange::new("mu_w", 0.0, setup.wall_friction)
+                        .suggesting(FULL_MOBILISATION),
+                )
+                .nested(nested)
+        }
+    }
+    .check(&report)?;
     let t = report.t_critical;
     let k = report.parameters[0].clone();
     let mu_w = match mu_fixed {
@@ -582,6 +622,16 @@ pub fn fit_janssen_k_mu(
         vec![0.1]
     };
     let report = fit_least_squares(&model, &obs, &theta0, &options.fit, validity(&sel))?;
+    let rg = setup.bulk_density_kg_m3 * setup.gravity_m_s2;
+    let hydrostatic: Vec<f64> = sel.z.iter().map(|z| rg * z).collect();
+    Acceptance::new("janssen-kmu", options.fit.min_r_squared)
+        .non_negative(&["K_mu_w"])
+        .nested(Some(NestedForm {
+            name: "the hydrostatic line rho_b*g*z".into(),
+            r_squared: r_squared_of(&sel.sv, &hydrostatic),
+            parameters: 0,
+        }))
+        .check(&report)?;
     let w = setup.width_m;
     let k_mu_w = report.parameters[0].clone();
     let lambda = report.derived("saturation_length", "m", |p| {

@@ -1,53 +1,349 @@
-//! Calibrated laws as versioned JSON, for continuum solvers.
+//! Calibrated laws as versioned JSON, for continuum solvers (schema version 2; version 1 is
+//! still read).
 //!
-//! A [`CalibratedLaw`] carries: `schema_version` ([`SCHEMA_VERSION`]), the law name, its
-//! formula as text, the input and output variables with units, the parameters with units,
-//! standard errors and intervals, the constants of the set-up (column width, density, ...),
-//! the validity range of the data, a fit summary (n, R², AIC, BIC), the AIC ranking when a
-//! model was chosen among candidates, and the provenance (scenario, seed, grainlaw version,
-//! source file).
+//! A law is one of a fixed registry ([`REGISTRY`]): its name fixes the formula, written in the
+//! convention `grainlaw-expr-1` ([`crate::expr`]), whose variable names are exactly the
+//! law's input, the names (keys) of its `parameters` and `constants`, its earlier outputs and
+//! the names and inputs of its `where` list. A [`CalibratedLaw`] (schema 2) carries:
 //!
-//! Example (`janssen`):
+//! - `expression`: registry name, convention, input and output with units, the formula, further
+//!   outputs (`also`, e.g. `sigma_h = K*sigma_v`) and `where` definitions that turn a
+//!   solver's variables into the law's input (`I = gamma_dot*d/sqrt(P/rho_s)`);
+//! - `parameters` (a list, each with its `name`): unit, value, standard error, 95 % interval, `at_bound`, and for
+//!   angles (unit `rad`) the same in degrees (`deg`);
+//! - `covariance`: the full covariance matrix of the parameters, in the order it names;
+//! - `derived` (a list): quantities computed from the parameters (`K_mu_w`, the saturation
+//!   length, ...), each with `"derived": true`, its formula and its delta-method interval;
+//! - `constants` (a list, each with its `name`): every constant the formulas need, with unit and description (μ(I)
+//!   needs `d` and `rho_s`);
+//! - `dimension` (`2D, per unit thickness`) and `geometry` (what set-up the law assumes);
+//! - `validity`, `fit` (n, dof, R², AIC, BIC, confidence), `model_selection`;
+//! - `provenance`: scenario, every override, seed, grainlaw version, date, and the SHA-256 of
+//!   each input file (`grainlaw fit` fills its CSV's).
+//!
+//! Example (`mu-i`, abridged):
 //! ```json
 //! {
-//!   "schema_version": 1,
-//!   "law": "janssen",
-//!   "formula": "sigma_v(z) = rho_b*g*W/(2*K*mu_w)*(1 - exp(-2*K*mu_w*z/W)); sigma_h = K*sigma_v; tau_w = mu_w*sigma_h",
-//!   "input": {"name": "z", "unit": "m"},
-//!   "output": {"name": "sigma_v", "unit": "Pa"},
-//!   "parameters": [{"name": "K", "unit": "1", "value": 0.61, "std_error": 0.02,
-//!                   "ci_low": 0.57, "ci_high": 0.65, "at_bound": false}, ...],
-//!   "constants": [{"name": "width", "unit": "m", "value": 0.03}, ...],
-//!   "validity": [{"variable": "z", "unit": "m", "min": 0.01, "max": 0.3}, ...],
-//!   "fit": {"n": 60, "dof": 58, "r_squared": 0.998, "aic": ..., "bic": ..., "confidence": 0.95},
+//!   "schema_version": 2,
+//!   "law": "mu-i",
+//!   "expression": {
+//!     "registry": "grainlaw", "convention": "grainlaw-expr-1",
+//!     "input": {"name": "I", "unit": "1"}, "output": {"name": "mu", "unit": "1"},
+//!     "formula": "mu_s + (mu_2 - mu_s)*I/(I + I_0)", "also": [],
+//!     "where": [{"name": "I", "unit": "1", "formula": "gamma_dot*d/sqrt(P/rho_s)",
+//!                "inputs": [{"name": "gamma_dot", "unit": "1/s"}, {"name": "P", "unit": "Pa"}]}]
+//!   },
+//!   "parameters": [{"name": "mu_s", "unit": "1", "value": 0.38, "std_error": 0.004,
+//!                   "ci_low": 0.372, "ci_high": 0.388, "at_bound": false}, {"name": "mu_2", ...},
+//!                  {"name": "I_0", ...}],
+//!   "covariance": {"order": ["mu_s", "mu_2", "I_0"], "matrix": [[...], [...], [...]]},
+//!   "derived": [],
+//!   "constants": [{"name": "d", "unit": "m", "value": 0.002, "description": "mean grain diameter"},
+//!                 {"name": "rho_s", "unit": "kg/m^3", "value": 2500.0, "description": "..."}],
+//!   "dimension": "2D, per unit thickness",
+//!   "geometry": "steady homogeneous simple shear at imposed pressure P ...",
+//!   "validity": [{"variable": "I", "unit": "1", "min": 0.001, "max": 0.3}],
+//!   "fit": {"n": 25, "dof": 22, "r_squared": 0.998, "aic": ..., "bic": ..., "confidence": 0.95},
 //!   "model_selection": null,
-//!   "provenance": {"scenario": "janssen", "seed": 1, "grainlaw_version": "0.1.0", "source": null}
+//!   "provenance": {"scenario": "user-csv", "overrides": [], "seed": null,
+//!                  "grainlaw_version": "0.1.0", "date": "2026-11-30T10:00:00Z",
+//!                  "inputs": [{"path": "mu.csv", "sha256": "..."}], "source": "mu.csv"}
 //! }
 //! ```
-//! [`CalibratedLaw::from_json_str`] checks the schema version and that the parameters and
-//! constants its law needs are present, so a loaded law can be evaluated
-//! ([`CalibratedLaw::evaluate`], or typed via [`CalibratedLaw::to_law`]).
+//! [`CalibratedLaw::from_json_str`] reads versions 1 and 2: version 2 is checked against the
+//! registry (formula, parameters, constants, covariance); version 1 is upgraded (its constants
+//! renamed to the registry's names, `K_mu_w` moved to `derived`, no covariance, and a μ(I) or
+//! φ(I) of version 1 lacks `d` and `rho_s`, so only the law in `I` can be evaluated).
+//! [`CalibratedLaw::evaluate`] evaluates a loaded law at many inputs.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 
 use crate::error::{IdentifyError, Result};
+use crate::expr::Expr;
 use crate::janssen::{JanssenFit, JanssenKMuFit};
 use crate::laws::{
-    JanssenLaw, JanssenVerticalLaw, LinearMuILaw, MohrCoulombLaw, MuILaw, PhiILaw,
+    JanssenLaw, JanssenVerticalLaw, LinearMuILaw, LinearPhiILaw, MohrCoulombLaw, MuILaw, PhiILaw,
     VelocityBoundaryLayer, WallFrictionLaw,
 };
 use crate::mohr_coulomb::MohrCoulombFit;
-use crate::mu_i::{LinearMuIFit, MuIFit, PhiIFit};
+use crate::mu_i::{LinearMuIFit, LinearPhiIFit, MuIFit, PhiIFit};
 use crate::report::{Estimate, FitReport, ModelComparison, ValidityRange};
-use crate::wall_law::{BoundaryLayerFit, WallLawFit, WallLawForm};
+use crate::wall_law::{BoundaryLayerFit, WallLawFit};
 
-/// Schema version written and read by this build.
-pub const SCHEMA_VERSION: u32 = 1;
+/// Schema version written by this build (it reads 1 and 2).
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// Version of grainlaw (the workspace version) recorded in provenance.
 pub const GRAINLAW_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The expression convention of the formulas ([`crate::expr`]).
+pub const EXPRESSION_CONVENTION: &str = "grainlaw-expr-1";
+
+/// Name of the law registry ([`REGISTRY`]).
+pub const REGISTRY_NAME: &str = "grainlaw";
+
+/// Dimension every law of the registry assumes.
+pub const DIMENSION: &str = "2D, per unit thickness";
+
+/// A further output of a law, computed after the main one (it may use it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutputSpec {
+    /// Name.
+    pub name: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// Formula.
+    pub formula: &'static str,
+}
+
+/// A `where` definition: the law's input in terms of a solver's variables.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DefinitionSpec {
+    /// Defined name (the law's input).
+    pub name: &'static str,
+    /// Its unit.
+    pub unit: &'static str,
+    /// Formula.
+    pub formula: &'static str,
+    /// The solver's variables it uses, with units.
+    pub inputs: &'static [(&'static str, &'static str)],
+}
+
+/// One law of the registry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LawSpec {
+    /// Registry name (the `law` field of the JSON).
+    pub name: &'static str,
+    /// Input variable and unit.
+    pub input: (&'static str, &'static str),
+    /// Output variable and unit.
+    pub output: (&'static str, &'static str),
+    /// Formula of the output.
+    pub formula: &'static str,
+    /// Further outputs.
+    pub also: &'static [OutputSpec],
+    /// `where` definitions.
+    pub definitions: &'static [DefinitionSpec],
+    /// Parameters `(name, unit)`, in covariance order.
+    pub parameters: &'static [(&'static str, &'static str)],
+    /// Constants `(name, unit, description)`.
+    pub constants: &'static [(&'static str, &'static str, &'static str)],
+    /// Derived quantities `(name, unit, formula)`.
+    pub derived: &'static [(&'static str, &'static str, &'static str)],
+    /// The set-up the law assumes.
+    pub geometry: &'static str,
+}
+
+const I_FROM_SHEAR: &[DefinitionSpec] = &[DefinitionSpec {
+    name: "I",
+    unit: "1",
+    formula: "gamma_dot*d/sqrt(P/rho_s)",
+    inputs: &[("gamma_dot", "1/s"), ("P", "Pa")],
+}];
+const GRAIN_CONSTANTS: &[(&str, &str, &str)] = &[
+    ("d", "m", "mean grain diameter"),
+    ("rho_s", "kg/m^3", "grain material density"),
+];
+const SHEAR_GEOMETRY: &str = "steady homogeneous simple shear at imposed pressure P (plane Couette, no gravity); mu = |tau|/P the local stress ratio, phi the solid fraction, I the local inertial number";
+const V_FROM_SLIP: &[DefinitionSpec] = &[DefinitionSpec {
+    name: "V",
+    unit: "1",
+    formula: "V_s/sqrt(g*d)",
+    inputs: &[("V_s", "m/s")],
+}];
+const WALL_CONSTANTS: &[(&str, &str, &str)] =
+    &[("d", "m", "mean grain diameter"), ("g", "m/s^2", "gravity")];
+const WALL_GEOMETRY: &str = "grains sliding along a flat rigid wall: mu_eff = tau_w/sigma_w the ratio of wall shear to wall normal stress, V_s the slip velocity of the grains along the wall";
+const JANSSEN_GEOMETRY: &str = "column of width W between two parallel vertical rigid walls, filled to a free surface at z = 0, z measured downward; stresses compressive positive, averaged across the width (slice balance)";
+
+/// The registry of laws a calibrated-law JSON can hold (schema 2).
+pub const REGISTRY: &[LawSpec] = &[
+    LawSpec {
+        name: "janssen",
+        input: ("z", "m"),
+        output: ("sigma_v", "Pa"),
+        formula: "rho_b*g*W/(2*K*mu_w)*(1 - exp(-2*K*mu_w*z/W))",
+        also: &[
+            OutputSpec {
+                name: "sigma_h",
+                unit: "Pa",
+                formula: "K*sigma_v",
+            },
+            OutputSpec {
+                name: "tau_w",
+                unit: "Pa",
+                formula: "mu_w*sigma_h",
+            },
+        ],
+        definitions: &[],
+        parameters: &[("K", "1"), ("mu_w", "1")],
+        constants: &[
+            ("W", "m", "column width between the two walls"),
+            ("rho_b", "kg/m^3", "bulk density phi*rho_s"),
+            ("g", "m/s^2", "gravity"),
+            (
+                "mu_wall",
+                "1",
+                "grain-wall friction coefficient, upper bound of mu_w",
+            ),
+        ],
+        derived: &[
+            ("K_mu_w", "1", "K*mu_w"),
+            ("saturation_length", "m", "W/(2*K*mu_w)"),
+            ("mobilisation", "1", "mu_w/mu_wall"),
+        ],
+        geometry: JANSSEN_GEOMETRY,
+    },
+    LawSpec {
+        name: "janssen-kmu",
+        input: ("z", "m"),
+        output: ("sigma_v", "Pa"),
+        formula: "rho_b*g*W/(2*K_mu_w)*(1 - exp(-2*K_mu_w*z/W))",
+        also: &[],
+        definitions: &[],
+        parameters: &[("K_mu_w", "1")],
+        constants: &[
+            ("W", "m", "column width between the two walls"),
+            ("rho_b", "kg/m^3", "bulk density phi*rho_s"),
+            ("g", "m/s^2", "gravity"),
+        ],
+        derived: &[("saturation_length", "m", "W/(2*K_mu_w)")],
+        geometry: JANSSEN_GEOMETRY,
+    },
+    LawSpec {
+        name: "wall-law-exponential",
+        input: ("V", "1"),
+        output: ("mu_eff", "1"),
+        formula: "mu_inf - (mu_inf - mu_0)*exp(-V/V_star)",
+        also: &[],
+        definitions: V_FROM_SLIP,
+        parameters: &[("mu_0", "1"), ("mu_inf", "1"), ("V_star", "1")],
+        constants: WALL_CONSTANTS,
+        derived: &[],
+        geometry: WALL_GEOMETRY,
+    },
+    LawSpec {
+        name: "wall-law-hyperbolic",
+        input: ("V", "1"),
+        output: ("mu_eff", "1"),
+        formula: "mu_0 + (mu_inf - mu_0)*V/(V + V_star)",
+        also: &[],
+        definitions: V_FROM_SLIP,
+        parameters: &[("mu_0", "1"), ("mu_inf", "1"), ("V_star", "1")],
+        constants: WALL_CONSTANTS,
+        derived: &[],
+        geometry: WALL_GEOMETRY,
+    },
+    LawSpec {
+        name: "wall-law-power",
+        input: ("V", "1"),
+        output: ("mu_eff", "1"),
+        formula: "mu_0 + k*V^n",
+        also: &[],
+        definitions: V_FROM_SLIP,
+        parameters: &[("mu_0", "1"), ("k", "1"), ("n", "1")],
+        constants: WALL_CONSTANTS,
+        derived: &[],
+        geometry: WALL_GEOMETRY,
+    },
+    LawSpec {
+        name: "boundary-layer",
+        input: ("y", "m"),
+        output: ("u", "m/s"),
+        formula: "u_bulk - (u_bulk - u_slip)*exp(-y/delta)",
+        also: &[],
+        definitions: &[],
+        parameters: &[("u_bulk", "m/s"), ("u_slip", "m/s"), ("delta", "m")],
+        constants: &[("d", "m", "mean grain diameter")],
+        derived: &[("delta_over_d", "1", "delta/d")],
+        geometry: "velocity parallel to a flat wall against the distance y from it",
+    },
+    LawSpec {
+        name: "mu-i",
+        input: ("I", "1"),
+        output: ("mu", "1"),
+        formula: "mu_s + (mu_2 - mu_s)*I/(I + I_0)",
+        also: &[],
+        definitions: I_FROM_SHEAR,
+        parameters: &[("mu_s", "1"), ("mu_2", "1"), ("I_0", "1")],
+        constants: GRAIN_CONSTANTS,
+        derived: &[],
+        geometry: SHEAR_GEOMETRY,
+    },
+    LawSpec {
+        name: "mu-i-linear",
+        input: ("I", "1"),
+        output: ("mu", "1"),
+        formula: "mu_s + b*I",
+        also: &[],
+        definitions: I_FROM_SHEAR,
+        parameters: &[("mu_s", "1"), ("b", "1")],
+        constants: GRAIN_CONSTANTS,
+        derived: &[],
+        geometry: SHEAR_GEOMETRY,
+    },
+    LawSpec {
+        name: "phi-i",
+        input: ("I", "1"),
+        output: ("phi", "1"),
+        formula: "phi_max - (phi_max - phi_min)*I",
+        also: &[],
+        definitions: I_FROM_SHEAR,
+        parameters: &[("phi_max", "1"), ("phi_min", "1")],
+        constants: GRAIN_CONSTANTS,
+        derived: &[],
+        geometry: SHEAR_GEOMETRY,
+    },
+    LawSpec {
+        name: "phi-i-linear",
+        input: ("I", "1"),
+        output: ("phi", "1"),
+        formula: "phi_max - a*I",
+        also: &[],
+        definitions: I_FROM_SHEAR,
+        parameters: &[("phi_max", "1"), ("a", "1")],
+        constants: GRAIN_CONSTANTS,
+        derived: &[],
+        geometry: SHEAR_GEOMETRY,
+    },
+    LawSpec {
+        name: "mohr-coulomb",
+        input: ("sigma_n", "Pa"),
+        output: ("tau", "Pa"),
+        formula: "cohesion + sigma_n*tan(friction_angle)",
+        also: &[],
+        definitions: &[],
+        parameters: &[("friction_angle", "rad"), ("cohesion", "Pa")],
+        constants: &[],
+        derived: &[
+            ("dp_alpha", "1", "sin(friction_angle)"),
+            ("dp_k", "Pa", "cohesion*cos(friction_angle)"),
+        ],
+        geometry: "plane strain (2D), compressive positive: shear strength tau on a plane of normal stress sigma_n; at yield the in-plane Mohr circle (centre p, radius q) touches the envelope, q = p*sin(friction_angle) + cohesion*cos(friction_angle), i.e. 2D Drucker-Prager q = dp_alpha*p + dp_k",
+    },
+];
+
+/// The registry entry of `law`. Errors: [`IdentifyError::LawFormat`] for a name not in
+/// [`REGISTRY`].
+pub fn law_spec(law: &str) -> Result<&'static LawSpec> {
+    REGISTRY
+        .iter()
+        .find(|s| s.name == law)
+        .ok_or_else(|| IdentifyError::LawFormat {
+            message: format!(
+                "unknown law '{law}' (registry: {})",
+                REGISTRY
+                    .iter()
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        })
+}
 
 /// A named variable with its unit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -58,15 +354,208 @@ pub struct Variable {
     pub unit: String,
 }
 
+fn var(name: &str, unit: &str) -> Variable {
+    Variable {
+        name: name.into(),
+        unit: unit.into(),
+    }
+}
+
+/// A further output: `name = formula`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NamedFormula {
+    /// Name.
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Formula (`grainlaw-expr-1`).
+    pub formula: String,
+}
+
+/// A `where` definition of the law's input from a solver's variables.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Definition {
+    /// Defined name.
+    pub name: String,
+    /// Its unit.
+    pub unit: String,
+    /// Formula.
+    pub formula: String,
+    /// The solver's variables it uses.
+    pub inputs: Vec<Variable>,
+}
+
+/// The machine-readable expression of a law.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Expression {
+    /// The registry ([`REGISTRY_NAME`]).
+    pub registry: String,
+    /// The convention of the formulas ([`EXPRESSION_CONVENTION`]).
+    pub convention: String,
+    /// Independent variable of the formula (and of [`CalibratedLaw::evaluate`]).
+    pub input: Variable,
+    /// Value of the formula.
+    pub output: Variable,
+    /// `output = formula`.
+    pub formula: String,
+    /// Further outputs, in order (each may use the earlier ones).
+    pub also: Vec<NamedFormula>,
+    /// Definitions of the input from a solver's variables.
+    #[serde(rename = "where")]
+    pub definitions: Vec<Definition>,
+}
+
+impl Expression {
+    fn of(spec: &LawSpec) -> Self {
+        Expression {
+            registry: REGISTRY_NAME.into(),
+            convention: EXPRESSION_CONVENTION.into(),
+            input: var(spec.input.0, spec.input.1),
+            output: var(spec.output.0, spec.output.1),
+            formula: spec.formula.into(),
+            also: spec
+                .also
+                .iter()
+                .map(|o| NamedFormula {
+                    name: o.name.into(),
+                    unit: o.unit.into(),
+                    formula: o.formula.into(),
+                })
+                .collect(),
+            definitions: spec
+                .definitions
+                .iter()
+                .map(|d| Definition {
+                    name: d.name.into(),
+                    unit: d.unit.into(),
+                    formula: d.formula.into(),
+                    inputs: d.inputs.iter().map(|(n, u)| var(n, u)).collect(),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// An angle's estimate in degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Degrees {
+    /// Value (°).
+    pub value: f64,
+    /// Standard error (°).
+    pub std_error: f64,
+    /// Lower end of the interval (°).
+    pub ci_low: f64,
+    /// Upper end of the interval (°).
+    pub ci_high: f64,
+}
+
+/// One fitted parameter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LawParameter {
+    /// Name, as the formula uses it.
+    pub name: String,
+    /// SI unit.
+    pub unit: String,
+    /// Estimate.
+    pub value: f64,
+    /// Standard error.
+    pub std_error: f64,
+    /// Lower end of the interval.
+    pub ci_low: f64,
+    /// Upper end of the interval.
+    pub ci_high: f64,
+    /// Held on an admissible bound (not an estimate; e.g. a cohesion at 0).
+    #[serde(default)]
+    pub at_bound: bool,
+    /// The same in degrees, for an angle (unit `rad`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deg: Option<Degrees>,
+}
+
+impl LawParameter {
+    fn of(e: &Estimate) -> Self {
+        let deg = (e.unit == "rad").then(|| {
+            let k = 180.0 / std::f64::consts::PI;
+            Degrees {
+                value: e.value * k,
+                std_error: e.std_error * k,
+                ci_low: e.ci_low * k,
+                ci_high: e.ci_high * k,
+            }
+        });
+        LawParameter {
+            name: e.name.clone(),
+            unit: e.unit.clone(),
+            value: e.value,
+            std_error: e.std_error,
+            ci_low: e.ci_low,
+            ci_high: e.ci_high,
+            at_bound: e.at_bound,
+            deg,
+        }
+    }
+}
+
+/// A quantity derived from the parameters (delta-method interval).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DerivedQuantity {
+    /// Name.
+    pub name: String,
+    /// Always true: this is not a fitted parameter.
+    pub derived: bool,
+    /// Its formula (`grainlaw-expr-1`) in the parameters and constants.
+    pub formula: String,
+    /// Unit.
+    pub unit: String,
+    /// Value.
+    pub value: f64,
+    /// Standard error.
+    pub std_error: f64,
+    /// Lower end of the interval.
+    pub ci_low: f64,
+    /// Upper end of the interval.
+    pub ci_high: f64,
+    /// Held on a bound (e.g. the mobilisation 1 under full mobilisation).
+    #[serde(default)]
+    pub at_bound: bool,
+}
+
+impl DerivedQuantity {
+    fn of(name: &str, unit: &str, formula: &str, e: &Estimate) -> Self {
+        DerivedQuantity {
+            name: name.to_string(),
+            derived: true,
+            formula: formula.to_string(),
+            unit: unit.to_string(),
+            value: e.value,
+            std_error: e.std_error,
+            ci_low: e.ci_low,
+            ci_high: e.ci_high,
+            at_bound: e.at_bound,
+        }
+    }
+}
+
+/// Covariance matrix of the parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Covariance {
+    /// Parameter names, in row (and column) order.
+    pub order: Vec<String>,
+    /// The matrix, row-major.
+    pub matrix: Vec<Vec<f64>>,
+}
+
 /// A constant of the set-up.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Constant {
-    /// Name.
+    /// Name, as the formulas use it.
     pub name: String,
     /// SI unit.
     pub unit: String,
     /// Value.
     pub value: f64,
+    /// What it is.
+    pub description: String,
 }
 
 /// Fit summary.
@@ -99,15 +588,35 @@ impl FitSummary {
     }
 }
 
+/// An input file and its SHA-256.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InputFile {
+    /// Path as given.
+    pub path: String,
+    /// SHA-256 of its bytes, lowercase hex.
+    pub sha256: String,
+}
+
 /// Where a calibrated law comes from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
     /// Scenario name (`janssen`, `shear-cell`, ...) or `user-csv`.
     pub scenario: String,
+    /// Every override of the scenario's or file's settings, as `key=value`.
+    #[serde(default)]
+    pub overrides: Vec<String>,
     /// Seed of the run, when there is one.
     pub seed: Option<u64>,
     /// grainlaw version.
     pub grainlaw_version: String,
+    /// UTC date and time of the fit (ISO 8601), when recorded: `grainlaw fit` records it; a
+    /// scenario records none, so that a resumed run writes the same bytes as an uninterrupted
+    /// one.
+    #[serde(default)]
+    pub date: Option<String>,
+    /// Input files with their SHA-256.
+    #[serde(default)]
+    pub inputs: Vec<InputFile>,
     /// Source file, when fitted from a file.
     #[serde(default)]
     pub source: Option<String>,
@@ -118,31 +627,101 @@ impl Provenance {
     pub fn new(scenario: &str, seed: Option<u64>) -> Self {
         Provenance {
             scenario: scenario.to_string(),
+            overrides: Vec::new(),
             seed,
             grainlaw_version: GRAINLAW_VERSION.to_string(),
+            date: None,
+            inputs: Vec::new(),
             source: None,
         }
     }
+
+    /// Records the overrides (`key=value`).
+    pub fn with_overrides(mut self, overrides: Vec<String>) -> Self {
+        self.overrides = overrides;
+        self
+    }
+
+    /// Records now as the date (UTC, `YYYY-MM-DDTHH:MM:SSZ`).
+    pub fn with_date_now(mut self) -> Self {
+        let secs = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs());
+        self.date = Some(utc_date(secs));
+        self
+    }
+
+    /// Records an input file read as `bytes` with its SHA-256.
+    pub fn with_input(mut self, path: &str, bytes: &[u8]) -> Self {
+        self.inputs.push(InputFile {
+            path: path.to_string(),
+            sha256: sha256_hex(bytes),
+        });
+        self
+    }
 }
 
-/// A calibrated law, as written to JSON.
+/// SHA-256 of `bytes` as lowercase hex (FIPS 180-4).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// `YYYY-MM-DDTHH:MM:SSZ` of `secs` seconds after 1970-01-01T00:00:00Z (proleptic Gregorian
+/// calendar, days to civil date by H. Hinnant's algorithm).
+pub fn utc_date(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+/// Grain constants a μ(I) or φ(I) law needs to turn `I = γ̇ d/√(P/ρ_s)` into a law of the shear
+/// rate and the pressure.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GrainScale {
+    /// Mean grain diameter `d` (m).
+    pub diameter_m: f64,
+    /// Grain material density `ρ_s` (kg/m³).
+    pub density_kg_m3: f64,
+}
+
+/// A calibrated law, as written to JSON (schema 2; see the module documentation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CalibratedLaw {
     /// Schema version ([`SCHEMA_VERSION`]).
     pub schema_version: u32,
-    /// Law name: `janssen`, `janssen-kmu`, `wall-law-exponential`, `wall-law-hyperbolic`,
-    /// `wall-law-power`, `boundary-layer`, `mu-i`, `mu-i-linear`, `phi-i`, `mohr-coulomb`.
+    /// Law name, a key of [`REGISTRY`].
     pub law: String,
-    /// Formula as text.
-    pub formula: String,
-    /// Independent variable of [`CalibratedLaw::evaluate`].
-    pub input: Variable,
-    /// Value returned by [`CalibratedLaw::evaluate`].
-    pub output: Variable,
-    /// Fitted parameters.
-    pub parameters: Vec<Estimate>,
-    /// Set-up constants.
+    /// The law's expression.
+    pub expression: Expression,
+    /// Fitted parameters, in the registry's order; their names are variables of the formula.
+    pub parameters: Vec<LawParameter>,
+    /// Covariance of the parameters (absent only in a law read from schema 1).
+    pub covariance: Option<Covariance>,
+    /// Derived quantities (`"derived": true`).
+    pub derived: Vec<DerivedQuantity>,
+    /// Set-up constants; their names are variables of the formulas.
     pub constants: Vec<Constant>,
+    /// [`DIMENSION`].
+    pub dimension: String,
+    /// The set-up the law assumes.
+    pub geometry: String,
     /// Data range the law was calibrated on.
     pub validity: Vec<ValidityRange>,
     /// Fit summary.
@@ -171,12 +750,14 @@ pub enum Law {
     MuILinear(LinearMuILaw),
     /// φ(I).
     PhiI(PhiILaw),
+    /// Linear φ(I), `φ_max − a I`.
+    PhiILinear(LinearPhiILaw),
     /// Mohr–Coulomb, shear strength `τ(σ_n)`.
     MohrCoulomb(MohrCoulombLaw),
 }
 
 impl Law {
-    /// Evaluates the law at its input variable (see [`CalibratedLaw::input`]).
+    /// Evaluates the law at its input variable (see [`Expression::input`]).
     pub fn evaluate(&self, x: f64) -> f64 {
         match self {
             Law::Janssen(l) => l.sigma_v(x),
@@ -186,46 +767,69 @@ impl Law {
             Law::MuI(l) => l.mu(x),
             Law::MuILinear(l) => l.mu(x),
             Law::PhiI(l) => l.phi(x),
+            Law::PhiILinear(l) => l.phi(x),
             Law::MohrCoulomb(l) => l.shear_strength(x),
         }
     }
 }
 
-fn var(name: &str, unit: &str) -> Variable {
-    Variable {
-        name: name.into(),
-        unit: unit.into(),
-    }
-}
-
-fn constant(name: &str, unit: &str, value: f64) -> Constant {
-    Constant {
-        name: name.into(),
-        unit: unit.into(),
-        value,
-    }
-}
-
 impl CalibratedLaw {
-    #[allow(clippy::too_many_arguments)]
+    /// Builds a law of the registry from its estimates: `parameters` and `derived` by name (every
+    /// name of the registry entry must be given), `constants` by name, the covariance from
+    /// `report` (entries of a parameter not in the report, i.e. fixed, are 0).
     fn build(
         law: &str,
-        formula: &str,
-        input: Variable,
-        output: Variable,
-        parameters: Vec<Estimate>,
-        constants: Vec<Constant>,
+        parameters: &[&Estimate],
+        derived: &[&Estimate],
+        constants: &[(&str, f64)],
         report: &FitReport,
         provenance: Provenance,
     ) -> Self {
+        let spec = law_spec(law).expect("a registry law");
+        let order: Vec<String> = spec.parameters.iter().map(|p| p.0.to_string()).collect();
+        let index = |name: &str| report.parameters.iter().position(|p| p.name == name);
+        let matrix = order
+            .iter()
+            .map(|a| {
+                order
+                    .iter()
+                    .map(|b| match (index(a), index(b)) {
+                        (Some(i), Some(j)) => report.covariance[i][j],
+                        _ => 0.0,
+                    })
+                    .collect()
+            })
+            .collect();
         CalibratedLaw {
             schema_version: SCHEMA_VERSION,
             law: law.into(),
-            formula: formula.into(),
-            input,
-            output,
-            parameters,
-            constants,
+            expression: Expression::of(spec),
+            parameters: spec
+                .parameters
+                .iter()
+                .filter_map(|(name, _)| parameters.iter().find(|e| e.name == *name))
+                .map(|e| LawParameter::of(e))
+                .collect(),
+            covariance: Some(Covariance { order, matrix }),
+            derived: spec
+                .derived
+                .iter()
+                .zip(derived)
+                .map(|((name, unit, formula), e)| DerivedQuantity::of(name, unit, formula, e))
+                .collect(),
+            constants: spec
+                .constants
+                .iter()
+                .zip(constants)
+                .map(|((name, unit, description), (_, value))| Constant {
+                    name: name.to_string(),
+                    unit: unit.to_string(),
+                    value: *value,
+                    description: description.to_string(),
+                })
+                .collect(),
+            dimension: DIMENSION.into(),
+            geometry: spec.geometry.into(),
             validity: report.validity.clone(),
             fit: FitSummary::of(report),
             model_selection: None,
@@ -233,46 +837,42 @@ impl CalibratedLaw {
         }
     }
 
-    /// From a joint Janssen fit: parameters `K`, `mu_w`, `K_mu_w`; constants `width`,
-    /// `bulk_density`, `gravity`, `wall_friction`.
+    /// From a joint (or full-mobilisation) Janssen fit: parameters `K`, `mu_w`; derived `K_mu_w`,
+    /// `saturation_length`, `mobilisation`; constants `W`, `rho_b`, `g`, `mu_wall`.
     pub fn from_janssen(fit: &JanssenFit, provenance: Provenance) -> Self {
         Self::build(
             "janssen",
-            "sigma_v(z) = rho_b*g*W/(2*K*mu_w)*(1 - exp(-2*K*mu_w*z/W)); sigma_h = K*sigma_v; tau_w = mu_w*sigma_h",
-            var("z", "m"),
-            var("sigma_v", "Pa"),
-            vec![fit.k.clone(), fit.mu_w.clone(), fit.k_mu_w.clone()],
-            vec![
-                constant("width", "m", fit.law.width_m),
-                constant("bulk_density", "kg/m^3", fit.law.bulk_density_kg_m3),
-                constant("gravity", "m/s^2", fit.law.gravity_m_s2),
-                constant("wall_friction", "1", fit.wall_friction),
+            &[&fit.k, &fit.mu_w],
+            &[&fit.k_mu_w, &fit.saturation_length_m, &fit.mobilisation],
+            &[
+                ("W", fit.law.width_m),
+                ("rho_b", fit.law.bulk_density_kg_m3),
+                ("g", fit.law.gravity_m_s2),
+                ("mu_wall", fit.wall_friction),
             ],
             &fit.report,
             provenance,
         )
     }
 
-    /// From a one-parameter Janssen fit: parameter `K_mu_w`.
+    /// From a one-parameter Janssen fit: parameter `K_mu_w`, derived `saturation_length`.
     pub fn from_janssen_k_mu(fit: &JanssenKMuFit, provenance: Provenance) -> Self {
         Self::build(
             "janssen-kmu",
-            "sigma_v(z) = rho_b*g*W/(2*K_mu_w)*(1 - exp(-2*K_mu_w*z/W))",
-            var("z", "m"),
-            var("sigma_v", "Pa"),
-            vec![fit.k_mu_w.clone()],
-            vec![
-                constant("width", "m", fit.law.width_m),
-                constant("bulk_density", "kg/m^3", fit.law.bulk_density_kg_m3),
-                constant("gravity", "m/s^2", fit.law.gravity_m_s2),
+            &[&fit.k_mu_w],
+            &[&fit.saturation_length_m],
+            &[
+                ("W", fit.law.width_m),
+                ("rho_b", fit.law.bulk_density_kg_m3),
+                ("g", fit.law.gravity_m_s2),
             ],
             &fit.report,
             provenance,
         )
     }
 
-    /// From a wall-law fit; `selection` is the AIC ranking it won, if any. Constants:
-    /// `grain_diameter`, `gravity` (to turn `V_s` into `V = V_s/√(g d)`).
+    /// From a wall-law fit; `selection` is the AIC ranking it won, if any. Constants `d`, `g`
+    /// (to turn `V_s` into `V = V_s/√(g d)`).
     pub fn from_wall_law(
         fit: &WallLawFit,
         grain_diameter_m: f64,
@@ -280,25 +880,12 @@ impl CalibratedLaw {
         selection: Option<ModelComparison>,
         provenance: Provenance,
     ) -> Self {
-        let formula = match fit.form {
-            WallLawForm::Exponential => {
-                "mu_eff(V) = mu_inf - (mu_inf - mu_0)*exp(-V/V_star); V = V_s/sqrt(g*d)"
-            }
-            WallLawForm::Hyperbolic => {
-                "mu_eff(V) = mu_0 + (mu_inf - mu_0)*V/(V + V_star); V = V_s/sqrt(g*d)"
-            }
-            WallLawForm::PowerLaw => "mu_eff(V) = mu_0 + k*V^n; V = V_s/sqrt(g*d)",
-        };
+        let params: Vec<&Estimate> = fit.report.parameters.iter().collect();
         let mut law = Self::build(
             fit.form.law_name(),
-            formula,
-            var("V", "1"),
-            var("mu_eff", "1"),
-            fit.report.parameters.clone(),
-            vec![
-                constant("grain_diameter", "m", grain_diameter_m),
-                constant("gravity", "m/s^2", gravity_m_s2),
-            ],
+            &params,
+            &[],
+            &[("d", grain_diameter_m), ("g", gravity_m_s2)],
             &fit.report,
             provenance,
         );
@@ -306,75 +893,75 @@ impl CalibratedLaw {
         law
     }
 
-    /// From a boundary-layer fit (parameters `u_bulk`, `u_slip`, `delta`).
+    /// From a boundary-layer fit (parameters `u_bulk`, `u_slip`, `delta`; derived
+    /// `delta_over_d`).
     pub fn from_boundary_layer(
         fit: &BoundaryLayerFit,
         grain_diameter_m: f64,
         provenance: Provenance,
     ) -> Self {
+        let params: Vec<&Estimate> = fit.report.parameters.iter().collect();
         Self::build(
             "boundary-layer",
-            "u(y) = u_bulk - (u_bulk - u_slip)*exp(-y/delta)",
-            var("y", "m"),
-            var("u", "m/s"),
-            fit.report.parameters.clone(),
-            vec![constant("grain_diameter", "m", grain_diameter_m)],
+            &params,
+            &[&fit.thickness_diameters],
+            &[("d", grain_diameter_m)],
             &fit.report,
             provenance,
         )
     }
 
-    /// From a μ(I) fit (parameters `mu_s`, `mu_2`, `I_0`).
-    pub fn from_mu_i(fit: &MuIFit, provenance: Provenance) -> Self {
+    fn rheology(law: &str, report: &FitReport, grain: GrainScale, provenance: Provenance) -> Self {
+        let params: Vec<&Estimate> = report.parameters.iter().collect();
         Self::build(
-            "mu-i",
-            "mu(I) = mu_s + (mu_2 - mu_s)/(1 + I_0/I); I = gamma_dot*d/sqrt(P/rho_s)",
-            var("I", "1"),
-            var("mu", "1"),
-            fit.report.parameters.clone(),
-            vec![],
-            &fit.report,
+            law,
+            &params,
+            &[],
+            &[("d", grain.diameter_m), ("rho_s", grain.density_kg_m3)],
+            report,
             provenance,
         )
     }
 
-    /// From a linear μ(I) fit (parameters `mu_s`, `b`).
-    pub fn from_mu_i_linear(fit: &LinearMuIFit, provenance: Provenance) -> Self {
-        Self::build(
-            "mu-i-linear",
-            "mu(I) = mu_s + b*I",
-            var("I", "1"),
-            var("mu", "1"),
-            fit.report.parameters.clone(),
-            vec![],
-            &fit.report,
-            provenance,
-        )
+    /// From a μ(I) fit (parameters `mu_s`, `mu_2`, `I_0`; constants `d`, `rho_s`).
+    pub fn from_mu_i(fit: &MuIFit, grain: GrainScale, provenance: Provenance) -> Self {
+        Self::rheology("mu-i", &fit.report, grain, provenance)
     }
 
-    /// From a φ(I) fit (parameters `phi_max`, `phi_min`).
-    pub fn from_phi_i(fit: &PhiIFit, provenance: Provenance) -> Self {
-        Self::build(
-            "phi-i",
-            "phi(I) = phi_max - (phi_max - phi_min)*I",
-            var("I", "1"),
-            var("phi", "1"),
-            fit.report.parameters.clone(),
-            vec![],
-            &fit.report,
-            provenance,
-        )
+    /// From a linear μ(I) fit (parameters `mu_s`, `b`; constants `d`, `rho_s`).
+    pub fn from_mu_i_linear(fit: &LinearMuIFit, grain: GrainScale, provenance: Provenance) -> Self {
+        Self::rheology("mu-i-linear", &fit.report, grain, provenance)
     }
 
-    /// From a Mohr–Coulomb fit (parameters `friction_angle` (rad), `cohesion` (Pa)).
+    /// From a φ(I) fit (parameters `phi_max`, `phi_min`; constants `d`, `rho_s`).
+    pub fn from_phi_i(fit: &PhiIFit, grain: GrainScale, provenance: Provenance) -> Self {
+        Self::rheology("phi-i", &fit.report, grain, provenance)
+    }
+
+    /// From a linear φ(I) fit (parameters `phi_max`, `a`; constants `d`, `rho_s`).
+    pub fn from_phi_i_linear(
+        fit: &LinearPhiIFit,
+        grain: GrainScale,
+        provenance: Provenance,
+    ) -> Self {
+        Self::rheology("phi-i-linear", &fit.report, grain, provenance)
+    }
+
+    /// From a Mohr–Coulomb fit (parameters `friction_angle` (rad, with degrees), `cohesion`
+    /// (Pa); derived `dp_alpha = sin φ`, `dp_k = c cos φ` of the 2D Drucker–Prager equivalent).
     pub fn from_mohr_coulomb(fit: &MohrCoulombFit, provenance: Provenance) -> Self {
+        let alpha = fit
+            .report
+            .derived("dp_alpha", "1", |p| (p[0].sin(), vec![p[0].cos(), 0.0]));
+        let mut k = fit.report.derived("dp_k", "Pa", |p| {
+            (p[1] * p[0].cos(), vec![-p[1] * p[0].sin(), p[0].cos()])
+        });
+        k.at_bound = fit.cohesion.at_bound;
         Self::build(
             "mohr-coulomb",
-            "tau(sigma_n) = cohesion + sigma_n*tan(friction_angle); at yield q = p*sin(friction_angle) + cohesion*cos(friction_angle); 2D Drucker-Prager: alpha = sin(friction_angle), k = cohesion*cos(friction_angle)",
-            var("sigma_n", "Pa"),
-            var("tau", "Pa"),
-            fit.report.parameters.clone(),
-            vec![],
+            &[&fit.friction_angle, &fit.cohesion],
+            &[&alpha, &k],
+            &[],
             &fit.report,
             provenance,
         )
@@ -410,15 +997,15 @@ impl CalibratedLaw {
             "janssen" => Law::Janssen(JanssenLaw {
                 k: p("K")?,
                 mu_w: p("mu_w")?,
-                width_m: c("width")?,
-                bulk_density_kg_m3: c("bulk_density")?,
-                gravity_m_s2: c("gravity")?,
+                width_m: c("W")?,
+                bulk_density_kg_m3: c("rho_b")?,
+                gravity_m_s2: c("g")?,
             }),
             "janssen-kmu" => Law::JanssenKMu(JanssenVerticalLaw {
                 k_mu_w: p("K_mu_w")?,
-                width_m: c("width")?,
-                bulk_density_kg_m3: c("bulk_density")?,
-                gravity_m_s2: c("gravity")?,
+                width_m: c("W")?,
+                bulk_density_kg_m3: c("rho_b")?,
+                gravity_m_s2: c("g")?,
             }),
             "wall-law-exponential" => Law::WallFriction(WallFrictionLaw::Exponential {
                 mu_0: p("mu_0")?,
@@ -453,21 +1040,41 @@ impl CalibratedLaw {
                 phi_max: p("phi_max")?,
                 phi_min: p("phi_min")?,
             }),
+            "phi-i-linear" => Law::PhiILinear(LinearPhiILaw {
+                phi_max: p("phi_max")?,
+                slope: p("a")?,
+            }),
             "mohr-coulomb" => Law::MohrCoulomb(MohrCoulombLaw {
                 friction_angle_rad: p("friction_angle")?,
                 cohesion_pa: p("cohesion")?,
             }),
-            other => {
-                return Err(IdentifyError::LawFormat {
-                    message: format!("unknown law '{other}'"),
-                })
-            }
+            other => return Err(law_spec(other).err().unwrap_or(unknown_law(other))),
         })
     }
 
-    /// Evaluates the law at `x` (its `input` variable, in its unit).
-    pub fn evaluate(&self, x: f64) -> Result<f64> {
-        Ok(self.to_law()?.evaluate(x))
+    /// Evaluates the law at each `x` (its input variable, in its unit), vectorised:
+    /// `[f(x₀), f(x₁), …]`.
+    pub fn evaluate(&self, x: &[f64]) -> Result<Vec<f64>> {
+        let law = self.to_law()?;
+        Ok(x.iter().map(|&v| law.evaluate(v)).collect())
+    }
+
+    /// Evaluates the JSON's formula text at each `x` with the law's parameters and constants
+    /// (parsed by [`crate::expr`]): what a solver reading only the expression computes.
+    pub fn evaluate_formula(&self, x: &[f64]) -> Result<Vec<f64>> {
+        let expr = Expr::parse(&self.expression.formula)?;
+        let mut vars: BTreeMap<String, f64> = self
+            .parameters
+            .iter()
+            .map(|p| (p.name.clone(), p.value))
+            .chain(self.constants.iter().map(|c| (c.name.clone(), c.value)))
+            .collect();
+        x.iter()
+            .map(|&v| {
+                vars.insert(self.expression.input.name.clone(), v);
+                expr.eval(&vars)
+            })
+            .collect()
     }
 
     /// True when `x` lies inside the validity range of the law's input variable (true when
@@ -475,7 +1082,7 @@ impl CalibratedLaw {
     pub fn in_validity_range(&self, x: f64) -> bool {
         self.validity
             .iter()
-            .find(|v| v.variable == self.input.name)
+            .find(|v| v.variable == self.expression.input.name)
             .is_none_or(|v| v.contains(x))
     }
 
@@ -486,31 +1093,86 @@ impl CalibratedLaw {
         })
     }
 
-    /// Parses JSON: checks `schema_version` first ([`IdentifyError::UnsupportedSchema`]), then
-    /// the structure, then that the law can be built ([`CalibratedLaw::to_law`]).
+    /// Parses JSON of schema version 1 or 2 ([`IdentifyError::UnsupportedSchema`] otherwise):
+    /// version 2 is checked against the registry ([`CalibratedLaw::check`]), version 1 is
+    /// upgraded (module documentation); then the law must be buildable
+    /// ([`CalibratedLaw::to_law`]).
     pub fn from_json_str(text: &str) -> Result<Self> {
-        let value: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| IdentifyError::LawFormat {
-                message: e.to_string(),
-            })?;
+        let value: serde_json::Value = serde_json::from_str(text).map_err(format_error)?;
         let version = value
             .get("schema_version")
             .and_then(|v| v.as_u64())
             .ok_or_else(|| IdentifyError::LawFormat {
                 message: "missing or non-integer 'schema_version'".into(),
             })?;
-        if version != SCHEMA_VERSION as u64 {
-            return Err(IdentifyError::UnsupportedSchema {
-                found: version.min(u32::MAX as u64) as u32,
-                supported: SCHEMA_VERSION,
-            });
-        }
-        let law: CalibratedLaw =
-            serde_json::from_value(value).map_err(|e| IdentifyError::LawFormat {
-                message: e.to_string(),
-            })?;
+        let law = match version {
+            1 => serde_json::from_value::<LawV1>(value)
+                .map_err(format_error)?
+                .upgrade()?,
+            2 => {
+                let law: CalibratedLaw = serde_json::from_value(value).map_err(format_error)?;
+                law.check()?;
+                law
+            }
+            other => {
+                return Err(IdentifyError::UnsupportedSchema {
+                    found: other.min(u32::MAX as u64) as u32,
+                    supported: SCHEMA_VERSION,
+                })
+            }
+        };
         law.to_law()?;
         Ok(law)
+    }
+
+    /// Checks a schema-2 law against its registry entry: the same formulas, exactly the
+    /// registry's parameters and constants, a covariance of matching size, the variable names
+    /// of the formulas exactly the input, outputs, `where` names and inputs, parameters and
+    /// constants. Errors: [`IdentifyError::LawFormat`].
+    pub fn check(&self) -> Result<()> {
+        let spec = law_spec(&self.law)?;
+        let fail = |message: String| Err(IdentifyError::LawFormat { message });
+        if self.expression != Expression::of(spec) {
+            return fail(format!(
+                "law '{}': the expression differs from the registry's ({})",
+                self.law, spec.formula
+            ));
+        }
+        let keys = |names: Vec<&str>| {
+            let mut v: Vec<String> = names.into_iter().map(String::from).collect();
+            v.sort();
+            v
+        };
+        let want_p = keys(spec.parameters.iter().map(|p| p.0).collect());
+        let have_p = keys(self.parameters.iter().map(|p| p.name.as_str()).collect());
+        if want_p != have_p {
+            return fail(format!(
+                "law '{}': parameters {have_p:?}, the registry has {want_p:?}",
+                self.law
+            ));
+        }
+        let want_c = keys(spec.constants.iter().map(|c| c.0).collect());
+        let have_c = keys(self.constants.iter().map(|c| c.name.as_str()).collect());
+        if want_c != have_c {
+            return fail(format!(
+                "law '{}': constants {have_c:?}, the registry has {want_c:?}",
+                self.law
+            ));
+        }
+        if let Some(c) = &self.covariance {
+            let mut order = c.order.clone();
+            order.sort();
+            if order != want_p || c.matrix.len() != order.len() {
+                return fail(format!(
+                    "law '{}': covariance over {:?}, not the parameters",
+                    self.law, c.order
+                ));
+            }
+            if c.matrix.iter().any(|r| r.len() != order.len()) {
+                return fail(format!("law '{}': covariance is not square", self.law));
+            }
+        }
+        check_variable_names(spec)
     }
 
     /// Writes pretty JSON to `path`.
@@ -522,12 +1184,189 @@ impl CalibratedLaw {
         })
     }
 
-    /// Reads and checks a law from `path`.
+    /// Reads and checks a law from `path` (schema 1 or 2).
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|source| IdentifyError::Io {
             path: path.display().to_string(),
             source,
         })?;
         Self::from_json_str(&text)
+    }
+}
+
+fn format_error(e: serde_json::Error) -> IdentifyError {
+    IdentifyError::LawFormat {
+        message: e.to_string(),
+    }
+}
+
+fn unknown_law(law: &str) -> IdentifyError {
+    IdentifyError::LawFormat {
+        message: format!("unknown law '{law}'"),
+    }
+}
+
+/// Checks that the names used by the formulas of `spec` are exactly its input, its outputs, its
+/// `where` names and inputs, its parameters and its constants, each used at least once (except
+/// the outputs, which need not be reused).
+pub fn check_variable_names(spec: &LawSpec) -> Result<()> {
+    let mut used = Vec::new();
+    let formulas = std::iter::once(spec.formula)
+        .chain(spec.also.iter().map(|o| o.formula))
+        .chain(spec.definitions.iter().map(|d| d.formula))
+        .chain(spec.derived.iter().map(|d| d.2));
+    for f in formulas {
+        used.extend(Expr::parse(f)?.variables());
+    }
+    used.sort();
+    used.dedup();
+    let mut must: Vec<&str> = vec![spec.input.0];
+    must.extend(spec.parameters.iter().map(|p| p.0));
+    must.extend(spec.constants.iter().map(|c| c.0));
+    must.extend(
+        spec.definitions
+            .iter()
+            .flat_map(|d| d.inputs.iter().map(|i| i.0)),
+    );
+    let mut may: Vec<&str> = vec![spec.output.0];
+    may.extend(spec.also.iter().map(|o| o.name));
+    let fail = |message: String| Err(IdentifyError::LawFormat { message });
+    if let Some(u) = used
+        .iter()
+        .find(|u| !must.contains(&u.as_str()) && !may.contains(&u.as_str()))
+    {
+        return fail(format!(
+            "law '{}': formula variable '{u}' is neither the input, a parameter nor a constant",
+            spec.name
+        ));
+    }
+    if let Some(m) = must.iter().find(|m| !used.iter().any(|u| u == *m)) {
+        return fail(format!(
+            "law '{}': '{m}' is not used by any formula",
+            spec.name
+        ));
+    }
+    Ok(())
+}
+
+/// The schema-2 name of a schema-1 constant.
+fn v1_constant_name(name: &str) -> &str {
+    match name {
+        "width" => "W",
+        "bulk_density" => "rho_b",
+        "gravity" => "g",
+        "wall_friction" => "mu_wall",
+        "grain_diameter" => "d",
+        other => other,
+    }
+}
+
+/// Schema 1 (read only).
+#[derive(Deserialize)]
+struct LawV1 {
+    law: String,
+    parameters: Vec<Estimate>,
+    constants: Vec<ConstantV1>,
+    validity: Vec<ValidityRange>,
+    fit: FitSummary,
+    #[serde(default)]
+    model_selection: Option<ModelComparison>,
+    provenance: ProvenanceV1,
+}
+
+#[derive(Deserialize)]
+struct ConstantV1 {
+    name: String,
+    value: f64,
+}
+
+#[derive(Deserialize)]
+struct ProvenanceV1 {
+    scenario: String,
+    seed: Option<u64>,
+    grainlaw_version: String,
+    #[serde(default)]
+    source: Option<String>,
+}
+
+impl LawV1 {
+    /// The schema-2 form: constants renamed to the registry's (`width` → `W`, `bulk_density` →
+    /// `rho_b`, `gravity` → `g`, `wall_friction` → `mu_wall`, `grain_diameter` → `d`), parameters
+    /// not in the registry entry (`K_mu_w` of `janssen`) moved to `derived`, no covariance.
+    fn upgrade(self) -> Result<CalibratedLaw> {
+        let spec = law_spec(&self.law)?;
+        let mut parameters = Vec::new();
+        let mut derived = Vec::new();
+        for e in &self.parameters {
+            if spec.parameters.iter().any(|p| p.0 == e.name) {
+                parameters.push(LawParameter::of(e));
+            } else if let Some((name, unit, formula)) =
+                spec.derived.iter().find(|d| d.0 == e.name.as_str())
+            {
+                derived.push(DerivedQuantity::of(name, unit, formula, e));
+            }
+        }
+        let constants = self
+            .constants
+            .iter()
+            .filter_map(|c| {
+                let name = v1_constant_name(&c.name);
+                spec.constants
+                    .iter()
+                    .find(|s| s.0 == name)
+                    .map(|(n, unit, description)| Constant {
+                        name: n.to_string(),
+                        unit: unit.to_string(),
+                        value: c.value,
+                        description: description.to_string(),
+                    })
+            })
+            .collect();
+        Ok(CalibratedLaw {
+            schema_version: 1,
+            law: self.law,
+            expression: Expression::of(spec),
+            parameters,
+            covariance: None,
+            derived,
+            constants,
+            dimension: DIMENSION.into(),
+            geometry: spec.geometry.into(),
+            validity: self.validity,
+            fit: self.fit,
+            model_selection: self.model_selection,
+            provenance: Provenance {
+                scenario: self.provenance.scenario,
+                overrides: Vec::new(),
+                seed: self.provenance.seed,
+                grainlaw_version: self.provenance.grainlaw_version,
+                date: None,
+                inputs: Vec::new(),
+                source: self.provenance.source,
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_registry_formula_parses_and_uses_exactly_its_variables() {
+        for spec in REGISTRY {
+            check_variable_names(spec).unwrap();
+        }
+    }
+
+    #[test]
+    fn dates_and_digests() {
+        assert_eq!(utc_date(0), "1970-01-01T00:00:00Z");
+        assert_eq!(utc_date(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(utc_date(1_700_000_000), "2023-11-14T22:13:20Z");
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
     }
 }

@@ -6,6 +6,7 @@
 //! | module | holds |
 //! |---|---|
 //! | [`error`] | [`IdentifyError`], every way identification fails |
+//! | [`accept`] | the checks a fit passes before a law is exported (scales, physical ranges, R², nested form) |
 //! | [`stats`] | Student-t quantile, AIC/BIC, Akaike weights |
 //! | [`report`] | [`FitReport`], [`Estimate`], [`ValidityRange`], [`ModelComparison`] (data) |
 //! | [`lm`] | box-constrained Levenberg–Marquardt as an argmin solver |
@@ -15,7 +16,8 @@
 //! | [`wall_law`] | wall friction vs slip velocity (model choice by AIC), boundary-layer thickness |
 //! | [`mu_i`] | μ(I), φ(I) and their linear forms |
 //! | [`mohr_coulomb`] | Mohr–Coulomb envelope from stress states at yield (conic program, Clarabel) |
-//! | [`law`] | calibrated-law JSON (schema, loader, evaluation) |
+//! | [`law`] | calibrated-law JSON (schema 2, the law registry, loader of schemas 1 and 2, evaluation) |
+//! | [`expr`] | the expression convention of the law formulas (parser, evaluator) |
 //! | [`continuum`] | closing the loop: Janssen ODE (RK4), Bagnold profile on a slope |
 //! | [`data`] | user tables read from CSV with typed, line-numbered errors |
 //! | [`user_fit`] | fitting a law by name from a CSV file |
@@ -42,16 +44,18 @@
 //! assert_eq!(keys[0].0, "janssen_K");
 //! let json = CalibratedLaw::from_janssen(&fit, Provenance::new("janssen", Some(1))).to_json_string()?;
 //! let law = CalibratedLaw::from_json_str(&json)?;
-//! assert!((law.evaluate(0.1)? - fit.law.sigma_v(0.1)).abs() < 1e-9);
+//! assert!((law.evaluate(&[0.1])?[0] - fit.law.sigma_v(0.1)).abs() < 1e-9);
 //! # Ok::<(), identify::IdentifyError>(())
 //! ```
 //!
 //! Units: SI throughout. Stresses entering the fits are compressive-positive magnitudes
 //! (pressure-like): with the project's tension-positive tensors, `σ_v = −Σ_yy`, `p = −tr Σ / 2`.
 
+pub mod accept;
 pub mod continuum;
 pub mod data;
 pub mod error;
+pub mod expr;
 pub mod fit;
 pub mod janssen;
 pub mod law;

@@ -23,6 +23,14 @@
 //! `[0, max(0, b_ols + t·se(b_ols))]` from the unconstrained regression. The friction
 //! coefficient ending at `a = 0` (or `sin φ = 1`) is [`IdentifyError::ParameterAtBound`].
 //!
+//! With the cohesion fixed at zero ([`MohrCoulombOptions::cohesionless`], `# cohesion = 0` in a
+//! CSV) only `a` is fitted, through the origin, and three states at yield suffice (`n ≥ p + 2`).
+//!
+//! The fit then passes the checks of [`crate::accept`] or is refused: the interval of `φ`
+//! inside `[0, π/2]` and of `c` above 0 (a cohesion whose interval crosses 0 offers to fix it
+//! at zero), standard errors below the values, `R²` above the threshold, and an adjusted `R²`
+//! not below that of the cohesionless envelope.
+//!
 //! The 2D Drucker–Prager equivalent is [`MohrCoulombLaw::drucker_prager_2d`]
 //! (`α = sin φ`, `k = c cos φ`, exact in 2D).
 
@@ -33,6 +41,7 @@ use clarabel::solver::{
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+use crate::accept::{Acceptance, NestedForm, PhysicalRange};
 use crate::error::{
     check_finite, check_non_negative_pressure, check_same_len, check_spread, min_max, BoundSide,
     IdentifyError, Result,
@@ -105,6 +114,41 @@ pub struct MohrCoulombFit {
     /// The fit, with parameters `friction_angle` (rad) and `cohesion` (Pa); residuals on `q`
     /// (circles) or `|τ|` (failure plane).
     pub report: FitReport,
+}
+
+/// What a refusal offers when the cohesion is not supported by the data.
+const COHESIONLESS: &str =
+    "fix the cohesion at zero ('# cohesion = 0', MohrCoulombOptions::cohesionless)";
+
+/// Options of [`fit_mohr_coulomb_with`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MohrCoulombOptions {
+    /// Confidence level of the intervals (default 0.95).
+    pub confidence: f64,
+    /// Fix the cohesion at `c = 0` instead of fitting it (default false).
+    pub cohesion_fixed_zero: bool,
+    /// R² threshold (default [`crate::accept::MIN_R_SQUARED`]).
+    pub min_r_squared: f64,
+}
+
+impl Default for MohrCoulombOptions {
+    fn default() -> Self {
+        MohrCoulombOptions {
+            confidence: 0.95,
+            cohesion_fixed_zero: false,
+            min_r_squared: crate::accept::MIN_R_SQUARED,
+        }
+    }
+}
+
+impl MohrCoulombOptions {
+    /// Defaults with the cohesion fixed at zero.
+    pub fn cohesionless() -> Self {
+        MohrCoulombOptions {
+            cohesion_fixed_zero: true,
+            ..Default::default()
+        }
+    }
 }
 
 /// Solves `min ‖y − a x − b‖₂` s.t. `a ≥ 0`, `b ≥ 0`, `a ≤ a_max` (if finite) with Clarabel.
@@ -202,14 +246,31 @@ fn ols(x: &[f64], y: &[f64]) -> (f64, f64, DMatrix<f64>, f64) {
     (beta[0], beta[1], inv * s2, rss)
 }
 
+/// Fits the Mohr–Coulomb envelope with the default options (see the module documentation and
+/// [`fit_mohr_coulomb_with`]).
+pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulombFit> {
+    fit_mohr_coulomb_with(
+        data,
+        &MohrCoulombOptions {
+            confidence,
+            ..Default::default()
+        },
+    )
+}
+
 /// Fits the Mohr–Coulomb envelope (see the module documentation).
 ///
-/// Errors: [`IdentifyError::TooFewPoints`] (< 4), [`IdentifyError::NonFinite`],
+/// Errors: [`IdentifyError::TooFewPoints`] (< 4, < 3 with the cohesion fixed at zero),
+/// [`IdentifyError::NonFinite`],
 /// [`IdentifyError::NegativePressure`] (`p` or `σ_n` < 0: tensile states are not handled),
 /// [`IdentifyError::OutOfDomain`] (`q < 0`), [`IdentifyError::ZeroVariance`] (all states at the
 /// same pressure), [`IdentifyError::ParameterAtBound`] (`φ = 0` or `φ = 90°`),
-/// [`IdentifyError::ConicSolver`].
-pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulombFit> {
+/// [`IdentifyError::ConicSolver`], and the refusals of the module documentation.
+pub fn fit_mohr_coulomb_with(
+    data: &YieldData,
+    options: &MohrCoulombOptions,
+) -> Result<MohrCoulombFit> {
+    let confidence = options.confidence;
     let (x, y, circles, xname, yname) = match data {
         YieldData::Circles { p_pa, q_pa } => (p_pa.clone(), q_pa.clone(), true, "p_Pa", "q_Pa"),
         YieldData::FailurePlane { sigma_n_pa, tau_pa } => (
@@ -233,30 +294,47 @@ pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulomb
         });
     }
     let n = x.len();
-    if n < 4 {
+    let fixed = options.cohesion_fixed_zero;
+    let needed = if fixed { 3 } else { 4 };
+    if n < needed {
         return Err(IdentifyError::TooFewPoints {
-            law: "mohr-coulomb".into(),
-            needed: 4,
+            law: if fixed {
+                "mohr-coulomb (cohesion fixed at 0)".into()
+            } else {
+                "mohr-coulomb (with cohesion free; 3 suffice with '# cohesion = 0')".into()
+            },
+            needed,
             got: n,
         });
     }
     check_spread(xname, &x)?;
     let a_max = if circles { 1.0 } else { f64::INFINITY };
-    let (a, b) = solve_conic(&x, &y, a_max)?;
+    let (a, b) = if fixed {
+        (0.0, 0.0)
+    } else {
+        solve_conic(&x, &y, a_max)?
+    };
     let (_, y_max) = min_max(&y);
-    let cohesionless = b <= 1e-8 * y_max;
+    let cohesionless = fixed || b <= 1e-8 * y_max;
+    // The cohesionless envelope through the origin: the nested form.
+    let sxx: f64 = x.iter().map(|v| v * v).sum();
+    let a_origin = (x.iter().zip(&y).map(|(u, v)| u * v).sum::<f64>() / sxx).clamp(0.0, a_max);
+    let origin_fit: Vec<f64> = x.iter().map(|u| a_origin * u).collect();
 
     // Covariance of (a, b) and the degrees of freedom.
     let (a, b, cov_ab, dof, b_upper) = if cohesionless {
-        let sxx: f64 = x.iter().map(|v| v * v).sum();
-        let a0 = x.iter().zip(&y).map(|(u, v)| u * v).sum::<f64>() / sxx;
-        let a0 = a0.clamp(0.0, a_max);
+        let a0 = a_origin;
         let rss: f64 = x.iter().zip(&y).map(|(u, v)| (v - a0 * u).powi(2)).sum();
         let dof = n - 1;
         let var_a = rss / dof as f64 / sxx;
-        let (_, b_ols, cov_ols, _) = ols(&x, &y);
-        let t2 = stats::t_critical(confidence, n - 2);
-        let upper = (b_ols + t2 * cov_ols[(1, 1)].max(0.0).sqrt()).max(0.0);
+        // Fixed by the user: the interval of c is [0, 0]; held at 0 by the data: one-sided.
+        let upper = if fixed {
+            0.0
+        } else {
+            let (_, b_ols, cov_ols, _) = ols(&x, &y);
+            let t2 = stats::t_critical(confidence, n - 2);
+            (b_ols + t2 * cov_ols[(1, 1)].max(0.0).sqrt()).max(0.0)
+        };
         let cov = DMatrix::from_row_slice(2, 2, &[var_a, 0.0, 0.0, 0.0]);
         (a0, 0.0, cov, dof, Some(upper))
     } else {
@@ -334,8 +412,23 @@ pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulomb
             bound,
             side,
             report: Box::new(report),
+            suggestion: crate::error::Suggestion::none(),
         });
     }
+    let nested = (!cohesionless).then(|| NestedForm {
+        name: "the cohesionless envelope (# cohesion = 0)".into(),
+        r_squared: crate::accept::r_squared_of(&y, &origin_fit),
+        parameters: 1,
+    });
+    Acceptance::new("mohr-coulomb", options.min_r_squared)
+        .range(PhysicalRange::new(
+            "friction_angle",
+            0.0,
+            std::f64::consts::FRAC_PI_2,
+        ))
+        .range(PhysicalRange::non_negative("cohesion").suggesting(COHESIONLESS))
+        .nested(nested)
+        .check(&report)?;
     let deg = 180.0 / std::f64::consts::PI;
     let friction_angle_deg = Estimate {
         name: "friction_angle_deg".into(),

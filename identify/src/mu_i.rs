@@ -1,30 +1,38 @@
 //! μ(I) and φ(I) fits from steady shear (laws in [`crate::laws::mu_i`]).
 //!
-//! - [`fit_mu_i`]: `μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)`, fitted in the parameters
-//!   `(μ_s, Δμ = μ₂ − μ_s, I₀)` with box bounds `μ_s > 0`, `0 < Δμ ≤ 10`, `I₀ > 0` (so that
-//!   `μ_s < μ₂` holds by construction) and reported as `(μ_s, μ₂, I₀)` (exact linear
-//!   reparametrisation of the covariance). Started from a variable-projection grid over `I₀`
-//!   (the law is linear in `μ_s, Δμ` for fixed `I₀`).
-//! - [`fit_mu_i_linear`]: `μ = μ_s + b I`, for comparison ([`compare_mu_i_forms`] ranks both by
-//!   AIC).
-//! - [`fit_phi_i`]: `φ(I) = φ_max − (φ_max − φ_min) I`, with `0 < φ_min < φ_max ≤ 1`.
+//! - [`fit_mu_i`]: `μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)` (GDR MiDi 2004; Jop, Forterre &
+//!   Pouliquen 2006), fitted in the parameters `(μ_s, Δμ = μ₂ − μ_s, I₀)` with box bounds
+//!   `μ_s > 0`, `0 < Δμ ≤ 10`, `I₀ > 0` (so that `μ_s < μ₂` holds by construction) and reported
+//!   as `(μ_s, μ₂, I₀)` (exact linear reparametrisation of the covariance). Started from a
+//!   variable-projection grid over `I₀` (the law is linear in `μ_s, Δμ` for fixed `I₀`).
+//! - [`fit_mu_i_linear`]: `μ = μ_s + b I`, the form nested in μ(I) as `I₀ → ∞` with
+//!   `(μ₂ − μ_s)/I₀ = b` ([`compare_mu_i_forms`] ranks both by AIC).
+//! - [`fit_mu_i_or_linear`]: μ(I), or the linear form with the reason μ(I) was refused.
+//! - [`fit_phi_i`]: `φ(I) = φ_max − (φ_max − φ_min) I`, with `0 < φ_min < φ_max ≤ 1`
+//!   (`φ_min` is the value extrapolated to `I = 1`).
+//! - [`fit_phi_i_linear`]: the same line as `φ = φ_max − a I`, which claims nothing at `I = 1`.
 //!
-//! Identifiability: when every `I` is far below `I₀` (`I_max < I₀/10`) the data only see the
-//! initial slope `(μ₂ − μ_s)/I₀` → [`IdentifyError::IRangeBelowI0`]; when every `I` is far above
-//! (`I_min > 10 I₀`) they only see `μ₂` → [`IdentifyError::IRangeAboveI0`].
+//! Every fit passes the checks of [`crate::accept`] or is refused. For μ(I): `I₀` inside the
+//! range of `I` in the data (above `I_max` the data see only the initial slope
+//! `(μ₂ − μ_s)/I₀`, below `I_min` only the plateau `μ₂`), the intervals of `μ_s`, `μ₂ − μ_s` and
+//! `I₀` non-negative, every standard error below its value, `R²` above the threshold, and an
+//! adjusted `R²` not below that of `μ_s + b I`. A refusal offers `use mu-i-linear` when the
+//! linear form passes its own checks. Physical ranges: `μ_s ≥ 0`, `b ≥ 0` (friction grows with
+//! `I`), `0 ≤ φ_min, φ_max ≤ 1`, `a ≥ 0` (dilatancy); a refusal of `phi-i` for `φ_min` offers
+//! `use phi-i-linear` when that passes.
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use crate::accept::{Acceptance, NestedForm, PhysicalRange, ScaleCheck};
 use crate::error::{
-    check_finite, check_non_negative_pressure, check_same_len, check_spread, min_max,
-    IdentifyError, Result,
+    check_finite, check_non_negative_pressure, check_same_len, check_spread, IdentifyError, Result,
 };
 use crate::fit::{
     fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel, Observations,
     ParameterSpec,
 };
-use crate::laws::mu_i::{LinearMuILaw, MuILaw, PhiILaw};
+use crate::laws::mu_i::{LinearMuILaw, LinearPhiILaw, MuILaw, PhiILaw};
 use crate::report::{FitReport, ModelComparison, ValidityRange};
 
 /// Steady-shear measurements (data): one row per steady state.
@@ -56,6 +64,30 @@ pub struct LinearMuIFit {
     pub law: LinearMuILaw,
     /// Parameters `mu_s`, `b`.
     pub report: FitReport,
+}
+
+/// Result of [`fit_phi_i_linear`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinearPhiIFit {
+    /// The calibrated law.
+    pub law: LinearPhiILaw,
+    /// Parameters `phi_max`, `a`.
+    pub report: FitReport,
+}
+
+/// Result of [`fit_mu_i_or_linear`]: the full μ(I) when it is accepted, else the linear form
+/// with the reason the full form was refused.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MuIChoice {
+    /// μ(I) passed its checks.
+    Full(MuIFit),
+    /// μ(I) was refused; `μ_s + b I` passed its checks.
+    Linear {
+        /// The linear fit.
+        fit: LinearMuIFit,
+        /// Why the full form was refused (one line, e.g. `I_0` above the data).
+        full_refusal: String,
+    },
 }
 
 /// Result of [`fit_phi_i`].
@@ -158,21 +190,14 @@ impl LeastSquaresModel for MuIModel<'_> {
     }
 }
 
-fn check_i_range(i_min: f64, i_max: f64, i0: f64) -> Result<()> {
-    if i_max < 0.1 * i0 {
-        return Err(IdentifyError::IRangeBelowI0 { i_max, i0 });
-    }
-    if i_min > 10.0 * i0 {
-        return Err(IdentifyError::IRangeAboveI0 { i_min, i0 });
-    }
-    Ok(())
-}
-
 /// Fits `μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)` (see the module documentation).
 ///
 /// Errors: too few points (< 5), non-finite values, `I ≤ 0`, negative pressure, zero variance
-/// of `I` or `μ`, [`IdentifyError::IRangeBelowI0`], [`IdentifyError::IRangeAboveI0`],
-/// [`IdentifyError::ParameterAtBound`].
+/// of `I` or `μ`; refusals ([`IdentifyError::is_refusal`]): [`IdentifyError::ScaleNotResolved`]
+/// (`I₀` outside the `I` of the data), [`IdentifyError::ParameterAtBound`],
+/// [`IdentifyError::IntervalCrossesBound`], [`IdentifyError::ParameterNotIdentified`],
+/// [`IdentifyError::RSquaredTooLow`], [`IdentifyError::WorseThanNested`] (against
+/// `μ_s + b I`), each offering `use mu-i-linear` when the linear form passes.
 pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit> {
     let i = checked_i(series)?;
     let mu = checked_column(series, "mu", &series.mu)?;
@@ -185,7 +210,17 @@ pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit>
     }
     check_spread("I", i)?;
     check_spread("mu", mu)?;
-    let (i_min, i_max) = min_max(i);
+    let linear = linear_mu_report(series, options);
+    let simpler = linear
+        .as_ref()
+        .ok()
+        .filter(|r| accept_linear_mu(r, options).is_ok())
+        .map(|_| "use mu-i-linear");
+    let refuse = |e: IdentifyError| match simpler {
+        Some(s) => e.suggesting(s),
+        None => e,
+    };
+    let (i_min, i_max) = crate::error::min_max(i);
     let grid = log_grid(1e-2 * i_min, 1e2 * i_max, 121);
     let (i0, c) = separable_start(&grid, mu, |i0| {
         DMatrix::from_fn(
@@ -197,9 +232,9 @@ pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit>
     .ok_or_else(|| IdentifyError::NotIdentifiable {
         reason: "no start value for μ(I)".into(),
     })?;
-    check_i_range(i_min, i_max, i0)?;
     let model = MuIModel { i, i_max };
     let theta0 = [c[0].max(1e-3), c[1].clamp(1e-3, 9.0), i0];
+    let scale = ScaleCheck::new("I_0", "I", i);
     let result = fit_least_squares(
         &model,
         &Observations::single("mu", mu.to_vec()),
@@ -209,25 +244,28 @@ pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit>
     );
     let report = match result {
         Ok(r) => r,
-        Err(IdentifyError::ParameterAtBound {
-            report,
-            name,
-            value,
-            bound,
-            side,
-        }) => {
-            check_i_range(i_min, i_max, report.parameters[2].value)?;
-            return Err(IdentifyError::ParameterAtBound {
-                name,
-                value,
-                bound,
-                side,
-                report,
-            });
+        Err(e @ IdentifyError::ParameterAtBound { .. }) => {
+            // A runaway I₀ is the more telling diagnosis.
+            if let IdentifyError::ParameterAtBound { report, name, .. } = &e {
+                if name == "I_0" {
+                    crate::accept::check_scale("mu-i", &scale, report.parameters[2].value)
+                        .map_err(refuse)?;
+                }
+            }
+            return Err(refuse(e));
         }
-        Err(e) => return Err(e),
+        Err(e) => return Err(refuse(e)),
     };
-    check_i_range(i_min, i_max, report.parameters[2].value)?;
+    Acceptance::new("mu-i", options.min_r_squared)
+        .scale(scale)
+        .non_negative(&["mu_s", "delta_mu", "I_0"])
+        .nested(linear.ok().map(|r| NestedForm {
+            name: "mu-i-linear".into(),
+            r_squared: r.r_squared,
+            parameters: 2,
+        }))
+        .check(&report)
+        .map_err(refuse)?;
     let report = report.reparametrised(&[("mu_s", "1"), ("mu_2", "1"), ("I_0", "1")], |p| {
         (
             vec![p[0], p[0] + p[1], p[2]],
@@ -240,6 +278,24 @@ pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit>
         i0: report.parameters[2].value,
     };
     Ok(MuIFit { law, report })
+}
+
+/// Fits μ(I) ([`fit_mu_i`]) and, when it is refused, the linear form `μ_s + b I`
+/// ([`fit_mu_i_linear`]), returned with the reason of the refusal. Errors: bad input (the error
+/// of [`fit_mu_i`] that is not a refusal), or, when both forms are refused, the full form's
+/// refusal.
+pub fn fit_mu_i_or_linear(series: &RheologySeries, options: &FitOptions) -> Result<MuIChoice> {
+    match fit_mu_i(series, options) {
+        Ok(f) => Ok(MuIChoice::Full(f)),
+        Err(e) if e.is_refusal() => match fit_mu_i_linear(series, options) {
+            Ok(fit) => Ok(MuIChoice::Linear {
+                fit,
+                full_refusal: e.to_string(),
+            }),
+            Err(_) => Err(e),
+        },
+        Err(e) => Err(e),
+    }
 }
 
 struct LinearModel<'a> {
@@ -285,9 +341,8 @@ fn ols_start(x: &[f64], y: &[f64]) -> (f64, f64) {
     (my - b * mx, b)
 }
 
-/// Fits the linear form `μ = μ_s + b I` (no bounds). Errors: data checks as [`fit_mu_i`]
-/// (at least 4 points).
-pub fn fit_mu_i_linear(series: &RheologySeries, options: &FitOptions) -> Result<LinearMuIFit> {
+/// The unchecked least-squares fit of `μ = μ_s + b I` (no bounds).
+fn linear_mu_report(series: &RheologySeries, options: &FitOptions) -> Result<FitReport> {
     let i = checked_i(series)?;
     let mu = checked_column(series, "mu", &series.mu)?;
     check_spread("I", i)?;
@@ -299,13 +354,29 @@ pub fn fit_mu_i_linear(series: &RheologySeries, options: &FitOptions) -> Result<
         decreasing: false,
     };
     let (a, b) = ols_start(i, mu);
-    let report = fit_least_squares(
+    fit_least_squares(
         &model,
         &Observations::single("mu", mu.to_vec()),
         &[a, b],
         options,
         validity(series),
-    )?;
+    )
+}
+
+/// The checks of `mu-i-linear`: `μ_s ≥ 0`, `b ≥ 0`, standard errors, R².
+fn accept_linear_mu(report: &FitReport, options: &FitOptions) -> Result<()> {
+    Acceptance::new("mu-i-linear", options.min_r_squared)
+        .non_negative(&["mu_s", "b"])
+        .check(report)
+}
+
+/// Fits the linear form `μ = μ_s + b I` (the limit `I₀ → ∞` of μ(I) with `(μ₂ − μ_s)/I₀ = b`;
+/// unbounded least squares, exact). Errors: data checks as [`fit_mu_i`] (at least 4 points);
+/// refusals: an interval of `μ_s` or `b` below 0 ([`IdentifyError::IntervalCrossesBound`]), a
+/// standard error above its value, `R²` below the threshold.
+pub fn fit_mu_i_linear(series: &RheologySeries, options: &FitOptions) -> Result<LinearMuIFit> {
+    let report = linear_mu_report(series, options)?;
+    accept_linear_mu(&report, options)?;
     let law = LinearMuILaw {
         mu_s: report.parameters[0].value,
         slope: report.parameters[1].value,
@@ -329,10 +400,7 @@ pub fn compare_mu_i_forms(series: &RheologySeries, options: &FitOptions) -> Mode
     ModelComparison::from_aics(&aics, failed)
 }
 
-/// Fits `φ(I) = φ_max − (φ_max − φ_min) I` with `0 < φ_max ≤ 1`, `0 < φ_max − φ_min ≤ 1`;
-/// reported as `(phi_max, phi_min)`. A `φ` that does not decrease with `I` ends at the bound
-/// `φ_max − φ_min = 0` ([`IdentifyError::ParameterAtBound`]).
-pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFit> {
+fn checked_phi(series: &RheologySeries) -> Result<(&[f64], &[f64])> {
     let i = checked_i(series)?;
     let phi = checked_column(series, "phi", &series.phi)?;
     if let Some(k) = phi.iter().position(|v| *v > 1.0) {
@@ -344,6 +412,66 @@ pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFi
         });
     }
     check_spread("I", i)?;
+    Ok((i, phi))
+}
+
+/// The unchecked fit of `φ = φ_max − a I` (no bounds).
+fn linear_phi_report(series: &RheologySeries, options: &FitOptions) -> Result<FitReport> {
+    let (i, phi) = checked_phi(series)?;
+    let model = LinearModel {
+        x: i,
+        name: "phi-i-linear",
+        names: ["phi_max", "a"],
+        bounds: [(f64::NEG_INFINITY, f64::INFINITY); 2],
+        decreasing: true,
+    };
+    let (a, b) = ols_start(i, phi);
+    fit_least_squares(
+        &model,
+        &Observations::single("phi", phi.to_vec()),
+        &[a, -b],
+        options,
+        validity(series),
+    )
+}
+
+/// The checks of `phi-i-linear`: `0 ≤ φ_max ≤ 1`, `a ≥ 0`, standard errors, R².
+fn accept_linear_phi(report: &FitReport, options: &FitOptions) -> Result<()> {
+    Acceptance::new("phi-i-linear", options.min_r_squared)
+        .range(PhysicalRange::new("phi_max", 0.0, 1.0))
+        .non_negative(&["a"])
+        .check(report)
+}
+
+/// Fits `φ(I) = φ_max − a I` (unbounded least squares, exact): the line of [`fit_phi_i`]
+/// without the extrapolated `φ_min = φ(1)`, valid over the `I` of the data. Refusals: the
+/// interval of `φ_max` outside `[0, 1]` or of `a` below 0, a standard error above its value,
+/// `R²` below the threshold.
+pub fn fit_phi_i_linear(series: &RheologySeries, options: &FitOptions) -> Result<LinearPhiIFit> {
+    let report = linear_phi_report(series, options)?;
+    accept_linear_phi(&report, options)?;
+    let law = LinearPhiILaw {
+        phi_max: report.parameters[0].value,
+        slope: report.parameters[1].value,
+    };
+    Ok(LinearPhiIFit { law, report })
+}
+
+/// Fits `φ(I) = φ_max − (φ_max − φ_min) I` with `0 < φ_max ≤ 1`, `0 < φ_max − φ_min ≤ 1`;
+/// reported as `(phi_max, phi_min)`. A `φ` that does not decrease with `I` ends at the bound
+/// `φ_max − φ_min = 0` ([`IdentifyError::ParameterAtBound`]). Refusals as [`fit_phi_i_linear`],
+/// and an interval of `φ_min` (the extrapolation to `I = 1`) outside `[0, 1]`, offering
+/// `use phi-i-linear` when that passes.
+pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFit> {
+    let (i, phi) = checked_phi(series)?;
+    let simpler = linear_phi_report(series, options)
+        .ok()
+        .filter(|r| accept_linear_phi(r, options).is_ok())
+        .map(|_| "use phi-i-linear");
+    let refuse = |e: IdentifyError| match simpler {
+        Some(s) => e.suggesting(s),
+        None => e,
+    };
     let model = LinearModel {
         x: i,
         name: "phi-i",
@@ -358,13 +486,22 @@ pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFi
         &[a.clamp(0.01, 0.99), (-b).clamp(1e-3, 0.99)],
         options,
         validity(series),
-    )?;
+    )
+    .map_err(refuse)?;
+    let delta_phi = report.parameters[1].clone();
     let report = report.reparametrised(&[("phi_max", "1"), ("phi_min", "1")], |p| {
         (
             vec![p[0], p[0] - p[1]],
             DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 1.0, -1.0]),
         )
     });
+    Acceptance::new("phi-i", options.min_r_squared)
+        .range(PhysicalRange::new("phi_max", 0.0, 1.0))
+        .range(PhysicalRange::new("phi_min", 0.0, 1.0))
+        .non_negative(&["delta_phi"])
+        .extra(delta_phi)
+        .check(&report)
+        .map_err(refuse)?;
     let law = PhiILaw {
         phi_max: report.parameters[0].value,
         phi_min: report.parameters[1].value,

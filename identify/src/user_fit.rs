@@ -1,22 +1,26 @@
 //! Fitting a law by name from a user's CSV file (`grainlaw fit LAW DATA.csv [--out law.json]`).
 //!
 //! File format: see [`crate::data`] (header with units in the names, `# key = value`
-//! metadata lines for set-up constants, `#` comments). Columns and metadata per law (headers
-//! are matched case-insensitively; stresses are compressive-positive magnitudes unless said):
+//! metadata lines for set-up constants, other `#` lines comments). Columns and metadata per law
+//! (headers are matched case-insensitively; stresses are compressive-positive magnitudes unless
+//! said; columns in Pa are also read in kPa or MPa, in m in mm, in m/s in mm/s):
 //!
 //! | law | required columns | optional columns | metadata (`# key = value`) |
 //! |---|---|---|---|
 //! | `janssen` | `z_m`, `sigma_v_Pa`, `sigma_h_Pa` | `tau_w_Pa` | `width_m`, `bulk_density_kg_m3`, `wall_friction`; optional `gravity_m_s2` (9.81), `depth_min_m`, `depth_max_m`, `full_mobilisation` (1 = fix μ_w = μ_wall) |
-//! | `janssen-kmu` | `z_m`, `sigma_v_Pa` | | `width_m`, `bulk_density_kg_m3`; optional `gravity_m_s2`, `depth_min_m`, `depth_max_m` |
+//! | `janssen-kmu` | `z_m`, `sigma_v_Pa` | | `width_m`, `bulk_density_kg_m3`; optional `gravity_m_s2`, `depth_min_m`, `depth_max_m`; `wall_friction`, `full_mobilisation` accepted (a `janssen` file) and not used |
 //! | `wall-law` | `slip_velocity_m_s` and either `mu_eff` or both `tau_w_Pa`, `sigma_w_Pa` | | `grain_diameter_m`; optional `gravity_m_s2` |
-//! | `mu-i` | `I`, `mu` | `P_Pa` | |
-//! | `phi-i` | `I`, `phi` | `P_Pa` | |
-//! | `mohr-coulomb` | one of: `p_Pa`, `q_Pa` (Mohr circles) · `sigma_xx_Pa`, `sigma_yy_Pa`, `sigma_xy_Pa` (2D tensors, **tension positive**) · `sigma_n_Pa`, `tau_Pa` (failure plane) | | |
+//! | `mu-i`, `mu-i-linear` | `I`, `mu` | `P_Pa` | `grain_diameter_m`, `grain_density_kg_m3` (the law's `d`, `rho_s`) |
+//! | `phi-i`, `phi-i-linear` | `I`, `phi` | `P_Pa` | `grain_diameter_m`, `grain_density_kg_m3` |
+//! | `mohr-coulomb` | one of: `p_Pa`, `q_Pa` (Mohr circles) · `sigma_xx_Pa`, `sigma_yy_Pa`, `sigma_xy_Pa` (2D tensors, **tension positive**) · `sigma_n_Pa`, `tau_Pa` (failure plane) | | optional `cohesion` (only `0`: fixes `c = 0`, and 3 states suffice) |
 //!
 //! `z` is the depth below the free surface, `I` the inertial number, `mu = τ/P`, `phi` the solid
 //! fraction, `p`/`q` the centre/radius of the Mohr circle at yield. `wall-law` fits the three
-//! candidate forms and keeps the lowest AIC (the ranking is stored in the JSON).
-//! Metadata given in [`CsvFitOptions::metadata`] override the file's.
+//! candidate forms and keeps the lowest AIC among those accepted (the ranking is stored in the
+//! JSON). A metadata key the law does not read is refused ([`IdentifyError::UnknownMetadata`],
+//! with the keys it reads); so is a key it reads whose value is not a finite number. Metadata
+//! given in [`CsvFitOptions::metadata`] override the file's and are recorded as overrides in the
+//! provenance, with the date and the SHA-256 of the file.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -28,21 +32,45 @@ use crate::janssen::{
     fit_janssen, fit_janssen_full_mobilisation, fit_janssen_k_mu, JanssenOptions, JanssenProfile,
     JanssenSetup,
 };
-use crate::law::{CalibratedLaw, Provenance};
+use crate::law::{CalibratedLaw, GrainScale, Provenance};
 use crate::laws::STANDARD_GRAVITY;
-use crate::mohr_coulomb::{fit_mohr_coulomb, YieldData};
-use crate::mu_i::{fit_mu_i, fit_phi_i, RheologySeries};
+use crate::mohr_coulomb::{fit_mohr_coulomb_with, MohrCoulombOptions, YieldData};
+use crate::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, fit_phi_i_linear, RheologySeries};
 use crate::wall_law::{select_wall_law, WallSlipSeries};
 
 /// Law names accepted by [`fit_csv_file`].
-pub const LAW_NAMES: [&str; 6] = [
+pub const LAW_NAMES: [&str; 8] = [
     "janssen",
     "janssen-kmu",
     "wall-law",
     "mu-i",
+    "mu-i-linear",
     "phi-i",
+    "phi-i-linear",
     "mohr-coulomb",
 ];
+
+/// The `# key = value` keys `law` reads (module documentation); any other key is refused.
+pub fn metadata_keys(law: &str) -> &'static [&'static str] {
+    const JANSSEN: &[&str] = &[
+        "width_m",
+        "bulk_density_kg_m3",
+        "wall_friction",
+        "gravity_m_s2",
+        "depth_min_m",
+        "depth_max_m",
+        "full_mobilisation",
+    ];
+    match law {
+        "janssen" | "janssen-kmu" => JANSSEN,
+        "wall-law" => &["grain_diameter_m", "gravity_m_s2"],
+        "mu-i" | "mu-i-linear" | "phi-i" | "phi-i-linear" => {
+            &["grain_diameter_m", "grain_density_kg_m3"]
+        }
+        "mohr-coulomb" => &["cohesion"],
+        _ => &[],
+    }
+}
 
 /// Options of [`fit_csv_file`].
 #[derive(Debug, Clone, PartialEq)]
@@ -75,9 +103,16 @@ impl Default for CsvFitOptions {
 pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<CalibratedLaw> {
     check_law_name(law)?;
     let source = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| IdentifyError::Io {
+    let bytes = std::fs::read(path).map_err(|e| IdentifyError::Io {
         path: source.clone(),
         source: e,
+    })?;
+    let text = String::from_utf8(bytes.clone()).map_err(|_| IdentifyError::Io {
+        path: source.clone(),
+        source: std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        ),
     })?;
     let table = Table::parse_csv(&text, &source)?;
     let header = header_line(&text);
@@ -89,7 +124,9 @@ pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<C
             message: "no data rows after the header".into(),
         });
     }
-    fit_table(law, &table, options)
+    let mut law = fit_table(law, &table, options)?;
+    law.provenance = law.provenance.with_input(&source, &bytes);
+    Ok(law)
 }
 
 /// 1-based line of the header: the first line that is neither blank nor a `#` comment.
@@ -133,14 +170,84 @@ fn check_law_name(law: &str) -> Result<()> {
     Ok(())
 }
 
+/// Refuses metadata keys `law` does not read, and keys it reads whose value is not a finite
+/// number.
+fn check_metadata(law: &str, table: &Table, options: &CsvFitOptions) -> Result<()> {
+    let known = metadata_keys(law);
+    let unknown = |key: &str, line: u64| IdentifyError::UnknownMetadata {
+        file: table.source.clone(),
+        line,
+        key: key.to_string(),
+        law: law.to_string(),
+        known: if known.is_empty() {
+            "none".into()
+        } else {
+            known.join(", ")
+        },
+    };
+    for (key, value) in &table.metadata {
+        let line = table.metadata_lines.get(key).copied().unwrap_or(0);
+        if !known.contains(&key.as_str()) {
+            return Err(unknown(key, line));
+        }
+        if !value.is_finite() {
+            return Err(IdentifyError::Metadata {
+                file: table.source.clone(),
+                message: format!("line {line}: metadata '{key}' is not finite"),
+            });
+        }
+    }
+    for (key, text, line) in &table.text_metadata {
+        if known.contains(&key.as_str()) {
+            return Err(IdentifyError::Metadata {
+                file: table.source.clone(),
+                message: format!("line {line}: metadata '{key}' = '{text}' is not a number"),
+            });
+        }
+    }
+    for (key, value) in &options.metadata {
+        if !known.contains(&key.as_str()) {
+            return Err(unknown(key, 0));
+        }
+        if !value.is_finite() {
+            return Err(IdentifyError::Metadata {
+                file: table.source.clone(),
+                message: format!("metadata override '{key}' is not finite"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `d` and `ρ_s` from the metadata, for a μ(I) or φ(I) law.
+fn grain_scale(table: &Table) -> Result<GrainScale> {
+    let d = table.metadata_value("grain_diameter_m")?;
+    let rho = table.metadata_value("grain_density_kg_m3")?;
+    crate::error::check_setup_positive("grain_diameter_m", d)?;
+    crate::error::check_setup_positive("grain_density_kg_m3", rho)?;
+    Ok(GrainScale {
+        diameter_m: d,
+        density_kg_m3: rho,
+    })
+}
+
 /// Fits `law` to an already-read table (see [`fit_csv_file`]).
 pub fn fit_table(law: &str, table: &Table, options: &CsvFitOptions) -> Result<CalibratedLaw> {
     check_law_name(law)?;
+    check_metadata(law, table, options)?;
     let mut table = table.clone();
     for (k, v) in &options.metadata {
         table.metadata.insert(k.clone(), *v);
     }
-    let mut provenance = Provenance::new(&options.scenario, options.seed);
+    let mut provenance = Provenance::new(&options.scenario, options.seed)
+        .with_overrides(
+            options
+                .metadata
+                .iter()
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect(),
+        )
+        .with_date_now();
     provenance.source = Some(table.source.clone());
     match law {
         "janssen" | "janssen-kmu" => {
@@ -230,21 +337,38 @@ pub fn fit_table(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Ca
                 provenance,
             ))
         }
-        "mu-i" | "phi-i" => {
+        "mu-i" | "mu-i-linear" | "phi-i" | "phi-i-linear" => {
             let mut series = RheologySeries {
                 inertial_number: table.column("I")?,
                 pressure_pa: table.optional_column("P_Pa")?,
                 ..Default::default()
             };
-            if law == "mu-i" {
+            // The constants are asked for after the fit, so that an error in the data is
+            // reported first.
+            let o = &options.fit;
+            if law.starts_with("mu") {
                 series.mu = Some(table.column("mu")?);
-                let fit = fit_mu_i(&series, &options.fit)?;
-                Ok(CalibratedLaw::from_mu_i(&fit, provenance))
             } else {
                 series.phi = Some(table.column("phi")?);
-                let fit = fit_phi_i(&series, &options.fit)?;
-                Ok(CalibratedLaw::from_phi_i(&fit, provenance))
             }
+            Ok(match law {
+                "mu-i" => {
+                    let fit = fit_mu_i(&series, o)?;
+                    CalibratedLaw::from_mu_i(&fit, grain_scale(&table)?, provenance)
+                }
+                "mu-i-linear" => {
+                    let fit = fit_mu_i_linear(&series, o)?;
+                    CalibratedLaw::from_mu_i_linear(&fit, grain_scale(&table)?, provenance)
+                }
+                "phi-i" => {
+                    let fit = fit_phi_i(&series, o)?;
+                    CalibratedLaw::from_phi_i(&fit, grain_scale(&table)?, provenance)
+                }
+                _ => {
+                    let fit = fit_phi_i_linear(&series, o)?;
+                    CalibratedLaw::from_phi_i_linear(&fit, grain_scale(&table)?, provenance)
+                }
+            })
         }
         _ => {
             // mohr-coulomb
@@ -266,7 +390,27 @@ pub fn fit_table(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Ca
                     (0..sxx.len()).map(|k| [sxx[k], syy[k], sxy[k]]).collect();
                 YieldData::from_tension_positive_tensors(&tensors)
             };
-            let fit = fit_mohr_coulomb(&data, options.fit.confidence)?;
+            let cohesion_fixed_zero = match table.metadata.get("cohesion") {
+                None => false,
+                Some(c) if *c == 0.0 => true,
+                Some(c) => {
+                    return Err(IdentifyError::Metadata {
+                        file: table.source.clone(),
+                        message: format!(
+                            "line {}: '# cohesion = {c}': only '# cohesion = 0' is read (it fixes c = 0); remove the line to fit c",
+                            table.metadata_lines.get("cohesion").copied().unwrap_or(0)
+                        ),
+                    })
+                }
+            };
+            let fit = fit_mohr_coulomb_with(
+                &data,
+                &MohrCoulombOptions {
+                    confidence: options.fit.confidence,
+                    cohesion_fixed_zero,
+                    min_r_squared: options.fit.min_r_squared,
+                },
+            )?;
             Ok(CalibratedLaw::from_mohr_coulomb(&fit, provenance))
         }
     }

@@ -9,14 +9,16 @@
 //! - power law `μ_0 + k V^n`.
 //!
 //! [`select_wall_law`] fits all three, ranks them by AIC and reports `ΔAIC` and Akaike weights.
-//! Bounds: `0 ≤ μ_0, μ_∞ ≤ 10`, `V* > 0`, `|k| ≤ 10`, `0 < n ≤ 5`. A velocity scale `V*`
-//! outside `[V_min⁺/10, 10 V_max]` (`V_min⁺` the smallest positive `V`) is
-//! [`IdentifyError::ScaleNotResolved`]: the data do not see the law's curvature. A form whose
-//! shape parameters ([`WallLawForm::shape_parameters`]: `V*`, or `k` and `n`) have a standard
-//! error above their value is [`IdentifyError::ParameterNotIdentified`]
-//! ([`crate::fit::check_identified`]): e.g. μ_eff falling like `a − b ln V` is fitted by the
-//! power law only as `n → 0`, `μ_0 → +∞`, `k → −∞`, with intervals spanning zero by orders of
-//! magnitude; such a form is left out of the AIC ranking (listed as failed with the reason).
+//! Bounds: `0 ≤ μ_0, μ_∞ ≤ 10`, `V* > 0`, `|k| ≤ 10`, `0 < n ≤ 5`. Each form passes the checks
+//! of [`crate::accept`] or is refused: a velocity scale `V*` outside `[V_min⁺, V_max]` (`V_min⁺`
+//! the smallest positive `V`) is [`IdentifyError::ScaleNotResolved`] (the data do not see the
+//! law's curvature); intervals of `μ_0`, `μ_∞`, `V*`, `n` below 0 are
+//! [`IdentifyError::IntervalCrossesBound`]; a parameter with a standard error above its value is
+//! [`IdentifyError::ParameterNotIdentified`] ([`crate::accept::check_identified`]): e.g. μ_eff
+//! falling like `a − b ln V` is fitted by the power law only as `n → 0`, `μ_0 → +∞`,
+//! `k → −∞`, with intervals spanning zero by orders of magnitude; `R²` below the threshold is
+//! [`IdentifyError::RSquaredTooLow`]. A refused form is left out of the AIC ranking (listed as
+//! failed with the reason).
 //!
 //! [`fit_boundary_layer`] fits `u(y) = u_b − (u_b − u_s) exp(−y/δ)` to a velocity profile
 //! (`y` distance from the wall, m) and reports `δ` in metres and in grain diameters.
@@ -24,13 +26,14 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use crate::accept::{check_scale, Acceptance, ScaleCheck};
 use crate::error::{
     check_finite, check_same_len, check_setup_positive, check_spread, min_max, IdentifyError,
     Result,
 };
 use crate::fit::{
-    check_identified, fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel,
-    Observations, ParameterSpec,
+    fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel, Observations,
+    ParameterSpec,
 };
 use crate::laws::boundary_layer::VelocityBoundaryLayer;
 use crate::laws::janssen::STANDARD_GRAVITY;
@@ -98,10 +101,8 @@ impl WallLawForm {
         }
     }
 
-    /// The parameters the velocity dependence rests on, which must be identified
-    /// ([`check_identified`]): `V_star` for the saturating forms, `k` and `n` for the power law
-    /// (with `k → 0` or `n → 0` the law is a constant). `mu_0` is an offset that may rightly be
-    /// close to zero and is not checked.
+    /// The parameters the velocity dependence rests on: `V_star` for the saturating forms, `k`
+    /// and `n` for the power law (with `k → 0` or `n → 0` the law is a constant).
     pub fn shape_parameters(&self) -> &'static [&'static str] {
         match self {
             WallLawForm::Exponential | WallLawForm::Hyperbolic => &["V_star"],
@@ -198,24 +199,6 @@ impl LeastSquaresModel for WallModel<'_> {
     }
 }
 
-fn check_scale(parameter: &str, value: f64, x: &[f64]) -> Result<()> {
-    let (_, x_max) = min_max(x);
-    let x_min_pos = x
-        .iter()
-        .cloned()
-        .filter(|v| *v > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    if value > 10.0 * x_max || value < 0.1 * x_min_pos {
-        return Err(IdentifyError::ScaleNotResolved {
-            parameter: parameter.into(),
-            value,
-            data_min: x_min_pos,
-            data_max: x_max,
-        });
-    }
-    Ok(())
-}
-
 fn checked_series(series: &WallSlipSeries) -> Result<Vec<f64>> {
     check_setup_positive("grain_diameter_m", series.grain_diameter_m)?;
     check_setup_positive("gravity_m_s2", series.gravity_m_s2)?;
@@ -245,10 +228,10 @@ fn checked_series(series: &WallSlipSeries) -> Result<Vec<f64>> {
     Ok(series.normalised_velocity())
 }
 
-/// Fits one wall-law form. Errors: data checks (≥ 5 points, finite, non-negative, spread),
-/// [`IdentifyError::ScaleNotResolved`] for `V*`, [`IdentifyError::ParameterAtBound`],
-/// [`IdentifyError::ParameterNotIdentified`] for a shape parameter whose standard error exceeds
-/// its value.
+/// Fits one wall-law form. Errors: data checks (≥ 5 points, finite, non-negative, spread);
+/// refusals (module documentation): [`IdentifyError::ScaleNotResolved`] for `V*`,
+/// [`IdentifyError::ParameterAtBound`], [`IdentifyError::IntervalCrossesBound`],
+/// [`IdentifyError::ParameterNotIdentified`], [`IdentifyError::RSquaredTooLow`].
 pub fn fit_wall_law(
     series: &WallSlipSeries,
     form: WallLawForm,
@@ -297,11 +280,9 @@ pub fn fit_wall_law(
     })?;
     let theta0 = match form {
         WallLawForm::PowerLaw => [c[0].clamp(1e-3, 9.0), c[1].clamp(-9.0, 9.0), s],
-        _ => {
-            check_scale("V_star", s, &v)?;
-            [c[0].clamp(1e-3, 9.0), c[1].clamp(1e-3, 9.0), s]
-        }
+        _ => [c[0].clamp(1e-3, 9.0), c[1].clamp(1e-3, 9.0), s],
     };
+    let scale = ScaleCheck::new("V_star", "V", &v);
     let model = WallModel { v: &v, form, v_max };
     let validity = vec![
         ValidityRange {
@@ -321,31 +302,25 @@ pub fn fit_wall_law(
     );
     let report = match result {
         Ok(r) => r,
-        Err(IdentifyError::ParameterAtBound {
-            report,
-            name,
-            value,
-            bound,
-            side,
-        }) => {
+        Err(e @ IdentifyError::ParameterAtBound { .. }) => {
             // A runaway velocity scale is the more telling diagnosis.
-            if form != WallLawForm::PowerLaw {
-                check_scale("V_star", report.parameters[2].value, &v)?;
+            if let IdentifyError::ParameterAtBound { report, name, .. } = &e {
+                if name == "V_star" {
+                    check_scale(form.law_name(), &scale, report.parameters[2].value)?;
+                }
             }
-            return Err(IdentifyError::ParameterAtBound {
-                name,
-                value,
-                bound,
-                side,
-                report,
-            });
+            return Err(e);
         }
         Err(e) => return Err(e),
     };
-    if form != WallLawForm::PowerLaw {
-        check_scale("V_star", report.parameters[2].value, &v)?;
+    let acceptance = Acceptance::new(form.law_name(), options.min_r_squared);
+    match form {
+        WallLawForm::PowerLaw => acceptance.non_negative(&["mu_0", "n"]),
+        _ => acceptance
+            .scale(scale)
+            .non_negative(&["mu_0", "mu_inf", "V_star"]),
     }
-    check_identified(&report, form.shape_parameters())?;
+    .check(&report)?;
     Ok(WallLawFit {
         form,
         law: form.build(&report.values()),
@@ -448,8 +423,10 @@ impl LeastSquaresModel for LayerModel<'_> {
 }
 
 /// Fits `u(y) = u_b − (u_b − u_s) exp(−y/δ)`. Errors: data checks (≥ 5 points, `y ≥ 0`,
-/// spread), [`IdentifyError::ScaleNotResolved`] for `δ` outside `[y_min⁺/10, 10 y_max]`,
-/// [`IdentifyError::ParameterAtBound`].
+/// spread); refusals ([`crate::accept`]): [`IdentifyError::ScaleNotResolved`] for `δ` outside
+/// `[y_min⁺, y_max]`, [`IdentifyError::ParameterAtBound`], an interval of `δ` below 0, a standard
+/// error above its value (`u_slip` exempt: a no-slip wall has `u_s ≈ 0`), `R²` below the
+/// threshold.
 pub fn fit_boundary_layer(
     profile: &VelocityProfile,
     options: &FitOptions,
@@ -496,16 +473,31 @@ pub fn fit_boundary_layer(
     .ok_or_else(|| IdentifyError::NotIdentifiable {
         reason: "no start value for the boundary layer".into(),
     })?;
-    check_scale("delta", s, y)?;
     let model = LayerModel { y, y_max };
-    let report = fit_least_squares(
+    let scale = ScaleCheck::new("delta", "y", y);
+    let report = match fit_least_squares(
         &model,
         &Observations::single("u", u.clone()),
         &[c[0], c[1], s],
         options,
         vec![ValidityRange::of("y", "m", y)],
-    )?;
-    check_scale("delta", report.parameters[2].value, y)?;
+    ) {
+        Ok(r) => r,
+        Err(e @ IdentifyError::ParameterAtBound { .. }) => {
+            if let IdentifyError::ParameterAtBound { report, name, .. } = &e {
+                if name == "delta" {
+                    check_scale("boundary-layer", &scale, report.parameters[2].value)?;
+                }
+            }
+            return Err(e);
+        }
+        Err(e) => return Err(e),
+    };
+    Acceptance::new("boundary-layer", options.min_r_squared)
+        .scale(scale)
+        .non_negative(&["delta"])
+        .may_vanish(&["u_slip"])
+        .check(&report)?;
     let d = profile.grain_diameter_m;
     let thickness_m = report.parameters[2].clone();
     let thickness_diameters =

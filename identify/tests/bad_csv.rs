@@ -161,8 +161,8 @@ fn rows() -> Vec<Row> {
             law: "mu-i",
             text: "I,mu\n1e-6,0.3\n2e-6,0.3001\n3e-6,0.3002\n4e-6,0.3003\n5e-6,0.3004\n6e-6,0.3005\n"
                 .into(),
-            is_expected: |e| matches!(e, IdentifyError::IRangeBelowI0 { .. }),
-            needle: "not separately identifiable",
+            is_expected: |e| matches!(e, IdentifyError::ScaleNotResolved { .. }),
+            needle: "I_0 and the law's asymptote are not separately identifiable",
         },
         Row {
             label: "no spread in I",
@@ -219,9 +219,9 @@ fn rows() -> Vec<Row> {
             text: "# grain_diameter_m = 0.002\nslip_velocity_m_s,mu_eff\n0.01,0.47\n0.02,0.44\n0.05,0.45\n0.1,0.43\n0.2,0.44\n0.5,0.42\n1.0,0.43\n"
                 .into(),
             is_expected: |e| {
-                matches!(e, IdentifyError::ParameterNotIdentified { name, .. } if name == "V_star")
+                matches!(e, IdentifyError::ScaleNotResolved { parameter, .. } if parameter == "V_star")
             },
-            needle: "wall-law-exponential: not identifiable: V_star",
+            needle: "wall-law-exponential: refused: V_star = 0.0414559 lies below the smallest V in the data",
         },
         Row {
             label: "constant wall friction: not identifiable",
@@ -278,7 +278,14 @@ fn every_bad_csv_gives_its_typed_one_line_error() {
 fn the_reference_rows_fit() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("good.csv");
-    std::fs::write(&path, format!("I,mu\n{}", mu_i_rows())).unwrap();
+    std::fs::write(
+        &path,
+        format!(
+            "# grain_diameter_m = 0.002\n# grain_density_kg_m3 = 2500\nI,mu\n{}",
+            mu_i_rows()
+        ),
+    )
+    .unwrap();
     let law = fit_csv_file("mu-i", &path, &CsvFitOptions::default()).unwrap();
     let mu_s = law.parameters.iter().find(|p| p.name == "mu_s").unwrap();
     assert!((mu_s.value - 0.38).abs() < 1e-6, "{mu_s:?}");

@@ -3,6 +3,7 @@
 mod common;
 
 use common::gaussian;
+use identify::error::ScaleSide;
 use identify::fit::{BootstrapOptions, FitOptions};
 use identify::laws::MuILaw;
 use identify::mu_i::{compare_mu_i_forms, fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
@@ -132,9 +133,20 @@ fn i_range_far_below_i0_is_not_identifiable() {
         ..Default::default()
     };
     let err = fit_mu_i(&s, &FitOptions::default()).unwrap_err();
-    assert!(matches!(err, IdentifyError::IRangeBelowI0 { .. }), "{err}");
-    // The linear form is what these data support.
+    assert!(
+        matches!(
+            err,
+            IdentifyError::ScaleNotResolved {
+                side: ScaleSide::AboveData,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    // The linear form is what these data support, and the refusal offers it.
     assert!(fit_mu_i_linear(&s, &FitOptions::default()).is_ok());
+    assert_eq!(err.suggestion(), Some("use mu-i-linear"));
+    assert!(err.to_string().ends_with("; use mu-i-linear"), "{err}");
 }
 
 #[test]
@@ -146,7 +158,16 @@ fn i_range_far_above_i0_is_not_identifiable() {
         ..Default::default()
     };
     let err = fit_mu_i(&s, &FitOptions::default()).unwrap_err();
-    assert!(matches!(err, IdentifyError::IRangeAboveI0 { .. }), "{err}");
+    assert!(
+        matches!(
+            err,
+            IdentifyError::ScaleNotResolved {
+                side: ScaleSide::BelowData,
+                ..
+            }
+        ),
+        "{err}"
+    );
 }
 
 #[test]

@@ -68,7 +68,8 @@ fn mu_i_wall_law_and_mohr_coulomb_from_csv() {
         mu_2: 0.64,
         i0: 0.279,
     };
-    let mut s = String::from("I,mu,P_Pa\n");
+    let mut s =
+        String::from("# grain_diameter_m = 0.002\n# grain_density_kg_m3 = 2500\nI,mu,P_Pa\n");
     let e = gaussian(8, 25, 0.004);
     for (k, ek) in e.iter().enumerate() {
         let i = 10f64.powf(-3.0 + 3.0 * k as f64 / 24.0);

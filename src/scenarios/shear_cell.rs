@@ -15,7 +15,7 @@ use homogenise::kinematics::{velocity_gradient, VelocityWeight};
 use homogenise::state::solid_fraction;
 use homogenise::walls::{near_wall_profile, NearWallSpec};
 use homogenise::Region;
-use identify::law::Provenance;
+use identify::law::{GrainScale, Provenance};
 use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use identify::wall_law::{select_wall_law, WallSlipSeries};
 use identify::{CalibratedLaw, FitOptions};
@@ -278,6 +278,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         table.push(r.clone());
     }
     table.comments.push("steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip; fit again with grainlaw fit mu-i rheology.csv".into());
+    table.metadata = vec![
+        ("grain_diameter_m".into(), d),
+        ("grain_density_kg_m3".into(), c.grain.density),
+    ];
     table.write(&mut ctx.out, "rheology.csv")?;
 
     // Fits.
@@ -289,6 +293,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     };
     let opts = FitOptions::default();
     let prov = || Provenance::new("shear-cell", Some(c.seed));
+    let grain = GrainScale {
+        diameter_m: d,
+        density_kg_m3: c.grain.density,
+    };
     let mut s = Summary::new();
     s.int("grains", c.grains as u64)
         .num("pressure_Pa", c.pressure)
@@ -350,7 +358,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             write_law(
                 &mut ctx.out,
                 "mu_i_law.json",
-                &CalibratedLaw::from_mu_i(&f, prov()),
+                &CalibratedLaw::from_mu_i(&f, grain, prov()),
             )?;
         }
         Err(e) => {
@@ -379,7 +387,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                     write_law(
                         &mut ctx.out,
                         "mu_i_law.json",
-                        &CalibratedLaw::from_mu_i_linear(&f, prov()),
+                        &CalibratedLaw::from_mu_i_linear(&f, grain, prov()),
                     )?;
                 }
                 Err(e2) => {
@@ -426,7 +434,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             write_law(
                 &mut ctx.out,
                 "phi_i_law.json",
-                &CalibratedLaw::from_phi_i(&f, prov()),
+                &CalibratedLaw::from_phi_i(&f, grain, prov()),
             )?;
         }
         Err(e) => {

@@ -11,5 +11,5 @@ pub mod wall_friction;
 pub use boundary_layer::VelocityBoundaryLayer;
 pub use janssen::{JanssenLaw, JanssenVerticalLaw, STANDARD_GRAVITY};
 pub use mohr_coulomb::{DruckerPrager, MohrCoulombLaw};
-pub use mu_i::{LinearMuILaw, MuILaw, PhiILaw};
+pub use mu_i::{LinearMuILaw, LinearPhiILaw, MuILaw, PhiILaw};
 pub use wall_friction::WallFrictionLaw;

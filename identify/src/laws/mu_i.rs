@@ -3,7 +3,8 @@
 //! Inertial number `I = γ̇ d / √(P/ρ_s)` (1), `ρ_s` the grain material density.
 //! - `μ(I) = μ_s + (μ₂ − μ_s) / (1 + I₀/I)` with `0 < μ_s < μ₂`, `I₀ > 0`;
 //! - linear form `μ(I) = μ_s + b I`;
-//! - `φ(I) = φ_max − (φ_max − φ_min) I` (φ_min is the extrapolated value at `I = 1`).
+//! - `φ(I) = φ_max − (φ_max − φ_min) I` (φ_min is the extrapolated value at `I = 1`);
+//! - linear form `φ(I) = φ_max − a I` (the same line, claiming nothing at `I = 1`).
 
 use serde::{Deserialize, Serialize};
 
@@ -70,6 +71,22 @@ impl PhiILaw {
     /// `φ(I)`.
     pub fn phi(&self, i: f64) -> f64 {
         self.phi_max - (self.phi_max - self.phi_min) * i
+    }
+}
+
+/// `φ(I) = φ_max − a I`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LinearPhiILaw {
+    /// Solid fraction at `I = 0` (1).
+    pub phi_max: f64,
+    /// Dilatancy slope `a = −dφ/dI` (1).
+    pub slope: f64,
+}
+
+impl LinearPhiILaw {
+    /// `φ(I) = φ_max − a I`.
+    pub fn phi(&self, i: f64) -> f64 {
+        self.phi_max - self.slope * i
     }
 }
 
