@@ -55,7 +55,8 @@ pub enum Command {
         #[arg(long, value_name = "NAME")]
         show: Option<String>,
     },
-    /// Fit a law to your own data: janssen, janssen-kmu, wall-law, mu-i, phi-i, mohr-coulomb.
+    /// Fit a law to your own data: janssen, janssen-kmu, wall-law, mu-i, mu-i-linear, phi-i,
+    /// phi-i-linear, mohr-coulomb. Exit code 2 for bad input, 3 when the fit is refused.
     Fit {
         /// Law name.
         law: String,
