@@ -160,6 +160,47 @@ const WALL_CONSTANTS: &[(&str, &str, &str)] =
 const WALL_GEOMETRY: &str = "grains sliding along a flat rigid wall: mu_eff = tau_w/sigma_w the ratio of wall shear to wall normal stress, V_s the slip velocity of the grains along the wall";
 const JANSSEN_GEOMETRY: &str = "column of width W between two parallel vertical rigid walls, filled to a free surface at z = 0, z measured downward; stresses compressive positive, averaged across the width (slice balance)";
 
+/// A wall-friction law of `V = V_s/√(g d)`.
+const fn wall_law(
+    name: &'static str,
+    formula: &'static str,
+    parameters: &'static [(&'static str, &'static str)],
+) -> LawSpec {
+    LawSpec {
+        name,
+        input: ("V", "1"),
+        output: ("mu_eff", "1"),
+        formula,
+        also: &[],
+        definitions: V_FROM_SLIP,
+        parameters,
+        constants: WALL_CONSTANTS,
+        derived: &[],
+        geometry: WALL_GEOMETRY,
+    }
+}
+
+/// A law of the inertial number `I = γ̇ d/√(P/ρ_s)` (output `mu` or `phi`).
+const fn rheology(
+    name: &'static str,
+    output: &'static str,
+    formula: &'static str,
+    parameters: &'static [(&'static str, &'static str)],
+) -> LawSpec {
+    LawSpec {
+        name,
+        input: ("I", "1"),
+        output: (output, "1"),
+        formula,
+        also: &[],
+        definitions: I_FROM_SHEAR,
+        parameters,
+        constants: GRAIN_CONSTANTS,
+        derived: &[],
+        geometry: SHEAR_GEOMETRY,
+    }
+}
+
 /// The registry of laws a calibrated-law JSON can hold (schema 2).
 pub const REGISTRY: &[LawSpec] = &[
     LawSpec {
@@ -214,42 +255,21 @@ pub const REGISTRY: &[LawSpec] = &[
         derived: &[("saturation_length", "m", "W/(2*K_mu_w)")],
         geometry: JANSSEN_GEOMETRY,
     },
-    LawSpec {
-        name: "wall-law-exponential",
-        input: ("V", "1"),
-        output: ("mu_eff", "1"),
-        formula: "mu_inf - (mu_inf - mu_0)*exp(-V/V_star)",
-        also: &[],
-        definitions: V_FROM_SLIP,
-        parameters: &[("mu_0", "1"), ("mu_inf", "1"), ("V_star", "1")],
-        constants: WALL_CONSTANTS,
-        derived: &[],
-        geometry: WALL_GEOMETRY,
-    },
-    LawSpec {
-        name: "wall-law-hyperbolic",
-        input: ("V", "1"),
-        output: ("mu_eff", "1"),
-        formula: "mu_0 + (mu_inf - mu_0)*V/(V + V_star)",
-        also: &[],
-        definitions: V_FROM_SLIP,
-        parameters: &[("mu_0", "1"), ("mu_inf", "1"), ("V_star", "1")],
-        constants: WALL_CONSTANTS,
-        derived: &[],
-        geometry: WALL_GEOMETRY,
-    },
-    LawSpec {
-        name: "wall-law-power",
-        input: ("V", "1"),
-        output: ("mu_eff", "1"),
-        formula: "mu_0 + k*V^n",
-        also: &[],
-        definitions: V_FROM_SLIP,
-        parameters: &[("mu_0", "1"), ("k", "1"), ("n", "1")],
-        constants: WALL_CONSTANTS,
-        derived: &[],
-        geometry: WALL_GEOMETRY,
-    },
+    wall_law(
+        "wall-law-exponential",
+        "mu_inf - (mu_inf - mu_0)*exp(-V/V_star)",
+        &[("mu_0", "1"), ("mu_inf", "1"), ("V_star", "1")],
+    ),
+    wall_law(
+        "wall-law-hyperbolic",
+        "mu_0 + (mu_inf - mu_0)*V/(V + V_star)",
+        &[("mu_0", "1"), ("mu_inf", "1"), ("V_star", "1")],
+    ),
+    wall_law(
+        "wall-law-power",
+        "mu_0 + k*V^n",
+        &[("mu_0", "1"), ("k", "1"), ("n", "1")],
+    ),
     LawSpec {
         name: "boundary-layer",
         input: ("y", "m"),
@@ -262,54 +282,30 @@ pub const REGISTRY: &[LawSpec] = &[
         derived: &[("delta_over_d", "1", "delta/d")],
         geometry: "velocity parallel to a flat wall against the distance y from it",
     },
-    LawSpec {
-        name: "mu-i",
-        input: ("I", "1"),
-        output: ("mu", "1"),
-        formula: "mu_s + (mu_2 - mu_s)*I/(I + I_0)",
-        also: &[],
-        definitions: I_FROM_SHEAR,
-        parameters: &[("mu_s", "1"), ("mu_2", "1"), ("I_0", "1")],
-        constants: GRAIN_CONSTANTS,
-        derived: &[],
-        geometry: SHEAR_GEOMETRY,
-    },
-    LawSpec {
-        name: "mu-i-linear",
-        input: ("I", "1"),
-        output: ("mu", "1"),
-        formula: "mu_s + b*I",
-        also: &[],
-        definitions: I_FROM_SHEAR,
-        parameters: &[("mu_s", "1"), ("b", "1")],
-        constants: GRAIN_CONSTANTS,
-        derived: &[],
-        geometry: SHEAR_GEOMETRY,
-    },
-    LawSpec {
-        name: "phi-i",
-        input: ("I", "1"),
-        output: ("phi", "1"),
-        formula: "phi_max - (phi_max - phi_min)*I",
-        also: &[],
-        definitions: I_FROM_SHEAR,
-        parameters: &[("phi_max", "1"), ("phi_min", "1")],
-        constants: GRAIN_CONSTANTS,
-        derived: &[],
-        geometry: SHEAR_GEOMETRY,
-    },
-    LawSpec {
-        name: "phi-i-linear",
-        input: ("I", "1"),
-        output: ("phi", "1"),
-        formula: "phi_max - a*I",
-        also: &[],
-        definitions: I_FROM_SHEAR,
-        parameters: &[("phi_max", "1"), ("a", "1")],
-        constants: GRAIN_CONSTANTS,
-        derived: &[],
-        geometry: SHEAR_GEOMETRY,
-    },
+    rheology(
+        "mu-i",
+        "mu",
+        "mu_s + (mu_2 - mu_s)*I/(I + I_0)",
+        &[("mu_s", "1"), ("mu_2", "1"), ("I_0", "1")],
+    ),
+    rheology(
+        "mu-i-linear",
+        "mu",
+        "mu_s + b*I",
+        &[("mu_s", "1"), ("b", "1")],
+    ),
+    rheology(
+        "phi-i",
+        "phi",
+        "phi_max - (phi_max - phi_min)*I",
+        &[("phi_max", "1"), ("phi_min", "1")],
+    ),
+    rheology(
+        "phi-i-linear",
+        "phi",
+        "phi_max - a*I",
+        &[("phi_max", "1"), ("a", "1")],
+    ),
     LawSpec {
         name: "mohr-coulomb",
         input: ("sigma_n", "Pa"),
@@ -449,27 +445,23 @@ pub struct Degrees {
     pub ci_high: f64,
 }
 
-/// One fitted parameter.
+/// One fitted parameter: its estimate (name, unit, value, standard error, interval,
+/// `at_bound`), and for an angle (unit `rad`) the same in degrees.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LawParameter {
-    /// Name, as the formula uses it.
-    pub name: String,
-    /// SI unit.
-    pub unit: String,
-    /// Estimate.
-    pub value: f64,
-    /// Standard error.
-    pub std_error: f64,
-    /// Lower end of the interval.
-    pub ci_low: f64,
-    /// Upper end of the interval.
-    pub ci_high: f64,
-    /// Held on an admissible bound (not an estimate; e.g. a cohesion at 0).
-    #[serde(default)]
-    pub at_bound: bool,
+    /// The estimate; its name is a variable of the formula.
+    #[serde(flatten)]
+    pub estimate: Estimate,
     /// The same in degrees, for an angle (unit `rad`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub deg: Option<Degrees>,
+}
+
+impl std::ops::Deref for LawParameter {
+    type Target = Estimate;
+    fn deref(&self) -> &Estimate {
+        &self.estimate
+    }
 }
 
 impl LawParameter {
@@ -484,54 +476,42 @@ impl LawParameter {
             }
         });
         LawParameter {
-            name: e.name.clone(),
-            unit: e.unit.clone(),
-            value: e.value,
-            std_error: e.std_error,
-            ci_low: e.ci_low,
-            ci_high: e.ci_high,
-            at_bound: e.at_bound,
+            estimate: e.clone(),
             deg,
         }
     }
 }
 
-/// A quantity derived from the parameters (delta-method interval).
+/// A quantity derived from the parameters (delta-method interval), not a parameter.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DerivedQuantity {
-    /// Name.
-    pub name: String,
+    /// The estimate (`at_bound` when it is fixed, e.g. the mobilisation 1 under full
+    /// mobilisation).
+    #[serde(flatten)]
+    pub estimate: Estimate,
     /// Always true: this is not a fitted parameter.
     pub derived: bool,
     /// Its formula (`grainlaw-expr-1`) in the parameters and constants.
     pub formula: String,
-    /// Unit.
-    pub unit: String,
-    /// Value.
-    pub value: f64,
-    /// Standard error.
-    pub std_error: f64,
-    /// Lower end of the interval.
-    pub ci_low: f64,
-    /// Upper end of the interval.
-    pub ci_high: f64,
-    /// Held on a bound (e.g. the mobilisation 1 under full mobilisation).
-    #[serde(default)]
-    pub at_bound: bool,
+}
+
+impl std::ops::Deref for DerivedQuantity {
+    type Target = Estimate;
+    fn deref(&self) -> &Estimate {
+        &self.estimate
+    }
 }
 
 impl DerivedQuantity {
     fn of(name: &str, unit: &str, formula: &str, e: &Estimate) -> Self {
         DerivedQuantity {
-            name: name.to_string(),
+            estimate: Estimate {
+                name: name.to_string(),
+                unit: unit.to_string(),
+                ..e.clone()
+            },
             derived: true,
             formula: formula.to_string(),
-            unit: unit.to_string(),
-            value: e.value,
-            std_error: e.std_error,
-            ci_low: e.ci_low,
-            ci_high: e.ci_high,
-            at_bound: e.at_bound,
         }
     }
 }

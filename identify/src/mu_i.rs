@@ -341,25 +341,46 @@ fn ols_start(x: &[f64], y: &[f64]) -> (f64, f64) {
     (my - b * mx, b)
 }
 
-/// The unchecked least-squares fit of `μ = μ_s + b I` (no bounds).
+/// The unchecked least-squares fit of the line `y = a ± b I` (no bounds; `decreasing` for
+/// `a − b I`), parameters `names`, to the column `y` of `series`.
+fn linear_report(
+    series: &RheologySeries,
+    options: &FitOptions,
+    law: &'static str,
+    column: (&str, &[f64]),
+    names: [&'static str; 2],
+    decreasing: bool,
+) -> Result<FitReport> {
+    let i = &series.inertial_number;
+    let model = LinearModel {
+        x: i,
+        name: law,
+        names,
+        bounds: [(f64::NEG_INFINITY, f64::INFINITY); 2],
+        decreasing,
+    };
+    let (a, b) = ols_start(i, column.1);
+    fit_least_squares(
+        &model,
+        &Observations::single(column.0, column.1.to_vec()),
+        &[a, if decreasing { -b } else { b }],
+        options,
+        validity(series),
+    )
+}
+
+/// The unchecked fit of `μ = μ_s + b I`.
 fn linear_mu_report(series: &RheologySeries, options: &FitOptions) -> Result<FitReport> {
     let i = checked_i(series)?;
     let mu = checked_column(series, "mu", &series.mu)?;
     check_spread("I", i)?;
-    let model = LinearModel {
-        x: i,
-        name: "mu-i-linear",
-        names: ["mu_s", "b"],
-        bounds: [(f64::NEG_INFINITY, f64::INFINITY); 2],
-        decreasing: false,
-    };
-    let (a, b) = ols_start(i, mu);
-    fit_least_squares(
-        &model,
-        &Observations::single("mu", mu.to_vec()),
-        &[a, b],
+    linear_report(
+        series,
         options,
-        validity(series),
+        "mu-i-linear",
+        ("mu", mu),
+        ["mu_s", "b"],
+        false,
     )
 }
 
@@ -415,23 +436,16 @@ fn checked_phi(series: &RheologySeries) -> Result<(&[f64], &[f64])> {
     Ok((i, phi))
 }
 
-/// The unchecked fit of `φ = φ_max − a I` (no bounds).
+/// The unchecked fit of `φ = φ_max − a I`.
 fn linear_phi_report(series: &RheologySeries, options: &FitOptions) -> Result<FitReport> {
-    let (i, phi) = checked_phi(series)?;
-    let model = LinearModel {
-        x: i,
-        name: "phi-i-linear",
-        names: ["phi_max", "a"],
-        bounds: [(f64::NEG_INFINITY, f64::INFINITY); 2],
-        decreasing: true,
-    };
-    let (a, b) = ols_start(i, phi);
-    fit_least_squares(
-        &model,
-        &Observations::single("phi", phi.to_vec()),
-        &[a, -b],
+    let (_, phi) = checked_phi(series)?;
+    linear_report(
+        series,
         options,
-        validity(series),
+        "phi-i-linear",
+        ("phi", phi),
+        ["phi_max", "a"],
+        true,
     )
 }
 

@@ -240,12 +240,8 @@ pub fn fit_wall_law(
     let v = checked_series(series)?;
     let mu = &series.mu_eff;
     let (v_min, v_max) = min_max(&v);
-    let v_min_pos = v
-        .iter()
-        .cloned()
-        .filter(|x| *x > 0.0)
-        .fold(f64::INFINITY, f64::min)
-        .min(v_max);
+    let scale = ScaleCheck::new("V_star", "V", &v);
+    let v_min_pos = scale.data_min.min(v_max);
     let start = match form {
         WallLawForm::Exponential => {
             separable_start(&log_grid(1e-2 * v_min_pos, 1e2 * v_max, 121), mu, |s| {
@@ -282,7 +278,6 @@ pub fn fit_wall_law(
         WallLawForm::PowerLaw => [c[0].clamp(1e-3, 9.0), c[1].clamp(-9.0, 9.0), s],
         _ => [c[0].clamp(1e-3, 9.0), c[1].clamp(1e-3, 9.0), s],
     };
-    let scale = ScaleCheck::new("V_star", "V", &v);
     let model = WallModel { v: &v, form, v_max };
     let validity = vec![
         ValidityRange {
@@ -454,12 +449,8 @@ pub fn fit_boundary_layer(
     }
     check_spread("y_m", y)?;
     check_spread("u_m_s", u)?;
-    let (_, y_max) = min_max(y);
-    let y_min_pos = y
-        .iter()
-        .cloned()
-        .filter(|v| *v > 0.0)
-        .fold(f64::INFINITY, f64::min);
+    let scale = ScaleCheck::new("delta", "y", y);
+    let (y_min_pos, y_max) = (scale.data_min, scale.data_max);
     let (s, c) = separable_start(&log_grid(1e-2 * y_min_pos, 1e2 * y_max, 121), u, |d| {
         DMatrix::from_fn(y.len(), 2, |k, j| {
             let e = (-y[k] / d).exp();
@@ -474,7 +465,6 @@ pub fn fit_boundary_layer(
         reason: "no start value for the boundary layer".into(),
     })?;
     let model = LayerModel { y, y_max };
-    let scale = ScaleCheck::new("delta", "y", y);
     let report = match fit_least_squares(
         &model,
         &Observations::single("u", u.clone()),
