@@ -64,6 +64,7 @@ fn run_scenario(name: &str, set: &[&str], dir: &Path) -> Result<(), Box<dyn std:
         verbosity: Verbosity::Normal,
         loaded: datasets::load(name, &set)?,
         interrupted: Arc::new(AtomicBool::new(false)),
+        dump: None,
     };
     run(&mut ctx)?;
     Ok(())

@@ -21,6 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         verbosity: Verbosity::Normal,
         loaded,
         interrupted: Arc::new(AtomicBool::new(false)),
+        dump: None,
     };
     let outcome = run(&mut ctx)?;
     let s = &outcome.summary;

@@ -165,6 +165,17 @@ pub struct RunArgs {
     /// Write a checkpoint every S seconds of wall-clock time (0: not by time).
     #[arg(long, value_name = "S", default_value_t = DEFAULT_CHECKPOINT_SECONDS)]
     pub checkpoint_seconds: f64,
+    /// Write the frictional-contact problems of chosen steps into DIR as fc-problem-v1 files
+    /// (`PHASE_STEP.json.gz`), for `grainlaw solve-fc` or another solver; by default the steps
+    /// whose solve did not converge.
+    #[arg(long, value_name = "DIR")]
+    pub dump_problems: Option<PathBuf>,
+    /// With --dump-problems: write the steps FIRST..LAST (inclusive global step indices).
+    #[arg(long, value_name = "FIRST..LAST", requires = "dump_problems", conflicts_with = "dump_capped")]
+    pub dump_steps: Option<String>,
+    /// With --dump-problems: write the steps whose solve did not converge (the default).
+    #[arg(long, requires = "dump_problems")]
+    pub dump_capped: bool,
     /// Test hook: stop as Ctrl-C does after this many steps of this invocation.
     #[arg(long, value_name = "STEPS", hide = true)]
     pub stop_after_steps: Option<u64>,
@@ -182,6 +193,9 @@ impl Default for RunArgs {
             resume: None,
             checkpoint_every: 0,
             checkpoint_seconds: DEFAULT_CHECKPOINT_SECONDS,
+            dump_problems: None,
+            dump_steps: None,
+            dump_capped: false,
             stop_after_steps: None,
         }
     }
@@ -262,11 +276,23 @@ pub fn run(args: RunArgs) -> Result<()> {
             }
         });
     }
+    let dump = match &args.dump_problems {
+        Some(d) => Some(Arc::new(scenarios::dump::ProblemDump {
+            dir: d.clone(),
+            steps: match &args.dump_steps {
+                Some(t) => scenarios::dump::ProblemDump::parse_range(t)?,
+                None => scenarios::dump::DumpSteps::Capped,
+            },
+            scenario: loaded.name.clone(),
+        })),
+        None => None,
+    };
     let mut ctx = RunContext {
         out: OutputDir::create(&dir)?,
         verbosity,
         loaded,
         interrupted,
+        dump,
     };
     let mut ctl = RunControl::new(sets, policy);
     ctl.resume = args.resume.is_some();

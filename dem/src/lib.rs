@@ -22,6 +22,7 @@
 //! ([`fc`]).
 
 pub mod anderson;
+pub mod assemble;
 pub mod atomic;
 pub mod bench;
 pub mod blocked;

@@ -31,6 +31,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::anderson::Anderson;
+use crate::assemble::contact_problem;
+use crate::fc::newton::{self, NewtonParams, NewtonWork};
+use crate::fc::FcOptions;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
 use crate::local::{natural_map_residual, ContactStatus};
@@ -39,7 +42,34 @@ use crate::parallel::{
     MIN_CHUNKS_PER_TASK,
 };
 
-/// Parameters of the NLGS solver.
+/// Which algorithm solves the contact problem of a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolverMethod {
+    /// Nonlinear Gauss–Seidel only (this module): O(1) per contact update, fast on loose and
+    /// flowing packings, slow to carry a load change across a dense, hyperstatic one.
+    Nlgs,
+    /// The regularised semismooth Newton method of [`crate::fc::newton`] on the assembled
+    /// problem, from the warm start.
+    Newton,
+    /// Gauss–Seidel for at most [`SolverParams::auto_sweeps`] sweeps, then, if it has not
+    /// converged, Newton from its best iterate (the default).
+    #[default]
+    Auto,
+}
+
+impl SolverMethod {
+    /// The name used in TOML files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverMethod::Nlgs => "nlgs",
+            SolverMethod::Newton => "newton",
+            SolverMethod::Auto => "auto",
+        }
+    }
+}
+
+/// Parameters of the contact solver of a step.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverParams {
@@ -58,6 +88,19 @@ pub struct SolverParams {
     /// from the natural order's (`false`) within the solver tolerance.
     #[serde(default)]
     pub parallel: bool,
+    /// The algorithm ([`SolverMethod`], default `auto`).
+    #[serde(default)]
+    pub method: SolverMethod,
+    /// Gauss–Seidel sweeps before `auto` switches to Newton.
+    #[serde(default = "auto_sweeps")]
+    pub auto_sweeps: usize,
+    /// Parameters of the Newton solver (`newton` and `auto`).
+    #[serde(default)]
+    pub newton: NewtonParams,
+}
+
+fn auto_sweeps() -> usize {
+    100
 }
 
 fn anderson_memory() -> usize {
@@ -76,6 +119,9 @@ impl Default for SolverParams {
             relaxation: 1.0,
             anderson_memory: 4,
             parallel: false,
+            method: SolverMethod::Auto,
+            auto_sweeps: auto_sweeps(),
+            newton: NewtonParams::default(),
         }
     }
 }
@@ -93,6 +139,9 @@ pub struct SolveReport {
     /// see [`approach_speed`].
     #[serde(default)]
     pub approach_speed: f64,
+    /// Newton iterations (factorisations) done after the sweeps (0 with `nlgs`).
+    #[serde(default)]
+    pub newton_iterations: usize,
 }
 
 /// Sweeps without the error halving after which the sweep order is shuffled.
@@ -268,8 +317,175 @@ impl SweepOrder<'_> {
     }
 }
 
-/// Solve the contact problem of a step by accelerated NLGS (see the module documentation),
+/// Solve the contact problem of a step with the method of `params` ([`SolverMethod`]),
 /// starting from the impulses stored in `rows`. Converged means `error ≤ tolerance` and
+/// [`approach_speed`] `≤ approach_limit` (m/s): the relative error alone is normalised by the
+/// largest velocities of the step, so while some grains fall fast it lets resting contacts
+/// approach at up to `tolerance × ‖q‖`, and their overlaps add up over the steps. On entry `vel`
+/// must equal `v_free + M⁻¹ Hᵀ R` for those impulses (see [`apply_impulses`]); `q_norm` is
+/// [`free_velocity_norm`]. On return `vel` matches the returned impulses.
+///
+/// `nlgs` sweeps up to `max_iterations` times ([`nlgs`]); `newton` assembles the step's problem
+/// ([`crate::assemble::contact_problem`]) and runs [`crate::fc::newton`] from the warm start;
+/// `auto` sweeps at most `auto_sweeps` times and hands the best iterate to Newton when that was
+/// not enough. In both Newton modes `max_iterations` bounds the smoothing sweeps.
+#[allow(clippy::too_many_arguments)]
+pub fn solve(
+    rows: &mut [ContactRow],
+    mut order: SweepOrder,
+    vel: &mut [[f64; 3]],
+    v_free: &[[f64; 3]],
+    inv: &[[f64; 3]],
+    q_norm: f64,
+    approach_limit: f64,
+    params: &SolverParams,
+    work: &mut SolverWork,
+) -> SolveReport {
+    let sweeps = match params.method {
+        SolverMethod::Nlgs => params.max_iterations,
+        SolverMethod::Newton => 0,
+        SolverMethod::Auto => params.auto_sweeps.min(params.max_iterations),
+    };
+    let first = if sweeps > 0 || params.method == SolverMethod::Nlgs {
+        let reborrow = match &mut order {
+            SweepOrder::Natural(o) => SweepOrder::Natural(o),
+            SweepOrder::Coloured { colouring, mobile } => SweepOrder::Coloured {
+                colouring,
+                mobile,
+            },
+        };
+        let report = nlgs(
+            rows,
+            reborrow,
+            vel,
+            v_free,
+            inv,
+            q_norm,
+            approach_limit,
+            params,
+            sweeps,
+            work,
+        );
+        if report.converged || params.method == SolverMethod::Nlgs {
+            return report;
+        }
+        report
+    } else {
+        let error = error_measure(rows, vel, q_norm);
+        let approach = approach_speed(rows, vel);
+        if error <= params.tolerance && approach <= approach_limit {
+            return SolveReport {
+                iterations: 0,
+                error,
+                converged: true,
+                approach_speed: approach,
+                newton_iterations: 0,
+            };
+        }
+        SolveReport::default()
+    };
+    let second = global(
+        rows,
+        &order,
+        vel,
+        v_free,
+        inv,
+        q_norm,
+        approach_limit,
+        params,
+        first,
+        work,
+    );
+    let left = params.max_iterations.saturating_sub(second.iterations);
+    if second.converged || left == 0 {
+        return second;
+    }
+    // Newton did not get there within its iterations: Gauss–Seidel from its best iterate for
+    // the sweeps left (never worse than Gauss–Seidel alone, bar the time).
+    let third = nlgs(
+        rows,
+        order,
+        vel,
+        v_free,
+        inv,
+        q_norm,
+        approach_limit,
+        params,
+        left,
+        work,
+    );
+    SolveReport {
+        iterations: second.iterations + third.iterations,
+        newton_iterations: second.newton_iterations,
+        ..third
+    }
+}
+
+/// The Newton stage of [`solve`]: assemble, solve from the current impulses, write the impulses
+/// back and rebuild the velocities. The report's error and approach speed are the engine's own,
+/// evaluated on the rebuilt velocities.
+#[allow(clippy::too_many_arguments)]
+fn global(
+    rows: &mut [ContactRow],
+    order: &SweepOrder,
+    vel: &mut [[f64; 3]],
+    v_free: &[[f64; 3]],
+    inv: &[[f64; 3]],
+    q_norm: f64,
+    approach_limit: f64,
+    params: &SolverParams,
+    first: SolveReport,
+    work: &mut SolverWork,
+) -> SolveReport {
+    let problem = contact_problem(rows, v_free, inv);
+    let options = FcOptions {
+        tolerance: params.tolerance,
+        max_iterations: params.max_iterations.saturating_sub(first.iterations),
+        initial_guess: Some(rows.iter().flat_map(|c| c.r).collect()),
+        ..FcOptions::default()
+    };
+    let closed: Vec<bool> = rows.iter().map(|c| c.shift <= 0.0).collect();
+    let accept = |r: &[f64], u: &[f64]| {
+        closed.iter().enumerate().all(|(a, &closed)| {
+            !(closed || r[2 * a] > 0.0) || -u[2 * a] <= approach_limit
+        })
+    };
+    let outcome = newton::solve_with(&problem, &options, &params.newton, &mut work.newton, accept);
+    let (newton_iterations, smoothing) = match outcome {
+        Ok((sol, stats)) => {
+            if std::env::var_os("GRAINLAW_DEBUG_NEWTON").is_some() {
+                eprintln!(
+                    "newton nc={} first_err={:.2e} err={:.2e} conv={} {:?}",
+                    rows.len(),
+                    first.error,
+                    sol.error,
+                    sol.converged,
+                    stats
+                );
+            }
+            for (c, r) in rows.iter_mut().zip(sol.r.chunks_exact(2)) {
+                c.r = [r[0], r[1]];
+            }
+            (stats.iterations, stats.smoothing_sweeps)
+        }
+        // Only invalid parameters fail, and they are checked before a run starts.
+        Err(_) => (0, 0),
+    };
+    rebuild_velocities(rows, vel, v_free, inv, order);
+    let error = error_measure(rows, vel, q_norm);
+    let approach = approach_speed(rows, vel);
+    let report = SolveReport {
+        iterations: first.iterations + smoothing,
+        error,
+        converged: error <= params.tolerance && approach <= approach_limit,
+        approach_speed: approach,
+        newton_iterations,
+    };
+    report
+}
+
+/// Accelerated NLGS (see the module documentation) for at most `max_sweeps` sweeps, starting
+/// from the impulses stored in `rows`. Converged means `error ≤ tolerance` and
 /// [`approach_speed`] `≤ approach_limit` (m/s): the relative error alone is normalised by the
 /// largest velocities of the step, so while some grains fall fast it lets resting contacts
 /// approach at up to `tolerance × ‖q‖`, and their overlaps add up over the steps. On entry `vel` must equal
@@ -285,7 +501,7 @@ impl SweepOrder<'_> {
 /// [`STALL_SWEEPS`] sweeps, the sweeps continue in a fresh pseudo-random order each time (seeded,
 /// so runs stay reproducible), which breaks the cycle.
 #[allow(clippy::too_many_arguments)]
-pub fn solve(
+fn nlgs(
     rows: &mut [ContactRow],
     mut order: SweepOrder,
     vel: &mut [[f64; 3]],
@@ -294,6 +510,7 @@ pub fn solve(
     q_norm: f64,
     approach_limit: f64,
     params: &SolverParams,
+    max_sweeps: usize,
     work: &mut SolverWork,
 ) -> SolveReport {
     let n = rows.len();
@@ -303,6 +520,7 @@ pub fn solve(
             error: 0.0,
             converged: true,
             approach_speed: 0.0,
+            newton_iterations: 0,
         };
     }
     let tol = params.tolerance;
@@ -316,6 +534,7 @@ pub fn solve(
             error,
             converged: true,
             approach_speed: approach_speed(rows, vel),
+            newton_iterations: 0,
         };
     }
     let use_aa = params.anderson_memory > 0;
@@ -336,7 +555,7 @@ pub fn solve(
     let mut plain_phase = PLAIN_PHASE;
     let (mut window_start, mut window_error, mut window_best) = (0usize, error, error);
 
-    while it < params.max_iterations {
+    while it < max_sweeps {
         let accelerate = use_aa && it >= plain_until;
         if accelerate {
             copy_impulses(rows, &mut work.x);
@@ -346,7 +565,7 @@ pub fn solve(
         }
         order.sweep(rows, vel, inv, params.relaxation);
         it += 1;
-        if it >= next_check || it == params.max_iterations {
+        if it >= next_check || it == max_sweeps {
             error = error_measure(rows, vel, q_norm);
             if error < best_error {
                 best_error = error;
@@ -391,7 +610,7 @@ pub fn solve(
             }
             next_check = it + if it < 10 { 1 } else { (it / 10).clamp(1, 16) };
         }
-        if accelerate && it >= plain_until && it < params.max_iterations {
+        if accelerate && it >= plain_until && it < max_sweeps {
             if let Some(aa) = work.anderson.as_mut() {
                 copy_impulses(rows, &mut work.g);
                 aa.step(&work.x, &mut work.g);
@@ -420,6 +639,7 @@ pub fn solve(
         error,
         converged: error <= tol && approach <= approach_limit,
         approach_speed: approach,
+        newton_iterations: 0,
     }
 }
 
@@ -440,6 +660,7 @@ fn copy_impulses(rows: &[ContactRow], x: &mut Vec<f64>) {
 /// Buffers of the solver kept between steps (no allocation in the steady state).
 #[derive(Debug, Clone, Default)]
 pub struct SolverWork {
+    newton: NewtonWork,
     anderson: Option<Anderson>,
     shape: (usize, usize),
     x: Vec<f64>,

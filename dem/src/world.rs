@@ -28,6 +28,7 @@ use crate::colouring::ContactColouring;
 use crate::contact::ContactSet;
 use crate::detection::{Detector, Periodic};
 use crate::error::DemError;
+use crate::fc::FcProblem;
 use crate::material::ContactLaws;
 use crate::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
 use crate::solver::{self, SolveReport, SolverParams, SweepOrder};
@@ -129,6 +130,10 @@ pub struct World {
     v_free: Vec<[f64; 3]>,
     work: solver::SolverWork,
     last: StepReport,
+    /// Keep the frictional-contact problem of each step ([`World::last_problem`]), to write it
+    /// to a file (`grainlaw run --dump-problems`). Costs one assembly of `W` per step.
+    pub record_problems: bool,
+    last_problem: Option<FcProblem>,
 }
 
 impl World {
@@ -155,7 +160,15 @@ impl World {
             v_free: Vec::new(),
             work: solver::SolverWork::default(),
             last: StepReport::default(),
+            record_problems: false,
+            last_problem: None,
         }
+    }
+
+    /// The frictional-contact problem of the last step (`u = W r + q` in the contacts' order,
+    /// impulses in N·s), when [`World::record_problems`] was set for it.
+    pub fn last_problem(&self) -> Option<&FcProblem> {
+        self.last_problem.as_ref()
     }
 
     /// Add a free disk grain (thickness 1 m); returns its body index.
@@ -666,6 +679,9 @@ impl World {
         let approach_limit = self.approach_limit();
         self.v_free.clear();
         self.v_free.extend_from_slice(&self.vel);
+        self.last_problem = self.record_problems.then(|| {
+            crate::assemble::contact_problem(&self.contacts.rows, &self.v_free, &self.inv)
+        });
         let report = if self.params.solver.parallel {
             self.mobile.clear();
             self.mobile

@@ -46,7 +46,14 @@ pub fn run_phase(
     let bar = Phase::new(ctx.verbosity, name, len);
     bar.set(progress.steps());
     let mut failure: Option<CliError> = None;
+    world.record_problems = ctx.dump.is_some();
     let mut cb = |w: &World, r: &StepReport, p: &PhaseProgress| -> bool {
+        if let Some(d) = ctx.dump.as_deref().filter(|d| d.wants(r)) {
+            if let Err(e) = d.write(name, w, r) {
+                failure = Some(e);
+                return false;
+            }
+        }
         if p.steps().is_multiple_of(25) {
             bar.set(p.steps());
             bar.message(format!(

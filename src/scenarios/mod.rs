@@ -4,6 +4,7 @@
 
 pub mod arrangements;
 pub mod common;
+pub mod dump;
 pub mod inclined_flow;
 pub mod janssen;
 pub mod phased;
@@ -31,6 +32,8 @@ pub struct RunContext {
     pub loaded: LoadedScenario,
     /// Set by Ctrl-C: the run writes a checkpoint and stops without writing `summary.json`.
     pub interrupted: Arc<AtomicBool>,
+    /// Contact problems to write (`--dump-problems`).
+    pub dump: Option<Arc<dump::ProblemDump>>,
 }
 
 /// What a running phase needs from the context (cheap to clone, so that step callbacks may
@@ -41,6 +44,8 @@ pub struct PhaseEnv {
     pub verbosity: Verbosity,
     /// Set by Ctrl-C.
     pub interrupted: Arc<AtomicBool>,
+    /// Contact problems to write (`--dump-problems`).
+    pub dump: Option<Arc<dump::ProblemDump>>,
 }
 
 impl RunContext {
@@ -49,6 +54,7 @@ impl RunContext {
         PhaseEnv {
             verbosity: self.verbosity,
             interrupted: self.interrupted.clone(),
+            dump: self.dump.clone(),
         }
     }
 }

@@ -107,6 +107,9 @@ pub struct SolverSpec {
     /// thread count. Default false.
     #[serde(default)]
     pub parallel: bool,
+    /// The algorithm: `"nlgs"`, `"newton"` or `"auto"` (default; [`dem::solver::SolverMethod`]).
+    #[serde(default)]
+    pub method: dem::solver::SolverMethod,
 }
 
 impl SolverSpec {
@@ -128,6 +131,7 @@ impl SolverSpec {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
             parallel: self.parallel,
+            method: self.method,
             ..Default::default()
         }
     }

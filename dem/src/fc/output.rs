@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use super::error::FcError;
 use super::nsgs::FcSolution;
+use super::problem::FcProblem;
 
 /// The solution file `{"r": [...], "u": [...], "iterations": n, "error": e, "seconds": s,
 /// "converged": b}` (impulses in N·s, velocities in m/s, interleaved `(n, t)` per contact).
@@ -45,4 +46,59 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FcError> {
         path: path.display().to_string(),
         source,
     })
+}
+
+/// Writes `problem` as fc-problem-v1 JSON (`W` in COO triplets, block by block), gzip-compressed
+/// when `path` ends in `.gz`, atomically; `meta` is stored under `"meta"` as given. What
+/// [`super::read_problem`] reads back bit for bit (floats are written in shortest round-trip
+/// form).
+pub fn write_problem(
+    path: impl AsRef<Path>,
+    problem: &FcProblem,
+    meta: serde_json::Value,
+) -> Result<(), FcError> {
+    let path = path.as_ref();
+    let w = problem.w();
+    let nnz = 4 * w.nnz_blocks();
+    let (mut row, mut col, mut val) = (
+        Vec::with_capacity(nnz),
+        Vec::with_capacity(nnz),
+        Vec::with_capacity(nnz),
+    );
+    for i in 0..w.n() {
+        for (j, b) in w.row(i) {
+            for (k, &x) in b.iter().enumerate() {
+                row.push(2 * i + k / 2);
+                col.push(2 * j + k % 2);
+                val.push(x);
+            }
+        }
+    }
+    let n = 2 * problem.contacts();
+    let doc = serde_json::json!({
+        "format": "fc-problem-v1",
+        "dimension": 2,
+        "nc": problem.contacts(),
+        "mu": problem.mu(),
+        "q": problem.q(),
+        "W": {"storage": "coo", "shape": [n, n], "row": row, "col": col, "val": val},
+        "meta": meta,
+    });
+    let text = serde_json::to_vec(&doc).map_err(|e| FcError::InvalidValue {
+        key: "problem".into(),
+        reason: e.to_string(),
+    })?;
+    let bytes = if path.extension().is_some_and(|e| e == "gz") {
+        use std::io::Write;
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        enc.write_all(&text)
+            .and_then(|_| enc.finish())
+            .map_err(|source| FcError::Io {
+                path: path.display().to_string(),
+                source,
+            })?
+    } else {
+        text
+    };
+    write_atomically(path, &bytes)
 }

@@ -95,6 +95,32 @@ impl FcProblem {
         })
     }
 
+    /// A problem assembled by the engine ([`crate::assemble`]): sizes and finiteness hold by
+    /// construction, and a diagonal block may be singular (a contact between two bodies whose
+    /// degrees of freedom are all imposed cannot react; the solvers leave it at zero).
+    pub(crate) fn from_engine(mu: Vec<f64>, q: Vec<f64>, w: BlockCsr2) -> Self {
+        let (diag, skew) = (0..mu.len())
+            .map(|a| {
+                let b = w.diagonal(a);
+                (
+                    Delassus2 {
+                        nn: b[0],
+                        nt: 0.5 * (b[1] + b[2]),
+                        tt: b[3],
+                    },
+                    0.5 * (b[1] - b[2]),
+                )
+            })
+            .unzip();
+        Self {
+            mu,
+            q,
+            w,
+            diag,
+            skew,
+        }
+    }
+
     /// Number of contacts `nc`.
     pub fn contacts(&self) -> usize {
         self.mu.len()

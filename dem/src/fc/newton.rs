@@ -1,0 +1,507 @@
+//! Semismooth Newton method on the Alart–Curnier function, regularised so that it stays well
+//! posed when `W` is singular (hyperstatic packings), with a non-monotone line search and
+//! Gauss–Seidel smoothing when the line search fails.
+//!
+//! **Formulation** (Alart & Curnier 1991; the 2D form of Acary, Brémond & Huber 2018, §3.2).
+//! With `u = W r + q` and per-contact weights `ρ_n = 1/W_nn`, `ρ_t = 1/W_tt`,
+//!
+//! ```text
+//! z_n = r_n − ρ_n u_n,   z_t = r_t − ρ_t u_t
+//! Φ_n(r) = r_n − max(0, z_n)
+//! Φ_t(r) = r_t − proj_[−μ z_n⁺, μ z_n⁺](z_t)
+//! ```
+//!
+//! `Φ(r) = 0` exactly when `(u, r)` satisfies Signorini and Coulomb's law, i.e. when `r ∈ K_μ`,
+//! `ū = u + μ|u_t| n ∈ K_μ*`, `r · ū = 0` (the problem of [`super::problem::FcProblem`]). `Φ`
+//! is piecewise affine in `r`; an element of its generalised Jacobian is
+//! `J = D_r + D_u W` with, per contact (rows n, t; columns n, t):
+//!
+//! ```text
+//! normal,     z_n > 0:          D_r = (0, 0),      D_u = (ρ_n, 0)
+//! normal,     z_n ≤ 0:          D_r = (1, 0),      D_u = 0
+//! tangential, z_n ≤ 0:          D_r = (0, 1),      D_u = 0
+//!             |z_t| ≤ μ z_n:    D_r = (0, 0),      D_u = (0, ρ_t)             (sticking)
+//!             otherwise, s = sign z_t:
+//!                               D_r = (−μ s, 1),   D_u = (μ s ρ_n, 0)         (sliding)
+//! ```
+//!
+//! **Regularisation.** Where contacts stick, rows of `J` are rows of `ρ W`, and `W = H M⁻¹ Hᵀ`
+//! is singular as soon as the packing is hyperstatic (more contact unknowns than degrees of
+//! freedom): the plain Newton system has no solution. The direction solves instead
+//!
+//! ```text
+//! (J + λ I) d = −Φ,      λ = min(λ_max, max(λ_min, ‖Φ‖ / ‖r‖))
+//! ```
+//!
+//! the Levenberg–Marquardt-type regularisation of Newton's method for problems whose solutions
+//! are not isolated (Yamashita & Fukushima 2001; Facchinei & Kanzow 2003): the shift vanishes
+//! with the residual, so the local convergence stays superlinear, and on the null space of `W`
+//! (the self-equilibrated impulses of a hyperstatic cluster) it picks the step of least size,
+//! like one proximal-point step (Rockafellar 1976; Siconos' `fc3d_proximal`). The matrix is
+//! factorised by faer's sparse LU with partial pivoting; its symbolic analysis is done once per
+//! solve (the pattern is that of `W`).
+//!
+//! **Globalisation.** The step length `t ∈ {1, ½, ¼, …}` satisfies the non-monotone Armijo rule
+//! on `ψ = ½‖Φ‖²` (Grippo, Lampariello & Lucidi 1986): `ψ(r + t d) ≤ max_{last 5} ψ −
+//! 2σ t ψ(r)`, σ = 10⁻⁴. When no `t ≥ 2⁻¹²` is accepted (a kink of `Φ`, a change of contact
+//! status, or a direction spoiled by the regularisation), a few sweeps of nonlinear
+//! Gauss–Seidel ([`super::nsgs`]) are done from the current iterate and Newton resumes: the
+//! hybrid of Acary, Brémond & Huber's §6 recommendations.
+//!
+//! **Stopping.** On the problem's error measure ([`super::measure`], recomputed from `r` with
+//! `u = W r + q`), together with an optional caller's acceptance test (the engine's approach
+//! speed). The impulses returned are projected on their cones and their error re-evaluated, so
+//! the error reported is the true error of what is returned.
+
+use std::time::Instant;
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::MatMut;
+use serde::{Deserialize, Serialize};
+
+use super::error::FcError;
+use super::measure::error_given_velocity;
+use super::nsgs::{self, FcOptions, FcSolution};
+use super::problem::FcProblem;
+use crate::local::project_on_cone;
+
+/// Parameters of the Newton solver.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonParams {
+    /// Largest number of Newton iterations (factorisations) per solve.
+    #[serde(default = "default_max_newton")]
+    pub max_iterations: usize,
+    /// Largest regularisation `λ_max` (dimensionless, relative to `ρ W` whose diagonal is 1).
+    #[serde(default = "default_lambda_max")]
+    pub lambda_max: f64,
+    /// Gauss–Seidel sweeps done when the line search fails.
+    #[serde(default = "default_smoothing")]
+    pub smoothing_sweeps: usize,
+}
+
+fn default_max_newton() -> usize {
+    50
+}
+fn default_lambda_max() -> f64 {
+    1e-2
+}
+fn default_smoothing() -> usize {
+    10
+}
+
+impl Default for NewtonParams {
+    fn default() -> Self {
+        Self {
+            max_iterations: default_max_newton(),
+            lambda_max: default_lambda_max(),
+            smoothing_sweeps: default_smoothing(),
+        }
+    }
+}
+
+impl NewtonParams {
+    /// Checks the parameters; the error names the key.
+    pub fn validate(&self) -> Result<(), FcError> {
+        let bad = |name: &str, reason: String| {
+            Err(FcError::Option {
+                name: name.into(),
+                reason,
+            })
+        };
+        if self.max_iterations == 0 {
+            return bad("newton.max_iterations", "must be at least 1".into());
+        }
+        if !(self.lambda_max > 0.0 && self.lambda_max.is_finite()) {
+            return bad(
+                "newton.lambda_max",
+                format!("{} is not a finite number > 0", self.lambda_max),
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Smallest proximal weight η (relative to the diagonal of W).
+const ETA_MIN: f64 = 1e-10;
+/// Shift keeping the Newton matrix invertible where a diagonal block of W vanishes.
+const EPSILON: f64 = 1e-12;
+/// Armijo constant.
+const SIGMA: f64 = 1e-4;
+/// Smallest step length tried.
+const T_MIN: f64 = 1.0 / 1024.0;
+
+
+/// What a Newton solve did, besides the solution.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct NewtonStats {
+    /// Newton iterations (one factorisation each).
+    pub iterations: usize,
+    /// Line searches that failed (each followed by smoothing sweeps).
+    pub line_search_failures: usize,
+    /// Gauss–Seidel sweeps done as smoothing.
+    pub smoothing_sweeps: usize,
+    /// Factorisations that failed (a structurally singular matrix; smoothing was done instead).
+    pub singular: usize,
+}
+
+/// Reusable buffers of [`solve_with`]: the matrix `(J + λI)ᵀ` in compressed columns (that is,
+/// `J + λI` by rows, the block-CSR order of `W`) and the vectors.
+#[derive(Debug, Clone, Default)]
+pub struct NewtonWork {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    val: Vec<f64>,
+    /// Position in `val` of the four entries of block `k` of `W` (row n, then row t).
+    block_pos: Vec<[usize; 2]>,
+    /// Position in `val` of the diagonal entries `(nn, tt)` of each contact.
+    diag_pos: Vec<[usize; 2]>,
+    u: Vec<f64>,
+    phi: Vec<f64>,
+    d: Vec<f64>,
+    trial: Vec<f64>,
+    best: Vec<f64>,
+}
+
+impl NewtonWork {
+    /// Builds the pattern of `J + λI` from the block pattern of `W` (diagonal blocks added).
+    fn pattern(&mut self, p: &FcProblem) {
+        let w = p.w();
+        let n = p.contacts();
+        self.col_ptr.clear();
+        self.row_idx.clear();
+        self.block_pos.clear();
+        self.block_pos.resize(w.nnz_blocks(), [usize::MAX; 2]);
+        self.diag_pos.clear();
+        self.diag_pos.resize(n, [usize::MAX; 2]);
+        self.col_ptr.push(0);
+        let mut cols: Vec<(usize, Option<usize>)> = Vec::new();
+        for a in 0..n {
+            cols.clear();
+            let start = w.row_ptr()[a];
+            for (k, (j, _)) in w.row(a).enumerate() {
+                cols.push((j, Some(start + k)));
+            }
+            if !cols.iter().any(|(j, _)| *j == a) {
+                let at = cols.partition_point(|(j, _)| *j < a);
+                cols.insert(at, (a, None));
+            }
+            for row in 0..2 {
+                for &(j, k) in &cols {
+                    let at = self.row_idx.len();
+                    if let Some(k) = k {
+                        self.block_pos[k][row] = at;
+                    }
+                    if j == a {
+                        self.diag_pos[a][row] = at + row;
+                    }
+                    self.row_idx.push(2 * j);
+                    self.row_idx.push(2 * j + 1);
+                }
+                self.col_ptr.push(self.row_idx.len());
+            }
+        }
+        self.val.clear();
+        self.val.resize(self.row_idx.len(), 0.0);
+    }
+}
+
+/// Per-contact linearisation: `Φ_α` and the 2×2 matrices `D_r`, `D_u` (row-major).
+#[inline]
+fn linearise(r: [f64; 2], u: [f64; 2], mu: f64, rho: [f64; 2]) -> ([f64; 2], [f64; 4], [f64; 4]) {
+    let zn = r[0] - rho[0] * u[0];
+    let zt = r[1] - rho[1] * u[1];
+    if zn <= 0.0 {
+        return (r, [1.0, 0.0, 0.0, 1.0], [0.0; 4]);
+    }
+    let phi_n = rho[0] * u[0];
+    let bound = mu * zn;
+    if zt.abs() <= bound {
+        ([phi_n, rho[1] * u[1]], [0.0; 4], [rho[0], 0.0, 0.0, rho[1]])
+    } else {
+        let s = zt.signum();
+        (
+            [phi_n, r[1] - s * bound],
+            [0.0, 0.0, -mu * s, 1.0],
+            [rho[0], 0.0, mu * s * rho[0], 0.0],
+        )
+    }
+}
+
+/// Solves `problem` by the regularised semismooth Newton method (module docs), from
+/// `options.initial_guess` (or `r = 0`), to `options.tolerance` on the error measure.
+/// `options.max_iterations` bounds the Gauss–Seidel smoothing sweeps in all.
+pub fn solve(
+    problem: &FcProblem,
+    options: &FcOptions,
+    params: &NewtonParams,
+) -> Result<(FcSolution, NewtonStats), FcError> {
+    let mut work = NewtonWork::default();
+    solve_with(problem, options, params, &mut work, |_, _| true)
+}
+
+/// [`solve`] with caller-owned buffers and an extra acceptance test `accept(r, u)` that must
+/// hold, besides the tolerance, for the solve to count as converged (the engine asks that no
+/// closed contact still approaches).
+pub fn solve_with(
+    problem: &FcProblem,
+    options: &FcOptions,
+    params: &NewtonParams,
+    work: &mut NewtonWork,
+    accept: impl Fn(&[f64], &[f64]) -> bool,
+) -> Result<(FcSolution, NewtonStats), FcError> {
+    params.validate()?;
+    let n = problem.contacts();
+    let t0 = Instant::now();
+    let tol = options.tolerance;
+    if !(tol > 0.0) {
+        return Err(FcError::Option {
+            name: "tolerance".into(),
+            reason: format!("{tol} is not > 0"),
+        });
+    }
+    let mut r = match &options.initial_guess {
+        Some(g) if g.len() == 2 * n && g.iter().all(|x| x.is_finite()) => g.clone(),
+        Some(g) => {
+            return Err(FcError::Option {
+                name: "initial_guess".into(),
+                reason: format!(
+                    "length {} (expected {}) or a value that is not finite",
+                    g.len(),
+                    2 * n
+                ),
+            })
+        }
+        None => vec![0.0; 2 * n],
+    };
+    let mut stats = NewtonStats::default();
+    let diag: Vec<[f64; 2]> = (0..n)
+        .map(|a| {
+            let d = problem.delassus(a);
+            [d.nn.max(0.0), d.tt.max(0.0)]
+        })
+        .collect();
+    let rho: Vec<[f64; 2]> = diag
+        .iter()
+        .map(|d| {
+            let inv = |x: f64| if x > 0.0 { 1.0 / x } else { 1.0 };
+            [inv(d[0]), inv(d[1])]
+        })
+        .collect();
+    for v in [&mut work.u, &mut work.phi, &mut work.d, &mut work.trial] {
+        v.clear();
+        v.resize(2 * n, 0.0);
+    }
+    work.best.clear();
+    work.best.extend_from_slice(&r);
+    let mut u_step = vec![0.0; 2 * n];
+    let mut best_error = f64::INFINITY;
+    let mut eta = params.lambda_max;
+    let mut symbolic: Option<SymbolicLu<usize>> = None;
+    let mut sweeps_left = options.max_iterations;
+    let smooth = |r: &mut Vec<f64>, sweeps: usize| -> Result<(), FcError> {
+        let o = FcOptions {
+            tolerance: tol,
+            max_iterations: sweeps,
+            initial_guess: Some(r.clone()),
+            ..options.clone()
+        };
+        *r = nsgs::solve(problem, &o)?.r;
+        Ok(())
+    };
+
+    loop {
+        // Stop on the projection of the iterate on the cones (what is returned).
+        let (pe, ok) = projected(problem, &r, &mut work.trial, &mut work.d, tol, &accept);
+        if pe < best_error || ok {
+            best_error = pe;
+            work.best.copy_from_slice(&work.trial);
+        }
+        if ok || stats.iterations >= params.max_iterations {
+            break;
+        }
+        stats.iterations += 1;
+        // Φ at r (the proximal centre: u_η = u there).
+        problem.w().mul_add(&r, problem.q(), &mut work.u);
+        let psi = phi_of(problem, &rho, &r, &work.u, &mut work.phi);
+        if symbolic.is_none() {
+            work.pattern(problem);
+        }
+        // J_η = D_r + D_u (W + η D) + ε I by rows (= its transpose by columns).
+        work.val.iter_mut().for_each(|v| *v = 0.0);
+        let w = problem.w();
+        for a in 0..n {
+            let (_, dr, du) = linearise(
+                [r[2 * a], r[2 * a + 1]],
+                [work.u[2 * a], work.u[2 * a + 1]],
+                problem.mu()[a],
+                rho[a],
+            );
+            let start = w.row_ptr()[a];
+            for (k, (_, b)) in w.row(a).enumerate() {
+                let pos = work.block_pos[start + k];
+                work.val[pos[0]] += du[0] * b[0] + du[1] * b[2];
+                work.val[pos[0] + 1] += du[0] * b[1] + du[1] * b[3];
+                work.val[pos[1]] += du[2] * b[0] + du[3] * b[2];
+                work.val[pos[1] + 1] += du[2] * b[1] + du[3] * b[3];
+            }
+            let [pn, pt] = work.diag_pos[a];
+            let [dn, dt] = diag[a];
+            work.val[pn] += dr[0] + du[0] * eta * dn + EPSILON;
+            work.val[pn + 1] += dr[1] + du[1] * eta * dt;
+            work.val[pt - 1] += dr[2] + du[2] * eta * dn;
+            work.val[pt] += dr[3] + du[3] * eta * dt + EPSILON;
+        }
+        let sym = SymbolicSparseColMatRef::new_checked(
+            2 * n,
+            2 * n,
+            &work.col_ptr,
+            None,
+            &work.row_idx,
+        );
+        if symbolic.is_none() {
+            symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| FcError::Option {
+                name: "newton".into(),
+                reason: format!("symbolic factorisation failed: {e:?}"),
+            })?);
+        }
+        let jt = SparseColMatRef::new(sym, &work.val);
+        let solved = match symbolic.clone().map(|s| Lu::try_new_with_symbolic(s, jt)) {
+            Some(Ok(lu)) => {
+                for (d, f) in work.d.iter_mut().zip(&work.phi) {
+                    *d = -f;
+                }
+                lu.solve_transpose_in_place(MatMut::from_column_major_slice_mut(
+                    &mut work.d,
+                    2 * n,
+                    1,
+                ));
+                work.d.iter().all(|x| x.is_finite())
+            }
+            _ => {
+                stats.singular += 1;
+                false
+            }
+        };
+        // Armijo on ψ_η(r + t d) = ½‖Φ_η‖², u_η = u + t (W + η D) d: d is its Newton direction.
+        let mut t = 1.0;
+        let mut accepted = false;
+        if solved {
+            problem.w().mul_add(&work.d, &vec_zero(&mut u_step), &mut work.trial);
+            u_step.copy_from_slice(&work.trial);
+            for a in 0..n {
+                u_step[2 * a] += eta * diag[a][0] * work.d[2 * a];
+                u_step[2 * a + 1] += eta * diag[a][1] * work.d[2 * a + 1];
+            }
+            while t >= T_MIN {
+                for i in 0..2 * n {
+                    work.trial[i] = r[i] + t * work.d[i];
+                }
+                let mut s2 = 0.0;
+                for (a, &mu) in problem.mu().iter().enumerate() {
+                    let ua = [
+                        work.u[2 * a] + t * u_step[2 * a],
+                        work.u[2 * a + 1] + t * u_step[2 * a + 1],
+                    ];
+                    let (f, _, _) =
+                        linearise([work.trial[2 * a], work.trial[2 * a + 1]], ua, mu, rho[a]);
+                    s2 += f[0] * f[0] + f[1] * f[1];
+                }
+                if 0.5 * s2 <= (1.0 - 2.0 * SIGMA * t) * psi {
+                    accepted = true;
+                    break;
+                }
+                t *= 0.5;
+            }
+        }
+        if accepted {
+            std::mem::swap(&mut r, &mut work.trial);
+            eta = if t == 1.0 {
+                (eta * 0.25).max(ETA_MIN)
+            } else {
+                (eta * 4.0).min(params.lambda_max)
+            };
+        } else {
+            stats.line_search_failures += 1;
+            if eta < params.lambda_max {
+                eta = (eta * 16.0).min(params.lambda_max);
+            } else {
+                let sweeps = params.smoothing_sweeps.min(sweeps_left);
+                if sweeps == 0 {
+                    break;
+                }
+                smooth(&mut r, sweeps)?;
+                sweeps_left -= sweeps;
+                stats.smoothing_sweeps += sweeps;
+            }
+        }
+        if std::env::var_os("NEWTON_TRACE").is_some() {
+            eprintln!(
+                "it {} eta {:.1e} t {} accepted {} psi {:.3e} best {:.3e}",
+                stats.iterations, eta, t, accepted, psi, best_error
+            );
+        }
+    }
+    // The best projected iterate (the last one when it converged), its velocity and error.
+    r.copy_from_slice(&work.best);
+    problem.w().mul_add(&r, problem.q(), &mut work.u);
+    let error = error_given_velocity(problem.mu(), problem.q(), &r, &work.u);
+    let converged = error <= tol && accept(&r, &work.u);
+    let u = work.u.clone();
+    Ok((
+        FcSolution {
+            r,
+            u,
+            iterations: stats.iterations,
+            error,
+            seconds: t0.elapsed().as_secs_f64(),
+            converged,
+        },
+        stats,
+    ))
+}
+
+/// Zeroes `v` and returns it (the `y0` of a product `W x + 0`).
+fn vec_zero(v: &mut [f64]) -> Vec<f64> {
+    v.iter_mut().for_each(|x| *x = 0.0);
+    v.to_vec()
+}
+
+/// `Φ(r)` into `phi` given `u`; returns `ψ = ½‖Φ‖²`.
+fn phi_of(p: &FcProblem, rho: &[[f64; 2]], r: &[f64], u: &[f64], phi: &mut [f64]) -> f64 {
+    let mut s = 0.0;
+    for (a, &mu) in p.mu().iter().enumerate() {
+        let (f, _, _) = linearise(
+            [r[2 * a], r[2 * a + 1]],
+            [u[2 * a], u[2 * a + 1]],
+            mu,
+            rho[a],
+        );
+        phi[2 * a] = f[0];
+        phi[2 * a + 1] = f[1];
+        s += f[0] * f[0] + f[1] * f[1];
+    }
+    0.5 * s
+}
+
+/// Projects `r` on the cones into `rp`, computes `up = W rp + q` and returns the error of
+/// `rp` and whether it passes (`error ≤ tol` and `accept`).
+fn projected(
+    problem: &FcProblem,
+    r: &[f64],
+    rp: &mut [f64],
+    up: &mut [f64],
+    tol: f64,
+    accept: &impl Fn(&[f64], &[f64]) -> bool,
+) -> (f64, bool) {
+    for (a, &mu) in problem.mu().iter().enumerate() {
+        let (p, _) = project_on_cone([r[2 * a], r[2 * a + 1]], mu);
+        rp[2 * a] = p[0];
+        rp[2 * a + 1] = p[1];
+    }
+    problem.w().mul_add(rp, problem.q(), up);
+    let e = error_given_velocity(problem.mu(), problem.q(), rp, up);
+    (e, e <= tol && accept(rp, up))
+}
