@@ -6,7 +6,7 @@
 //! grainlaw run --resume DIR [--checkpoint-every STEPS] [--checkpoint-seconds S] [--quiet]
 //! grainlaw scenarios [--show NAME]
 //! grainlaw fit LAW DATA.csv [--out law.json]
-//! grainlaw solve-fc PROBLEM.json [--tol T] [--out SOLUTION.json]
+//! grainlaw solve-fc PROBLEM.json [--tol T] [--method nlgs|newton|auto] [--out SOLUTION.json]
 //! grainlaw bench [--dir DIR] [--engine-grains N ...]
 //! ```
 //!
@@ -76,7 +76,11 @@ pub enum Command {
         /// Largest number of Gauss–Seidel sweeps.
         #[arg(long, default_value_t = 100_000)]
         max_iterations: usize,
-        /// Write `{"r", "u", "iterations", "error", "seconds"}` here.
+        /// The solver: nlgs (Gauss–Seidel), newton (proximal semismooth Newton) or auto
+        /// (Gauss–Seidel, then Newton if it stalls).
+        #[arg(long, default_value = "auto")]
+        method: String,
+        /// Write `{"r", "u", "iterations", "error", "seconds", "converged"}` here.
         #[arg(long, value_name = "SOLUTION.json")]
         out: Option<PathBuf>,
     },
@@ -171,7 +175,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     pub dump_problems: Option<PathBuf>,
     /// With --dump-problems: write the steps FIRST..LAST (inclusive global step indices).
-    #[arg(long, value_name = "FIRST..LAST", requires = "dump_problems", conflicts_with = "dump_capped")]
+    #[arg(
+        long,
+        value_name = "FIRST..LAST",
+        requires = "dump_problems",
+        conflicts_with = "dump_capped"
+    )]
     pub dump_steps: Option<String>,
     /// With --dump-problems: write the steps whose solve did not converge (the default).
     #[arg(long, requires = "dump_problems")]
@@ -210,8 +219,9 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             problem,
             tol,
             max_iterations,
+            method,
             out,
-        } => crate::fc_cmd::solve_fc(&problem, tol, max_iterations, out.as_deref()),
+        } => crate::fc_cmd::solve_fc(&problem, tol, max_iterations, &method, out.as_deref()),
         Command::Bench {
             dir,
             engine_grains,

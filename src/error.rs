@@ -41,6 +41,15 @@ pub enum CliError {
         /// Why the fit was refused (one line), with the simpler form when there is one.
         reason: String,
     },
+    /// A solve ran to its end without reaching its tolerance (`grainlaw solve-fc`): its result
+    /// was written, marked `converged: false`, and the exit code is 3.
+    #[error("{path}: {reason}")]
+    NotConverged {
+        /// The problem file.
+        path: String,
+        /// What was reached (one line).
+        reason: String,
+    },
     /// Reading or writing a file.
     #[error("{path}: {reason}")]
     Io {
@@ -97,7 +106,7 @@ impl CliError {
     pub fn exit_code(&self) -> i32 {
         match self {
             CliError::Interrupted { .. } => 130,
-            CliError::FitRefused { .. } => 3,
+            CliError::FitRefused { .. } | CliError::NotConverged { .. } => 3,
             _ => 2,
         }
     }

@@ -1,6 +1,6 @@
-//! `grainlaw solve-fc`: standalone frictional-contact problems (`formats/frictional-contact.md`)
-//! solved by [`dem::fc`] (NSGS with the exact bipotential local step, Anderson-accelerated),
-//! with the error measure of Siconos' fc2d. The benchmark is in [`crate::bench_cmd`].
+//! `grainlaw solve-fc`: standalone frictional-contact problems (`docs/formats.md` §1) solved by
+//! [`dem::fc`] (NSGS with the exact bipotential local step, Anderson-accelerated, and a
+//! proximal semismooth Newton method), with the error measure of Siconos' fc2d. The benchmark is in [`crate::bench_cmd`].
 
 use std::path::{Path, PathBuf};
 
@@ -18,25 +18,56 @@ fn check_tol(tol: f64) -> Result<()> {
     }
 }
 
-/// Solves one problem ([`dem::fc::solve_file`]); prints one line (contacts, iterations, error,
-/// seconds); with `out`, writes `{"r", "u", "iterations", "error", "seconds", "converged"}`
-/// atomically. Non-convergence is printed and warned, and recorded in the file.
-pub fn solve_fc(problem: &Path, tol: f64, max_iterations: usize, out: Option<&Path>) -> Result<()> {
+/// The solver named on the command line (`--method`, or `solver.method` in a scenario).
+pub fn parse_method(name: &str) -> Result<dem::fc::SolverMethod> {
+    match name {
+        "nlgs" => Ok(dem::fc::SolverMethod::Nlgs),
+        "newton" => Ok(dem::fc::SolverMethod::Newton),
+        "auto" => Ok(dem::fc::SolverMethod::Auto),
+        other => Err(CliError::Usage(format!(
+            "--method must be nlgs, newton or auto, got `{other}`"
+        ))),
+    }
+}
+
+/// Solves one problem ([`dem::fc::solve_file`]) with `method`; prints one line (contacts,
+/// method, sweeps, Newton iterations, error and the error recomputed from `r`, seconds); with
+/// `out`, writes `{"r", "u", "iterations", "error", "seconds", "converged"}` atomically. A solve
+/// that does not reach the tolerance is written (marked `converged: false`) and ends with
+/// [`CliError::NotConverged`] (exit code 3).
+pub fn solve_fc(
+    problem: &Path,
+    tol: f64,
+    max_iterations: usize,
+    method: &str,
+    out: Option<&Path>,
+) -> Result<()> {
     check_tol(tol)?;
     if max_iterations == 0 {
         return Err(CliError::Usage("--max-iterations must be ≥ 1".into()));
     }
+    let method = parse_method(method)?;
     let options = FcOptions {
         tolerance: tol,
         max_iterations,
         ..Default::default()
     };
-    let report = dem::fc::solve_file(problem, &options, out)?;
+    let report = dem::fc::solve_file(
+        problem,
+        &options,
+        method,
+        &dem::fc::NewtonParams::default(),
+        out,
+    )?;
     println!("{report}");
     if !report.solution.converged {
-        crate::progress::warn(&format!(
-            "did not reach the tolerance {tol:.0e} within {max_iterations} iterations"
-        ));
+        return Err(CliError::NotConverged {
+            path: problem.display().to_string(),
+            reason: format!(
+                "did not reach the tolerance {tol:.0e} (error {:.3e} after {} sweeps and {} Newton iterations)",
+                report.solution.error, report.solution.iterations, report.method.newton.iterations
+            ),
+        });
     }
     Ok(())
 }

@@ -32,10 +32,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::anderson::Anderson;
 use crate::assemble::contact_problem;
-use crate::fc::newton::{self, NewtonParams, NewtonWork};
-use crate::fc::FcOptions;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
+use crate::fc::newton::{self, NewtonParams, NewtonWork};
+use crate::fc::FcOptions;
 use crate::local::{natural_map_residual, ContactStatus};
 use crate::parallel::{
     coloured_sweep, local_update, max_over, reduce_chunks, scatter_velocities, CHUNK,
@@ -349,10 +349,9 @@ pub fn solve(
     let first = if sweeps > 0 || params.method == SolverMethod::Nlgs {
         let reborrow = match &mut order {
             SweepOrder::Natural(o) => SweepOrder::Natural(o),
-            SweepOrder::Coloured { colouring, mobile } => SweepOrder::Coloured {
-                colouring,
-                mobile,
-            },
+            SweepOrder::Coloured { colouring, mobile } => {
+                SweepOrder::Coloured { colouring, mobile }
+            }
         };
         let report = nlgs(
             rows,
@@ -446,23 +445,14 @@ fn global(
     };
     let closed: Vec<bool> = rows.iter().map(|c| c.shift <= 0.0).collect();
     let accept = |r: &[f64], u: &[f64]| {
-        closed.iter().enumerate().all(|(a, &closed)| {
-            !(closed || r[2 * a] > 0.0) || -u[2 * a] <= approach_limit
-        })
+        closed
+            .iter()
+            .enumerate()
+            .all(|(a, &closed)| !(closed || r[2 * a] > 0.0) || -u[2 * a] <= approach_limit)
     };
     let outcome = newton::solve_with(&problem, &options, &params.newton, &mut work.newton, accept);
     let (newton_iterations, smoothing) = match outcome {
         Ok((sol, stats)) => {
-            if std::env::var_os("GRAINLAW_DEBUG_NEWTON").is_some() {
-                eprintln!(
-                    "newton nc={} first_err={:.2e} err={:.2e} conv={} {:?}",
-                    rows.len(),
-                    first.error,
-                    sol.error,
-                    sol.converged,
-                    stats
-                );
-            }
             for (c, r) in rows.iter_mut().zip(sol.r.chunks_exact(2)) {
                 c.r = [r[0], r[1]];
             }
@@ -474,14 +464,13 @@ fn global(
     rebuild_velocities(rows, vel, v_free, inv, order);
     let error = error_measure(rows, vel, q_norm);
     let approach = approach_speed(rows, vel);
-    let report = SolveReport {
+    SolveReport {
         iterations: first.iterations + smoothing,
         error,
         converged: error <= params.tolerance && approach <= approach_limit,
         approach_speed: approach,
         newton_iterations,
-    };
-    report
+    }
 }
 
 /// Accelerated NLGS (see the module documentation) for at most `max_sweeps` sweeps, starting

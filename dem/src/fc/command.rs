@@ -6,7 +6,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::error::FcError;
-use super::nsgs::{solve, FcOptions, FcSolution};
+use super::measure::fc_error;
+use super::method::{solve_by, MethodReport, SolverMethod};
+use super::newton::NewtonParams;
+use super::nsgs::{FcOptions, FcSolution};
 use super::output::write_solution;
 use super::reader::read_problem;
 
@@ -23,18 +26,27 @@ pub struct SolveReport {
     pub read_seconds: f64,
     /// The solution (with iterations, error, solve seconds and the converged flag).
     pub solution: FcSolution,
+    /// The method and what Newton did.
+    pub method: MethodReport,
+    /// The error measure recomputed from the returned `r` alone (`u = W r + q` anew), as a
+    /// check of `solution.error`.
+    pub verified_error: f64,
 }
 
 impl fmt::Display for SolveReport {
-    /// One line: `problem=… contacts=… iterations=… error=… seconds=… converged=…`.
+    /// One line: `problem=… contacts=… method=… iterations=… newton_iterations=… error=…
+    /// verified_error=… seconds=… converged=…`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "problem={} contacts={} iterations={} error={:.3e} tolerance={:.1e} seconds={:.4} converged={}",
+            "problem={} contacts={} method={} iterations={} newton_iterations={} error={:.3e} verified_error={:.3e} tolerance={:.1e} seconds={:.4} converged={}",
             self.problem,
             self.contacts,
+            self.method.method.name(),
             self.solution.iterations,
+            self.method.newton.iterations,
             self.solution.error,
+            self.verified_error,
             self.tolerance,
             self.solution.seconds,
             self.solution.converged
@@ -43,7 +55,7 @@ impl fmt::Display for SolveReport {
 }
 
 /// Reads the problem at `problem` (fc-problem-v1 JSON, plain or gzip), solves it with `options`
-/// and, when `out` is given, writes the solution there atomically
+/// by `method` ([`solve_by`]) and, when `out` is given, writes the solution there atomically
 /// (`{"r", "u", "iterations", "error", "seconds", "converged"}`).
 ///
 /// The solution is written even when the solver did not converge (`converged: false` in the
@@ -51,12 +63,15 @@ impl fmt::Display for SolveReport {
 pub fn solve_file(
     problem: &Path,
     options: &FcOptions,
+    method: SolverMethod,
+    newton: &NewtonParams,
     out: Option<&Path>,
 ) -> Result<SolveReport, FcError> {
     let t0 = Instant::now();
     let p = read_problem(problem)?;
     let read_seconds = t0.elapsed().as_secs_f64();
-    let solution = solve(&p, options)?;
+    let (solution, method) = solve_by(&p, options, method, newton)?;
+    let verified_error = fc_error(&p, &solution.r);
     if let Some(out) = out {
         write_solution(out, &solution)?;
     }
@@ -69,10 +84,13 @@ pub fn solve_file(
         tolerance: options.tolerance,
         read_seconds,
         solution,
+        method,
+        verified_error,
     })
 }
 
-/// [`solve_file`] with the default options and tolerance `tol` (1e-6 when `None`).
+/// [`solve_file`] with the default options and method (`auto`) and tolerance `tol` (1e-6 when
+/// `None`).
 pub fn solve_fc(
     problem: &Path,
     tol: Option<f64>,
@@ -82,5 +100,11 @@ pub fn solve_fc(
         tolerance: tol.unwrap_or(1e-6),
         ..FcOptions::default()
     };
-    solve_file(problem, &options, out)
+    solve_file(
+        problem,
+        &options,
+        SolverMethod::default(),
+        &NewtonParams::default(),
+        out,
+    )
 }
