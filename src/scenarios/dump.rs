@@ -3,7 +3,8 @@
 //! solve-fc`, Siconos) can be compared on the exact problems a run met.
 //!
 //! A problem is the step's `u = W r + q` ([`dem::assemble::contact_problem`]) before the solve;
-//! the file `DIR/PHASE_STEP.json.gz` holds it with `meta`: the scenario, the phase, the step
+//! the file `DIR/PHASE_STEP.json.gz` (the phase name with `-` for anything but letters and
+//! digits, the step on seven digits) holds it with `meta`: the scenario, the phase, the step
 //! index and time, the time step, the solver's tolerance, method and sweep cap, and what the
 //! engine's solve did (sweeps, Newton iterations, error, converged).
 
@@ -85,7 +86,11 @@ impl ProblemDump {
             "engine_error": r.solver.error,
             "engine_converged": r.solver.converged,
         });
-        let path = self.dir.join(format!("{phase}_{:07}.json.gz", r.step));
+        let name: String = phase
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+            .collect();
+        let path = self.dir.join(format!("{name}_{:07}.json.gz", r.step));
         dem::fc::write_problem(&path, problem, meta)?;
         Ok(())
     }

@@ -309,6 +309,7 @@ impl PhasedRun for Column<'_> {
                 world.params.solver = dem::SolverParams {
                     tolerance: c.relax.solver.tolerance,
                     max_iterations: c.analysis.final_max_iterations,
+                    method: c.relax.solver.method,
                     ..Default::default()
                 };
                 info(

