@@ -305,7 +305,10 @@ pub fn check_physical_ranges(
                 side,
                 confidence: report.confidence,
                 report: Box::new(report.clone()),
-                suggestion: Suggestion(r.suggestion.clone()),
+                suggestion: r
+                    .suggestion
+                    .as_deref()
+                    .map_or_else(Suggestion::none, Suggestion::of),
             });
         }
     }

@@ -34,7 +34,7 @@ impl std::fmt::Display for BoundSide {
 /// A simpler form to offer in a refusal (`use mu-i-linear`, `fix the cohesion at zero with
 /// '# cohesion = 0'`); shown as `; {text}` at the end of the message, nothing when empty.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Suggestion(pub Option<String>);
+pub struct Suggestion(Option<Box<str>>);
 
 impl Suggestion {
     /// No suggestion.
@@ -44,7 +44,7 @@ impl Suggestion {
 
     /// A suggestion with this text.
     pub fn of(text: &str) -> Self {
-        Suggestion(Some(text.to_string()))
+        Suggestion(Some(text.into()))
     }
 
     /// The text, if any.
@@ -479,7 +479,7 @@ impl IdentifyError {
             | IdentifyError::IntervalCrossesBound { suggestion, .. }
             | IdentifyError::RSquaredTooLow { suggestion, .. }
             | IdentifyError::WorseThanNested { suggestion, .. }
-                if suggestion.0.is_none() =>
+                if suggestion.text().is_none() =>
             {
                 *suggestion = Suggestion::of(text);
             }
