@@ -1,0 +1,139 @@
+//! The solver choice on the command line: bad settings are refused on one line with exit 2,
+//! `solve-fc` reports non-convergence with exit 3, and `--dump-problems` writes problems that
+//! read back and solve.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn grainlaw(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .current_dir(cwd)
+        .args(args)
+        .output()
+        .expect("grainlaw runs")
+}
+
+/// Exit code 2 and one stderr line containing `needle`.
+fn refused(o: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "stderr: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.contains(needle), "`{needle}` not in: {err}");
+    assert!(!err.contains("panicked"));
+}
+
+fn pile() -> String {
+    format!(
+        "{}/datasets/fc-problems/piles/pile_pert_100.json.gz",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+#[test]
+fn bad_solver_settings_are_refused_with_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = pile();
+    refused(
+        &grainlaw(&["solve-fc", &p, "--method", "lemke"], d),
+        "--method",
+    );
+    refused(&grainlaw(&["solve-fc", &p, "--tol", "0"], d), "--tol");
+    refused(&grainlaw(&["solve-fc", &p, "--tol=-1e-6"], d), "--tol");
+    for (set, key) in [
+        ("solver.method=gauss", "solver.method"),
+        ("solver.tolerance=0", "solver.tolerance"),
+        ("solver.tolerance=-1", "solver.tolerance"),
+        ("solver.max_iterations=0", "solver.max_iterations"),
+    ] {
+        let o = grainlaw(&["run", "shear-cell", "--out", "x", "--set", set], d);
+        refused(&o, key);
+    }
+    let o = grainlaw(
+        &[
+            "run",
+            "stick-slip",
+            "--dump-problems",
+            "p",
+            "--dump-steps",
+            "9..2",
+        ],
+        d,
+    );
+    refused(&o, "--dump-steps");
+}
+
+#[test]
+fn solve_fc_methods_solve_a_pile_and_non_convergence_exits_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = pile();
+    for m in ["nlgs", "newton", "auto"] {
+        let o = grainlaw(&["solve-fc", &p, "--tol", "1e-10", "--method", m], d);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{m}: {out}");
+        assert!(out.contains(&format!("method={m}")) && out.contains("converged=true"));
+    }
+    // Two sweeps cannot solve the pile to 1e-12: the solution is written, marked, exit 3.
+    let sol = d.join("s.json");
+    let o = grainlaw(
+        &[
+            "solve-fc",
+            &p,
+            "--tol",
+            "1e-12",
+            "--method",
+            "nlgs",
+            "--max-iterations",
+            "2",
+            "--out",
+            sol.to_str().unwrap(),
+        ],
+        d,
+    );
+    assert_eq!(o.status.code(), Some(3));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&sol).unwrap()).unwrap();
+    assert_eq!(v["converged"], serde_json::Value::Bool(false));
+}
+
+/// `--dump-steps` writes exactly the steps asked for, as problems `dem::fc` reads, and the
+/// engine's recorded error is what solving them from zero reaches to the same tolerance or
+/// better.
+#[test]
+fn dumped_problems_read_back_and_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = grainlaw(
+        &[
+            "run",
+            "stick-slip",
+            "--quiet",
+            "--out",
+            "run",
+            "--set",
+            "grains=60",
+            "--set",
+            "push_duration=0.1",
+            "--dump-problems",
+            "p",
+            "--dump-steps",
+            "40..42",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut files: Vec<_> = std::fs::read_dir(d.join("p"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    // Each world of the scenario counts its own steps: 3 files per world that reached step 42.
+    assert!(!files.is_empty() && files.len() % 3 == 0, "{files:?}");
+    for f in &files {
+        let p = dem::fc::read_problem(f).unwrap();
+        assert!(p.contacts() > 0);
+        let o = grainlaw(&["solve-fc", f.to_str().unwrap(), "--tol", "1e-8"], d);
+        assert_eq!(o.status.code(), Some(0), "{}", f.display());
+    }
+}
