@@ -65,7 +65,9 @@ pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
                 let hb = body_rows(&rows[kb as usize], sb as usize);
                 for (i, hai) in ha.iter().enumerate() {
                     for (j, hbj) in hb.iter().enumerate() {
-                        let x = hai[0] * m[0] * hbj[0] + hai[1] * m[1] * hbj[1] + hai[2] * m[2] * hbj[2];
+                        let x = hai[0] * m[0] * hbj[0]
+                            + hai[1] * m[1] * hbj[1]
+                            + hai[2] * m[2] * hbj[2];
                         ri.push(2 * ka as usize + i);
                         ci.push(2 * kb as usize + j);
                         v.push(x);

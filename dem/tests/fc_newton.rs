@@ -36,7 +36,12 @@ fn stack(cols: usize, rows: usize, method: SolverMethod, tol: f64) -> (World, f6
     let width = 2.0 * r * cols as f64;
     w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
     w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall("right", Vector2::new(width, 0.0), Vector2::new(-1.0, 0.0), 0);
+    w.add_line_wall(
+        "right",
+        Vector2::new(width, 0.0),
+        Vector2::new(-1.0, 0.0),
+        0,
+    );
     for j in 0..rows {
         for i in 0..cols {
             w.add_grain(
@@ -74,7 +79,10 @@ fn hyperstatic_stack_between_frictional_walls_carries_its_weight_exactly() {
         .iter()
         .map(|b| b.velocity.norm().max(b.omega.abs() * 1e-3))
         .fold(0.0, f64::max);
-    assert!(vmax <= 1e-10 * 9.81e-3 * 50.0, "largest velocity {vmax:e} m/s");
+    assert!(
+        vmax <= 1e-10 * 9.81e-3 * 50.0,
+        "largest velocity {vmax:e} m/s"
+    );
     // Statics: the walls and the floor carry the whole weight (relative 1e-9).
     let support: f64 = (0..3).map(|b| w.contact_force(b).0.y).sum::<f64>();
     assert!(
