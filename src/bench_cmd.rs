@@ -1,6 +1,6 @@
 //! `grainlaw bench`: the performance figures of the project in one table.
 //!
-//! 1. Frictional-contact problems of `formats/frictional-contact.md` solved to 10⁻⁶ against the
+//! 1. Frictional-contact problems of `docs/formats.md` §1 solved to 10⁻⁶ against the
 //!    Siconos fc2d NSGS times ([`dem::fc::bench`]).
 //! 2. Bare Gauss–Seidel sweep throughput (contact updates per second, one core).
 //! 3. Engine time per step of a settled deposit about 25 grains deep in a box that widens with

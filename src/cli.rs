@@ -1,4 +1,4 @@
-//! The `grainlaw` command line (DESIGN §5).
+//! The `grainlaw` command line (`docs/cli.md`).
 //!
 //! ```text
 //! grainlaw [run [SCENARIO] [--out DIR] [--set KEY=VALUE ...] [--quiet]]   (default: run janssen)

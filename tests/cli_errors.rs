@@ -1,5 +1,5 @@
 //! Bad input gives one line on stderr naming the key, file or line, exit code 2, no panic, and
-//! no `summary.json` (DESIGN §5).
+//! no `summary.json` (`docs/cli.md`).
 
 use std::path::Path;
 use std::process::{Command, Output};

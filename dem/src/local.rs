@@ -129,7 +129,7 @@ pub fn predictor_corrector(
 }
 
 /// Natural-map residual of one contact, `r − proj_K(r − ū)` with ρ = 1: the per-contact term of
-/// the error measure of `formats/frictional-contact.md` (Siconos' fc2d error).
+/// the error measure of `docs/formats.md` §1.2 (Siconos' fc2d error).
 #[inline(always)]
 pub fn natural_map_residual(r: [f64; 2], u: [f64; 2], mu: f64) -> [f64; 2] {
     let ub = modified_velocity(u, mu);

@@ -184,7 +184,7 @@ fn every_pile_and_siconos_problem_converges_to_1e_6() {
 
 #[test]
 fn large_pile_converges_to_1e_6() {
-    // 9891 contacts (make_pile.py --contacts 10000 --perturb 0.02 --seed 1): Siconos' NSGS needs
+    // 9891 contacts (the pile generator of `docs/formats.md` §1.3, 10000 contacts, seed 1): Siconos' NSGS needs
     // about 5900 sweeps here.
     let s = solve_and_check(
         &data_dir().join("large/pile_pert_10000.json.gz"),

@@ -8,7 +8,7 @@ use nalgebra::{Matrix2, Vector2};
 
 const G: f64 = 9.81;
 
-/// The rolling disk of DESIGN §2 simulated by the engine (θ = 1/2 so that the travelled length
+/// The rolling disk of `docs/physics.md` §2.3 simulated by the engine (θ = 1/2 so that the travelled length
 /// is exactly `a t²/2`), slope made by a tilted wall and by rotated gravity: per-grain stress
 /// `ρ g a [[0, sinφ/6], [sinφ/6, −cosφ]] + (ρ g L sinφ/3) 𝟙` and contact part
 /// `ρ g a [[0, sinφ/3], [0, −cosφ]]` in the slope frame, to 1e-6 relative (of ‖Σ‖).

@@ -1,4 +1,4 @@
-//! Mean stress with inertia: the rolling disk exact solution (DESIGN §2, eq. 13–14), symmetry,
+//! Mean stress with inertia: the rolling disk exact solution (`docs/physics.md` §2.3), symmetry,
 //! translation invariance, and the boundary (virial) identity.
 
 mod support;

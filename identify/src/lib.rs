@@ -1,6 +1,6 @@
 //! # identify — calibrated continuum laws from homogenised granular data
 //!
-//! Fits the laws of `DESIGN.md` §3 to homogenised DEM histories or to a user's CSV, with
+//! Fits the laws of `docs/physics.md` §3 to homogenised DEM histories or to a user's CSV, with
 //! uncertainty, and exports them as versioned JSON for continuum solvers.
 //!
 //! | module | holds |

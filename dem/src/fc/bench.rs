@@ -26,7 +26,7 @@ pub struct BenchRow {
     /// Contact updates per second of plain Gauss–Seidel sweeps on one core (updates / s).
     pub updates_per_second: f64,
     /// Siconos 4.4 fc2d NSGS seconds on the same problem (tolerance 1e-6, `r = 0`, one core),
-    /// measured with `tools/solve_fc.py` on the development machine; `None` if not measured.
+    /// measured with Siconos 4.4 (see `datasets/fc-problems/README.md`) on the development machine; `None` if not measured.
     pub siconos_seconds: Option<f64>,
     /// Siconos NSGS iterations on the same problem.
     pub siconos_iterations: Option<usize>,
@@ -43,8 +43,7 @@ impl BenchRow {
 }
 
 /// Siconos 4.4 fc2d NSGS (sparse block storage) at tolerance 1e-6 from `r = 0`, one core,
-/// measured with `tools/solve_fc.py F.json --solver NSGS --tol 1e-6 --repeat 3` (`--repeat 1`
-/// for the large pile) on the development machine (2 vCPU Xeon, shared), fastest of two rounds
+/// best of three repeats (one for the large pile) on the development machine (2 vCPU Xeon, shared), fastest of two rounds
 /// in the same session as the `dem::fc` figures of `datasets/fc-problems/README.md`:
 /// (problem, iterations, seconds). Times below 10⁻⁴ s were not resolved (stored as 0).
 pub const SICONOS_REFERENCE: &[(&str, usize, f64)] = &[
