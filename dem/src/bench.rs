@@ -27,6 +27,7 @@ pub fn grid_world(n: usize, width: f64, mu: f64, seed: u64) -> World {
         periodic_x: None,
         detection_gap: 0.1 * r_min,
         overlap_rate: 1e-4,
+        position_correction: true,
         solver: SolverParams {
             tolerance: 1e-4,
             max_iterations: 1000,

@@ -12,7 +12,8 @@
 //! [`detection`] (cell grid, O(N)) → free velocities → [`solver`] (NLGS, O(1) per contact
 //! update, local law in [`local`]; optionally on several threads by spatial slabs and a
 //! coloured separator, [`colouring`], [`blocked`] and [`parallel`], with the same numbers on any
-//! thread count) → θ-method position update.
+//! thread count) → θ-method position update → [`stabilise`] (a frictionless projection of the
+//! positions that removes the overlaps deeper than a slop, without touching the velocities).
 //!
 //! Helpers for runs that only want a state: [`hydrostatic`] (a weight-carrying first guess of
 //! the impulses of a packing generated at rest, [`world::World::prime_with_weight`]) and
@@ -37,10 +38,12 @@ pub mod fc;
 pub mod hydrostatic;
 pub mod local;
 pub mod material;
+pub mod nlgs;
 pub mod parallel;
 pub mod serde_float;
 pub mod snapshot;
 pub mod solver;
+pub mod stabilise;
 pub mod step_control;
 pub mod world;
 

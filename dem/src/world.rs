@@ -13,9 +13,22 @@
 //! The shift lets a contact that is still open at the start of the step close during it (it
 //! stops exactly at contact for θ = 1); a gap below 10⁻⁴ of the smaller radius counts as closed
 //! ([`crate::contact::CLOSED_GAP`]) and adds Newton restitution `u_n⁺ ≥ −e u_n⁻` on impacts;
-//! with `e = 0` (the default) an impact is perfectly inelastic. Overlaps are never pushed apart,
-//! so the scheme injects no energy: with θ = 1 the energy change of a step is
-//! `R·u⁺ − ½ ‖v⁺ − v⁻‖²_M ≤ 0`.
+//! with `e = 0` (the default) an impact is perfectly inelastic. The velocities never push an
+//! overlap apart, so the scheme injects no kinetic energy: with θ = 1 the energy change of a
+//! step is `R·u⁺ − ½ ‖v⁺ − v⁻‖²_M ≤ 0`.
+//!
+//! ```text
+//! 5. position correction (WorldParams::position_correction, on by default): for the contacts
+//!    whose predicted gap g⁺ = g⁻ + H_n (q⁺ − q⁻) is below −s (s = 10⁻⁴ of the smaller radius),
+//!    q⁺ ← q⁺ + M⁻¹ H_nᵀ P with P ≥ 0,  g⁺ + W_nn P ≥ −s,  Pᵀ(g⁺ + W_nn P + s) = 0
+//! ```
+//!
+//! Overlaps left by a step (an inexact solve, a fast impact, an imposed wall) are thus removed at
+//! position level, down to the slop, by a frictionless projection that changes no velocity
+//! ([`crate::stabilise`]; Cline & Pai's post-stabilisation, the position projection of Acary's
+//! combined-projection Moreau–Jean scheme): the kinetic energy is untouched, and the work of
+//! gravity and the applied loads over the correction, the opposite of the potential energy it
+//! adds, is reported in [`StepReport::position_correction`] (`load_work`).
 
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
@@ -32,6 +45,7 @@ use crate::fc::FcProblem;
 use crate::material::ContactLaws;
 use crate::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
 use crate::solver::{self, SolveReport, SolverParams, SweepOrder};
+use crate::stabilise::{CorrectionReport, Projection};
 
 /// Parameters of the time stepping.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -55,6 +69,13 @@ pub struct WorldParams {
     /// residuals can let them build up. 0 disables the check.
     #[serde(default = "default_overlap_rate")]
     pub overlap_rate: f64,
+    /// Post-stabilisation of positions after each step ([`crate::stabilise`]): overlaps deeper
+    /// than the slop ([`crate::stabilise::SLOP`] of the smaller radius of the pair) are removed by
+    /// a frictionless projection `q ← q + M⁻¹ H_nᵀ P` that changes no velocity (Cline & Pai
+    /// 2003). On by default (also when absent from a file); `false` gives the plain Moreau–Jean
+    /// step, where overlaps are never pushed apart.
+    #[serde(default = "default_position_correction")]
+    pub position_correction: bool,
     /// Contact solver.
     pub solver: SolverParams,
 }
@@ -68,6 +89,7 @@ impl Default for WorldParams {
             periodic_x: None,
             detection_gap: 1e-4,
             overlap_rate: default_overlap_rate(),
+            position_correction: default_position_correction(),
             solver: SolverParams::default(),
         }
     }
@@ -82,6 +104,10 @@ pub const BLOCKED_MIN_CONTACTS: usize = 4096;
 
 fn default_overlap_rate() -> f64 {
     1e-4
+}
+
+fn default_position_correction() -> bool {
+    true
 }
 
 /// What one step did.
@@ -99,6 +125,10 @@ pub struct StepReport {
     pub solver: SolveReport,
     /// Largest overlap (−gap) at the start of the step (m), 0 if none.
     pub max_penetration: f64,
+    /// The position correction after the update ([`crate::stabilise`]); all zeros when it is
+    /// off or found nothing to correct.
+    #[serde(default)]
+    pub position_correction: CorrectionReport,
 }
 
 /// A 2D granular world.
@@ -129,6 +159,8 @@ pub struct World {
     colouring: ContactColouring,
     v_free: Vec<[f64; 3]>,
     work: solver::SolverWork,
+    displacement: Vec<[f64; 3]>,
+    projection: Projection,
     last: StepReport,
     /// Keep the frictional-contact problem of each step ([`World::last_problem`]), to write it
     /// to a file (`grainlaw run --dump-problems`). Costs one assembly of `W` per step.
@@ -159,6 +191,8 @@ impl World {
             colouring: ContactColouring::default(),
             v_free: Vec::new(),
             work: solver::SolverWork::default(),
+            displacement: Vec::new(),
+            projection: Projection::default(),
             last: StepReport::default(),
             record_problems: false,
             last_problem: None,
@@ -751,6 +785,7 @@ impl World {
         solver::classify(&self.contacts.rows, &mut self.contacts.status);
 
         // 4. Positions, accelerations.
+        self.displacement.clear();
         for (i, b) in self.bodies.iter_mut().enumerate() {
             let v = self.vel[i];
             for (d, x) in v.iter().enumerate() {
@@ -765,9 +800,15 @@ impl World {
             let vm = [b.velocity.x, b.velocity.y, b.omega];
             b.acceleration = Vector2::new((v[0] - vm[0]) / h, (v[1] - vm[1]) / h);
             b.angular_acceleration = (v[2] - vm[2]) / h;
-            b.position.x += h * ((1.0 - theta) * vm[0] + theta * v[0]);
-            b.position.y += h * ((1.0 - theta) * vm[1] + theta * v[1]);
-            b.angle += h * ((1.0 - theta) * vm[2] + theta * v[2]);
+            let d = [
+                h * ((1.0 - theta) * vm[0] + theta * v[0]),
+                h * ((1.0 - theta) * vm[1] + theta * v[1]),
+                h * ((1.0 - theta) * vm[2] + theta * v[2]),
+            ];
+            self.displacement.push(d);
+            b.position.x += d[0];
+            b.position.y += d[1];
+            b.angle += d[2];
             b.velocity = Vector2::new(v[0], v[1]);
             b.omega = v[2];
             if let Some(p) = periodic {
@@ -776,6 +817,13 @@ impl World {
                 }
             }
         }
+
+        // 5. Position correction (velocities untouched).
+        let correction = if self.params.position_correction {
+            self.correct_positions()
+        } else {
+            CorrectionReport::default()
+        };
 
         let active = self.refresh_body_forces();
 
@@ -788,8 +836,63 @@ impl World {
             active_contacts: active,
             solver: report,
             max_penetration: max_pen,
+            position_correction: correction,
         };
         Ok(self.last)
+    }
+
+    /// Step 5 (module documentation, [`crate::stabilise`]): projects the positions after the
+    /// update so that no contact of the step overlaps by more than its slop, moving free degrees
+    /// of freedom only and no velocity, and wraps moved grains into the periodic cell. Returns
+    /// the projection's report with the work of gravity and the applied loads over it.
+    fn correct_positions(&mut self) -> CorrectionReport {
+        let mut report = self.projection.project(
+            &self.contacts.rows,
+            &self.contacts.geometry,
+            &self.displacement,
+            &self.inv,
+        );
+        if report.corrected_contacts == 0 {
+            return report;
+        }
+        let g = self.params.gravity;
+        let periodic = self.periodic();
+        let mut work = 0.0;
+        for ((b, dq), inv) in self
+            .bodies
+            .iter_mut()
+            .zip(self.projection.correction())
+            .zip(&self.inv)
+        {
+            if *dq == [0.0; 3] {
+                continue;
+            }
+            b.position.x += dq[0];
+            b.position.y += dq[1];
+            b.angle += dq[2];
+            let grav = if b.gravity {
+                g * b.mass
+            } else {
+                Vector2::zeros()
+            };
+            let f = [
+                grav.x + b.applied_force.x,
+                grav.y + b.applied_force.y,
+                b.applied_torque,
+            ];
+            for d in 0..3 {
+                if inv[d] != 0.0 {
+                    work += f[d] * dq[d];
+                }
+            }
+            if let Some(p) = periodic {
+                if b.kind == BodyKind::Grain {
+                    b.position.x = p.wrap(b.position.x);
+                }
+            }
+        }
+        report.load_work = work;
+        report
     }
 
     /// Largest approach speed of a converged solve (m/s): `overlap_rate · R_min / h`, infinite

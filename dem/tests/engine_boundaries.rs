@@ -14,6 +14,7 @@ fn params(dt: f64) -> WorldParams {
         periodic_x: None,
         detection_gap: 1e-4,
         overlap_rate: 1e-4,
+        position_correction: true,
         solver: SolverParams {
             tolerance: 1e-12,
             max_iterations: 10_000,

@@ -15,6 +15,7 @@ fn params(dt: f64, gravity: Vector2<f64>) -> WorldParams {
         periodic_x: None,
         detection_gap: 1e-4,
         overlap_rate: 1e-4,
+        position_correction: true,
         solver: SolverParams {
             tolerance: 1e-12,
             max_iterations: 100_000,

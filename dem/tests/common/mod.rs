@@ -25,6 +25,7 @@ pub fn random_box(
         periodic_x: None,
         detection_gap: 0.2 * r_min,
         overlap_rate: 1e-4,
+        position_correction: true,
         solver: SolverParams {
             tolerance: 1e-10,
             max_iterations: 20_000,
