@@ -9,7 +9,9 @@ mod common;
 /// 1e-7 of the energy scale `Σ m g d` per step, with the solver at tolerance 1e-6. The time
 /// step (0.2 ms) keeps the grains' travel per step below a tenth of a radius during the
 /// collapse, where Gauss–Seidel needs few sweeps; at most 1 % of the steps may stop at the
-/// sweep limit, with an error below 1e-5.
+/// sweep limit, with an error below 1e-5. The position correction after each step
+/// (`dem::stabilise`) adds the potential energy `−load_work` when it lifts grains out of
+/// overlaps; it is not the scheme's and is taken out of the balance.
 fn energy_never_increases(theta: f64, allowance: f64) {
     let mut w = common::random_box(200, 0.15, 0.003, 0.005, 0.3, theta, 11);
     w.params.dt = 2e-4;
@@ -34,7 +36,8 @@ fn energy_never_increases(theta: f64, allowance: f64) {
             assert!(rep.solver.error < 1e-5, "{rep:?}");
         }
         let e = w.kinetic_energy() + w.potential_energy();
-        worst = worst.max((e - e_prev) / scale);
+        let corrected = -rep.position_correction.load_work;
+        worst = worst.max((e - e_prev - corrected) / scale);
         e_prev = e;
     }
     assert!(
