@@ -18,10 +18,13 @@
 //! Gauss–Seidel converges linearly and slowly (the weight of a pile diffuses through the
 //! network). After [`PLAIN_SWEEPS`] plain sweeps, the sweeps are accelerated by Anderson mixing
 //! of the impulse vector (GMRES on an affine map, [`crate::anderson`]); after each mix the
-//! body velocities are rebuilt, `v = v_free + M⁻¹ Hᵀ R` (O(N)). The mixing is safeguarded as in
-//! [`crate::fc::nsgs`]: no progress by a factor 0.7 over [`STAGNATION_WINDOW`] sweeps clears the
-//! history and continues with plain sweeps for a while; an error that blows up restores the
-//! best iterate. A solve that does not converge returns its best iterate.
+//! body velocities are rebuilt, `v = v_free + M⁻¹ Hᵀ R` (O(N)). The iteration, the mixing and
+//! its safeguard are the driver shared with [`crate::fc::nsgs`], [`crate::nlgs::drive`]: no
+//! progress by a factor 0.7 over [`STAGNATION_WINDOW`] sweeps clears the history and continues
+//! with plain sweeps for a while; an error that blows up restores the best iterate. A solve that
+//! does not converge returns its best iterate. This module supplies what is the engine's own
+//! ([`crate::nlgs::SweepProblem`]): the O(1) contact update, the sweep order (natural or
+//! coloured, shuffled on a stall), the error measure and the approach-speed limit.
 //!
 //! Convergence is judged on the error measure of `formats/frictional-contact.md` (Siconos'
 //! natural-map error): `e = ‖r − proj_K(r − ū)‖ / max(‖q‖, ‖r‖, ‖u‖)`, `q` the local velocity at
@@ -30,13 +33,13 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::anderson::Anderson;
 use crate::assemble::contact_problem;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
 use crate::fc::newton::{self, NewtonParams, NewtonWork};
 use crate::fc::FcOptions;
 use crate::local::{natural_map_residual, ContactStatus};
+use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
 use crate::parallel::{
     coloured_sweep, local_update, max_over, reduce_chunks, scatter_velocities, CHUNK,
     MIN_CHUNKS_PER_TASK,
@@ -144,8 +147,7 @@ pub struct SolveReport {
     pub newton_iterations: usize,
 }
 
-/// Sweeps without the error halving after which the sweep order is shuffled.
-pub const STALL_SWEEPS: usize = 500;
+pub use crate::nlgs::{STAGNATION_WINDOW, STALL_SWEEPS};
 
 /// Apply the impulses currently stored in `rows` to the velocities (warm start):
 /// `v ← v + M⁻¹ Hᵀ R`.
@@ -235,11 +237,6 @@ pub fn sweep(
 
 /// Plain sweeps before Anderson mixing starts (easy, warm-started steps never pay for it).
 pub const PLAIN_SWEEPS: usize = 6;
-/// Stagnation window of the Anderson safeguard (sweeps).
-pub const STAGNATION_WINDOW: usize = 60;
-const STAGNATION_FACTOR: f64 = 0.7;
-const PLAIN_PHASE: usize = 32;
-const BLOW_UP: f64 = 1e3;
 
 /// Rebuild the body velocities from the free velocities and the impulses:
 /// `v = v_free + M⁻¹ Hᵀ R`.
@@ -325,14 +322,14 @@ impl SweepOrder<'_> {
 /// must equal `v_free + M⁻¹ Hᵀ R` for those impulses (see [`apply_impulses`]); `q_norm` is
 /// [`free_velocity_norm`]. On return `vel` matches the returned impulses.
 ///
-/// `nlgs` sweeps up to `max_iterations` times ([`nlgs`]); `newton` assembles the step's problem
-/// ([`crate::assemble::contact_problem`]) and runs [`crate::fc::newton`] from the warm start;
-/// `auto` sweeps at most `auto_sweeps` times and hands the best iterate to Newton when that was
-/// not enough. In both Newton modes `max_iterations` bounds the smoothing sweeps.
+/// `nlgs` sweeps up to `max_iterations` times ([`crate::nlgs::drive`]); `newton` assembles the
+/// step's problem ([`crate::assemble::contact_problem`]) and runs [`crate::fc::newton`] from the
+/// warm start; `auto` sweeps at most `auto_sweeps` times and hands the best iterate to Newton
+/// when that was not enough. In both Newton modes `max_iterations` bounds the smoothing sweeps.
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     rows: &mut [ContactRow],
-    mut order: SweepOrder,
+    order: SweepOrder,
     vel: &mut [[f64; 3]],
     v_free: &[[f64; 3]],
     inv: &[[f64; 3]],
@@ -341,67 +338,7 @@ pub fn solve(
     params: &SolverParams,
     work: &mut SolverWork,
 ) -> SolveReport {
-    let sweeps = match params.method {
-        SolverMethod::Nlgs => params.max_iterations,
-        SolverMethod::Newton => 0,
-        SolverMethod::Auto => params.auto_sweeps.min(params.max_iterations),
-    };
-    let first = if sweeps > 0 || params.method == SolverMethod::Nlgs {
-        let reborrow = match &mut order {
-            SweepOrder::Natural(o) => SweepOrder::Natural(o),
-            SweepOrder::Coloured { colouring, mobile } => {
-                SweepOrder::Coloured { colouring, mobile }
-            }
-        };
-        let report = nlgs(
-            rows,
-            reborrow,
-            vel,
-            v_free,
-            inv,
-            q_norm,
-            approach_limit,
-            params,
-            sweeps,
-            work,
-        );
-        if report.converged || params.method == SolverMethod::Nlgs {
-            return report;
-        }
-        report
-    } else {
-        let error = error_measure(rows, vel, q_norm);
-        let approach = approach_speed(rows, vel);
-        if error <= params.tolerance && approach <= approach_limit {
-            return SolveReport {
-                iterations: 0,
-                error,
-                converged: true,
-                approach_speed: approach,
-                newton_iterations: 0,
-            };
-        }
-        SolveReport::default()
-    };
-    let second = global(
-        rows,
-        &order,
-        vel,
-        v_free,
-        inv,
-        q_norm,
-        approach_limit,
-        params,
-        first,
-        work,
-    );
-    let left = params.max_iterations.saturating_sub(second.iterations);
-    if second.converged || left == 0 {
-        return second;
-    }
-    // Newton did not get there within its iterations: Gauss–Seidel from its best iterate for
-    // the sweeps left (never worse than Gauss–Seidel alone, bar the time).
-    let third = nlgs(
+    let mut step = Step {
         rows,
         order,
         vel,
@@ -409,10 +346,27 @@ pub fn solve(
         inv,
         q_norm,
         approach_limit,
-        params,
-        left,
-        work,
-    );
+        omega: params.relaxation,
+        seed: SHUFFLE_SEED,
+    };
+    let sweeps = match params.method {
+        SolverMethod::Nlgs => params.max_iterations,
+        SolverMethod::Newton => 0,
+        SolverMethod::Auto => params.auto_sweeps.min(params.max_iterations),
+    };
+    // With no sweeps (`newton`), this only tells whether the warm start is already a solution.
+    let first = nlgs(&mut step, params, sweeps, work);
+    if first.converged || params.method == SolverMethod::Nlgs {
+        return first;
+    }
+    let second = global(&mut step, params, first, work);
+    let left = params.max_iterations.saturating_sub(second.iterations);
+    if second.converged || left == 0 {
+        return second;
+    }
+    // Newton did not get there within its iterations: Gauss–Seidel from its best iterate for
+    // the sweeps left (never worse than Gauss–Seidel alone, bar the time).
+    let third = nlgs(&mut step, params, left, work);
     SolveReport {
         iterations: second.iterations + third.iterations,
         newton_iterations: second.newton_iterations,
@@ -420,30 +374,108 @@ pub fn solve(
     }
 }
 
+/// Seed of the LCG that shuffles the sweep order on a stall (every solve starts from it, so runs
+/// are reproducible).
+const SHUFFLE_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// The contact problem of a step as [`crate::nlgs::drive`] sees it: the impulses live in the
+/// rows, the body velocities `v = v_free + M⁻¹ Hᵀ R` are kept current.
+struct Step<'a> {
+    rows: &'a mut [ContactRow],
+    order: SweepOrder<'a>,
+    vel: &'a mut [[f64; 3]],
+    v_free: &'a [[f64; 3]],
+    inv: &'a [[f64; 3]],
+    q_norm: f64,
+    approach_limit: f64,
+    /// Relaxation factor of the contact updates.
+    omega: f64,
+    /// State of the shuffling LCG.
+    seed: u64,
+}
+
+impl Step<'_> {
+    /// `v = v_free + M⁻¹ Hᵀ R` for the impulses in the rows.
+    fn rebuild(&mut self) {
+        rebuild_velocities(self.rows, self.vel, self.v_free, self.inv, &self.order);
+    }
+
+    fn approach_speed(&self) -> f64 {
+        approach_speed(self.rows, self.vel)
+    }
+}
+
+impl SweepProblem for Step<'_> {
+    fn dim(&self) -> usize {
+        2 * self.rows.len()
+    }
+
+    fn sweep(&mut self) -> Option<f64> {
+        self.order.sweep(self.rows, self.vel, self.inv, self.omega);
+        None
+    }
+
+    fn error(&mut self) -> f64 {
+        error_measure(self.rows, self.vel, self.q_norm)
+    }
+
+    /// The error within the tolerance and no closed or loaded contact approaching faster than
+    /// the limit.
+    fn converged(&self, error: f64, tolerance: f64) -> bool {
+        error <= tolerance && self.approach_speed() <= self.approach_limit
+    }
+
+    /// `x ← (r_α)` flattened, in parallel over fixed chunks.
+    fn save(&self, x: &mut [f64]) {
+        self.rows
+            .par_chunks(CHUNK)
+            .zip(x.par_chunks_mut(2 * CHUNK))
+            .with_min_len(MIN_CHUNKS_PER_TASK)
+            .for_each(|(rs, x)| {
+                for (c, x) in rs.iter().zip(x.chunks_exact_mut(2)) {
+                    x[0] = c.r[0];
+                    x[1] = c.r[1];
+                }
+            });
+    }
+
+    /// `(r_α) ← x`, then the velocities rebuilt (O(N)).
+    fn load(&mut self, x: &[f64]) {
+        self.rows
+            .par_chunks_mut(CHUNK)
+            .zip(x.par_chunks(2 * CHUNK))
+            .with_min_len(MIN_CHUNKS_PER_TASK)
+            .for_each(|(rs, x)| {
+                for (c, r) in rs.iter_mut().zip(x.chunks_exact(2)) {
+                    c.r = [r[0], r[1]];
+                }
+            });
+        self.rebuild();
+    }
+
+    fn shuffle(&mut self) {
+        self.order.shuffle(&mut self.seed);
+    }
+}
+
 /// The Newton stage of [`solve`]: assemble, solve from the current impulses, write the impulses
 /// back and rebuild the velocities. The report's error and approach speed are the engine's own,
 /// evaluated on the rebuilt velocities.
-#[allow(clippy::too_many_arguments)]
 fn global(
-    rows: &mut [ContactRow],
-    order: &SweepOrder,
-    vel: &mut [[f64; 3]],
-    v_free: &[[f64; 3]],
-    inv: &[[f64; 3]],
-    q_norm: f64,
-    approach_limit: f64,
+    step: &mut Step,
     params: &SolverParams,
     first: SolveReport,
     work: &mut SolverWork,
 ) -> SolveReport {
-    let problem = contact_problem(rows, v_free, inv);
+    let problem = contact_problem(step.rows, step.v_free, step.inv);
     let options = FcOptions {
         tolerance: params.tolerance,
         max_iterations: params.max_iterations.saturating_sub(first.iterations),
-        initial_guess: Some(rows.iter().flat_map(|c| c.r).collect()),
+        initial_guess: Some(step.rows.iter().flat_map(|c| c.r).collect()),
         ..FcOptions::default()
     };
-    let closed: Vec<bool> = rows.iter().map(|c| c.shift <= 0.0).collect();
+    let closed: Vec<bool> = step.rows.iter().map(|c| c.shift <= 0.0).collect();
+    let approach_limit = step.approach_limit;
     let accept = |r: &[f64], u: &[f64]| {
         closed
             .iter()
@@ -453,7 +485,7 @@ fn global(
     let outcome = newton::solve_with(&problem, &options, &params.newton, &mut work.newton, accept);
     let (newton_iterations, smoothing) = match outcome {
         Ok((sol, stats)) => {
-            for (c, r) in rows.iter_mut().zip(sol.r.chunks_exact(2)) {
+            for (c, r) in step.rows.iter_mut().zip(sol.r.chunks_exact(2)) {
                 c.r = [r[0], r[1]];
             }
             (stats.iterations, stats.smoothing_sweeps)
@@ -461,9 +493,9 @@ fn global(
         // Only invalid parameters fail, and they are checked before a run starts.
         Err(_) => (0, 0),
     };
-    rebuild_velocities(rows, vel, v_free, inv, order);
-    let error = error_measure(rows, vel, q_norm);
-    let approach = approach_speed(rows, vel);
+    step.rebuild();
+    let error = step.error();
+    let approach = step.approach_speed();
     SolveReport {
         iterations: first.iterations + smoothing,
         error,
@@ -474,200 +506,59 @@ fn global(
 }
 
 /// Accelerated NLGS (see the module documentation) for at most `max_sweeps` sweeps, starting
-/// from the impulses stored in `rows`. Converged means `error ≤ tolerance` and
-/// [`approach_speed`] `≤ approach_limit` (m/s): the relative error alone is normalised by the
-/// largest velocities of the step, so while some grains fall fast it lets resting contacts
-/// approach at up to `tolerance × ‖q‖`, and their overlaps add up over the steps. On entry `vel` must equal
-/// `v_free + M⁻¹ Hᵀ R` for those impulses (see [`apply_impulses`]); `q_norm` is
-/// [`free_velocity_norm`].
+/// from the impulses stored in the rows: [`crate::nlgs::drive`] on the step. Converged means
+/// `error ≤ tolerance` and [`approach_speed`] `≤ approach_limit` (m/s): the relative error alone
+/// is normalised by the largest velocities of the step, so while some grains fall fast it lets
+/// resting contacts approach at up to `tolerance × ‖q‖`, and their overlaps add up over the
+/// steps. On entry the velocities must equal `v_free + M⁻¹ Hᵀ R` for those impulses (see
+/// [`apply_impulses`]); `q_norm` is [`free_velocity_norm`].
 ///
 /// The error is evaluated after every sweep during the first ten, then every
-/// `max(1, iterations/10)` sweeps (at most 16): the reported error is always the true error at
-/// the returned impulses.
+/// `max(1, iterations/10)` sweeps (at most 16, [`CheckSchedule::Growing`]): the reported error is
+/// always the true error at the returned impulses.
 ///
 /// Without acceleration, Gauss–Seidel in a fixed order can cycle on statically indeterminate
 /// clusters of sticking contacts (closed loops of grains). When the error has not halved over
 /// [`STALL_SWEEPS`] sweeps, the sweeps continue in a fresh pseudo-random order each time (seeded,
 /// so runs stay reproducible), which breaks the cycle.
-#[allow(clippy::too_many_arguments)]
 fn nlgs(
-    rows: &mut [ContactRow],
-    mut order: SweepOrder,
-    vel: &mut [[f64; 3]],
-    v_free: &[[f64; 3]],
-    inv: &[[f64; 3]],
-    q_norm: f64,
-    approach_limit: f64,
+    step: &mut Step,
     params: &SolverParams,
     max_sweeps: usize,
     work: &mut SolverWork,
 ) -> SolveReport {
-    let n = rows.len();
-    if n == 0 {
+    if step.rows.is_empty() {
         return SolveReport {
-            iterations: 0,
-            error: 0.0,
             converged: true,
-            approach_speed: 0.0,
-            newton_iterations: 0,
+            ..SolveReport::default()
         };
     }
-    let tol = params.tolerance;
-    let done = |rows: &[ContactRow], vel: &[[f64; 3]], error: f64| {
-        error <= tol && approach_speed(rows, vel) <= approach_limit
-    };
-    let mut error = error_measure(rows, vel, q_norm);
-    if done(rows, vel, error) {
-        return SolveReport {
-            iterations: 0,
-            error,
-            converged: true,
-            approach_speed: approach_speed(rows, vel),
-            newton_iterations: 0,
-        };
-    }
-    let use_aa = params.anderson_memory > 0;
-    if use_aa {
-        work.prepare(params.anderson_memory, n);
-    }
-    work.best.clear();
-    work.best.extend(rows.iter().map(|c| c.r));
-    let mut best_error = error;
-
-    let mut it = 0;
-    let mut next_check = 1;
-    let (mut halving_ref, mut halving_it) = (error, 0usize);
-    let mut shuffling = false;
-    let mut seed = 0x9E37_79B9_7F4A_7C15u64;
-    // Anderson safeguard.
-    let mut plain_until = PLAIN_SWEEPS;
-    let mut plain_phase = PLAIN_PHASE;
-    let (mut window_start, mut window_error, mut window_best) = (0usize, error, error);
-
-    while it < max_sweeps {
-        let accelerate = use_aa && it >= plain_until;
-        if accelerate {
-            copy_impulses(rows, &mut work.x);
-        }
-        if shuffling {
-            order.shuffle(&mut seed);
-        }
-        order.sweep(rows, vel, inv, params.relaxation);
-        it += 1;
-        if it >= next_check || it == max_sweeps {
-            error = error_measure(rows, vel, q_norm);
-            if error < best_error {
-                best_error = error;
-                for (b, c) in work.best.iter_mut().zip(rows.iter()) {
-                    *b = c.r;
-                }
-            } else if !error.is_finite() || error > BLOW_UP * best_error {
-                for (c, b) in rows.iter_mut().zip(work.best.iter()) {
-                    c.r = *b;
-                }
-                rebuild_velocities(rows, vel, v_free, inv, &order);
-                error = error_measure(rows, vel, q_norm);
-                if let Some(aa) = work.anderson.as_mut() {
-                    aa.reset();
-                }
-                plain_until = it + plain_phase;
-                plain_phase = plain_phase.saturating_mul(2);
-            }
-            if done(rows, vel, error) {
-                break;
-            }
-            if use_aa {
-                if it <= plain_until {
-                    (window_start, window_error, window_best) = (it, error, error);
-                } else {
-                    window_best = window_best.min(error);
-                    if it - window_start >= STAGNATION_WINDOW {
-                        if window_best > STAGNATION_FACTOR * window_error {
-                            if let Some(aa) = work.anderson.as_mut() {
-                                aa.reset();
-                            }
-                            plain_until = it + plain_phase;
-                            plain_phase = plain_phase.saturating_mul(2);
-                        }
-                        (window_start, window_error, window_best) = (it, window_best, error);
-                    }
-                }
-            } else if error < 0.5 * halving_ref {
-                (halving_ref, halving_it) = (error, it);
-            } else if !shuffling && it - halving_it >= STALL_SWEEPS {
-                shuffling = true;
-            }
-            next_check = it + if it < 10 { 1 } else { (it / 10).clamp(1, 16) };
-        }
-        if accelerate && it >= plain_until && it < max_sweeps {
-            if let Some(aa) = work.anderson.as_mut() {
-                copy_impulses(rows, &mut work.g);
-                aa.step(&work.x, &mut work.g);
-                rows.par_chunks_mut(CHUNK)
-                    .zip(work.g.par_chunks(2 * CHUNK))
-                    .with_min_len(MIN_CHUNKS_PER_TASK)
-                    .for_each(|(rs, g)| {
-                        for (c, r) in rs.iter_mut().zip(g.chunks_exact(2)) {
-                            c.r = [r[0], r[1]];
-                        }
-                    });
-                rebuild_velocities(rows, vel, v_free, inv, &order);
-            }
-        }
-    }
-    if !done(rows, vel, error) && best_error < error {
-        for (c, b) in rows.iter_mut().zip(work.best.iter()) {
-            c.r = *b;
-        }
-        rebuild_velocities(rows, vel, v_free, inv, &order);
-        error = error_measure(rows, vel, q_norm);
-    }
-    let approach = approach_speed(rows, vel);
+    step.seed = SHUFFLE_SEED;
+    let report = drive(
+        step,
+        &DriveParams {
+            tolerance: params.tolerance,
+            max_sweeps,
+            anderson_memory: params.anderson_memory,
+            plain_sweeps: PLAIN_SWEEPS,
+            schedule: CheckSchedule::Growing,
+        },
+        &mut work.nlgs,
+    );
     SolveReport {
-        iterations: it,
-        error,
-        converged: error <= tol && approach <= approach_limit,
-        approach_speed: approach,
+        iterations: report.iterations,
+        error: report.error,
+        converged: report.converged,
+        approach_speed: step.approach_speed(),
         newton_iterations: 0,
     }
-}
-
-/// `x ← (r_α)` flattened, in parallel over fixed chunks.
-fn copy_impulses(rows: &[ContactRow], x: &mut Vec<f64>) {
-    x.resize(2 * rows.len(), 0.0);
-    rows.par_chunks(CHUNK)
-        .zip(x.par_chunks_mut(2 * CHUNK))
-        .with_min_len(MIN_CHUNKS_PER_TASK)
-        .for_each(|(rs, x)| {
-            for (c, x) in rs.iter().zip(x.chunks_exact_mut(2)) {
-                x[0] = c.r[0];
-                x[1] = c.r[1];
-            }
-        });
 }
 
 /// Buffers of the solver kept between steps (no allocation in the steady state).
 #[derive(Debug, Clone, Default)]
 pub struct SolverWork {
     newton: NewtonWork,
-    anderson: Option<Anderson>,
-    shape: (usize, usize),
-    x: Vec<f64>,
-    g: Vec<f64>,
-    best: Vec<[f64; 2]>,
-}
-
-impl SolverWork {
-    fn prepare(&mut self, memory: usize, n: usize) {
-        if self.anderson.is_some() && self.shape == (memory, n) {
-            if let Some(a) = self.anderson.as_mut() {
-                a.reset();
-            }
-        } else {
-            self.anderson = Some(Anderson::new(memory, 2 * n));
-            self.shape = (memory, n);
-        }
-    }
+    nlgs: DriveWork,
 }
 
 /// Status of each contact from its impulse: open when `r = 0`, sliding when on the cone's

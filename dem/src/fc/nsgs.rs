@@ -22,20 +22,24 @@
 //! `check_every` sweeps; if it has not dropped by a factor 0.7 over a window of 60 sweeps, the
 //! history is cleared and plain sweeps are done for 32 sweeps (doubling at each new stagnation),
 //! and if it ever becomes non-finite or 10³ times the best error, the best iterate is restored.
-//! The worst case is therefore plain Gauss–Seidel plus bounded overhead.
+//! The worst case is therefore plain Gauss–Seidel plus bounded overhead. The iteration, the
+//! mixing and the safeguard are the driver shared with the engine's solver,
+//! [`crate::nlgs::drive`]; this module supplies the sweep over the permuted block-CSR copy of
+//! `W` and the error evaluation ([`crate::nlgs::SweepProblem`]).
 //!
 //! **Stopping.** The error measure of [`super::measure`] is evaluated exactly (a full
 //! `u = W r + q`): every `check_every` sweeps, and earlier when the sweep's relative impulse
-//! change, scaled by the error / change ratio seen at the last evaluation, predicts convergence.
-//! The returned error is always the true error at the returned `r`.
+//! change, scaled by the error / change ratio seen at the last evaluation, predicts convergence
+//! ([`crate::nlgs::CheckSchedule::Every`]). The returned error is always the true error at the
+//! returned `r`.
 
 use std::time::Instant;
 
 use super::error::FcError;
 use super::ordering::{contact_order, ContactOrdering};
 use super::problem::FcProblem;
-use crate::anderson::Anderson;
 use crate::local::{natural_map_residual, project_on_cone, solve_local, Delassus2};
+use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
 
 /// Acceleration of the Gauss–Seidel sweeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,15 +114,6 @@ pub struct FcSolution {
     pub converged: bool,
 }
 
-/// Stagnation window of the Anderson safeguard (sweeps).
-const STAGNATION_WINDOW: usize = 60;
-/// Required error reduction over one window.
-const STAGNATION_FACTOR: f64 = 0.7;
-/// First plain-sweep phase after a stagnation (sweeps); doubles at each new stagnation.
-const PLAIN_PHASE: usize = 32;
-/// An error this many times the best one seen restores the best iterate.
-const BLOW_UP: f64 = 1e3;
-
 /// The problem copied into sweep order: structure of arrays, off-diagonal blocks only.
 struct Workspace {
     perm: Vec<u32>,
@@ -131,6 +126,8 @@ struct Workspace {
     q: Vec<[f64; 2]>,
     r: Vec<[f64; 2]>,
     u: Vec<[f64; 2]>,
+    /// Over-relaxation factor of [`SweepProblem::sweep`].
+    omega: f64,
 }
 
 impl Workspace {
@@ -188,6 +185,7 @@ impl Workspace {
             q,
             r: vec![[0.0; 2]; n],
             u: vec![[0.0; 2]; n],
+            omega: 1.0,
         }
     }
 
@@ -228,8 +226,8 @@ impl Workspace {
         [x0 + y0, x1 + y1]
     }
 
-    /// One forward sweep; returns `Σ_α |Δr_α|²`.
-    fn sweep(&mut self, omega: f64) -> f64 {
+    /// One forward sweep with over-relaxation `omega`; returns `Σ_α |Δr_α|²`.
+    fn relaxed_sweep(&mut self, omega: f64) -> f64 {
         let mut d = 0.0;
         for a in 0..self.r.len() {
             let qa = self.local_q(a);
@@ -252,7 +250,7 @@ impl Workspace {
     }
 
     /// Recomputes `u = W r + q` and returns the error measure.
-    fn error(&mut self) -> f64 {
+    fn evaluate(&mut self) -> f64 {
         let mut res2 = 0.0;
         let (mut q2, mut r2, mut u2) = (0.0, 0.0, 0.0);
         for a in 0..self.r.len() {
@@ -285,6 +283,32 @@ impl Workspace {
             .map(|r| r[0] * r[0] + r[1] * r[1])
             .sum::<f64>()
             .sqrt()
+    }
+}
+
+/// The problem in sweep order as [`drive`] sees it: the impulses are `r`; `u` is recomputed by
+/// each error evaluation.
+impl SweepProblem for Workspace {
+    fn dim(&self) -> usize {
+        2 * self.r.len()
+    }
+
+    /// One sweep; returns its relative impulse change `‖Δr‖ / ‖r‖`.
+    fn sweep(&mut self) -> Option<f64> {
+        let d2 = self.relaxed_sweep(self.omega);
+        Some(d2.sqrt() / self.r_norm().max(f64::MIN_POSITIVE))
+    }
+
+    fn error(&mut self) -> f64 {
+        self.evaluate()
+    }
+
+    fn save(&self, x: &mut [f64]) {
+        x.copy_from_slice(self.r.as_flattened());
+    }
+
+    fn load(&mut self, x: &[f64]) {
+        self.r.as_flattened_mut().copy_from_slice(x);
     }
 }
 
@@ -340,98 +364,22 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
             ws.r[new] = [g[2 * old], g[2 * old + 1]];
         }
     }
-    let tol = options.tolerance;
-    let mut anderson = match options.acceleration {
-        Acceleration::Anderson { memory } if n > 0 => Some(Anderson::new(memory, 2 * n)),
-        _ => None,
+    ws.omega = options.omega;
+    let memory = match options.acceleration {
+        Acceleration::Anderson { memory } => memory,
+        Acceleration::None => 0,
     };
-    let mut r_prev = if anderson.is_some() {
-        ws.r.clone()
-    } else {
-        Vec::new()
-    };
-
-    let mut error = ws.error();
-    let mut iterations = 0;
-    let mut best_error = error;
-    let mut best_r = ws.r.clone();
-    // Stopping prediction: ratio (true error) / (relative impulse change of a sweep).
-    let mut ratio = f64::NAN;
-    let mut last_check = 0;
-    // Anderson safeguard state.
-    let mut plain_until = 0;
-    let mut plain_phase = PLAIN_PHASE;
-    let mut window_start = 0;
-    let mut window_error = error;
-    let mut window_best = error;
-
-    while error > tol && iterations < options.max_iterations {
-        let accelerate = anderson.is_some() && iterations >= plain_until;
-        if accelerate {
-            r_prev.copy_from_slice(&ws.r);
-        }
-        let d2 = ws.sweep(options.omega);
-        iterations += 1;
-        let change = d2.sqrt() / ws.r_norm().max(f64::MIN_POSITIVE);
-        let due =
-            iterations - last_check >= options.check_every || iterations >= options.max_iterations;
-        let predicted = ratio * change;
-        if due || predicted.is_nan() || predicted <= 0.9 * tol {
-            error = ws.error();
-            last_check = iterations;
-            if change > 0.0 {
-                ratio = error / change;
-            }
-            if error < best_error {
-                best_error = error;
-                best_r.copy_from_slice(&ws.r);
-            } else if !error.is_finite() || error > BLOW_UP * best_error {
-                // The mixing went astray: back to the best iterate, plain sweeps for a while.
-                ws.r.copy_from_slice(&best_r);
-                error = ws.error();
-                if let Some(aa) = anderson.as_mut() {
-                    aa.reset();
-                }
-                plain_until = iterations + plain_phase;
-                plain_phase = plain_phase.saturating_mul(2);
-            }
-            // Stagnation window of the Anderson safeguard.
-            if iterations <= plain_until {
-                window_start = iterations;
-                window_error = error;
-                window_best = error;
-            } else {
-                window_best = window_best.min(error);
-                if iterations - window_start >= STAGNATION_WINDOW {
-                    if window_best > STAGNATION_FACTOR * window_error {
-                        if let Some(aa) = anderson.as_mut() {
-                            aa.reset();
-                        }
-                        plain_until = iterations + plain_phase;
-                        plain_phase = plain_phase.saturating_mul(2);
-                    }
-                    window_start = iterations;
-                    window_error = window_best;
-                    window_best = error;
-                }
-            }
-            if error <= tol {
-                break;
-            }
-        }
-        // Mix, unless the safeguard just switched to plain sweeps or this was the last sweep
-        // (the returned r must be the one whose error was evaluated).
-        if accelerate && iterations >= plain_until && iterations < options.max_iterations {
-            if let Some(aa) = anderson.as_mut() {
-                aa.step(r_prev.as_flattened(), ws.r.as_flattened_mut());
-            }
-        }
-    }
-    if error > tol && best_error < error {
-        // Not converged: return the best iterate seen (its u and error recomputed).
-        ws.r.copy_from_slice(&best_r);
-        error = ws.error();
-    }
+    let report = drive(
+        &mut ws,
+        &DriveParams {
+            tolerance: options.tolerance,
+            max_sweeps: options.max_iterations,
+            anderson_memory: memory,
+            plain_sweeps: 0,
+            schedule: CheckSchedule::Every(options.check_every),
+        },
+        &mut DriveWork::default(),
+    );
     let mut r = vec![0.0; 2 * n];
     let mut u = vec![0.0; 2 * n];
     for (new, &old) in ws.perm.iter().enumerate() {
@@ -442,10 +390,10 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
     Ok(FcSolution {
         r,
         u,
-        iterations,
-        error,
+        iterations: report.iterations,
+        error: report.error,
         seconds: t0.elapsed().as_secs_f64(),
-        converged: error <= tol,
+        converged: report.converged,
     })
 }
 
@@ -456,7 +404,7 @@ pub fn sweep_rate(problem: &FcProblem, sweeps: usize) -> f64 {
     let t = Instant::now();
     let mut d = 0.0;
     for _ in 0..sweeps {
-        d += ws.sweep(1.0);
+        d += ws.relaxed_sweep(1.0);
     }
     let s = t.elapsed().as_secs_f64();
     std::hint::black_box(d);
