@@ -94,7 +94,9 @@ pub struct SolverParams {
     /// The algorithm ([`SolverMethod`], default `auto`).
     #[serde(default)]
     pub method: SolverMethod,
-    /// Gauss–Seidel sweeps before `auto` switches to Newton.
+    /// Gauss–Seidel sweeps between two progress checks of `auto`: Newton takes over after a
+    /// chunk whose rate would not reach the tolerance within the sweep cap
+    /// ([`gauss_seidel_will_finish`]).
     #[serde(default = "auto_sweeps")]
     pub auto_sweeps: usize,
     /// Parameters of the Newton solver (`newton` and `auto`).
@@ -104,6 +106,25 @@ pub struct SolverParams {
 
 fn auto_sweeps() -> usize {
     100
+}
+
+/// The stall test of `auto`: Gauss–Seidel, whose error went from `before` to `after` over the
+/// last `chunk` sweeps, continues when at that linear rate it reaches `tolerance` within
+/// `left` sweeps, `chunk · ln(tol/after) / ln(after/before) ≤ left`. One Newton iteration costs
+/// as much as 10–1000 sweeps on the reference problems, so a Gauss–Seidel that converges is
+/// left to finish; Newton takes over where the sweeps stall.
+pub fn gauss_seidel_will_finish(
+    before: f64,
+    after: f64,
+    chunk: usize,
+    tolerance: f64,
+    left: usize,
+) -> bool {
+    if left == 0 || !(after < before) || after <= 0.0 {
+        return false;
+    }
+    let needed = chunk as f64 * (tolerance / after).ln() / (after / before).ln();
+    needed <= left as f64
 }
 
 fn anderson_memory() -> usize {
@@ -354,8 +375,35 @@ pub fn solve(
         SolverMethod::Newton => 0,
         SolverMethod::Auto => params.auto_sweeps.min(params.max_iterations),
     };
+    let start_error = if params.method == SolverMethod::Auto {
+        error_measure(step.rows, step.vel, step.q_norm)
+    } else {
+        0.0
+    };
     // With no sweeps (`newton`), this only tells whether the warm start is already a solution.
-    let first = nlgs(&mut step, params, sweeps, work);
+    let mut first = nlgs(&mut step, params, sweeps, work);
+    if params.method == SolverMethod::Auto {
+        // Gauss–Seidel goes on, chunk after chunk, while its rate would reach the tolerance
+        // within the sweeps left: Newton only takes over where the sweeps stall.
+        let mut reference = start_error;
+        while !first.converged
+            && gauss_seidel_will_finish(
+                reference,
+                first.error,
+                sweeps,
+                params.tolerance,
+                params.max_iterations.saturating_sub(first.iterations),
+            )
+        {
+            reference = first.error;
+            let chunk = sweeps.min(params.max_iterations - first.iterations);
+            let more = nlgs(&mut step, params, chunk, work);
+            first = SolveReport {
+                iterations: first.iterations + more.iterations,
+                ..more
+            };
+        }
+    }
     if first.converged || params.method == SolverMethod::Nlgs {
         return first;
     }

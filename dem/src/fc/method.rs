@@ -7,7 +7,7 @@ use super::error::FcError;
 use super::newton::{self, NewtonParams, NewtonStats};
 use super::nsgs::{self, FcOptions, FcSolution};
 use super::problem::FcProblem;
-pub use crate::solver::SolverMethod;
+pub use crate::solver::{gauss_seidel_will_finish, SolverMethod};
 
 /// Gauss–Seidel sweeps before `auto` hands over to Newton (as the engine's default
 /// [`crate::SolverParams::auto_sweeps`]).
@@ -27,9 +27,10 @@ pub struct MethodReport {
 /// Solves `problem` with `method`:
 /// - `nlgs`: [`nsgs::solve`] with `options`;
 /// - `newton`: [`newton::solve`] from `options.initial_guess`;
-/// - `auto`: Gauss–Seidel for at most [`AUTO_SWEEPS`] sweeps, then Newton from its best
-///   iterate, then Gauss–Seidel again for the sweeps left of `options.max_iterations` if Newton
-///   did not reach the tolerance within `params.max_iterations`.
+/// - `auto`: Gauss–Seidel in chunks of [`AUTO_SWEEPS`] sweeps while its rate would reach the
+///   tolerance within the sweeps left ([`gauss_seidel_will_finish`]), then Newton from its best iterate, then Gauss–Seidel again for
+///   the sweeps left of `options.max_iterations` if Newton did not reach the tolerance within
+///   `params.max_iterations`.
 ///
 /// `solution.iterations` counts the Gauss–Seidel sweeps (smoothing included), `seconds` the
 /// whole solve.
@@ -57,13 +58,46 @@ pub fn solve_by(
             ))
         }
         SolverMethod::Auto => {
-            let first = nsgs::solve(
+            // Gauss–Seidel in chunks while its rate would reach the tolerance in time.
+            let mut reference = super::measure::fc_error(
+                problem,
+                options
+                    .initial_guess
+                    .as_deref()
+                    .unwrap_or(&vec![0.0; 2 * problem.contacts()]),
+            );
+            let mut first = nsgs::solve(
                 problem,
                 &FcOptions {
                     max_iterations: options.max_iterations.min(AUTO_SWEEPS),
                     ..options.clone()
                 },
             )?;
+            while !first.converged
+                && gauss_seidel_will_finish(
+                    reference,
+                    first.error,
+                    AUTO_SWEEPS,
+                    options.tolerance,
+                    options.max_iterations - first.iterations,
+                )
+            {
+                reference = first.error;
+                let more = nsgs::solve(
+                    problem,
+                    &FcOptions {
+                        max_iterations: AUTO_SWEEPS
+                            .min(options.max_iterations - first.iterations),
+                        initial_guess: Some(first.r.clone()),
+                        ..options.clone()
+                    },
+                )?;
+                first = FcSolution {
+                    iterations: first.iterations + more.iterations,
+                    seconds: first.seconds + more.seconds,
+                    ..more
+                };
+            }
             if first.converged {
                 return Ok((first, report(NewtonStats::default())));
             }

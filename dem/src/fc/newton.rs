@@ -268,7 +268,7 @@ pub fn solve_with(
     let n = problem.contacts();
     let t0 = Instant::now();
     let tol = options.tolerance;
-    if !(tol > 0.0) {
+    if tol.is_nan() || tol <= 0.0 {
         return Err(FcError::Option {
             name: "tolerance".into(),
             reason: format!("{tol} is not > 0"),
@@ -424,8 +424,8 @@ pub fn solve_with(
                 u_step[2 * a + 1] += eta * diag[a][1] * work.d[2 * a + 1];
             }
             while t >= T_MIN {
-                for i in 0..2 * n {
-                    work.trial[i] = r[i] + t * work.d[i];
+                for ((x, r0), d) in work.trial.iter_mut().zip(&r).zip(&work.d) {
+                    *x = r0 + t * d;
                 }
                 let mut s2 = 0.0;
                 for (a, &mu) in problem.mu().iter().enumerate() {
