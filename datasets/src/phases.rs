@@ -25,6 +25,20 @@
 //! [`EnergyProbe`] measures δ; a step with `δ > ENERGY_GROWTH_TOLERANCE · E_load` (see
 //! [`load_energy_scale`]) is counted as an energy growth. It is flagged, not fatal: θ = 1/2, a
 //! non-converged contact solve or Newton restitution between several contacts can produce one.
+//!
+//! ## The position correction
+//!
+//! After the θ-method update the engine projects the positions out of the overlaps deeper than
+//! a slop (`dem::stabilise`, on by default): `q⁺ ← q⁺ + Δq_c` with `Δq_c = M⁻¹ H_nᵀ P`, velocities
+//! untouched. It changes no kinetic energy, and `W_ext` above is the work of the loads along the
+//! velocities, so δ does not see it: δ stays the residual of the scheme alone, and the check
+//! above keeps its meaning. The correction does change the potential energy of the loads, by
+//! `−W_c` with `W_c = Σ f·Δq_c` (gravity and applied loads on free degrees of freedom, reported
+//! by the step as `position_correction.load_work`). That energy is accounted separately, not as
+//! growth of the scheme: [`PhaseStats::position_correction_energy`] sums `−W_c` over the phase
+//! (positive when the correction lifted grains or pushed a loaded platen back), and
+//! [`PhaseStats::position_corrected_steps`] counts the steps where it moved something. The
+//! mechanical energy of a phase therefore changes by `Σ (δ + W_drive) + position_correction_energy`.
 
 use dem::{BodyKind, Dof, StepReport, World};
 use serde::{Deserialize, Serialize};
@@ -76,6 +90,18 @@ pub struct PhaseStats {
     /// Largest energy residual of a step over E_load, `max(δ / E_load, 0)` (1).
     #[serde(with = "dem::serde_float")]
     pub worst_energy_growth: f64,
+    /// Steps whose position correction moved something (`dem::stabilise`).
+    #[serde(default)]
+    pub position_corrected_steps: u64,
+    /// Potential energy added by the position corrections, `−Σ W_c` over the steps (J), with
+    /// `W_c` the work of gravity and the applied loads over a step's correction (module
+    /// documentation). Not part of the energy residual δ.
+    #[serde(default, with = "dem::serde_float")]
+    pub position_correction_energy: f64,
+    /// Largest predicted overlap a step's correction removed, over the smallest grain radius (1):
+    /// what the step would have left without it.
+    #[serde(default, with = "dem::serde_float")]
+    pub max_corrected_overlap_ratio: f64,
     /// Whether the rest criterion was met (phases that look for rest).
     pub at_rest: bool,
     /// Translational kinetic energy over `Σ m g d` at the end (1).
@@ -108,9 +134,20 @@ impl PhaseStats {
     }
 
     /// Accounts for one step's numerics checks: its overlap against [`PENETRATION_LIMIT`] of
-    /// `min_radius` (m), and its energy residual `growth = δ / E_load` against
-    /// [`ENERGY_GROWTH_TOLERANCE`] (`None` where no balance is checked).
+    /// `min_radius` (m), its energy residual `growth = δ / E_load` against
+    /// [`ENERGY_GROWTH_TOLERANCE`] (`None` where no balance is checked), and its position
+    /// correction (steps, potential energy added, overlap removed).
     pub fn record_checks(&mut self, r: &StepReport, min_radius: f64, growth: Option<f64>) {
+        let c = &r.position_correction;
+        if c.corrected_contacts > 0 {
+            self.position_corrected_steps += 1;
+            self.position_correction_energy -= c.load_work;
+            if min_radius > 0.0 {
+                self.max_corrected_overlap_ratio = self
+                    .max_corrected_overlap_ratio
+                    .max(c.overlap_before / min_radius);
+            }
+        }
         if min_radius > 0.0 {
             let ratio = r.max_penetration / min_radius;
             self.max_penetration_ratio = self.max_penetration_ratio.max(ratio);
@@ -148,6 +185,11 @@ impl PhaseStats {
         self.first_energy_growth_step =
             earliest(self.first_energy_growth_step, o.first_energy_growth_step);
         self.worst_energy_growth = self.worst_energy_growth.max(o.worst_energy_growth);
+        self.position_corrected_steps += o.position_corrected_steps;
+        self.position_correction_energy += o.position_correction_energy;
+        self.max_corrected_overlap_ratio = self
+            .max_corrected_overlap_ratio
+            .max(o.max_corrected_overlap_ratio);
         self.at_rest = o.at_rest;
         self.final_energy_ratio = o.final_energy_ratio;
     }
@@ -297,7 +339,9 @@ impl EnergyProbe {
     /// The residual `δ = ΔK − W_ext − W_drive` (J) of the step that took the world from the
     /// probed state to `after` (module documentation): `W_ext = h[(1 − θ) Σ f·v⁻ + θ Σ f·v⁺]`,
     /// `W_drive = −h Σ F_c·v` over imposed degrees of freedom, `F_c` the contact force received
-    /// during the step. At most round-off for θ = 1 and an exact solve.
+    /// during the step. At most round-off for θ = 1 and an exact solve. The position correction
+    /// of the step moves no velocity and is not in δ; its work is in
+    /// `StepReport::position_correction.load_work`.
     pub fn residual(&self, after: &World) -> f64 {
         let h = self.dt;
         let th = self.theta;
@@ -542,12 +586,22 @@ mod tests {
         );
     }
 
-    /// θ = 1/2 on a collapsing stack gains energy in some steps and lets grains overlap; the
-    /// same stack with θ = 1 is never flagged.
+    /// θ = 1/2 on a collapsing stack, without the position correction (the plain Moreau–Jean
+    /// step), gains energy in some steps and lets grains overlap beyond the limit; with the
+    /// correction (the default) the projection removes those overlaps (above the limit when
+    /// predicted) and no step starts beyond the limit. The same stack with θ = 1 is never
+    /// flagged.
     #[test]
     fn theta_half_stack_is_flagged_theta_one_is_not() {
+        let mut corrected = stack(6, 1e-3, 2e-4, 0.3, 0.5);
+        let s = run_steps(&mut corrected, 400, |_, _| true).unwrap();
+        assert!(s.position_corrected_steps > 0, "{s:?}");
+        assert!(s.max_corrected_overlap_ratio > PENETRATION_LIMIT, "{s:?}");
+        assert_eq!(s.penetration_flagged_steps, 0, "{s:?}");
         let mut half = stack(6, 1e-3, 2e-4, 0.3, 0.5);
+        half.params.position_correction = false;
         let s = run_steps(&mut half, 400, |_, _| true).unwrap();
+        assert_eq!(s.position_corrected_steps, 0, "{s:?}");
         assert!(s.energy_growth_steps > 0, "{s:?}");
         assert!(
             s.worst_energy_growth > 10.0 * ENERGY_GROWTH_TOLERANCE,
@@ -563,6 +617,39 @@ mod tests {
         assert!(s.worst_energy_growth <= 1e-12, "{s:?}");
         assert_eq!(s.penetration_flagged_steps, 0, "{s:?}");
         assert_eq!(s.first_energy_growth_step, None);
+    }
+
+    /// A disk started 5 % of its radius inside the floor, at rest under gravity: the step's
+    /// position correction lifts it to the slop without a velocity, so the energy residual δ of
+    /// the step stays at round-off (no growth flagged), while the potential energy it added,
+    /// `m g (0.05 R − s)`, is reported apart in `position_correction_energy` (10⁻⁹ relative) and
+    /// equals the change of `World::potential_energy` over the phase (10⁻⁶ relative).
+    #[test]
+    fn position_correction_is_accounted_apart_from_the_residual() {
+        let r = 1e-3;
+        let mut w = World::new(params(1.0), ContactLaws::new(&["glass"], 0.3));
+        w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
+        let g = w.add_grain(Vector2::new(0.0, 0.95 * r), r, 2500.0, 0) as usize;
+        let m = w.bodies[g].mass;
+        let e_pot = w.potential_energy();
+        let s = run_steps(&mut w, 5, |_, _| true).unwrap();
+        let lift = 0.05 * r - dem::stabilise::SLOP * r;
+        let added = m * w.params.gravity.norm() * lift;
+        assert_eq!(s.position_corrected_steps, 1, "{s:?}");
+        assert!(
+            (s.position_correction_energy - added).abs() <= 1e-9 * added,
+            "{s:?}, expected {added:e} J"
+        );
+        assert!((s.max_corrected_overlap_ratio - 0.05).abs() < 1e-9, "{s:?}");
+        assert_eq!(s.energy_growth_steps, 0, "{s:?}");
+        assert!(s.worst_energy_growth <= 1e-12, "{s:?}");
+        let de_pot = w.potential_energy() - e_pot;
+        assert!((de_pot - added).abs() <= 1e-6 * added, "ΔE_pot {de_pot:e}");
+        let mut other = PhaseStats::default();
+        other.merge(&s);
+        other.merge(&s);
+        assert_eq!(other.position_corrected_steps, 2);
+        assert!((other.position_correction_energy - 2.0 * added).abs() <= 1e-9 * added);
     }
 
     /// Synthetic steps: counts, first step, worst value, and the earliest first step on merge.

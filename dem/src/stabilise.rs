@@ -29,8 +29,11 @@
 //! times the smaller radius of the pair, the gap below which a contact already counts as closed
 //! ([`crate::contact::CLOSED_GAP`], stored per contact as `ContactGeometry::closed_gap`): an
 //! overlap up to it is tolerated, so a resting contact is not pushed apart and pulled back every
-//! step. The sweeps stop when no pseudo-impulse moves its gap by more than [`TOLERANCE`] of its
-//! slop, or after [`MAX_SWEEPS`]; what is left is corrected by the next step. The contacts are
+//! step. A projection runs only when some predicted overlap exceeds its slop by more than
+//! [`TOLERANCE`] of it (`g⁺_α < −(1 + TOLERANCE) s_α`): a contact left at the slop by an earlier
+//! correction does not trigger one every step on rounding-level excursions. The sweeps stop when
+//! no pseudo-impulse moves its gap by more than [`TOLERANCE`] of its slop, or after
+//! [`MAX_SWEEPS`]; what is left is corrected by the next step. The contacts are
 //! swept in their stored order (sorted by collider pair) on one thread, so the result does not
 //! depend on the thread count.
 //!
@@ -59,14 +62,16 @@ pub const SLOP: f64 = crate::contact::CLOSED_GAP;
 /// Largest number of projected Gauss–Seidel sweeps of one step's projection.
 pub const MAX_SWEEPS: usize = 100;
 
-/// The sweeps stop when the largest change of a gap in a sweep, `W_αα |ΔP_α|`, is below this
-/// fraction of the contact's slop (1): the overlaps left are then at most about `(1 + TOLERANCE) s`.
+/// Tolerance of the projection, as a fraction of each contact's slop (1): a projection runs when
+/// a predicted overlap exceeds `(1 + TOLERANCE) s`, and its sweeps stop when no pseudo-impulse
+/// changes its gap by more than `TOLERANCE · s` in a sweep, `W_αα |ΔP_α| ≤ TOLERANCE · s_α`.
 pub const TOLERANCE: f64 = 0.1;
 
 /// What the position projection of one step did.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct CorrectionReport {
-    /// Contacts whose predicted overlap after the step exceeded their slop (before projecting).
+    /// Contacts whose predicted overlap after the step exceeded their slop by more than
+    /// [`TOLERANCE`] of it (before projecting); the projection runs when there is one.
     pub violated_contacts: usize,
     /// Contacts with a positive pseudo-impulse at the end.
     pub corrected_contacts: usize,
@@ -133,7 +138,7 @@ impl Projection {
                 )
         }));
         for ((row, geo), &g) in rows.iter().zip(geometry).zip(&self.gap) {
-            if g < -geo.closed_gap && row.w.nn > 0.0 {
+            if g < -(1.0 + TOLERANCE) * geo.closed_gap && row.w.nn > 0.0 {
                 report.violated_contacts += 1;
                 report.overlap_before = report.overlap_before.max(-g);
             }

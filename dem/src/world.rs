@@ -18,9 +18,9 @@
 //! step is `R·u⁺ − ½ ‖v⁺ − v⁻‖²_M ≤ 0`.
 //!
 //! ```text
-//! 5. position correction (WorldParams::position_correction, on by default): for the contacts
-//!    whose predicted gap g⁺ = g⁻ + H_n (q⁺ − q⁻) is below −s (s = 10⁻⁴ of the smaller radius),
-//!    q⁺ ← q⁺ + M⁻¹ H_nᵀ P with P ≥ 0,  g⁺ + W_nn P ≥ −s,  Pᵀ(g⁺ + W_nn P + s) = 0
+//! 5. position correction (WorldParams::position_correction, on by default): when a contact's
+//!    predicted gap g⁺ = g⁻ + H_n (q⁺ − q⁻) is below −s (s = 10⁻⁴ of the smaller radius; by more
+//!    than s/10), q⁺ ← q⁺ + M⁻¹ H_nᵀ P with P ≥ 0,  g⁺ + W_nn P ≥ −s,  Pᵀ(g⁺ + W_nn P + s) = 0
 //! ```
 //!
 //! Overlaps left by a step (an inexact solve, a fast impact, an imposed wall) are thus removed at
