@@ -120,7 +120,7 @@ pub fn gauss_seidel_will_finish(
     tolerance: f64,
     left: usize,
 ) -> bool {
-    if left == 0 || !(after < before) || after <= 0.0 {
+    if left == 0 || after.is_nan() || after >= before || after <= 0.0 {
         return false;
     }
     let needed = chunk as f64 * (tolerance / after).ln() / (after / before).ln();
