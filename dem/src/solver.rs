@@ -110,7 +110,8 @@ fn auto_sweeps() -> usize {
 
 /// The stall test of `auto`: Gauss–Seidel, whose error went from `before` to `after` over the
 /// last `chunk` sweeps, continues when at that linear rate it reaches `tolerance` within
-/// `left` sweeps, `chunk · ln(tol/after) / ln(after/before) ≤ left`. One Newton iteration costs
+/// `left` sweeps and [`AUTO_HORIZON`] chunks, `chunk · ln(tol/after) / ln(after/before) ≤
+/// min(left, AUTO_HORIZON · chunk)`. One Newton iteration costs
 /// as much as 10–1000 sweeps on the reference problems, so a Gauss–Seidel that converges is
 /// left to finish; Newton takes over where the sweeps stall.
 pub fn gauss_seidel_will_finish(
@@ -124,8 +125,13 @@ pub fn gauss_seidel_will_finish(
         return false;
     }
     let needed = chunk as f64 * (tolerance / after).ln() / (after / before).ln();
-    needed <= left as f64
+    needed <= (left as f64).min((AUTO_HORIZON * chunk) as f64)
 }
+
+/// `auto` hands over to Newton when Gauss–Seidel would need more than this many chunks to reach
+/// the tolerance at its current rate (on 700-contact columns a Newton iteration costs about 20
+/// sweeps, and the ones Gauss–Seidel cannot finish in 400 sweeps are those it stalls on).
+pub const AUTO_HORIZON: usize = 4;
 
 fn anderson_memory() -> usize {
     4
