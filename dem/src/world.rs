@@ -110,6 +110,20 @@ fn default_position_correction() -> bool {
     true
 }
 
+/// Gravity (if it acts on the body) plus the applied force and torque, `(f_x, f_y, torque)`.
+fn external_loads(b: &Body, g: Vector2<f64>) -> [f64; 3] {
+    let grav = if b.gravity {
+        g * b.mass
+    } else {
+        Vector2::zeros()
+    };
+    [
+        grav.x + b.applied_force.x,
+        grav.y + b.applied_force.y,
+        b.applied_torque,
+    ]
+}
+
 /// What one step did.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct StepReport {
@@ -691,16 +705,7 @@ impl World {
         }
         for (i, b) in self.bodies.iter().enumerate() {
             let inv = &self.inv[i];
-            let grav = if b.gravity {
-                g * b.mass
-            } else {
-                Vector2::zeros()
-            };
-            let f = [
-                grav.x + b.applied_force.x,
-                grav.y + b.applied_force.y,
-                b.applied_torque,
-            ];
+            let f = external_loads(b, g);
             for d in 0..3 {
                 if b.dofs[d] == Dof::Free {
                     self.vel[i][d] += h * inv[d] * f[d];
@@ -870,16 +875,7 @@ impl World {
             b.position.x += dq[0];
             b.position.y += dq[1];
             b.angle += dq[2];
-            let grav = if b.gravity {
-                g * b.mass
-            } else {
-                Vector2::zeros()
-            };
-            let f = [
-                grav.x + b.applied_force.x,
-                grav.y + b.applied_force.y,
-                b.applied_torque,
-            ];
+            let f = external_loads(b, g);
             for d in 0..3 {
                 if inv[d] != 0.0 {
                     work += f[d] * dq[d];
