@@ -275,15 +275,19 @@ pub fn run(args: RunArgs) -> Result<()> {
     let interrupted = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupted.clone();
-        // The first Ctrl-C asks for a checkpoint and a clean stop after the current step; a
-        // second one stops at once (files are written atomically: nothing half-written is
-        // left that looks complete). A second handler cannot be installed (library callers
+        // The first Ctrl-C, SIGTERM (what batch schedulers send before they kill a job) or
+        // SIGHUP asks for a checkpoint and a clean stop after the current step, and says so at
+        // once; a second one stops at once (files are written atomically: nothing half-written
+        // is left that looks complete). A second handler cannot be installed (library callers
         // may run several times in one process): ignore.
         let _ = ctrlc::set_handler(move || {
             if flag.swap(true, Ordering::SeqCst) {
                 eprintln!("error: interrupted twice: stopped at once (the last checkpoint, if any, is kept)");
                 std::process::exit(130);
             }
+            eprintln!(
+                "warning: stop requested: writing a checkpoint after the current step (a second signal stops at once)"
+            );
         });
     }
     let dump = match &args.dump_problems {

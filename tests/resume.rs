@@ -173,6 +173,19 @@ fn stopped_and_resumed_runs_give_the_same_files() {
 #[cfg(unix)]
 #[test]
 fn sigint_stops_cleanly_and_the_run_resumes() {
+    signal_stops_cleanly_and_the_run_resumes("-INT");
+}
+
+/// SIGTERM, what batch schedulers (Slurm, PBS) send before killing a job, does the same, and
+/// the request is acknowledged on stderr.
+#[cfg(unix)]
+#[test]
+fn sigterm_stops_cleanly_and_the_run_resumes() {
+    signal_stops_cleanly_and_the_run_resumes("-TERM");
+}
+
+#[cfg(unix)]
+fn signal_stops_cleanly_and_the_run_resumes(signal: &str) {
     let tmp = tempfile::tempdir().unwrap();
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
     reference(&a);
@@ -199,12 +212,17 @@ fn sigint_stops_cleanly_and_the_run_resumes() {
         std::thread::sleep(Duration::from_millis(2));
     }
     let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .unwrap();
     assert!(kill.success());
     let o = child.wait_with_output().unwrap();
     assert_stopped(&o, &b);
+    assert!(
+        stderr(&o).contains("warning: stop requested"),
+        "{}",
+        stderr(&o)
+    );
     let o = grainlaw(&["run", "-q", "--resume"], &[&b]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_same_outputs(&a, &b);
