@@ -334,13 +334,18 @@ fn shear_cell_short() {
     // (80 grains over 1.5 strain do not reach the target inertial numbers, and the μ(I) slope
     // of five noisy points can be refused: both outcomes are legitimate, a silent one is not).
     for (file, keys) in [
-        ("mu_i_law.json", &["mu_i_fit_error", "mu_i_linear_fit_error"][..]),
+        (
+            "mu_i_law.json",
+            &["mu_i_fit_error", "mu_i_linear_fit_error"][..],
+        ),
         ("phi_i_law.json", &["phi_i_fit_error"][..]),
     ] {
         let written = out.join(file).exists();
-        let refused = keys
-            .iter()
-            .all(|k| s.get(*k).and_then(Value::as_str).is_some_and(|r| !r.is_empty()));
+        let refused = keys.iter().all(|k| {
+            s.get(*k)
+                .and_then(Value::as_str)
+                .is_some_and(|r| !r.is_empty())
+        });
         assert!(
             written != refused,
             "{file}: written = {written}, refusal recorded = {refused}"

@@ -1,6 +1,9 @@
 //! No overlap drift (issue 12): the position correction after each step ([`dem::stabilise`])
 //! removes the overlaps a step leaves, down to the slop, without touching the velocities.
 
+mod common;
+use common::fingerprint;
+
 use dem::{BodyKind, ContactLaws, Dof, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
@@ -430,27 +433,6 @@ fn a_disk_resting_on_a_floor_is_never_corrected() {
         assert!(body.velocity.norm() < 1e-12);
         assert!((body.position.x - 0.3).abs() < 1e-15);
     }
-}
-
-/// Every number of the state: positions, angles, velocities, impulses.
-fn fingerprint(w: &World) -> Vec<u64> {
-    let mut f = Vec::new();
-    for b in &w.bodies {
-        for x in [
-            b.position.x,
-            b.position.y,
-            b.angle,
-            b.velocity.x,
-            b.velocity.y,
-            b.omega,
-        ] {
-            f.push(x.to_bits());
-        }
-    }
-    for c in &w.contacts().rows {
-        f.extend([c.r[0].to_bits(), c.r[1].to_bits()]);
-    }
-    f
 }
 
 /// A hexagonal crystal of `nx × ny` disks of radius `R_MIN` whose neighbours overlap by

@@ -1,6 +1,9 @@
 //! The parallel (colour-ordered) contact solve: the same bits on any number of threads, and the
 //! same physics as the natural order.
 
+mod common;
+use common::fingerprint;
+
 use dem::colouring::ContactColouring;
 use dem::{ContactLaws, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
@@ -41,27 +44,6 @@ fn crystal(nx: usize, ny: usize, parallel: bool) -> World {
         }
     }
     w
-}
-
-/// Every number of the state after `steps` steps: positions, velocities, impulses.
-fn fingerprint(w: &World) -> Vec<u64> {
-    let mut f = Vec::new();
-    for b in &w.bodies {
-        for x in [
-            b.position.x,
-            b.position.y,
-            b.angle,
-            b.velocity.x,
-            b.velocity.y,
-            b.omega,
-        ] {
-            f.push(x.to_bits());
-        }
-    }
-    for c in &w.contacts().rows {
-        f.extend([c.r[0].to_bits(), c.r[1].to_bits()]);
-    }
-    f
 }
 
 fn run_on(threads: usize, steps: usize) -> (Vec<u64>, usize) {

@@ -86,8 +86,7 @@ pub fn solve_by(
                 let more = nsgs::solve(
                     problem,
                     &FcOptions {
-                        max_iterations: AUTO_SWEEPS
-                            .min(options.max_iterations - first.iterations),
+                        max_iterations: AUTO_SWEEPS.min(options.max_iterations - first.iterations),
                         initial_guess: Some(first.r.clone()),
                         ..options.clone()
                     },
