@@ -253,7 +253,16 @@ impl Detector {
                         Shape::Line { point, .. } => point.norm(),
                         Shape::Disk { .. } => 0.0,
                     };
-                    let wall_margin = dt * (wb.velocity.norm() + wb.omega.abs() * extent);
+                    // Swept margin of the wall, with its acceleration bound (gravity plus the
+                    // applied force per unit mass) as for disks: a pressure-driven wall that
+                    // starts at rest would otherwise miss the grains it reaches in the step.
+                    let acc = if wb.mass > 0.0 && wb.mass.is_finite() {
+                        wb.applied_force.norm() / wb.mass + if wb.gravity { gravity } else { 0.0 }
+                    } else {
+                        0.0
+                    };
+                    let wall_margin =
+                        dt * (wb.velocity.norm() + dt * acc + wb.omega.abs() * extent);
                     let shape = match &col.shape {
                         Shape::Line { point, normal } => WallShape::Line {
                             p: wb.position + rotate(*point, wb.angle),
@@ -318,6 +327,26 @@ impl Detector {
                     .push(dt * (b.velocity.norm() + dt * (g + f) + b.omega.abs() * offset.norm()));
             }
         }
+    }
+
+    /// Whether some disk moved, over a step whose contacts the last [`Detector::detect`] found,
+    /// farther than the swept margin that detection allowed it (`displacement` per body,
+    /// `[Δx, Δy, Δθ]`): a disk kicked by a contact impulse can travel beyond the bound its
+    /// velocity and loads gave at the start of the step, and then meet a disk no contact of the
+    /// step knew about.
+    pub fn outran(&self, colliders: &[Collider], displacement: &[[f64; 3]]) -> bool {
+        self.disk_collider
+            .iter()
+            .zip(&self.margin)
+            .any(|(&ci, &m)| {
+                let col = &colliders[ci as usize];
+                let d = displacement[col.body as usize];
+                let arm = match col.shape {
+                    Shape::Disk { offset, .. } => offset.norm(),
+                    _ => 0.0,
+                };
+                d[0].hypot(d[1]) + d[2].abs() * arm > m
+            })
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -175,6 +175,8 @@ pub struct World {
     work: solver::SolverWork,
     displacement: Vec<[f64; 3]>,
     projection: Projection,
+    /// Contacts detected again after a step whose disks outran their swept margins.
+    fresh: ContactSet,
     last: StepReport,
     /// Keep the frictional-contact problem of each step ([`World::last_problem`]), to write it
     /// to a file (`grainlaw run --dump-problems`). Costs one assembly of `W` per step.
@@ -207,6 +209,7 @@ impl World {
             work: solver::SolverWork::default(),
             displacement: Vec::new(),
             projection: Projection::default(),
+            fresh: ContactSet::default(),
             last: StepReport::default(),
             record_problems: false,
             last_problem: None,
@@ -857,9 +860,41 @@ impl World {
             &self.displacement,
             &self.inv,
         );
-        if report.corrected_contacts == 0 {
-            return report;
+        if report.corrected_contacts > 0 {
+            report.load_work = self.apply_correction();
         }
+        // A disk that travelled beyond its swept margin may overlap one that no contact of the
+        // step knew: detect again at the corrected positions (nothing moves now, so no swept
+        // margin; pairs up to a quarter of the smallest radius apart, which the projection can
+        // push into contact) and project the actual gaps.
+        if self.detector.outran(&self.colliders, &self.displacement) {
+            let mut fresh = std::mem::take(&mut self.fresh);
+            let reach = 0.25 * self.smallest_radius().unwrap_or(0.0);
+            let detected = self.detect_into(reach, 0.0, 0.0, &mut fresh);
+            if detected.is_ok() {
+                let still = vec![[0.0; 3]; self.bodies.len()];
+                let second =
+                    self.projection
+                        .project(&fresh.rows, &fresh.geometry, &still, &self.inv);
+                if second.corrected_contacts > 0 {
+                    report.load_work += self.apply_correction();
+                }
+                report.violated_contacts += second.violated_contacts;
+                report.corrected_contacts += second.corrected_contacts;
+                report.sweeps += second.sweeps;
+                report.capped |= second.capped;
+                report.overlap_before = report.overlap_before.max(second.overlap_before);
+                report.overlap_after = second.overlap_after;
+                report.max_displacement = report.max_displacement.max(second.max_displacement);
+            }
+            self.fresh = fresh;
+        }
+        report
+    }
+
+    /// Moves the bodies by the last projection's correction (free degrees of freedom only,
+    /// periodic wrap) and returns the work of gravity and the applied loads over it.
+    fn apply_correction(&mut self) -> f64 {
         let g = self.params.gravity;
         let periodic = self.periodic();
         let mut work = 0.0;
@@ -887,24 +922,29 @@ impl World {
                 }
             }
         }
-        report.load_work = work;
-        report
+        work
     }
 
     /// Largest approach speed of a converged solve (m/s): `overlap_rate · R_min / h`, infinite
     /// when the rate is 0 or there is no grain.
     fn approach_limit(&self) -> f64 {
+        match self.smallest_radius() {
+            Some(r_min) if self.params.overlap_rate > 0.0 => {
+                self.params.overlap_rate * r_min / self.params.dt
+            }
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// The smallest grain radius (m), if there is a grain.
+    fn smallest_radius(&self) -> Option<f64> {
         let r_min = self
             .bodies
             .iter()
             .filter(|b| b.kind == BodyKind::Grain && b.radius > 0.0)
             .map(|b| b.radius)
             .fold(f64::INFINITY, f64::min);
-        if self.params.overlap_rate > 0.0 && r_min.is_finite() {
-            self.params.overlap_rate * r_min / self.params.dt
-        } else {
-            f64::INFINITY
-        }
+        r_min.is_finite().then_some(r_min)
     }
 
     /// Time step (s) of the impulses held in the contact set: forces are impulses divided by it.

@@ -545,3 +545,48 @@ fn old_parameter_files_load_with_the_correction_on() {
     assert!(p.position_correction);
     assert!(WorldParams::default().position_correction);
 }
+
+/// A disk knocked by an impact travels farther in the step than its swept margin allowed at
+/// detection, into a disk no contact of the step knew: the correction detects again at the
+/// new positions and removes that overlap too (≤ the slop, relative 1e-9 besides), with the
+/// velocities bit for bit those of the uncorrected step.
+#[test]
+fn a_disk_knocked_beyond_its_detection_margin_is_kept_out_of_its_neighbour() {
+    let r = 1e-3;
+    let h = 1e-3;
+    let step = |correction: bool| {
+        let params = WorldParams {
+            dt: h,
+            gravity: Vector2::zeros(),
+            position_correction: correction,
+            ..WorldParams::default()
+        };
+        let mut w = World::new(params, ContactLaws::new(&["glass"], 0.0));
+        // A (fast) touches B (at rest); C sits 0.15 r beyond B, outside B's detection reach (the
+        // detection gap is 10⁻⁴ m = 0.1 r, B's swept margin 0).
+        // The impact is perfectly inelastic: A and B leave at v/2 and B travels 0.2 r.
+        let v = 0.4 * r / h;
+        let a = w.add_grain(Vector2::new(0.0, 0.0), r, 2500.0, 0) as usize;
+        w.add_grain(Vector2::new(2.0 * r, 0.0), r, 2500.0, 0);
+        w.add_grain(Vector2::new(4.15 * r, 0.0), r, 2500.0, 0);
+        w.bodies[a].velocity = Vector2::new(v, 0.0);
+        w.step().unwrap();
+        w
+    };
+    let off = step(false);
+    let on = step(true);
+    let gap_bc = |w: &World| (w.bodies[2].position - w.bodies[1].position).norm() - 2.0 * r;
+    // Without the correction B ends inside C by 0.05 r.
+    assert!(
+        (gap_bc(&off) + 0.05 * r).abs() <= 1e-9 * r,
+        "gap {}",
+        gap_bc(&off)
+    );
+    // With it, at most the slop (1e-4 r) and the projection's tolerance.
+    assert!(gap_bc(&on) >= -1e-4 * r * 1.1, "gap {}", gap_bc(&on));
+    for (x, y) in off.bodies.iter().zip(&on.bodies) {
+        assert_eq!(x.velocity, y.velocity);
+        assert_eq!(x.omega, y.omega);
+    }
+    assert!(on.last_report().position_correction.corrected_contacts > 0);
+}
