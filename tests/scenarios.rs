@@ -303,6 +303,30 @@ fn inclined_flow_short() {
     let f = num(&s, "fluid_fraction");
     assert!((0.0..=1.0).contains(&f));
     assert!(num(&s, "flow_height_diameters") > 2.0);
+    // Layers at least a mean diameter (3 mm) thick, and solid fractions that are area fractions.
+    let text = std::fs::read_to_string(out.join("profiles.csv")).unwrap();
+    let heights: Vec<(f64, f64)> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("height"))
+        .map(|l| {
+            let c: Vec<f64> = l
+                .split(',')
+                .map(|x| x.parse().unwrap_or(f64::NAN))
+                .collect();
+            (c[0], c[2])
+        })
+        .collect();
+    assert!(heights.len() >= 2);
+    assert!(
+        heights[1].0 - heights[0].0 >= 3e-3 * (1.0 - 1e-12),
+        "{heights:?}"
+    );
+    for (_, phi) in &heights {
+        assert!(
+            (0.0..1.0).contains(phi),
+            "solid fraction {phi} is not an area fraction"
+        );
+    }
 }
 
 /// Shear cell, short: friction and solid fraction in their physical ranges, friction growing

@@ -67,7 +67,15 @@ impl Profiles {
             let k = k as usize;
             self.mv[k] += b.mass * b.velocity.x;
             self.m[k] += b.mass;
-            self.area[k] += std::f64::consts::PI * b.radius * b.radius;
+            // The solid fraction counts the part of each disk inside each layer (exact
+            // circular-segment areas), so that it stays below 1 whatever the layer thickness.
+            let (yc, rad) = (b.position.y - base, b.radius);
+            let first = ((yc - rad) / self.dy).floor().max(0.0) as usize;
+            let last = (((yc + rad) / self.dy).floor().max(0.0) as usize).min(self.area.len() - 1);
+            for j in first..=last {
+                let (y0, y1) = (j as f64 * self.dy, (j + 1) as f64 * self.dy);
+                self.area[j] += disk_area_below(y1 - yc, rad) - disk_area_below(y0 - yc, rad);
+            }
             if let Some(x) = r.ratio.filter(|x| *x > 0.0) {
                 self.log_ratio[k] += x.log10();
                 self.n_ratio[k] += 1.0;
@@ -168,6 +176,13 @@ impl PhasedRun for Flow<'_> {
     }
 }
 
+/// Area of a disk of radius `r` below the line at height `z` above its centre:
+/// `r² (t √(1 − t²) + asin t + π/2)`, `t = z/r` clamped to [−1, 1].
+fn disk_area_below(z: f64, r: f64) -> f64 {
+    let t = (z / r).clamp(-1.0, 1.0);
+    r * r * (t * (1.0 - t * t).sqrt() + t.asin() + std::f64::consts::FRAC_PI_2)
+}
+
 /// Runs the scenario.
 pub fn run(
     c: &InclinedFlowConfig,
@@ -175,12 +190,20 @@ pub fn run(
     ctl: &mut RunControl,
 ) -> Result<RunOutcome> {
     let length = c.cell_length_diameters * 2.0 * c.grain.radius_mean;
-    let bins = c.profile_bins;
+    // Layers are never thinner than a mean grain diameter: a thinner layer holds a fraction of
+    // a grain and its averages are noise. Their number follows from the sample.
+    let layer_height = |world: &dem::World| {
+        // Layer height estimate from the grains' area at φ ≈ 0.75, with room for dilation.
+        1.6 * datasets::build::grain_area(world) / (0.75 * length)
+    };
+    let bins = {
+        let world = datasets::build::inclined_flow(c)?;
+        let fit = (layer_height(&world) / (2.0 * c.grain.radius_mean)).floor() as usize;
+        c.profile_bins.min(fit.max(1))
+    };
     let fresh = || -> Result<(dem::World, FlowState)> {
         let world = datasets::build::inclined_flow(c)?;
-        // Layer height estimate from the grains' area at φ ≈ 0.75, with room for dilation.
-        let area = datasets::build::grain_area(&world);
-        let h_est = area / (0.75 * length);
+        let h_est = layer_height(&world) / 1.6;
         let state = FlowState {
             base: c.grain.radius_mean, // top of the rough base (disks centred on y = 0)
             prof: Profiles::new(bins, 1.6 * h_est / bins as f64),
