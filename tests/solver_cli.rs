@@ -1,4 +1,5 @@
-//! The solver choice on the command line: bad settings are refused on one line with exit 2,
+//! The solver choice on the command line, and time steps too large for the physics: bad settings
+//! are refused on one line with exit 2,
 //! `solve-fc` reports non-convergence with exit 3, and `--dump-problems` writes problems that
 //! read back and solve.
 
@@ -136,4 +137,22 @@ fn dumped_problems_read_back_and_solve() {
         let o = grainlaw(&["solve-fc", f.to_str().unwrap(), "--tol", "1e-8"], d);
         assert_eq!(o.status.code(), Some(0), "{}", f.display());
     }
+}
+
+/// A time step under which gravity moves a resting grain by more than a quarter of the smallest
+/// radius in one step is refused before any work, naming `dt` (janssen with `dt = 0.1` used to
+/// run to 42 % overlaps and exit 0); the defaults pass the check.
+#[test]
+fn time_steps_too_large_for_gravity_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for sc in ["janssen", "inclined-flow", "stick-slip"] {
+        let o = grainlaw(&["run", sc, "--out", "x", "--set", "dt=0.1"], d);
+        refused(&o, "key `dt`");
+        assert!(String::from_utf8_lossy(&o.stderr).contains("quarter of the smallest radius"));
+        assert!(!d.join("x/summary.json").exists());
+    }
+    // janssen: R_min = 0.5 mm, so the bound is √(0.25 · 5e-4 / 9.81) = 3.57 ms.
+    let o = grainlaw(&["run", "janssen", "--out", "y", "--set", "dt=3.6e-3"], d);
+    refused(&o, "use at most 3.570e-3 s");
 }

@@ -3,7 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_dt, check_periodic_cell, FrictionSpec, GrainSpec, SolverSpec};
+use super::common::{
+    check_dt, check_dt_gravity, check_periodic_cell, FrictionSpec, GrainSpec, SolverSpec,
+};
 use crate::error::{at_least, in_range, num, positive, DatasetError, Result};
 use crate::limits;
 
@@ -60,6 +62,7 @@ impl InclinedFlowConfig {
         self.friction.validate("friction")?;
         positive("duration", self.duration)?;
         check_dt("dt", self.dt, self.duration)?;
+        check_dt_gravity("dt", self.dt, self.grain.radius_min())?;
         limits::steps("dt", "duration / dt", self.duration, self.dt)?;
         positive("average", self.average)?;
         if self.average > self.duration {

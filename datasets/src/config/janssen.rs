@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_dt, FrictionSpec, GrainSpec};
+use super::common::{check_dt, check_dt_gravity, FrictionSpec, GrainSpec};
 use super::deposit::{DepositSpec, RelaxSpec};
 use crate::error::{at_least, in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
@@ -78,6 +78,7 @@ impl JanssenConfig {
         self.grain.validate("grain")?;
         self.friction.validate("friction")?;
         check_dt("dt", self.dt, 1.0)?;
+        check_dt_gravity("dt", self.dt, self.grain.radius_min())?;
         self.deposit.validate("deposit", self.dt)?;
         non_negative("release.floor_drop", self.release.floor_drop)?;
         positive("release.speed", self.release.speed)?;

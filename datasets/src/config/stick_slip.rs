@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_dt, FrictionSpec, GrainSpec, SolverSpec};
+use super::common::{check_dt, check_dt_gravity, FrictionSpec, GrainSpec, SolverSpec};
 use super::deposit::DepositSpec;
 use crate::error::{in_range, positive, Result};
 use crate::limits;
@@ -70,6 +70,7 @@ impl StickSlipConfig {
         positive("push_velocity", self.push_velocity)?;
         positive("push_duration", self.push_duration)?;
         check_dt("dt", self.dt, self.push_duration)?;
+        check_dt_gravity("dt", self.dt, self.grain.radius_min())?;
         limits::steps("dt", "push_duration / dt", self.push_duration, self.dt)?;
         self.deposit.validate("deposit", self.dt)?;
         self.solver.validate("solver")?;
