@@ -45,6 +45,9 @@ pub struct WorldState {
     pub contacts: ContactSet,
     /// Report of the last step.
     pub last: StepReport,
+    /// Back-off of the `auto` solver's Newton stage.
+    #[serde(default)]
+    pub newton_backoff: crate::solver::NewtonBackoff,
 }
 
 #[derive(Serialize, Deserialize)]

@@ -413,7 +413,30 @@ pub fn solve(
     if first.converged || params.method == SolverMethod::Nlgs {
         return first;
     }
+    if work.backoff.params != Some(*params) {
+        // New solver settings (a new phase): Newton gets a fresh chance.
+        work.backoff = NewtonBackoff {
+            params: Some(*params),
+            ..NewtonBackoff::default()
+        };
+    }
+    if params.method == SolverMethod::Auto && work.backoff.skip > 0 {
+        // Newton failed on a recent step: Gauss–Seidel alone for the sweeps left.
+        work.backoff.skip -= 1;
+        let left = params.max_iterations.saturating_sub(first.iterations);
+        if left == 0 {
+            return first;
+        }
+        let more = nlgs(&mut step, params, left, work);
+        return SolveReport {
+            iterations: first.iterations + more.iterations,
+            ..more
+        };
+    }
     let second = global(&mut step, params, first, work);
+    if params.method == SolverMethod::Auto {
+        work.backoff.record(second.converged);
+    }
     let left = params.max_iterations.saturating_sub(second.iterations);
     if second.converged || left == 0 {
         return second;
@@ -608,11 +631,49 @@ fn nlgs(
     }
 }
 
-/// Buffers of the solver kept between steps (no allocation in the steady state).
+/// Buffers of the solver kept between steps (no allocation in the steady state), and the
+/// back-off of `auto`'s Newton stage.
 #[derive(Debug, Clone, Default)]
 pub struct SolverWork {
     newton: NewtonWork,
     nlgs: DriveWork,
+    /// When `auto` next tries Newton.
+    pub backoff: NewtonBackoff,
+}
+
+/// Back-off of `auto`'s Newton stage: after a step where Newton did not converge, the next
+/// `skip` steps that stall use Gauss–Seidel alone; `skip` starts at 1 and doubles with every
+/// further failure (up to [`NewtonBackoff::MAX_SKIP`]); a converged Newton stage, or new solver
+/// settings, reset it.
+/// In a regime where Newton does not help (many contacts on the stick–slip boundary) this
+/// spares its cost on most steps while still trying it regularly. Part of the world's state
+/// (checkpointed), so a resumed run takes the same decisions.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct NewtonBackoff {
+    /// Stalled steps left before Newton is tried again.
+    pub skip: u32,
+    /// The `skip` that the next failure sets.
+    pub next: u32,
+    /// The solver settings this back-off was learnt with: other settings (a new phase, a
+    /// tighter tolerance) start afresh.
+    #[serde(default)]
+    pub params: Option<SolverParams>,
+}
+
+impl NewtonBackoff {
+    /// Longest back-off (steps).
+    pub const MAX_SKIP: u32 = 8;
+
+    /// Records the outcome of a Newton stage.
+    pub fn record(&mut self, converged: bool) {
+        if converged {
+            self.skip = 0;
+            self.next = 0;
+        } else {
+            self.skip = self.next.max(1);
+            self.next = (self.skip * 2).min(Self::MAX_SKIP);
+        }
+    }
 }
 
 /// Status of each contact from its impulse: open when `r = 0`, sliding when on the cone's

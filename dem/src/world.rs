@@ -967,6 +967,7 @@ impl World {
             step_index: self.step_index,
             contacts: self.contacts.clone(),
             last: self.last,
+            newton_backoff: self.work.backoff,
         }
     }
 
@@ -980,6 +981,7 @@ impl World {
         w.step_index = s.step_index;
         w.contacts = s.contacts;
         w.last = s.last;
+        w.work.backoff = s.newton_backoff;
         w.refresh_inverse_mass();
         w.refresh_body_forces();
         w

@@ -194,3 +194,22 @@ fn assembled_delassus_diagonal_matches_the_rows() {
         }
     }
 }
+
+/// `auto`'s back-off after failed Newton stages: 1, 2, 4, 8, 8 stalled steps skipped, back to
+/// none after a converged stage.
+#[test]
+fn newton_backoff_doubles_to_its_cap_and_resets() {
+    use dem::solver::NewtonBackoff;
+    let mut b = NewtonBackoff::default();
+    let mut skips = Vec::new();
+    for _ in 0..5 {
+        b.record(false);
+        skips.push(b.skip);
+    }
+    assert_eq!(skips, [1, 2, 4, 8, 8]);
+    assert_eq!(NewtonBackoff::MAX_SKIP, 8);
+    b.record(true);
+    assert_eq!((b.skip, b.next), (0, 0));
+    b.record(false);
+    assert_eq!(b.skip, 1);
+}
