@@ -8,7 +8,7 @@
 //! [`continue_steps`] keep every loop counter in the progress, and check their stop criterion
 //! before each step, so a phase saved on the step where it ended ends at once when continued.
 //!
-//! ## Energy balance of a step
+//! ## Energy balance of a step ([`dem::energy`])
 //!
 //! With θ-method positions `q⁺ = q⁻ + h[(1 − θ) v⁻ + θ v⁺]`, the free degrees of freedom of a
 //! step satisfy
@@ -40,7 +40,8 @@
 //! [`PhaseStats::position_corrected_steps`] counts the steps where it moved something. The
 //! mechanical energy of a phase therefore changes by `Σ (δ + W_drive) + position_correction_energy`.
 
-use dem::{BodyKind, Dof, StepReport, World};
+pub use dem::energy::{load_energy_scale, EnergyProbe};
+use dem::{BodyKind, StepReport, World};
 use serde::{Deserialize, Serialize};
 
 /// A step whose energy residual δ exceeds this fraction of [`load_energy_scale`] is counted as
@@ -220,36 +221,6 @@ pub fn energy_scale(world: &World) -> f64 {
     }
 }
 
-/// Energy scale of the energy-balance check, `E_load = Σ_grains m |g| d + Σ_bodies |f_a| d̄`
-/// (J): the work of every external load over one diameter (`d = 2R` of the grain, `d̄` the mean
-/// grain diameter for a load `f_a` applied on another body, e.g. a pressure-controlled platen).
-/// Without loads it falls back to `Σ m d̄²/s²` (1 J for a world without grains).
-pub fn load_energy_scale(world: &World) -> f64 {
-    let g = world.params.gravity.norm();
-    let (mut n, mut dsum, mut mass, mut s) = (0usize, 0.0, 0.0, 0.0);
-    for b in world.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
-        n += 1;
-        dsum += 2.0 * b.radius;
-        mass += b.mass;
-        if b.gravity {
-            s += b.mass * g * 2.0 * b.radius;
-        }
-    }
-    let dmean = if n > 0 { dsum / n as f64 } else { 0.0 };
-    for b in &world.bodies {
-        if b.dofs.contains(&Dof::Free) {
-            s += (b.applied_force.norm() + b.applied_torque.abs() / dmean.max(1e-300)) * dmean;
-        }
-    }
-    if s > 0.0 && s.is_finite() {
-        s
-    } else if mass > 0.0 && dmean > 0.0 {
-        mass * dmean * dmean
-    } else {
-        1.0
-    }
-}
-
 /// Smallest grain radius (m), 0 without grains.
 pub fn min_grain_radius(world: &World) -> f64 {
     let r = world
@@ -275,93 +246,6 @@ pub fn translational_energy(world: &World) -> f64 {
         .filter(|b| b.kind == BodyKind::Grain)
         .map(|b| 0.5 * b.mass * b.velocity.norm_squared())
         .sum()
-}
-
-/// The external loads `f` on the free degrees of freedom of body `b` (gravity if it applies,
-/// applied force and torque), per degree of freedom (N, N, N·m), zero on imposed ones.
-fn free_loads(world: &World, b: &dem::Body) -> [f64; 3] {
-    let g = if b.gravity {
-        world.params.gravity * b.mass
-    } else {
-        nalgebra::Vector2::zeros()
-    };
-    let f = [
-        g.x + b.applied_force.x,
-        g.y + b.applied_force.y,
-        b.applied_torque,
-    ];
-    let mut out = [0.0; 3];
-    for d in 0..3 {
-        if b.dofs[d] == Dof::Free {
-            out[d] = f[d];
-        }
-    }
-    out
-}
-
-/// The power of the external loads on the free degrees of freedom, `Σ f·v` (W).
-fn load_power(world: &World) -> f64 {
-    world
-        .bodies
-        .iter()
-        .map(|b| {
-            let f = free_loads(world, b);
-            f[0] * b.velocity.x + f[1] * b.velocity.y + f[2] * b.omega
-        })
-        .sum()
-}
-
-/// What the energy balance of one step needs from the state before it: the kinetic energy of
-/// the free degrees of freedom and the power of the external loads, with the step's `h` and θ.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EnergyProbe {
-    /// Kinetic energy `K⁻` of the free degrees of freedom (J).
-    pub kinetic: f64,
-    /// Power of the external loads `Σ f·v⁻` (W).
-    pub load_power: f64,
-    /// Time step h (s).
-    pub dt: f64,
-    /// θ of the step.
-    pub theta: f64,
-}
-
-impl EnergyProbe {
-    /// Measures `world` before a step.
-    pub fn before(world: &World) -> Self {
-        EnergyProbe {
-            kinetic: world.kinetic_energy(),
-            load_power: load_power(world),
-            dt: world.params.dt,
-            theta: world.params.theta,
-        }
-    }
-
-    /// The residual `δ = ΔK − W_ext − W_drive` (J) of the step that took the world from the
-    /// probed state to `after` (module documentation): `W_ext = h[(1 − θ) Σ f·v⁻ + θ Σ f·v⁺]`,
-    /// `W_drive = −h Σ F_c·v` over imposed degrees of freedom, `F_c` the contact force received
-    /// during the step. At most round-off for θ = 1 and an exact solve. The position correction
-    /// of the step moves no velocity and is not in δ; its work is in
-    /// `StepReport::position_correction.load_work`.
-    pub fn residual(&self, after: &World) -> f64 {
-        let h = self.dt;
-        let th = self.theta;
-        let w_ext = h * ((1.0 - th) * self.load_power + th * load_power(after));
-        let mut w_drive = 0.0;
-        for (i, b) in after.bodies.iter().enumerate() {
-            if b.dofs.iter().all(|d| *d == Dof::Free) {
-                continue;
-            }
-            let (f, t) = after.contact_force(i);
-            let fc = [f.x, f.y, t];
-            let v = [b.velocity.x, b.velocity.y, b.omega];
-            for d in 0..3 {
-                if b.dofs[d] == Dof::Imposed && v[d] != 0.0 {
-                    w_drive -= h * fc[d] * v[d];
-                }
-            }
-        }
-        after.kinetic_energy() - self.kinetic - w_ext - w_drive
-    }
 }
 
 /// How long to run and when to stop.

@@ -33,6 +33,7 @@ pub mod collider;
 pub mod colouring;
 pub mod contact;
 pub mod detection;
+pub mod energy;
 pub mod error;
 pub mod fc;
 pub mod hydrostatic;

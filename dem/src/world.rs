@@ -40,6 +40,7 @@ use crate::collider::{rotate, Collider, Shape};
 use crate::colouring::ContactColouring;
 use crate::contact::ContactSet;
 use crate::detection::{Detector, Periodic};
+use crate::energy::external_loads;
 use crate::error::DemError;
 use crate::fc::FcProblem;
 use crate::material::ContactLaws;
@@ -108,20 +109,6 @@ fn default_overlap_rate() -> f64 {
 
 fn default_position_correction() -> bool {
     true
-}
-
-/// Gravity (if it acts on the body) plus the applied force and torque, `(f_x, f_y, torque)`.
-fn external_loads(b: &Body, g: Vector2<f64>) -> [f64; 3] {
-    let grav = if b.gravity {
-        g * b.mass
-    } else {
-        Vector2::zeros()
-    };
-    [
-        grav.x + b.applied_force.x,
-        grav.y + b.applied_force.y,
-        b.applied_torque,
-    ]
 }
 
 /// What one step did.

@@ -4,6 +4,7 @@
 mod common;
 use common::fingerprint;
 
+use dem::energy::{load_energy_scale, EnergyProbe};
 use dem::{BodyKind, ContactLaws, Dof, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
@@ -59,88 +60,6 @@ fn max_overlap(w: &World) -> f64 {
         }
     }
     worst / r_min
-}
-
-/// The energy residual of `datasets::phases::EnergyProbe`: `δ = ΔK − W_ext − W_drive` (J).
-struct Probe {
-    kinetic: f64,
-    load_power: f64,
-}
-
-fn free_loads(w: &World, b: &dem::Body) -> [f64; 3] {
-    let g = if b.gravity {
-        w.params.gravity * b.mass
-    } else {
-        Vector2::zeros()
-    };
-    let f = [
-        g.x + b.applied_force.x,
-        g.y + b.applied_force.y,
-        b.applied_torque,
-    ];
-    let mut out = [0.0; 3];
-    for d in 0..3 {
-        if b.dofs[d] == Dof::Free {
-            out[d] = f[d];
-        }
-    }
-    out
-}
-
-fn load_power(w: &World) -> f64 {
-    w.bodies
-        .iter()
-        .map(|b| {
-            let f = free_loads(w, b);
-            f[0] * b.velocity.x + f[1] * b.velocity.y + f[2] * b.omega
-        })
-        .sum()
-}
-
-impl Probe {
-    fn before(w: &World) -> Self {
-        Probe {
-            kinetic: w.kinetic_energy(),
-            load_power: load_power(w),
-        }
-    }
-
-    fn residual(&self, after: &World) -> f64 {
-        let (h, th) = (after.params.dt, after.params.theta);
-        let w_ext = h * ((1.0 - th) * self.load_power + th * load_power(after));
-        let mut w_drive = 0.0;
-        for (i, b) in after.bodies.iter().enumerate() {
-            let (f, t) = after.contact_force(i);
-            let fc = [f.x, f.y, t];
-            let v = [b.velocity.x, b.velocity.y, b.omega];
-            for d in 0..3 {
-                if b.dofs[d] == Dof::Imposed && v[d] != 0.0 {
-                    w_drive -= h * fc[d] * v[d];
-                }
-            }
-        }
-        after.kinetic_energy() - self.kinetic - w_ext - w_drive
-    }
-}
-
-/// `E_load` of `datasets::phases::load_energy_scale`: `Σ_grains m |g| d + Σ |f_a| d̄` (J).
-fn load_energy_scale(w: &World) -> f64 {
-    let g = w.params.gravity.norm();
-    let (mut n, mut dsum, mut s) = (0usize, 0.0, 0.0);
-    for b in w.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
-        n += 1;
-        dsum += 2.0 * b.radius;
-        if b.gravity {
-            s += b.mass * g * 2.0 * b.radius;
-        }
-    }
-    let dmean = dsum / n as f64;
-    for b in &w.bodies {
-        if b.dofs.contains(&Dof::Free) {
-            s += (b.applied_force.norm() + b.applied_torque.abs() / dmean) * dmean;
-        }
-    }
-    s
 }
 
 /// A periodic strip between a fixed rough floor (glued disks of radius `R_MIN` on y = 0, body 0)
@@ -240,7 +159,7 @@ struct Worst {
 fn run(w: &mut World, steps: usize, worst: &mut Worst) {
     let e_load = load_energy_scale(w);
     for _ in 0..steps {
-        let probe = Probe::before(w);
+        let probe = EnergyProbe::before(w);
         let rep = w.step().unwrap();
         worst.steps += 1;
         worst.growth = worst.growth.max(probe.residual(w) / e_load);
