@@ -150,7 +150,10 @@ pub fn phase_warnings(
 /// (overlap above [`PENETRATION_LIMIT`] of it) and `penetration_first_step`;
 /// `energy_growth_steps` (energy residual above [`ENERGY_GROWTH_TOLERANCE`] of the load energy
 /// scale), `energy_growth_first_step` and `energy_growth_worst` (largest residual over the
-/// scale). A first step is the world's step index, `null` when there is none.
+/// scale); `position_corrected_steps` (steps where the position correction moved something),
+/// `position_correction_energy_J` (the potential energy it added, `−Σ f·Δq_c`) and
+/// `max_corrected_overlap_over_radius` (the largest overlap it removed, over the smallest grain
+/// radius). A first step is the world's step index, `null` when there is none.
 pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
     let step = |v: Option<u64>| v.map_or(serde_json::Value::Null, serde_json::Value::from);
     s.int("solver_steps", stats.steps)
@@ -171,7 +174,16 @@ pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
             "energy_growth_first_step",
             step(stats.first_energy_growth_step),
         )
-        .num("energy_growth_worst", stats.worst_energy_growth);
+        .num("energy_growth_worst", stats.worst_energy_growth)
+        .int("position_corrected_steps", stats.position_corrected_steps)
+        .num(
+            "position_correction_energy_J",
+            stats.position_correction_energy,
+        )
+        .num(
+            "max_corrected_overlap_over_radius",
+            stats.max_corrected_overlap_ratio,
+        );
 }
 
 /// VTK frames every `interval` seconds of simulated time, at most `max_frames` (the final
