@@ -156,3 +156,38 @@ fn time_steps_too_large_for_gravity_are_refused() {
     let o = grainlaw(&["run", "janssen", "--out", "y", "--set", "dt=3.6e-3"], d);
     refused(&o, "use at most 3.570e-3 s");
 }
+
+/// `--out` naming a file, or a directory that holds another scenario's outputs, is refused on
+/// one line (exit 2) and nothing is written there; the same scenario may reuse its directory.
+#[test]
+fn out_directory_of_another_scenario_or_a_file_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("afile"), "x").unwrap();
+    refused(
+        &grainlaw(&["run", "rolling", "-q", "--out", "afile"], d),
+        "is a file, not a directory",
+    );
+    let o = grainlaw(&["run", "rolling", "-q", "--out", "r"], d);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let before: Vec<_> = std::fs::read_dir(d.join("r")).unwrap().collect();
+    let o = grainlaw(
+        &[
+            "run",
+            "arrangements",
+            "-q",
+            "--out",
+            "r",
+            "--set",
+            "columns=3",
+            "--set",
+            "rows=3",
+        ],
+        d,
+    );
+    refused(&o, "holds the outputs of a `rolling` run");
+    let after: Vec<_> = std::fs::read_dir(d.join("r")).unwrap().collect();
+    assert_eq!(before.len(), after.len(), "nothing added");
+    let o = grainlaw(&["run", "rolling", "-q", "--out", "r"], d);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
