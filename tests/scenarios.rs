@@ -32,6 +32,36 @@ fn run(scenario: &str, sets: &[&str], cwd: &Path) -> (PathBuf, Value) {
     )
 }
 
+/// `grainlaw fit LAW FILE --out law.json` on a CSV a scenario wrote (as the scenario tells the
+/// user to): the exit code, and the law's parameters by name when it was written.
+fn refit(dir: &Path, law: &str, file: &str) -> (i32, Vec<(String, f64)>) {
+    let out = dir.join(format!("refit_{law}.json"));
+    let o = Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .current_dir(dir)
+        .args(["fit", law, file, "--out"])
+        .arg(&out)
+        .output()
+        .expect("grainlaw runs");
+    let code = o.status.code().unwrap_or(-1);
+    let params = if code == 0 {
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        v["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                (
+                    p["name"].as_str().unwrap().to_string(),
+                    p["value"].as_f64().unwrap(),
+                )
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    (code, params)
+}
+
 fn num(s: &Value, key: &str) -> f64 {
     s.get(key)
         .and_then(Value::as_f64)
@@ -102,6 +132,17 @@ fn janssen_column() {
         ],
     );
     assert_eq!(num(&s, "grains"), 350.0);
+    // The profile the run says can be fitted again is fitted as written, to the same numbers.
+    let (code, p) = refit(&out, "janssen", "wall_profile.csv");
+    assert_eq!(code, 0, "grainlaw fit janssen wall_profile.csv");
+    for (name, v) in p {
+        let key = format!("janssen_{name}");
+        let expect = num(&s, &key);
+        assert!(
+            (v - expect).abs() <= 1e-12 * expect.abs(),
+            "{key}: {v} vs {expect}"
+        );
+    }
     let ratio = num(&s, "bottom_load_over_weight");
     assert!(ratio > 0.0 && ratio < 1.0, "bottom load / weight {ratio}");
     let mu_wall = num(&s, "wall_friction");
@@ -374,6 +415,29 @@ fn shear_cell_short() {
             written != refused,
             "{file}: written = {written}, refusal recorded = {refused}"
         );
+    }
+    // rheology.csv is fitted as written by `grainlaw fit`, with the run's verdict: the same law
+    // (same numbers) or the same refusal (exit code 3).
+    let form = s.get("mu_i_form").and_then(Value::as_str).map(String::from);
+    for law in ["mu-i", "mu-i-linear", "phi-i"] {
+        let (code, p) = refit(&out, law, "rheology.csv");
+        assert!(
+            code == 0 || code == 3,
+            "grainlaw fit {law} rheology.csv: exit {code}"
+        );
+        let prefix = if law == "phi-i" { "phi_i" } else { "mu_i" };
+        let run_used_it = match law {
+            "mu-i" => form.is_none() && s.get("mu_i_mu_s").is_some(),
+            "mu-i-linear" => form.as_deref() == Some("mu-i-linear"),
+            _ => s.get("phi_i_phi_max").is_some(),
+        };
+        if run_used_it {
+            assert_eq!(code, 0, "{law}: the run fitted it, grainlaw fit must too");
+            for (name, v) in p {
+                let expect = num(&s, &format!("{prefix}_{name}"));
+                assert!((v - expect).abs() <= 1e-12 * expect.abs(), "{law} {name}");
+            }
+        }
     }
     let text = std::fs::read_to_string(out.join("rheology.csv")).unwrap();
     let rows: Vec<Vec<f64>> = text
