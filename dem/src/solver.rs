@@ -351,8 +351,9 @@ impl SweepOrder<'_> {
 ///
 /// `nlgs` sweeps up to `max_iterations` times ([`crate::nlgs::drive`]); `newton` assembles the
 /// step's problem ([`crate::assemble::contact_problem`]) and runs [`crate::fc::newton`] from the
-/// warm start; `auto` sweeps at most `auto_sweeps` times and hands the best iterate to Newton
-/// when that was not enough. In both Newton modes `max_iterations` bounds the smoothing sweeps.
+/// warm start, then sweeps for what is left; `auto` follows [`run_auto`] (sweeps while they
+/// converge fast enough, Newton, sweeps), with the back-off of [`NewtonBackoff`]. In every mode
+/// `max_iterations` bounds the sweeps in all, smoothing sweeps included.
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     rows: &mut [ContactRow],
@@ -376,78 +377,135 @@ pub fn solve(
         omega: params.relaxation,
         seed: SHUFFLE_SEED,
     };
-    let sweeps = match params.method {
-        SolverMethod::Nlgs => params.max_iterations,
-        SolverMethod::Newton => 0,
-        SolverMethod::Auto => params.auto_sweeps.min(params.max_iterations),
-    };
-    let start_error = if params.method == SolverMethod::Auto {
-        error_measure(step.rows, step.vel, step.q_norm)
-    } else {
-        0.0
-    };
-    // With no sweeps (`newton`), this only tells whether the warm start is already a solution.
-    let mut first = nlgs(&mut step, params, sweeps, work);
-    if params.method == SolverMethod::Auto {
-        // Gauss–Seidel goes on, chunk after chunk, while its rate would reach the tolerance
-        // within the sweeps left: Newton only takes over where the sweeps stall.
-        let mut reference = start_error;
-        while !first.converged
-            && gauss_seidel_will_finish(
-                reference,
-                first.error,
-                sweeps,
-                params.tolerance,
-                params.max_iterations.saturating_sub(first.iterations),
-            )
-        {
-            reference = first.error;
-            let chunk = sweeps.min(params.max_iterations - first.iterations);
-            let more = nlgs(&mut step, params, chunk, work);
-            first = SolveReport {
-                iterations: first.iterations + more.iterations,
-                ..more
-            };
-        }
+    let SolverWork {
+        newton: newton_work,
+        nlgs: drive_work,
+        backoff,
+    } = work;
+    if params.method == SolverMethod::Nlgs {
+        return nlgs(&mut step, params, params.max_iterations, drive_work);
     }
-    if first.converged || params.method == SolverMethod::Nlgs {
-        return first;
-    }
-    if work.backoff.params != Some(*params) {
+    if backoff.params != Some(*params) {
         // New solver settings (a new phase): Newton gets a fresh chance.
-        work.backoff = NewtonBackoff {
+        *backoff = NewtonBackoff {
             params: Some(*params),
             ..NewtonBackoff::default()
         };
     }
-    if params.method == SolverMethod::Auto && work.backoff.skip > 0 {
-        // Newton failed on a recent step: Gauss–Seidel alone for the sweeps left.
-        work.backoff.skip -= 1;
-        let left = params.max_iterations.saturating_sub(first.iterations);
-        if left == 0 {
-            return first;
+    let (chunk, backoff) = match params.method {
+        SolverMethod::Auto => (params.auto_sweeps.min(params.max_iterations), Some(backoff)),
+        _ => (0, None),
+    };
+    let start_error = step.error();
+    let mut stages = EngineStages {
+        step: &mut step,
+        params,
+        drive_work,
+        newton_work,
+        report: SolveReport::default(),
+    };
+    let Ok(()) = run_auto(
+        &mut stages,
+        start_error,
+        chunk,
+        params.tolerance,
+        params.max_iterations,
+        backoff,
+    );
+    stages.report
+}
+
+/// The two stages that `auto` alternates ([`run_auto`]), as the engine and standalone problems
+/// ([`crate::fc::solve_by`]) provide them. Each continues from the current iterate.
+pub(crate) trait AutoStages {
+    /// What a stage can fail with.
+    type Error;
+    /// At most `sweeps` Gauss–Seidel sweeps: `(sweeps done, error, converged)`.
+    fn sweeps(&mut self, sweeps: usize) -> Result<(usize, f64, bool), Self::Error>;
+    /// The Newton stage, with at most `sweeps` smoothing sweeps: `(smoothing sweeps, converged)`.
+    fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), Self::Error>;
+}
+
+/// The `auto` schedule, for both the engine and `solve-fc`: Gauss–Seidel in chunks of `chunk`
+/// sweeps as long as [`gauss_seidel_will_finish`] (from the error `start_error` of the starting
+/// iterate); then, unless `backoff` says to skip it, Newton; then Gauss–Seidel for the sweeps
+/// left of `max_sweeps`. `chunk = 0` goes straight to Newton (the `newton` method). The back-off
+/// records the Newton stage's outcome. The stages keep their own report.
+pub(crate) fn run_auto<S: AutoStages>(
+    stages: &mut S,
+    start_error: f64,
+    chunk: usize,
+    tolerance: f64,
+    max_sweeps: usize,
+    backoff: Option<&mut NewtonBackoff>,
+) -> Result<(), S::Error> {
+    let (mut done, mut error, converged) = stages.sweeps(chunk.min(max_sweeps))?;
+    if converged {
+        return Ok(());
+    }
+    let mut reference = start_error;
+    while chunk > 0
+        && gauss_seidel_will_finish(reference, error, chunk, tolerance, max_sweeps - done)
+    {
+        reference = error;
+        let (n, e, c) = stages.sweeps(chunk.min(max_sweeps - done))?;
+        (done, error) = (done + n, e);
+        if c {
+            return Ok(());
         }
-        let more = nlgs(&mut step, params, left, work);
-        return SolveReport {
-            iterations: first.iterations + more.iterations,
-            ..more
+    }
+    match backoff {
+        Some(b) if b.skip > 0 => {
+            // Newton failed on a recent step: Gauss–Seidel alone for the sweeps left.
+            b.skip -= 1;
+        }
+        backoff => {
+            let (used, converged) = stages.newton(max_sweeps - done)?;
+            if let Some(b) = backoff {
+                b.record(converged);
+            }
+            done += used;
+            if converged {
+                return Ok(());
+            }
+        }
+    }
+    if done < max_sweeps {
+        stages.sweeps(max_sweeps - done)?;
+    }
+    Ok(())
+}
+
+/// The engine's stages of [`run_auto`], accumulating one [`SolveReport`].
+struct EngineStages<'s, 'a> {
+    step: &'s mut Step<'a>,
+    params: &'s SolverParams,
+    drive_work: &'s mut DriveWork,
+    newton_work: &'s mut NewtonWork,
+    report: SolveReport,
+}
+
+impl AutoStages for EngineStages<'_, '_> {
+    type Error = std::convert::Infallible;
+
+    fn sweeps(&mut self, sweeps: usize) -> Result<(usize, f64, bool), Self::Error> {
+        let r = nlgs(self.step, self.params, sweeps, self.drive_work);
+        self.report = SolveReport {
+            iterations: self.report.iterations + r.iterations,
+            newton_iterations: self.report.newton_iterations,
+            ..r
         };
+        Ok((r.iterations, r.error, r.converged))
     }
-    let second = global(&mut step, params, first, work);
-    if params.method == SolverMethod::Auto {
-        work.backoff.record(second.converged);
-    }
-    let left = params.max_iterations.saturating_sub(second.iterations);
-    if second.converged || left == 0 {
-        return second;
-    }
-    // Newton did not get there within its iterations: Gauss–Seidel from its best iterate for
-    // the sweeps left (never worse than Gauss–Seidel alone, bar the time).
-    let third = nlgs(&mut step, params, left, work);
-    SolveReport {
-        iterations: second.iterations + third.iterations,
-        newton_iterations: second.newton_iterations,
-        ..third
+
+    fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), Self::Error> {
+        let r = global(self.step, self.params, sweeps, self.newton_work);
+        self.report = SolveReport {
+            iterations: self.report.iterations + r.iterations,
+            newton_iterations: self.report.newton_iterations + r.newton_iterations,
+            ..r
+        };
+        Ok((r.iterations, r.converged))
     }
 }
 
@@ -535,19 +593,20 @@ impl SweepProblem for Step<'_> {
     }
 }
 
-/// The Newton stage of [`solve`]: assemble, solve from the current impulses, write the impulses
-/// back and rebuild the velocities. The report's error and approach speed are the engine's own,
+/// The Newton stage of [`solve`] (at most `max_sweeps` smoothing sweeps, which the report
+/// counts): assemble, solve from the current impulses, write the impulses back and rebuild the
+/// velocities. The report's error and approach speed are the engine's own,
 /// evaluated on the rebuilt velocities.
 fn global(
     step: &mut Step,
     params: &SolverParams,
-    first: SolveReport,
-    work: &mut SolverWork,
+    max_sweeps: usize,
+    newton_work: &mut NewtonWork,
 ) -> SolveReport {
     let problem = contact_problem(step.rows, step.v_free, step.inv);
     let options = FcOptions {
         tolerance: params.tolerance,
-        max_iterations: params.max_iterations.saturating_sub(first.iterations),
+        max_iterations: max_sweeps,
         initial_guess: Some(step.rows.iter().flat_map(|c| c.r).collect()),
         ..FcOptions::default()
     };
@@ -559,7 +618,7 @@ fn global(
             .enumerate()
             .all(|(a, &closed)| !(closed || r[2 * a] > 0.0) || -u[2 * a] <= approach_limit)
     };
-    let outcome = newton::solve_with(&problem, &options, &params.newton, &mut work.newton, accept);
+    let outcome = newton::solve_with(&problem, &options, &params.newton, newton_work, accept);
     let (newton_iterations, smoothing) = match outcome {
         Ok((sol, stats)) => {
             for (c, r) in step.rows.iter_mut().zip(sol.r.chunks_exact(2)) {
@@ -574,7 +633,7 @@ fn global(
     let error = step.error();
     let approach = step.approach_speed();
     SolveReport {
-        iterations: first.iterations + smoothing,
+        iterations: smoothing,
         error,
         converged: error <= params.tolerance && approach <= approach_limit,
         approach_speed: approach,
@@ -602,7 +661,7 @@ fn nlgs(
     step: &mut Step,
     params: &SolverParams,
     max_sweeps: usize,
-    work: &mut SolverWork,
+    drive_work: &mut DriveWork,
 ) -> SolveReport {
     if step.rows.is_empty() {
         return SolveReport {
@@ -620,7 +679,7 @@ fn nlgs(
             plain_sweeps: PLAIN_SWEEPS,
             schedule: CheckSchedule::Growing,
         },
-        &mut work.nlgs,
+        drive_work,
     );
     SolveReport {
         iterations: report.iterations,

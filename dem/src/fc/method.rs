@@ -8,6 +8,7 @@ use super::newton::{self, NewtonParams, NewtonStats};
 use super::nsgs::{self, FcOptions, FcSolution};
 use super::problem::FcProblem;
 pub use crate::solver::{gauss_seidel_will_finish, SolverMethod};
+use crate::solver::{run_auto, AutoStages};
 
 /// Gauss–Seidel sweeps before `auto` hands over to Newton (as the engine's default
 /// [`crate::SolverParams::auto_sweeps`]).
@@ -27,10 +28,11 @@ pub struct MethodReport {
 /// Solves `problem` with `method`:
 /// - `nlgs`: [`nsgs::solve`] with `options`;
 /// - `newton`: [`newton::solve`] from `options.initial_guess`;
-/// - `auto`: Gauss–Seidel in chunks of [`AUTO_SWEEPS`] sweeps while its rate would reach the
-///   tolerance within the sweeps left ([`gauss_seidel_will_finish`]), then Newton from its best iterate, then Gauss–Seidel again for
-///   the sweeps left of `options.max_iterations` if Newton did not reach the tolerance within
-///   `params.max_iterations`.
+/// - `auto`: the engine's schedule (`solver::run_auto`, without the back-off, which needs a
+///   sequence of steps): Gauss–Seidel in chunks of [`AUTO_SWEEPS`] sweeps while its rate would
+///   reach the tolerance in time ([`gauss_seidel_will_finish`]), then Newton from its best
+///   iterate, then Gauss–Seidel again for the sweeps left of `options.max_iterations` if Newton
+///   did not reach the tolerance within `params.max_iterations`.
 ///
 /// `solution.iterations` counts the Gauss–Seidel sweeps (smoothing included), `seconds` the
 /// whole solve.
@@ -58,87 +60,90 @@ pub fn solve_by(
             ))
         }
         SolverMethod::Auto => {
-            // Gauss–Seidel in chunks while its rate would reach the tolerance in time.
-            let mut reference = super::measure::fc_error(
+            let start = options
+                .initial_guess
+                .clone()
+                .unwrap_or_else(|| vec![0.0; 2 * problem.contacts()]);
+            let start_error = super::measure::fc_error(problem, &start);
+            let mut stages = FcStages {
                 problem,
-                options
-                    .initial_guess
-                    .as_deref()
-                    .unwrap_or(&vec![0.0; 2 * problem.contacts()]),
-            );
-            let mut first = nsgs::solve(
-                problem,
-                &FcOptions {
-                    max_iterations: options.max_iterations.min(AUTO_SWEEPS),
-                    ..options.clone()
-                },
-            )?;
-            while !first.converged
-                && gauss_seidel_will_finish(
-                    reference,
-                    first.error,
-                    AUTO_SWEEPS,
-                    options.tolerance,
-                    options.max_iterations - first.iterations,
-                )
-            {
-                reference = first.error;
-                let more = nsgs::solve(
-                    problem,
-                    &FcOptions {
-                        max_iterations: AUTO_SWEEPS.min(options.max_iterations - first.iterations),
-                        initial_guess: Some(first.r.clone()),
-                        ..options.clone()
-                    },
-                )?;
-                first = FcSolution {
-                    iterations: first.iterations + more.iterations,
-                    seconds: first.seconds + more.seconds,
-                    ..more
-                };
-            }
-            if first.converged {
-                return Ok((first, report(NewtonStats::default())));
-            }
-            let mut left = options.max_iterations - first.iterations;
-            let (second, stats) = newton::solve(
-                problem,
-                &FcOptions {
-                    max_iterations: left,
-                    initial_guess: Some(first.r),
-                    ..options.clone()
-                },
+                options,
                 params,
+                r: start,
+                last: None,
+                stats: NewtonStats::default(),
+                sweeps: 0,
+                seconds: 0.0,
+            };
+            run_auto(
+                &mut stages,
+                start_error,
+                AUTO_SWEEPS,
+                options.tolerance,
+                options.max_iterations,
+                None,
             )?;
-            left -= stats.smoothing_sweeps;
-            let sweeps = first.iterations + stats.smoothing_sweeps;
-            let seconds = first.seconds + second.seconds;
-            if second.converged || left == 0 {
-                return Ok((
-                    FcSolution {
-                        iterations: sweeps,
-                        seconds,
-                        ..second
-                    },
-                    report(stats),
-                ));
-            }
-            let third = nsgs::solve(
-                problem,
-                &FcOptions {
-                    max_iterations: left,
-                    initial_guess: Some(second.r),
-                    ..options.clone()
-                },
-            )?;
+            let solution = stages.last.take().expect("the first stage always runs");
             Ok((
                 FcSolution {
-                    iterations: sweeps + third.iterations,
-                    seconds: seconds + third.seconds,
-                    ..third
+                    iterations: stages.sweeps,
+                    seconds: stages.seconds,
+                    ..solution
                 },
-                report(stats),
+                report(stages.stats),
             ))
         }
+    }
+}
+
+/// The stages of [`run_auto`] on a standalone problem: each continues from the last solution.
+struct FcStages<'a> {
+    problem: &'a FcProblem,
+    options: &'a FcOptions,
+    params: &'a NewtonParams,
+    /// The current iterate.
+    r: Vec<f64>,
+    /// The last stage's solution.
+    last: Option<FcSolution>,
+    stats: NewtonStats,
+    /// Gauss–Seidel sweeps in all (smoothing included).
+    sweeps: usize,
+    seconds: f64,
+}
+
+impl FcStages<'_> {
+    fn options(&self, sweeps: usize) -> FcOptions {
+        FcOptions {
+            max_iterations: sweeps,
+            initial_guess: Some(self.r.clone()),
+            ..self.options.clone()
+        }
+    }
+
+    fn keep(&mut self, s: FcSolution) {
+        self.seconds += s.seconds;
+        self.r.clone_from(&s.r);
+        self.last = Some(s);
+    }
+}
+
+impl AutoStages for FcStages<'_> {
+    type Error = FcError;
+
+    fn sweeps(&mut self, sweeps: usize) -> Result<(usize, f64, bool), FcError> {
+        let s = nsgs::solve(self.problem, &self.options(sweeps))?;
+        let out = (s.iterations, s.error, s.converged);
+        self.sweeps += s.iterations;
+        self.keep(s);
+        Ok(out)
+    }
+
+    fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), FcError> {
+        let (s, stats) = newton::solve(self.problem, &self.options(sweeps), self.params)?;
+        let out = (stats.smoothing_sweeps, s.converged);
+        self.sweeps += stats.smoothing_sweeps;
+        self.stats = stats;
+        self.keep(s);
+        Ok(out)
     }
 }
