@@ -1,4 +1,4 @@
-//! Exact behaviours of the engine (DESIGN §1): rest on a plane, a column between smooth walls,
+//! Exact behaviours of the engine (`docs/physics.md` §1.7): rest on a plane, a column between smooth walls,
 //! a disk on a slope (rolling, rolling and sliding, locked rotation), for a slope made by
 //! rotated gravity and by a tilted wall.
 
@@ -24,37 +24,47 @@ fn params(dt: f64, gravity: Vector2<f64>) -> WorldParams {
     }
 }
 
+/// A disk resting on a floor, θ = 1/2 and θ = 1, with the position correction on: the normal
+/// impulse is `m g h` every step for 10⁴ steps (10⁻¹² relative), the centre does not drift
+/// (10⁻¹² m), and the correction never acts (no overlap beyond the slop).
 #[test]
 fn disk_resting_on_a_floor_receives_mgh_every_step_without_drift() {
     let h = 1e-3;
-    let mut w = World::new(
-        params(h, Vector2::new(0.0, -G)),
-        ContactLaws::new(&["m"], 0.4),
-    );
-    w.add_line_wall("floor", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
-    let r = 0.01;
-    let b = w.add_grain(Vector2::new(0.3, r), r, 2500.0, 0) as usize;
-    let m = w.bodies[b].mass;
-    for _ in 0..10_000 {
-        let rep = w.step().unwrap();
-        assert!(rep.solver.converged);
-        let c = &w.contacts().rows[0];
-        // Normal impulse = m g h to 1e-12 relative, no tangential impulse.
-        assert!(
-            (c.r[0] - m * G * h).abs() <= 1e-12 * m * G * h,
-            "r_n = {}",
-            c.r[0]
+    for theta in [0.5, 1.0] {
+        let mut w = World::new(
+            WorldParams {
+                theta,
+                ..params(h, Vector2::new(0.0, -G))
+            },
+            ContactLaws::new(&["m"], 0.4),
         );
-        assert!(c.r[1].abs() <= 1e-15);
+        w.add_line_wall("floor", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
+        let r = 0.01;
+        let b = w.add_grain(Vector2::new(0.3, r), r, 2500.0, 0) as usize;
+        let m = w.bodies[b].mass;
+        for _ in 0..10_000 {
+            let rep = w.step().unwrap();
+            assert!(rep.solver.converged);
+            assert_eq!(rep.position_correction.corrected_contacts, 0);
+            assert_eq!(rep.position_correction.load_work, 0.0);
+            let c = &w.contacts().rows[0];
+            // Normal impulse = m g h to 1e-12 relative, no tangential impulse.
+            assert!(
+                (c.r[0] - m * G * h).abs() <= 1e-12 * m * G * h,
+                "θ = {theta}: r_n = {}",
+                c.r[0]
+            );
+            assert!(c.r[1].abs() <= 1e-15);
+        }
+        // No drift: the centre stays at y = R to 1e-12 m, the velocity at 0.
+        assert!(
+            (w.bodies[b].position.y - r).abs() < 1e-12,
+            "y = {}",
+            w.bodies[b].position.y
+        );
+        assert!(w.bodies[b].velocity.norm() < 1e-12);
+        assert!((w.bodies[b].position.x - 0.3).abs() < 1e-15);
     }
-    // No drift: the centre stays at y = R to 1e-12 m, the velocity at 0.
-    assert!(
-        (w.bodies[b].position.y - r).abs() < 1e-12,
-        "y = {}",
-        w.bodies[b].position.y
-    );
-    assert!(w.bodies[b].velocity.norm() < 1e-12);
-    assert!((w.bodies[b].position.x - 0.3).abs() < 1e-15);
 }
 
 #[test]

@@ -307,53 +307,6 @@ fn a_sheared_dense_packing_keeps_its_overlaps_below_a_thousandth_of_the_radius()
     );
 }
 
-/// The exact rest of engine_exact.rs with the correction on (θ = 1/2 and θ = 1): a disk on a
-/// floor receives `m g h` every step for 10⁴ steps (10⁻¹² relative), does not drift (10⁻¹² m),
-/// and the correction never acts (nothing exceeds the slop).
-#[test]
-fn a_disk_resting_on_a_floor_is_never_corrected() {
-    let h = 1e-3;
-    for theta in [0.5, 1.0] {
-        let params = WorldParams {
-            dt: h,
-            theta,
-            position_correction: true,
-            solver: SolverParams {
-                tolerance: 1e-12,
-                max_iterations: 100_000,
-                ..Default::default()
-            },
-            ..Default::default()
-        };
-        let mut w = World::new(params, ContactLaws::new(&["m"], 0.4));
-        w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-        let r = 0.01;
-        let b = w.add_grain(Vector2::new(0.3, r), r, 2500.0, 0) as usize;
-        let m = w.bodies[b].mass;
-        for _ in 0..10_000 {
-            let rep = w.step().unwrap();
-            assert!(rep.solver.converged);
-            assert_eq!(rep.position_correction.corrected_contacts, 0);
-            assert_eq!(rep.position_correction.load_work, 0.0);
-            let c = &w.contacts().rows[0];
-            assert!(
-                (c.r[0] - m * G * h).abs() <= 1e-12 * m * G * h,
-                "θ = {theta}: r_n = {}",
-                c.r[0]
-            );
-            assert!(c.r[1].abs() <= 1e-15);
-        }
-        let body = &w.bodies[b];
-        assert!(
-            (body.position.y - r).abs() < 1e-12,
-            "y = {}",
-            body.position.y
-        );
-        assert!(body.velocity.norm() < 1e-12);
-        assert!((body.position.x - 0.3).abs() < 1e-15);
-    }
-}
-
 /// A hexagonal crystal of `nx × ny` disks of radius `R_MIN` whose neighbours overlap by
 /// 0.2 % of the radius (20 slops), in a box whose floor and side walls it also overlaps, under
 /// gravity, μ = 0.3, parallel solve: every contact needs the correction.
