@@ -30,7 +30,7 @@
 //! # Speed
 //!
 //! Tolerance 1e-6 from `r = 0`, one core, the same session on a shared 2 vCPU Xeon
-//! (`cargo bench -p dem --bench fc_table`; Siconos 4.4 fc2d NSGS through `tools/solve_fc.py`):
+//! (`cargo bench -p dem --bench fc_table`; Siconos 4.4 fc2d NSGS, see `datasets/fc-problems/README.md`):
 //!
 //! | problem | contacts | Siconos its / s | dem::fc its / s | ratio |
 //! |---|---|---|---|---|

@@ -5,7 +5,7 @@
 //! A problem ([`SweepProblem`]) holds impulses `r ∈ ℝ^{2n}` (`(r_n, r_t)` per contact) and knows
 //! how to do one Gauss–Seidel sweep `r ← G(r)` (each contact's local problem solved exactly with
 //! the others fixed), how to evaluate the true error measure `e(r)` of
-//! `formats/frictional-contact.md`, and how to copy `r` to and from a flat vector. What it keeps
+//! `docs/formats.md` §1.2, and how to copy `r` to and from a flat vector. What it keeps
 //! besides `r` (the engine's body velocities, the standalone solver's permuted copy of `W`) is
 //! its own business. [`drive`] iterates:
 //!

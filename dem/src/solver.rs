@@ -26,7 +26,7 @@
 //! ([`crate::nlgs::SweepProblem`]): the O(1) contact update, the sweep order (natural or
 //! coloured, shuffled on a stall), the error measure and the approach-speed limit.
 //!
-//! Convergence is judged on the error measure of `formats/frictional-contact.md` (Siconos'
+//! Convergence is judged on the error measure of `docs/formats.md` §1.2 (Siconos'
 //! natural-map error): `e = ‖r − proj_K(r − ū)‖ / max(‖q‖, ‖r‖, ‖u‖)`, `q` the local velocity at
 //! zero impulse, `ū = u + μ|u_t| n`.
 

@@ -166,7 +166,7 @@ impl Builder {
     }
 }
 
-/// The analytic rolling disk of DESIGN §2 at time `t`.
+/// The analytic rolling disk of `docs/physics.md` §2.3 at time `t`.
 pub struct Rolling {
     pub snap: Snapshot,
     /// Down the slope.
