@@ -351,7 +351,7 @@ impl SweepOrder<'_> {
 ///
 /// `nlgs` sweeps up to `max_iterations` times ([`crate::nlgs::drive`]); `newton` assembles the
 /// step's problem ([`crate::assemble::contact_problem`]) and runs [`crate::fc::newton`] from the
-/// warm start, then sweeps for what is left; `auto` follows [`run_auto`] (sweeps while they
+/// warm start, then sweeps for what is left; `auto` follows `run_auto` (sweeps while they
 /// converge fast enough, Newton, sweeps), with the back-off of [`NewtonBackoff`]. In every mode
 /// `max_iterations` bounds the sweeps in all, smoothing sweeps included.
 #[allow(clippy::too_many_arguments)]

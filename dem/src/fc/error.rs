@@ -6,7 +6,7 @@ use thiserror::Error;
 ///
 /// Every variant that comes from the file names the JSON key it is about (`q`, `W.row`, ...);
 /// [`crate::fc::read_problem`] wraps them in [`FcError::InFile`] so that the message also names
-/// the file (`path: key `mu[1]`: …`).
+/// the file (`path: key mu[1]: …`).
 #[derive(Debug, Error)]
 pub enum FcError {
     /// An error in the content of a problem file, with the file's path in front.

@@ -26,7 +26,7 @@ use super::problem::FcProblem;
 ///
 /// Errors: [`FcError::Io`] (unreadable file, cut gzip stream) and, for a content error, the
 /// error of [`parse_problem`] wrapped in [`FcError::InFile`], so that every message names the
-/// file and then the key (`p.json: key `mu[1]`: friction coefficient -0.5 < 0`); use
+/// file and then the key (`p.json: key mu[1]: friction coefficient -0.5 < 0`); use
 /// [`FcError::kind`] to match on the inner error.
 pub fn read_problem(path: impl AsRef<Path>) -> Result<FcProblem, FcError> {
     let path = path.as_ref();
