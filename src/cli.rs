@@ -84,6 +84,27 @@ pub enum Command {
         #[arg(long, value_name = "SOLUTION.json")]
         out: Option<PathBuf>,
     },
+    /// Run a sweep of scenario runs from a plan (TOML: `scenario`, `[set]`, `[sweep]`), in
+    /// parallel, resumable, then merge their tables and fit the laws (docs/cli.md §9).
+    Campaign {
+        /// The plan file.
+        plan: PathBuf,
+        /// The campaign directory (default `grainlaw-out/campaign-PLANSTEM`).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Run only the K-th share (1-based) of `--of N` (a cluster job array's task).
+        #[arg(long, value_name = "K")]
+        task: Option<usize>,
+        /// Number of shares the runs are split into.
+        #[arg(long, value_name = "N")]
+        of: Option<usize>,
+        /// Only merge the finished runs and fit the laws.
+        #[arg(long)]
+        collect: bool,
+        /// Runs at once (default: the cores available).
+        #[arg(long, value_name = "J")]
+        jobs: Option<usize>,
+    },
     /// Solve the reference frictional-contact problems and compare with Siconos' times.
     Bench {
         /// Directory of the reference problems (default: the repository's
@@ -215,6 +236,21 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
         Command::Run(args) => run(args),
         Command::Scenarios { show } => scenarios_cmd(show.as_deref()),
         Command::Fit { law, data, out } => crate::fit_cmd::fit(&law, &data, out.as_deref()),
+        Command::Campaign {
+            plan,
+            out,
+            task,
+            of,
+            collect,
+            jobs,
+        } => crate::campaign::campaign(crate::campaign::CampaignArgs {
+            plan,
+            out,
+            task,
+            of,
+            collect,
+            jobs,
+        }),
         Command::SolveFc {
             problem,
             tol,

@@ -89,6 +89,14 @@ pub enum CliError {
     /// A command-line argument is wrong.
     #[error("{0}")]
     Usage(String),
+    /// A campaign was stopped (Ctrl-C, SIGTERM): its running runs wrote their checkpoints.
+    #[error(
+        "campaign stopped: the running runs wrote their checkpoints; continue with the same command (finished runs are not redone), in {dir}"
+    )]
+    CampaignStopped {
+        /// The campaign directory.
+        dir: String,
+    },
 }
 
 impl CliError {
@@ -105,7 +113,7 @@ impl CliError {
     /// error.
     pub fn exit_code(&self) -> i32 {
         match self {
-            CliError::Interrupted { .. } => 130,
+            CliError::Interrupted { .. } | CliError::CampaignStopped { .. } => 130,
             CliError::FitRefused { .. } | CliError::NotConverged { .. } => 3,
             _ => 2,
         }

@@ -6,6 +6,7 @@
 //! [`datasets`]; the runners in [`scenarios`]; the command line in [`cli`].
 
 pub mod bench_cmd;
+pub mod campaign;
 pub mod checkpoint;
 pub mod cli;
 pub mod error;
