@@ -1,7 +1,7 @@
 //! The `grainlaw` command line (`docs/cli.md`).
 //!
 //! ```text
-//! grainlaw [run [SCENARIO] [--out DIR] [--set KEY=VALUE ...] [--quiet]]   (default: run janssen)
+//! grainlaw [run [SCENARIO] [--out DIR] [--set KEY=VALUE ...] [--quiet] [--allow-suspect]]   (default: run janssen)
 //!          [--checkpoint-every STEPS] [--checkpoint-seconds S]
 //! grainlaw run --resume DIR [--checkpoint-every STEPS] [--checkpoint-seconds S] [--quiet]
 //! grainlaw scenarios [--show NAME]
@@ -10,7 +10,9 @@
 //! grainlaw bench [--dir DIR] [--engine-grains N ...]
 //! ```
 //!
-//! Every error is one line on stderr and exit code 2.
+//! Every error is one line on stderr and exit code 2. A run that finishes with a `refused`
+//! verdict, or `suspect` without `--allow-suspect` ([`crate::verdict`]), writes everything, its
+//! laws as `NAME_law.rejected.json`, and exits with 3.
 //!
 //! `run` writes a checkpoint (`OUT/checkpoint/run.json.gz`, [`crate::checkpoint`]) every
 //! `--checkpoint-seconds` (default 60 s of wall-clock time) and every `--checkpoint-every` steps
@@ -108,7 +110,8 @@ pub enum Command {
     },
 }
 
-/// Parses `args` and runs; returns the process exit code (0, or 2 on any error).
+/// Parses `args` and runs; returns the process exit code (0; 2 on any error; 3 for a refused
+/// result; 130 for an interrupted run).
 pub fn main_with_args<I, T>(args: I) -> i32
 where
     I: IntoIterator<Item = T>,

@@ -443,7 +443,7 @@ impl Checks {
                 d,
                 tolerance,
                 format!(
-                    "{what} not steady over the averaging window: its second half differs from the first by {d:+.4} ({z:.1} standard errors, limit {STEADY_Z} and {tolerance})"
+                    "{what} not steady over the averaging window: its second half differs from the first by {d:+.3e} ({z:.1} standard errors; limits {STEADY_Z} standard errors and {tolerance:.3e})"
                 ),
             ),
             Some(_) => {}
@@ -522,15 +522,16 @@ impl RunVerdict {
     /// The block printed on stdout: `verdict: V`, one line per reason, one per law.
     pub fn lines(&self) -> Vec<String> {
         let mut out = vec![format!("verdict: {}", self.verdict())];
-        let mut seen: Vec<&Reason> = Vec::new();
+        let mut seen: Vec<(&str, &str)> = Vec::new();
         for r in self
             .run
             .reasons
             .iter()
             .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
         {
-            if !seen.contains(&r) {
-                seen.push(r);
+            let key = (r.check.as_str(), r.message.as_str());
+            if !seen.contains(&key) {
+                seen.push(key);
                 out.push(format!("  {:<8} {}: {}", r.verdict, r.check, r.message));
             }
         }
