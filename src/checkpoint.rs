@@ -63,6 +63,9 @@ pub struct ScenarioRecord {
     pub effective_toml: String,
     /// The `--set KEY=VALUE` overrides given.
     pub sets: Vec<String>,
+    /// `--allow-suspect` was given (a resume keeps it).
+    #[serde(default)]
+    pub allow_suspect: bool,
 }
 
 impl ScenarioRecord {

@@ -1,7 +1,7 @@
 //! The `grainlaw` command line (`docs/cli.md`).
 //!
 //! ```text
-//! grainlaw [run [SCENARIO] [--out DIR] [--set KEY=VALUE ...] [--quiet]]   (default: run janssen)
+//! grainlaw [run [SCENARIO] [--out DIR] [--set KEY=VALUE ...] [--quiet] [--allow-suspect]]   (default: run janssen)
 //!          [--checkpoint-every STEPS] [--checkpoint-seconds S]
 //! grainlaw run --resume DIR [--checkpoint-every STEPS] [--checkpoint-seconds S] [--quiet]
 //! grainlaw scenarios [--show NAME]
@@ -10,7 +10,9 @@
 //! grainlaw bench [--dir DIR] [--engine-grains N ...]
 //! ```
 //!
-//! Every error is one line on stderr and exit code 2.
+//! Every error is one line on stderr and exit code 2. A run that finishes with a `refused`
+//! verdict, or `suspect` without `--allow-suspect` ([`crate::verdict`]), writes everything, its
+//! laws as `NAME_law.rejected.json`, and exits with 3.
 //!
 //! `run` writes a checkpoint (`OUT/checkpoint/run.json.gz`, [`crate::checkpoint`]) every
 //! `--checkpoint-seconds` (default 60 s of wall-clock time) and every `--checkpoint-every` steps
@@ -129,7 +131,8 @@ pub enum Command {
     },
 }
 
-/// Parses `args` and runs; returns the process exit code (0, or 2 on any error).
+/// Parses `args` and runs; returns the process exit code (0; 2 on any error; 3 for a refused
+/// result; 130 for an interrupted run).
 pub fn main_with_args<I, T>(args: I) -> i32
 where
     I: IntoIterator<Item = T>,
@@ -206,6 +209,10 @@ pub struct RunArgs {
     /// With --dump-problems: write the steps whose solve did not converge (the default).
     #[arg(long, requires = "dump_problems")]
     pub dump_capped: bool,
+    /// Export suspect laws as calibrated laws (marked `"verdict": "suspect"`) and exit with 0;
+    /// refused results are never exported as laws. Recorded in the checkpoint.
+    #[arg(long)]
+    pub allow_suspect: bool,
     /// Test hook: stop as Ctrl-C does after this many steps of this invocation.
     #[arg(long, value_name = "STEPS", hide = true)]
     pub stop_after_steps: Option<u64>,
@@ -226,6 +233,7 @@ impl Default for RunArgs {
             dump_problems: None,
             dump_steps: None,
             dump_capped: false,
+            allow_suspect: false,
             stop_after_steps: None,
         }
     }
@@ -312,9 +320,11 @@ pub fn run(args: RunArgs) -> Result<()> {
         every_steps: (args.checkpoint_every > 0).then_some(args.checkpoint_every),
         every_seconds: (args.checkpoint_seconds > 0.0).then_some(args.checkpoint_seconds),
     };
+    let mut allow_suspect = args.allow_suspect;
     let (loaded, dir, sets) = match &args.resume {
         Some(dir) => {
             let loaded = resumed_scenario(dir, args.scenario.as_deref(), &args.set)?;
+            allow_suspect |= loaded.2;
             (loaded.0, dir.clone(), loaded.1)
         }
         None => {
@@ -372,22 +382,30 @@ pub fn run(args: RunArgs) -> Result<()> {
     let mut ctl = RunControl::new(sets, policy);
     ctl.resume = args.resume.is_some();
     ctl.stop_after_steps = args.stop_after_steps;
+    ctl.allow_suspect = allow_suspect;
     let outcome = scenarios::run_controlled(&mut ctx, &mut ctl)?;
     if !args.quiet {
-        for l in outcome.headline {
+        for l in outcome.headline.iter().chain(&outcome.verdict.lines()) {
             println!("{l}");
         }
     }
-    Ok(())
+    if outcome.verdict.passes() {
+        Ok(())
+    } else {
+        Err(CliError::Verdict {
+            dir: dir.display().to_string(),
+            reason: outcome.verdict.failure_line(),
+        })
+    }
 }
 
-/// The scenario of the checkpoint in `dir`, with its overrides; refuses a missing or unreadable
+/// The scenario of the checkpoint in `dir`, with its overrides and `--allow-suspect`; refuses a missing or unreadable
 /// checkpoint, and a SCENARIO or `--set` given on the command line that differs from it.
 fn resumed_scenario(
     dir: &Path,
     scenario: Option<&str>,
     set: &[String],
-) -> Result<(datasets::LoadedScenario, Vec<String>)> {
+) -> Result<(datasets::LoadedScenario, Vec<String>, bool)> {
     let cp: RunCheckpoint<serde::de::IgnoredAny> = checkpoint::read(dir)?;
     let rec = cp.scenario;
     let refuse = |given: String| CliError::Checkpoint {
@@ -425,7 +443,7 @@ fn resumed_scenario(
             path: checkpoint::file_of(dir).display().to_string(),
             reason: format!("its scenario does not load any more ({e})"),
         })?;
-    Ok((loaded, rec.sets))
+    Ok((loaded, rec.sets, rec.allow_suspect))
 }
 
 fn scenarios_cmd(show: Option<&str>) -> Result<()> {

@@ -50,6 +50,16 @@ pub enum CliError {
         /// What was reached (one line).
         reason: String,
     },
+    /// A scenario run finished but a result is refused or suspect ([`crate::verdict`]; suspect
+    /// passes with `--allow-suspect`): every file is written, refused laws as
+    /// `NAME_law.rejected.json`, and the exit code is 3.
+    #[error("{dir}: {reason}")]
+    Verdict {
+        /// The output directory.
+        dir: String,
+        /// The verdict and the checks that failed (one line).
+        reason: String,
+    },
     /// Reading or writing a file.
     #[error("{path}: {reason}")]
     Io {
@@ -109,12 +119,15 @@ impl CliError {
     }
 
     /// The process exit code: 130 (128 + SIGINT, the shells' convention) for a run stopped by
-    /// the user, which can be resumed; 3 for a fit refused on valid data; 2 for every other
+    /// the user, which can be resumed; 3 for a fit refused on valid data or a run whose verdict
+    /// fails; 2 for every other
     /// error.
     pub fn exit_code(&self) -> i32 {
         match self {
             CliError::Interrupted { .. } | CliError::CampaignStopped { .. } => 130,
-            CliError::FitRefused { .. } | CliError::NotConverged { .. } => 3,
+            CliError::FitRefused { .. }
+            | CliError::NotConverged { .. }
+            | CliError::Verdict { .. } => 3,
             _ => 2,
         }
     }

@@ -17,5 +17,6 @@ pub mod output;
 pub mod plot;
 pub mod progress;
 pub mod scenarios;
+pub mod verdict;
 
 pub use error::{CliError, Result};

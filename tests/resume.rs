@@ -29,6 +29,17 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
 }
 
+/// A run that finished: exit 0, or 3 when its verdict refused a result (the 60-grain column's
+/// Janssen fit may be refused; the resume must reproduce it all the same).
+fn assert_finished(o: &Output) {
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(3)),
+        "exit {:?}: {}",
+        o.status.code(),
+        stderr(o)
+    );
+}
+
 /// The error line of a failed command (the last line of stderr; warnings come before it).
 fn error_line(o: &Output) -> String {
     stderr(o)
@@ -86,7 +97,7 @@ fn assert_same_outputs(a: &Path, b: &Path) {
 /// An uninterrupted run of [`SCENARIO`] into `dir`.
 fn reference(dir: &Path) -> Value {
     let o = grainlaw(&[SCENARIO, &["--out"]].concat(), &[dir]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_finished(&o);
     serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
 }
 
@@ -143,7 +154,7 @@ fn stopped_and_resumed_runs_give_the_same_files() {
     );
     assert_stopped(&o, &b);
     let o = grainlaw(&["run", "-q", "--resume"], &[&b]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_finished(&o);
     assert!(!b.join("checkpoint").exists());
     assert_same_outputs(&a, &b);
     // The numerics keys; the deposit and the relaxation (converged solves at θ = 1) never
@@ -224,7 +235,7 @@ fn signal_stops_cleanly_and_the_run_resumes(signal: &str) {
         stderr(&o)
     );
     let o = grainlaw(&["run", "-q", "--resume"], &[&b]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_finished(&o);
     assert_same_outputs(&a, &b);
 }
 
@@ -308,7 +319,7 @@ fn bad_resumes_are_refused() {
     assert!(!dir.join("summary.json").exists());
     // A new run in the directory says it removes the old checkpoint, and finishes without one.
     let o = grainlaw(&[SCENARIO, &["--out"]].concat(), &[&dir]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_finished(&o);
     assert!(stderr(&o).contains("removed the checkpoint of an earlier, interrupted run"));
     assert!(!dir.join("checkpoint").exists() && dir.join("summary.json").is_file());
 }

@@ -711,6 +711,14 @@ pub struct CalibratedLaw {
     pub model_selection: Option<ModelComparison>,
     /// Provenance.
     pub provenance: Provenance,
+    /// Verdict of the `grainlaw run` that produced the law (`ok`, `suspect`, `refused`;
+    /// `docs/outputs.md` §2.1); absent from laws of `grainlaw fit`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<String>,
+    /// The checks that failed for that verdict (`check`, `verdict`, `value`, `threshold`,
+    /// `message`); absent when none did.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub verdict_reasons: Vec<serde_json::Value>,
 }
 
 /// A calibrated law in typed form, ready to evaluate.
@@ -814,6 +822,8 @@ impl CalibratedLaw {
             fit: FitSummary::of(report),
             model_selection: None,
             provenance,
+            verdict: None,
+            verdict_reasons: Vec::new(),
         }
     }
 
@@ -1324,6 +1334,8 @@ impl LawV1 {
                 inputs: Vec::new(),
                 source: self.provenance.source,
             },
+            verdict: None,
+            verdict_reasons: Vec::new(),
         })
     }
 }

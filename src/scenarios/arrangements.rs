@@ -77,6 +77,7 @@ impl PhasedRun for Stacks<'_> {
         out: &mut OutputDir,
         w: &dem::World,
         _r: &dem::StepReport,
+        _p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
         st.vtk.maybe(out, w)
     }
@@ -191,10 +192,49 @@ pub fn run(
         ..
     } = st;
     solver_keys(&mut s, &all);
+    // Verdict: each stack at rest carries its weight exactly: floor + side-wall friction − top
+    // load = weight (crate::verdict).
+    let mut checks = crate::verdict::Checks::new();
+    for (k, r) in table.rows.iter().enumerate() {
+        let name = Arrangement::ALL[k].name();
+        let balance = (r[3] + r[6] + r[7] - r[8]) / r[2] - 1.0;
+        checks.at_most(
+            &format!("arrangements.force_balance_{name}"),
+            balance.abs(),
+            BALANCE_SUSPECT,
+            Some(BALANCE_REFUSED),
+            |t| {
+                format!(
+                    "{name}: the walls carry {:.2} % of the weight (limit ±{:.0} %)",
+                    100.0 * (1.0 + balance),
+                    100.0 * t
+                )
+            },
+        );
+        if s.get(&format!("at_rest_{name}")) == Some(&serde_json::Value::Bool(false)) {
+            checks.fail(
+                &format!("arrangements.at_rest_{name}"),
+                crate::verdict::Verdict::Suspect,
+                0.0,
+                1.0,
+                format!("{name}: the stack did not come to rest within `duration`"),
+            );
+        }
+    }
     table.comments.push("one row per arrangement; forces of the grains on the walls at rest (N per metre of thickness)".into());
     table.write(&mut ctx.out, "wall_loads.csv")?;
     Ok(RunOutcome {
         summary: s,
         headline,
+        verdict: crate::verdict::RunVerdict {
+            run: checks,
+            ..Default::default()
+        },
     })
 }
+
+/// Relative imbalance between the loads on the walls and the weight of a stack at rest above
+/// which the run is suspect (1).
+pub const BALANCE_SUSPECT: f64 = 0.01;
+/// The same, above which it is refused (1).
+pub const BALANCE_REFUSED: f64 = 0.05;

@@ -25,6 +25,11 @@ use crate::plot::colormap::Scale;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
+use crate::verdict::{max_solid_fraction, Checks, RunVerdict, WindowStats};
+
+/// Relative difference of the window halves of the mean velocity that matters for a steady
+/// flow (1; [`crate::verdict::halves_drift`]).
+pub const STEADY_VELOCITY_TOLERANCE: f64 = 0.02;
 
 /// Accumulated profiles across the layer (bins of height y above the base).
 #[derive(Serialize, Deserialize)]
@@ -104,6 +109,9 @@ struct FlowState {
     /// Steps done.
     k: u64,
     stats: PhaseStats,
+    /// Numerics of the averaging window.
+    #[serde(default)]
+    window: WindowStats,
 }
 
 impl Flow<'_> {
@@ -140,11 +148,13 @@ impl PhasedRun for Flow<'_> {
         out: &mut OutputDir,
         w: &dem::World,
         r: &dem::StepReport,
+        p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
         let c = self.c;
         let avg_from = ((c.duration - c.average) / c.dt).round() as u64;
         let sample_every = ((0.002 / c.dt).round() as u64).max(1);
         st.k += 1;
+        st.window.step(st.k > avg_from, w, r, &p.stats);
         let (mut mv, mut m) = (0.0, 0.0);
         for b in w.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
             mv += b.mass * b.velocity.x;
@@ -217,6 +227,7 @@ pub fn run(
             vtk: VtkFrames::new(c.duration / c.vtk_frames.max(1) as f64, c.vtk_frames.max(1)),
             k: 0,
             stats: PhaseStats::default(),
+            window: WindowStats::default(),
         };
         Ok((world, state))
     };
@@ -227,6 +238,7 @@ pub fn run(
             hist,
             vtk,
             stats,
+            window,
             ..
         },
     ) = drive(ctx, ctl, &Flow { c }, fresh)?;
@@ -311,6 +323,30 @@ pub fn run(
         .int("grains_without_contact", n_contactless as u64)
         .num("max_solid_fraction", bulk);
     solver_keys(&mut s, &stats);
+    window.keys(&mut s, "window");
+
+    // Checks (crate::verdict): the numerics of the averaging window, the steady state of the
+    // mean velocity over it, the layer solid fractions.
+    let mut checks = Checks::new();
+    checks.window("averaging window", &window);
+    let avg_steps = window.steps as usize;
+    let v_window: Vec<f64> = hist.rows[hist.rows.len().saturating_sub(avg_steps)..]
+        .iter()
+        .map(|r| r[1])
+        .collect();
+    let v_mean = v_window.iter().sum::<f64>() / v_window.len().max(1) as f64;
+    checks.steady(
+        "inclined_flow.steady_velocity",
+        "the mean velocity (m/s)",
+        &v_window,
+        STEADY_VELOCITY_TOLERANCE * v_mean.abs(),
+    );
+    checks.solid_fraction(
+        "inclined_flow.solid_fraction",
+        "the densest layer",
+        bulk,
+        max_solid_fraction(c.grain.radius_spread),
+    );
 
     // Figures.
     // Colour range: the 2 % and 98 % quantiles, widened to whole decades.
@@ -406,5 +442,9 @@ pub fn run(
     Ok(RunOutcome {
         summary: s,
         headline,
+        verdict: RunVerdict {
+            run: checks,
+            ..Default::default()
+        },
     })
 }

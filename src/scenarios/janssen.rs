@@ -38,7 +38,7 @@ use nalgebra::Vector2;
 use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
-use super::common::{grain_weight, mean_diameter, solver_keys, write_law, Stop, VtkFrames};
+use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -49,9 +49,16 @@ use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, Band, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::{info, warn};
+use crate::verdict::{export_law, max_solid_fraction, Checks, RunVerdict, Verdict, WindowStats};
 
 /// Simulated seconds between two VTK frames.
 const VTK_INTERVAL: f64 = 0.02;
+
+/// Relative imbalance `|(floor + walls vertical load)/weight − 1|` of the measured column above
+/// which it is not at rest and its stresses are suspect (1).
+pub const FORCE_BALANCE_SUSPECT: f64 = 0.01;
+/// The same, above which the result is refused (1).
+pub const FORCE_BALANCE_REFUSED: f64 = 0.05;
 
 /// The measured profile of the relaxed column.
 #[derive(Debug, Clone)]
@@ -216,6 +223,9 @@ struct Column<'a> {
 struct ColumnState {
     /// Body index of the floor.
     bottom: usize,
+    /// Body indices of the left and right walls.
+    left: usize,
+    right: usize,
     /// Weight of the grains Σ m g (N).
     weight: f64,
     /// One row per step: `history.csv`.
@@ -231,6 +241,9 @@ struct ColumnState {
     deposit_load: f64,
     #[serde(with = "dem::serde_float")]
     relaxed_load: f64,
+    /// Numerics of the measured step (the last step of the relaxation without release).
+    #[serde(default)]
+    measured: WindowStats,
 }
 
 impl Column<'_> {
@@ -332,7 +345,18 @@ impl PhasedRun for Column<'_> {
         out: &mut OutputDir,
         w: &dem::World,
         r: &dem::StepReport,
+        p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
+        // The measured step: the one step of `measure`, or the last of `relax` without release.
+        let measured = if self.release_steps() > 0 {
+            k == MEASURE
+        } else {
+            k == RELAX
+        };
+        if measured && k == RELAX {
+            st.measured.restart();
+        }
+        st.measured.step(measured, w, r, &p.stats);
         let load = Self::floor_load(w, st);
         st.history.push(vec![
             w.time,
@@ -400,6 +424,8 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         )?;
         let state = ColumnState {
             bottom: col.bottom,
+            left: col.left,
+            right: col.right,
             weight: grain_weight(&col.world),
             history: CsvTable::new(&[
                 "time_s",
@@ -416,6 +442,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             release: PhaseStats::default(),
             deposit_load: f64::NAN,
             relaxed_load: f64::NAN,
+            measured: WindowStats::default(),
         };
         Ok((col.world, state))
     };
@@ -423,6 +450,8 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     let world = &world;
     let ColumnState {
         bottom,
+        left,
+        right,
         weight,
         history,
         vtk,
@@ -431,6 +460,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         release,
         deposit_load,
         relaxed_load,
+        measured,
     } = st;
     let final_report = world.last_report();
     if !final_report.solver.converged {
@@ -480,7 +510,46 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     let window = (top_skip, profile.surface - bottom_skip);
     let fitted = fit_profile(&profile, &setup, window);
 
-    // 5. Outputs.
+    // 5. Checks (crate::verdict): the measured step's numerics, the force balance of the
+    // column, the solid fraction, the depth bins.
+    let mut checks = Checks::new();
+    checks.window("measured step", &measured);
+    let wall_load = -(world.contact_force(left).0.y + world.contact_force(right).0.y);
+    let balance = (bottom_load + wall_load) / weight - 1.0;
+    checks.at_most(
+        "janssen.force_balance",
+        balance.abs(),
+        FORCE_BALANCE_SUSPECT,
+        Some(FORCE_BALANCE_REFUSED),
+        |t| {
+            format!(
+                "floor and wall vertical loads carry {:.2} % of the weight (the column is not at rest; limit ±{:.0} %)",
+                100.0 * (1.0 + balance),
+                100.0 * t
+            )
+        },
+    );
+    checks.solid_fraction(
+        "janssen.solid_fraction",
+        "the column's solid fraction",
+        phi,
+        max_solid_fraction(c.grain.radius_spread),
+    );
+    let bin = profile.surface / c.analysis.depth_bins as f64;
+    checks.at_most("janssen.bin_thickness", d / bin, 1.0, None, |_| {
+        format!(
+            "depth bins {:.2} mm thick, thinner than a mean diameter ({:.2} mm): lower analysis.depth_bins",
+            bin * 1e3,
+            d * 1e3
+        )
+    });
+    let mut verdict = RunVerdict {
+        run: checks.clone(),
+        ..Default::default()
+    };
+    verdict.allow_suspect = ctl.allow_suspect;
+
+    // 6. Outputs.
     let mut s = Summary::new();
     s.int("grains", c.grains as u64)
         .num("box_width_m", width)
@@ -492,6 +561,9 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .num("weight_N", weight)
         .num("bottom_load_N", bottom_load)
         .num("bottom_load_over_weight", bottom_load / weight)
+        .num("wall_load_N", wall_load)
+        .num("force_balance_residual", balance)
+        .num("depth_bin_thickness_m", bin)
         .num("wall_friction", c.friction.grain_wall)
         .num("grain_friction", c.friction.grain_grain);
     let mut headline = Vec::new();
@@ -509,7 +581,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 );
             }
             let law = CalibratedLaw::from_janssen(f, Provenance::new("janssen", Some(c.seed)));
-            write_law(&mut ctx.out, "janssen_law.json", &law)?;
+            export_law(&mut ctx.out, &mut verdict, "janssen", &law, checks.clone())?;
             headline.push(format!(
                 "K    = {:.3}  (95 % CI {:.3} … {:.3})",
                 f.k.value, f.k.ci_low, f.k.ci_high
@@ -539,6 +611,13 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             }
             s.text("janssen_fit_error", &e.to_string());
             headline.push(format!("Janssen fit failed: {e}"));
+            verdict.run.fail(
+                "janssen.fit",
+                Verdict::Refused,
+                f64::NAN,
+                f64::NAN,
+                format!("the Janssen fit failed: {e}"),
+            );
         }
     }
     s.num("wall_sliding_fraction", sliding)
@@ -575,8 +654,9 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .num("final_kinetic_energy_ratio", relax.final_energy_ratio)
         .num("final_solver_error", final_report.solver.error)
         .int("final_solver_sweeps", final_report.solver.iterations as u64)
-        .flag("final_solver_converged", final_report.solver.converged)
-        .int("vtk_frames", frames as u64);
+        .flag("final_solver_converged", final_report.solver.converged);
+    measured.keys(&mut s, "measured");
+    s.int("vtk_frames", frames as u64);
 
     // CSV: history and the fit-ready profile.
     history.write(&mut ctx.out, "history.csv")?;
@@ -731,6 +811,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     Ok(RunOutcome {
         summary: s,
         headline: lines,
+        verdict,
     })
 }
 

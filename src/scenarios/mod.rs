@@ -65,6 +65,8 @@ pub struct RunOutcome {
     pub summary: Summary,
     /// Headline lines for the terminal (where the report is, key numbers).
     pub headline: Vec<String>,
+    /// The verdict of the run and of its laws ([`crate::verdict`]).
+    pub verdict: crate::verdict::RunVerdict,
 }
 
 /// Runs the loaded scenario, writes every output and `summary.json` last, with the default
@@ -106,6 +108,8 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
     for (k, v) in outcome.summary.entries() {
         summary.set(k, v.clone());
     }
+    outcome.verdict.allow_suspect = ctl.allow_suspect;
+    outcome.verdict.keys(&mut summary);
     summary.num("wall_seconds", ctl.wall_seconds());
     summary.text("grainlaw_version", env!("CARGO_PKG_VERSION"));
     ctx.out

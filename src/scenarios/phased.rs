@@ -68,6 +68,9 @@ pub struct RunControl {
     pub stop_after_steps: Option<u64>,
     /// Wall-clock seconds of earlier invocations (read from the checkpoint on resume).
     pub previous_wall_seconds: f64,
+    /// `--allow-suspect`: suspect laws are exported as laws (marked suspect) and the run exits
+    /// with 0 ([`crate::verdict`]); recorded in checkpoints.
+    pub allow_suspect: bool,
     started: Instant,
     last_checkpoint: Instant,
     steps_since_checkpoint: u64,
@@ -91,6 +94,7 @@ impl RunControl {
             resume: false,
             stop_after_steps: None,
             previous_wall_seconds: 0.0,
+            allow_suspect: false,
             started: now,
             last_checkpoint: now,
             steps_since_checkpoint: 0,
@@ -135,7 +139,8 @@ pub trait PhasedRun {
         out: &mut OutputDir,
     ) -> Result<Option<PhasePlan>>;
 
-    /// Records step `report` of phase `k` (the world after it).
+    /// Records step `report` of phase `k` (the world after it; `progress`, the phase's
+    /// statistics and counters after it).
     fn step(
         &self,
         k: usize,
@@ -143,6 +148,7 @@ pub trait PhasedRun {
         out: &mut OutputDir,
         world: &World,
         report: &StepReport,
+        progress: &PhaseProgress,
     ) -> Result<()>;
 
     /// Ends phase `k` with its statistics.
@@ -182,6 +188,7 @@ pub fn drive<P: PhasedRun>(
         source: ctx.loaded.source.clone(),
         effective_toml: ctx.loaded.effective_toml.clone(),
         sets: ctl.sets.clone(),
+        allow_suspect: ctl.allow_suspect,
     };
     let cp_path: PathBuf = checkpoint::file_of(ctx.out.path());
     let dir_shown = shown(ctx.out.path());
@@ -230,7 +237,7 @@ pub fn drive<P: PhasedRun>(
             plan.stop,
             &mut progress,
             |w, r, p| {
-                run.step(k, st, out, w, r)?;
+                run.step(k, st, out, w, r, p)?;
                 ctl.steps_this_run += 1;
                 ctl.steps_total += 1;
                 ctl.steps_since_checkpoint += 1;

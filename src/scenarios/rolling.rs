@@ -112,6 +112,7 @@ impl PhasedRun for Roll<'_> {
         out: &mut OutputDir,
         w: &dem::World,
         _r: &dem::StepReport,
+        _p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
         let snap = w.snapshot();
         let gs = homogenise::grain_stresses(&snap)?;
@@ -408,8 +409,31 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             con[(0, 0)], con[(0, 1)], con[(1, 0)], con[(1, 1)], skew_ratio(&tot)
         ),
     ];
+    // Verdict: the comparison with the exact answers (crate::verdict).
+    let mut checks = crate::verdict::Checks::new();
+    for key in ["acceleration_rel_error", "stress_rel_error"] {
+        let e = s.get_f64(key).unwrap_or(f64::NAN);
+        checks.at_most(
+            &format!("rolling.{key}"),
+            e,
+            ROLLING_REL_ERROR_SUSPECT,
+            Some(ROLLING_REL_ERROR_REFUSED),
+            |t| format!("{key} = {e:.2e} against the exact answer (limit {t:.0e})"),
+        );
+    }
     Ok(RunOutcome {
         summary: s,
         headline,
+        verdict: crate::verdict::RunVerdict {
+            run: checks,
+            ..Default::default()
+        },
     })
 }
+
+/// Relative error of the acceleration, or of the mean stress, against the exact answer above
+/// which the run is suspect (1); the θ = 1 scheme is exact for uniform acceleration, so the
+/// defaults stay far below it.
+pub const ROLLING_REL_ERROR_SUSPECT: f64 = 1e-3;
+/// The same, above which it is refused (1).
+pub const ROLLING_REL_ERROR_REFUSED: f64 = 1e-2;

@@ -25,7 +25,7 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{
-    add_fitted_curve, delta_band, fit_keys, mean_diameter, solver_keys, write_law, Stop, VtkFrames,
+    add_fitted_curve, delta_band, fit_keys, mean_diameter, solver_keys, Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::{PhaseEnv, RunContext, RunOutcome};
@@ -36,6 +36,7 @@ use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::warn;
+use crate::verdict::{export_law, max_solid_fraction, Checks, RunVerdict, Verdict, WindowStats};
 
 /// Averages of one run (sums of finite samples).
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -47,7 +48,37 @@ struct RunAverages {
     samples: usize,
     walls: [(f64, f64, f64, usize); 2],
     profile: Vec<(f64, f64, f64)>,
+    /// μ = |Σ_xy|/(−Σ_yy) and φ of each sample, in order (steady-state check).
+    #[serde(default, with = "crate::floats::vec")]
+    mu_samples: Vec<f64>,
+    #[serde(default, with = "crate::floats::vec")]
+    phi_samples: Vec<f64>,
 }
+
+/// What the checks of one run need (crate::verdict).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+struct RunCheckData {
+    #[serde(with = "dem::serde_float")]
+    i_target: f64,
+    #[serde(with = "dem::serde_float")]
+    i_measured: f64,
+    /// Numerics of the averaging window.
+    window: WindowStats,
+    #[serde(with = "crate::floats::vec")]
+    mu: Vec<f64>,
+    #[serde(with = "crate::floats::vec")]
+    phi: Vec<f64>,
+}
+
+/// Measured inertial number over its target (or the inverse) above which a run is suspect: the
+/// point then belongs to another part of μ(I) than planned (1).
+pub const I_FACTOR_SUSPECT: f64 = 2.0;
+/// The same, above which the run is refused (1).
+pub const I_FACTOR_REFUSED: f64 = 10.0;
+/// Difference of the window halves of μ that matters (absolute; [`crate::verdict::halves_drift`]).
+pub const STEADY_MU_TOLERANCE: f64 = 0.02;
+/// Difference of the window halves of φ that matters (absolute).
+pub const STEADY_PHI_TOLERANCE: f64 = 0.005;
 
 /// The phases: compression at zero shear, then one steady shear run per inertial number
 /// (lowest first, each from the previous steady state).
@@ -96,6 +127,12 @@ struct ShearState {
     profiles: Vec<MeanProfile>,
     run: ShearRun,
     acc: RunAverages,
+    /// Numerics of the current run's averaging window.
+    #[serde(default)]
+    window: WindowStats,
+    /// One per finished run.
+    #[serde(default)]
+    checks: Vec<RunCheckData>,
 }
 
 const TOP: usize = 1;
@@ -144,6 +181,7 @@ impl PhasedRun for Shear<'_> {
             n: 0,
         };
         st.acc = RunAverages::default();
+        st.window.reset();
         Ok(Some(PhasePlan {
             name: format!("I={i_target}"),
             stop: Stop::Steps(steps),
@@ -156,13 +194,16 @@ impl PhasedRun for Shear<'_> {
         st: &mut ShearState,
         _out: &mut OutputDir,
         w: &dem::World,
-        _r: &dem::StepReport,
+        r: &dem::StepReport,
+        p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
         if k == 0 {
             return Ok(());
         }
         let run = &mut st.run;
         run.n += 1;
+        st.window
+            .step(run.n + run.avg_steps > run.steps, w, r, &p.stats);
         if run.n + run.avg_steps > run.steps && run.n.is_multiple_of(run.every) {
             let d = mean_diameter(w);
             sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
@@ -199,6 +240,13 @@ impl PhasedRun for Shear<'_> {
         };
         let (vb, mub) = wall(0);
         let (vt, mut_) = wall(1);
+        st.checks.push(RunCheckData {
+            i_target,
+            i_measured: i_meas,
+            window: st.window,
+            mu: acc.mu_samples.clone(),
+            phi: acc.phi_samples.clone(),
+        });
         st.rows.push(vec![
             i_target,
             i_meas,
@@ -243,6 +291,8 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             profiles: Vec::new(),
             run: ShearRun::default(),
             acc: RunAverages::default(),
+            window: WindowStats::default(),
+            checks: Vec::new(),
         };
         Ok((world, state))
     };
@@ -252,9 +302,65 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             all,
             rows,
             profiles,
+            checks: run_checks,
             ..
         },
     ) = drive(ctx, ctl, &shear, fresh)?;
+    // Checks (crate::verdict): per run, the numerics of its averaging window and the measured
+    // I against its target (all laws); the steady state of μ (μ(I)) and of φ with its bound
+    // (φ(I)).
+    let mut common = Checks::new();
+    let mut mu_checks = Checks::new();
+    let mut phi_checks = Checks::new();
+    let phi_bound = max_solid_fraction(c.grain.radius_spread);
+    let mut windows = WindowStats::default();
+    for rc in &run_checks {
+        let label = format!("I = {}", rc.i_target);
+        common.window(&format!("{label}, averaging window"), &rc.window);
+        windows.merge(&rc.window);
+        let ratio = rc.i_measured / rc.i_target;
+        let factor = if ratio >= 1.0 { ratio } else { 1.0 / ratio };
+        common.at_most(
+            "shear_cell.inertial_number_factor",
+            factor,
+            I_FACTOR_SUSPECT,
+            Some(I_FACTOR_REFUSED),
+            |t| {
+                format!(
+                    "{label}: measured I = {:.3e} is {factor:.2} times off its target (limit {t}×)",
+                    rc.i_measured
+                )
+            },
+        );
+        mu_checks.steady(
+            "shear_cell.steady_mu",
+            &format!("{label}: μ"),
+            &rc.mu,
+            STEADY_MU_TOLERANCE,
+        );
+        phi_checks.steady(
+            "shear_cell.steady_phi",
+            &format!("{label}: φ"),
+            &rc.phi,
+            STEADY_PHI_TOLERANCE,
+        );
+        let phi = rc.phi.iter().sum::<f64>() / rc.phi.len().max(1) as f64;
+        phi_checks.solid_fraction(
+            "shear_cell.solid_fraction",
+            &format!("{label}: the bulk"),
+            phi,
+            phi_bound,
+        );
+    }
+    mu_checks.extend(&common);
+    phi_checks.extend(&common);
+    let mut verdict = RunVerdict {
+        run: common.clone(),
+        allow_suspect: ctl.allow_suspect,
+        ..Default::default()
+    };
+    verdict.run.extend(&mu_checks);
+    verdict.run.extend(&phi_checks);
     let d = mean_diameter(&world);
     VtkFrames::new(f64::INFINITY, 1).finish(&mut ctx.out, &world)?;
     let headers = [
@@ -355,10 +461,12 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 "μ(I): μ_s = {:.3}, μ₂ = {:.3}, I₀ = {:.3} (R² = {:.3})",
                 f.law.mu_s, f.law.mu_2, f.law.i0, f.report.r_squared
             ));
-            write_law(
+            export_law(
                 &mut ctx.out,
-                "mu_i_law.json",
+                &mut verdict,
+                "mu_i",
                 &CalibratedLaw::from_mu_i(&f, grain, prov()),
+                mu_checks.clone(),
             )?;
         }
         Err(e) => {
@@ -384,15 +492,24 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                         "μ(I) (linear): μ_s = {:.3}, b = {:.3}",
                         f.law.mu_s, f.law.slope
                     ));
-                    write_law(
+                    export_law(
                         &mut ctx.out,
-                        "mu_i_law.json",
+                        &mut verdict,
+                        "mu_i",
                         &CalibratedLaw::from_mu_i_linear(&f, grain, prov()),
+                        mu_checks.clone(),
                     )?;
                 }
                 Err(e2) => {
                     warn(&format!("linear μ(I) fit failed too: {e2}"));
                     s.text("mu_i_linear_fit_error", &e2.to_string());
+                    verdict.run.fail(
+                        "shear_cell.mu_i_fit",
+                        Verdict::Refused,
+                        f64::NAN,
+                        f64::NAN,
+                        format!("no μ(I) law could be fitted: {e2}"),
+                    );
                 }
             }
         }
@@ -431,15 +548,24 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 "φ(I): φ_max = {:.3}, φ_min = {:.3}",
                 f.law.phi_max, f.law.phi_min
             ));
-            write_law(
+            export_law(
                 &mut ctx.out,
-                "phi_i_law.json",
+                &mut verdict,
+                "phi_i",
                 &CalibratedLaw::from_phi_i(&f, grain, prov()),
+                phi_checks.clone(),
             )?;
         }
         Err(e) => {
             warn(&format!("φ(I) fit failed: {e}"));
             s.text("phi_i_fit_error", &e.to_string());
+            verdict.run.fail(
+                "shear_cell.phi_i_fit",
+                Verdict::Refused,
+                f64::NAN,
+                f64::NAN,
+                format!("the φ(I) fit failed: {e}"),
+            );
         }
     }
     pphi.legend = LegendAt::UpperRight;
@@ -511,16 +637,25 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             s.text("wall_law_form", form.law_name());
             fit_keys(&mut s, "wall_law", &best.report.parameters);
             headline.push(format!("wall law: {} chosen by AIC", form.law_name()));
-            write_law(
+            export_law(
                 &mut ctx.out,
-                "wall_law.json",
+                &mut verdict,
+                "wall",
                 &CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov()),
+                common.clone(),
             )?;
         }
         Err(e) => {
             warn(&format!("wall-law fit failed: {e}"));
             s.text("wall_law_fit_error", &e.to_string());
             headline.push(format!("wall law not identified: {e}"));
+            verdict.run.fail(
+                "shear_cell.wall_law_fit",
+                Verdict::Refused,
+                f64::NAN,
+                f64::NAN,
+                format!("no wall law could be fitted: {e}"),
+            );
         }
     }
     pw.legend = LegendAt::LowerRight;
@@ -562,9 +697,11 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         },
     )?;
     solver_keys(&mut s, &all);
+    windows.keys(&mut s, "window");
     Ok(RunOutcome {
         summary: s,
         headline,
+        verdict,
     })
 }
 
@@ -582,7 +719,10 @@ fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<()> {
     let sym = (st.total + st.total.transpose()) * 0.5;
     acc.sxy += sym[(0, 1)];
     acc.syy += sym[(1, 1)];
-    acc.phi += solid_fraction(&snap, &region)?;
+    let phi = solid_fraction(&snap, &region)?;
+    acc.phi += phi;
+    acc.phi_samples.push(phi);
+    acc.mu_samples.push(sym[(0, 1)].abs() / -sym[(1, 1)]);
     acc.gamma_dot += velocity_gradient(&snap, &region, VelocityWeight::Mass)?.gradient[(0, 1)];
     for (j, wall) in ["bottom", "top"].iter().enumerate() {
         let h = top_y - 2.0 * r;

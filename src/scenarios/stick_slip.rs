@@ -120,6 +120,7 @@ impl PhasedRun for Push<'_> {
         out: &mut OutputDir,
         w: &dem::World,
         _r: &dem::StepReport,
+        _p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
         if !k.is_multiple_of(2) {
             st.force.push(-w.contact_force(st.bottom).0.y);
@@ -270,8 +271,29 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     );
     table.write(&mut ctx.out, "wall_force.csv")?;
     draw_column(&mut ctx.out, "wall_force.png", &plots, (1200, 1350))?;
+    // Verdict: without friction the floor pushes exactly the weight (crate::verdict).
+    let mut checks = crate::verdict::Checks::new();
+    let r = s
+        .get_f64("force_mean_over_weight_frictionless")
+        .unwrap_or(f64::NAN);
+    checks.at_most(
+        "stick_slip.frictionless_force_over_weight",
+        (r - 1.0).abs(),
+        super::arrangements::BALANCE_SUSPECT,
+        Some(super::arrangements::BALANCE_REFUSED),
+        |t| {
+            format!(
+                "without friction the floor should push the weight exactly; mean force / weight = {r:.4} (limit ±{:.0} %)",
+                100.0 * t
+            )
+        },
+    );
     Ok(RunOutcome {
         summary: s,
         headline,
+        verdict: crate::verdict::RunVerdict {
+            run: checks,
+            ..Default::default()
+        },
     })
 }

@@ -68,6 +68,12 @@ impl GrainSpec {
     }
 }
 
+/// Largest Coulomb friction coefficient of the scenarios that use [`FrictionSpec`] (`janssen`,
+/// `inclined-flow`, `shear-cell`, `stick-slip`, `arrangements`) (1). Measured grain–grain and
+/// grain–wall coefficients of dry granular materials lie between about 0.1 and 0.9; above 1 the
+/// Janssen fit degenerates (`friction.grain_wall = 1.5` gave K = 4.6·10⁶).
+pub const MAX_FRICTION: f64 = 1.0;
+
 /// Coulomb friction coefficients between grains and between grains and walls.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -79,10 +85,25 @@ pub struct FrictionSpec {
 }
 
 impl FrictionSpec {
-    /// Checks both coefficients are finite and ≥ 0.
+    /// Checks both coefficients are finite, ≥ 0 and at most [`MAX_FRICTION`].
     pub fn validate(&self, prefix: &str) -> Result<()> {
-        non_negative(&format!("{prefix}.grain_grain"), self.grain_grain)?;
-        non_negative(&format!("{prefix}.grain_wall"), self.grain_wall)?;
+        for (key, mu) in [
+            (format!("{prefix}.grain_grain"), self.grain_grain),
+            (format!("{prefix}.grain_wall"), self.grain_wall),
+        ] {
+            non_negative(&key, mu)?;
+            if mu > MAX_FRICTION {
+                return Err(DatasetError::invalid(
+                    &key,
+                    format!(
+                        "friction coefficient {} is above {MAX_FRICTION}, the range of this \
+                         scenario (dry granular materials and walls have μ ≈ 0.1–0.9; beyond 1 a \
+                         contact sticks at almost any load and the fitted laws lose their meaning)",
+                        num(mu)
+                    ),
+                ));
+            }
+        }
         Ok(())
     }
 

@@ -138,6 +138,22 @@ impl JanssenConfig {
                 ),
             ));
         }
+        // Depth bins never thinner than a mean diameter: the column settles about
+        // `column_aspect · W` high (W is chosen for that height at the packing guess).
+        let height = self.column_aspect * width;
+        let d = 2.0 * self.grain.radius_mean;
+        if (height / self.analysis.depth_bins as f64) < d {
+            return Err(DatasetError::invalid(
+                "analysis.depth_bins",
+                format!(
+                    "{} bins over a column about {height:.3e} m high ({} grains) are thinner than \
+                     a mean diameter ({d:.3e} m): use at most {} bins, or more grains",
+                    self.analysis.depth_bins,
+                    self.grains,
+                    ((height / d).floor() as usize).max(1)
+                ),
+            ));
+        }
         Ok(())
     }
 }

@@ -1,0 +1,685 @@
+//! Verdicts: every scenario run, and every result it exports, is judged `ok`, `suspect` or
+//! `refused` by checks with stated thresholds, so that no wrong number looks right
+//! (`docs/outputs.md` §2.1).
+//!
+//! A check compares one measured value with its thresholds: beyond the *suspect* threshold the
+//! result is suspect, beyond the *refused* one it is refused. Each failed check is kept as a
+//! [`Reason`] (check name, measured value, threshold, one sentence). The verdict of a result is
+//! the worst of its reasons (`ok` without any); the verdict of the run is the worst of its own
+//! reasons and of its results.
+//!
+//! The checks judge the steps that feed a result (its averaging window, or the measured step),
+//! not the preparation phases: a preparation leads to a state that is then checked on its own
+//! (equilibrium, overlap, convergence of the measured step). The thresholds:
+//!
+//! | check | suspect above | refused above |
+//! |---|---|---|
+//! | unconverged steps in the window ([`SOLVER_UNCONVERGED_SUSPECT`], [`SOLVER_UNCONVERGED_REFUSED`]) | 1 % of its steps | 25 % (windows of ≥ [`MIN_STEPS_FOR_FRACTION_REFUSAL`] steps) |
+//! | worst solver error in the window / tolerance ([`SOLVER_ERROR_SUSPECT`], [`SOLVER_ERROR_REFUSED`]) | 10 | 1000 |
+//! | steps of the window whose energy grew beyond `ENERGY_GROWTH_TOLERANCE` | 1 % | 25 % (≥ 20 steps) |
+//! | largest overlap in the window / smallest radius ([`OVERLAP_SUSPECT`], [`OVERLAP_REFUSED`]) | 0.1 % | 1 % |
+//! | solid fraction | — | outside (0, [`max_solid_fraction`]) |
+//!
+//! and the scenario's own checks (force balance, inertial number against its target, steady
+//! state), documented where they are made.
+
+use std::fmt;
+
+use datasets::phases::PhaseStats;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+use crate::error::Result;
+use crate::output::{OutputDir, Summary};
+
+/// Fraction of unconverged steps in a window above which the result is suspect (1).
+pub const SOLVER_UNCONVERGED_SUSPECT: f64 = 0.01;
+/// Fraction of unconverged steps above which the result is refused (1), for windows of at least
+/// [`MIN_STEPS_FOR_FRACTION_REFUSAL`] steps (a single measured step is judged by its error).
+pub const SOLVER_UNCONVERGED_REFUSED: f64 = 0.25;
+/// Smallest window on which a fraction of bad steps can refuse a result.
+pub const MIN_STEPS_FOR_FRACTION_REFUSAL: u64 = 20;
+/// Worst error over the tolerance above which the result is suspect (1).
+pub const SOLVER_ERROR_SUSPECT: f64 = 10.0;
+/// Worst error over the tolerance above which the result is refused (1).
+pub const SOLVER_ERROR_REFUSED: f64 = 1000.0;
+/// Fraction of window steps whose energy grew above which the result is suspect (1).
+pub const ENERGY_GROWTH_SUSPECT: f64 = 0.01;
+/// Fraction of window steps whose energy grew above which the result is refused (1).
+pub const ENERGY_GROWTH_REFUSED: f64 = 0.25;
+/// Largest overlap over the smallest radius above which the result is suspect (1).
+pub const OVERLAP_SUSPECT: f64 = 0.001;
+/// Largest overlap over the smallest radius above which the result is refused (1).
+pub const OVERLAP_REFUSED: f64 = 0.01;
+
+/// Densest packing of equal disks, `π / (2√3)` (Thue; Fejes Tóth 1940).
+pub const HEXAGONAL_PACKING: f64 = 0.906_899_682_117_108_9;
+/// Bound on the solid fraction of a polydisperse disk sample (1): above the densest known
+/// packings of disks of two sizes (about 0.93 for size ratios down to 0.2, the compact binary
+/// packings of Kennedy, Discrete Comput. Geom. 35, 2006), which exceed the hexagonal packing
+/// because small disks fill the holes between large ones. A measured φ above it is a counting
+/// or overlap error, not a packing.
+pub const POLYDISPERSE_PACKING_BOUND: f64 = 0.95;
+
+/// The bound on the solid fraction of disks with radii `R̄ ± spread`: the hexagonal packing
+/// `π/(2√3) ≈ 0.9069` for equal disks, [`POLYDISPERSE_PACKING_BOUND`] otherwise.
+pub fn max_solid_fraction(radius_spread: f64) -> f64 {
+    if radius_spread > 0.0 {
+        POLYDISPERSE_PACKING_BOUND
+    } else {
+        HEXAGONAL_PACKING
+    }
+}
+
+/// How a result is judged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// Every check passed.
+    Ok,
+    /// A check failed by a little: the number may be right but nothing guarantees it.
+    Suspect,
+    /// A check failed by far, or the physics of the result is impossible.
+    Refused,
+}
+
+impl Verdict {
+    /// `ok`, `suspect` or `refused`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Suspect => "suspect",
+            Verdict::Refused => "refused",
+        }
+    }
+}
+
+impl fmt::Display for Verdict {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One failed check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Reason {
+    /// Check name (`solver.unconverged_fraction`, `janssen.force_balance`, …).
+    pub check: String,
+    /// What it leads to.
+    pub verdict: Verdict,
+    /// Measured value.
+    pub value: f64,
+    /// The threshold it crossed.
+    pub threshold: f64,
+    /// One sentence.
+    pub message: String,
+}
+
+impl Reason {
+    /// As JSON (`check`, `verdict`, `value`, `threshold`, `message`; non-finite numbers null).
+    pub fn to_json(&self) -> Value {
+        let n = |v: f64| serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number);
+        json!({
+            "check": self.check,
+            "verdict": self.verdict.as_str(),
+            "value": n(self.value),
+            "threshold": n(self.threshold),
+            "message": self.message,
+        })
+    }
+}
+
+/// The failed checks of one result (or of a run).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Checks {
+    /// The reasons, in the order the checks were made.
+    pub reasons: Vec<Reason>,
+}
+
+impl Checks {
+    /// No check failed yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The worst verdict of the reasons (`Ok` without any).
+    pub fn verdict(&self) -> Verdict {
+        self.reasons
+            .iter()
+            .map(|r| r.verdict)
+            .max()
+            .unwrap_or(Verdict::Ok)
+    }
+
+    /// Adds a reason.
+    pub fn fail(
+        &mut self,
+        check: &str,
+        verdict: Verdict,
+        value: f64,
+        threshold: f64,
+        message: String,
+    ) {
+        if verdict != Verdict::Ok {
+            self.reasons.push(Reason {
+                check: check.into(),
+                verdict,
+                value,
+                threshold,
+                message,
+            });
+        }
+    }
+
+    /// `value` must stay at or below `suspect` (else suspect) and `refused` (else refused); a
+    /// value that is not a number is refused. `what(threshold)` says it in one sentence.
+    pub fn at_most(
+        &mut self,
+        check: &str,
+        value: f64,
+        suspect: f64,
+        refused: Option<f64>,
+        what: impl Fn(f64) -> String,
+    ) {
+        if value.is_nan() {
+            self.fail(check, Verdict::Refused, value, suspect, what(suspect));
+        } else if let Some(r) = refused.filter(|r| value > *r) {
+            self.fail(check, Verdict::Refused, value, r, what(r));
+        } else if value > suspect {
+            self.fail(check, Verdict::Suspect, value, suspect, what(suspect));
+        }
+    }
+
+    /// Adds the reasons of `other`.
+    pub fn extend(&mut self, other: &Checks) {
+        self.reasons.extend(other.reasons.iter().cloned());
+    }
+
+    /// The solid fraction `phi` (named `what`) must lie in (0, `bound`): refused otherwise.
+    pub fn solid_fraction(&mut self, check: &str, what: &str, phi: f64, bound: f64) {
+        if !(phi > 0.0) {
+            self.fail(
+                check,
+                Verdict::Refused,
+                phi,
+                0.0,
+                format!("{what} φ = {phi:.4} is not positive"),
+            );
+        } else if phi >= bound {
+            self.fail(
+                check,
+                Verdict::Refused,
+                phi,
+                bound,
+                format!(
+                    "{what} φ = {phi:.4} is at or above the densest packing of these disks ({bound:.4})"
+                ),
+            );
+        }
+    }
+
+    /// The numerics of the steps that feed a result: unconverged steps and worst error over the
+    /// tolerance, energy growth, largest overlap ([module documentation](self)).
+    pub fn window(&mut self, label: &str, w: &WindowStats) {
+        if w.steps == 0 {
+            return;
+        }
+        let n = w.steps as f64;
+        let long = w.steps >= MIN_STEPS_FOR_FRACTION_REFUSAL;
+        let f = w.unconverged as f64 / n;
+        self.at_most(
+            "solver.unconverged_fraction",
+            f,
+            SOLVER_UNCONVERGED_SUSPECT,
+            long.then_some(SOLVER_UNCONVERGED_REFUSED),
+            |t| {
+                format!(
+                    "{label}: {} of {} steps stopped above the solver tolerance ({:.1} %, limit {:.0} %)",
+                    w.unconverged,
+                    w.steps,
+                    100.0 * f,
+                    100.0 * t
+                )
+            },
+        );
+        let e = w.worst_error / w.tolerance;
+        self.at_most(
+            "solver.worst_error_over_tolerance",
+            e,
+            SOLVER_ERROR_SUSPECT,
+            Some(SOLVER_ERROR_REFUSED),
+            |t| {
+                format!(
+                    "{label}: worst solver error {:.2e} is {e:.0} times the tolerance {:.0e} (limit {t:.0}×)",
+                    w.worst_error, w.tolerance
+                )
+            },
+        );
+        let g = w.energy_growth as f64 / n;
+        self.at_most(
+            "energy.growth_fraction",
+            g,
+            ENERGY_GROWTH_SUSPECT,
+            long.then_some(ENERGY_GROWTH_REFUSED),
+            |t| {
+                format!(
+                    "{label}: the mechanical energy grew beyond its tolerance in {} of {} steps ({:.1} %, limit {:.0} %)",
+                    w.energy_growth,
+                    w.steps,
+                    100.0 * g,
+                    100.0 * t
+                )
+            },
+        );
+        self.at_most(
+            "overlap.max_over_radius",
+            w.max_overlap_ratio,
+            OVERLAP_SUSPECT,
+            Some(OVERLAP_REFUSED),
+            |t| {
+                format!(
+                    "{label}: largest overlap {:.3} % of the smallest radius (limit {:.1} %)",
+                    100.0 * w.max_overlap_ratio,
+                    100.0 * t
+                )
+            },
+        );
+    }
+}
+
+/// The numerics of the steps of an averaging window (or of a measured step), recorded step by
+/// step. Serialisable, for run checkpoints.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct WindowStats {
+    /// Steps in the window.
+    pub steps: u64,
+    /// Of which the solve stopped above its tolerance.
+    pub unconverged: u64,
+    /// Largest error measure at the end of a solve (1).
+    #[serde(with = "dem::serde_float")]
+    pub worst_error: f64,
+    /// Largest solver tolerance of the window's steps (1).
+    #[serde(with = "dem::serde_float")]
+    pub tolerance: f64,
+    /// Steps whose energy residual exceeded the tolerance (`PhaseStats::energy_growth_steps`).
+    pub energy_growth: u64,
+    /// Largest overlap at the start of a step over the smallest grain radius (1).
+    #[serde(with = "dem::serde_float")]
+    pub max_overlap_ratio: f64,
+    /// The phase's energy-growth count after the last step seen (to count this step's).
+    seen_growth: u64,
+}
+
+impl WindowStats {
+    /// Follows one step of a phase (`phase`: the phase's statistics after it, whose
+    /// energy-growth count tells whether this step's energy grew); counts it when `in_window`.
+    pub fn step(
+        &mut self,
+        in_window: bool,
+        world: &dem::World,
+        r: &dem::StepReport,
+        phase: &PhaseStats,
+    ) {
+        let grew = phase.energy_growth_steps > self.seen_growth;
+        self.seen_growth = phase.energy_growth_steps;
+        if !in_window {
+            return;
+        }
+        self.steps += 1;
+        if !r.solver.converged {
+            self.unconverged += 1;
+        }
+        self.worst_error = self.worst_error.max(r.solver.error);
+        self.tolerance = self.tolerance.max(world.params.solver.tolerance);
+        if grew {
+            self.energy_growth += 1;
+        }
+        let rmin = datasets::phases::min_grain_radius(world);
+        if rmin > 0.0 {
+            self.max_overlap_ratio = self.max_overlap_ratio.max(r.max_penetration / rmin);
+        }
+    }
+
+    /// Starts a new window in a new phase (whose energy-growth count starts again too).
+    pub fn reset(&mut self) {
+        *self = WindowStats::default();
+    }
+
+    /// Starts a new window within the same phase.
+    pub fn restart(&mut self) {
+        *self = WindowStats {
+            seen_growth: self.seen_growth,
+            ..WindowStats::default()
+        };
+    }
+
+    /// Adds another window's counts.
+    pub fn merge(&mut self, o: &WindowStats) {
+        self.steps += o.steps;
+        self.unconverged += o.unconverged;
+        self.worst_error = self.worst_error.max(o.worst_error);
+        self.tolerance = self.tolerance.max(o.tolerance);
+        self.energy_growth += o.energy_growth;
+        self.max_overlap_ratio = self.max_overlap_ratio.max(o.max_overlap_ratio);
+    }
+
+    /// Summary keys `PREFIX_steps`, `PREFIX_unconverged_steps`, `PREFIX_worst_error`,
+    /// `PREFIX_energy_growth_steps`, `PREFIX_max_overlap_over_radius`.
+    pub fn keys(&self, s: &mut Summary, prefix: &str) {
+        s.int(&format!("{prefix}_steps"), self.steps)
+            .int(&format!("{prefix}_unconverged_steps"), self.unconverged)
+            .num(&format!("{prefix}_worst_error"), self.worst_error)
+            .int(&format!("{prefix}_energy_growth_steps"), self.energy_growth)
+            .num(
+                &format!("{prefix}_max_overlap_over_radius"),
+                self.max_overlap_ratio,
+            );
+    }
+}
+
+/// Steady state of a sampled history over its window: the means of its two halves must not
+/// differ by more than [`STEADY_Z`] combined standard errors *and* by more than `tolerance`
+/// (absolute, the smallest change that matters for the result). The standard error of each
+/// half is that of its block means ([`STEADY_BLOCKS`] blocks per half, consecutive samples being
+/// correlated; Flyvbjerg & Petersen, J. Chem. Phys. 91, 1989). Returns `(Δ, z)` of the halves,
+/// `None` with fewer than `2 · STEADY_BLOCKS · 2` samples.
+pub fn halves_drift(samples: &[f64]) -> Option<(f64, f64)> {
+    let n = samples.len() / (2 * STEADY_BLOCKS) * (2 * STEADY_BLOCKS);
+    if n < 4 * STEADY_BLOCKS {
+        return None;
+    }
+    let s = &samples[samples.len() - n..];
+    let b = n / (2 * STEADY_BLOCKS);
+    let blocks: Vec<f64> = s
+        .chunks(b)
+        .map(|c| c.iter().sum::<f64>() / b as f64)
+        .collect();
+    let half = |h: &[f64]| {
+        let m = h.iter().sum::<f64>() / h.len() as f64;
+        let var = h.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (h.len() - 1) as f64;
+        (m, var / h.len() as f64)
+    };
+    let (m1, v1) = half(&blocks[..STEADY_BLOCKS]);
+    let (m2, v2) = half(&blocks[STEADY_BLOCKS..]);
+    let d = m2 - m1;
+    let se = (v1 + v2).sqrt();
+    let z = if se > 0.0 {
+        d.abs() / se
+    } else if d == 0.0 {
+        0.0
+    } else {
+        f64::INFINITY
+    };
+    Some((d, z))
+}
+
+/// Blocks per half of a window in [`halves_drift`].
+pub const STEADY_BLOCKS: usize = 4;
+/// Difference of the window halves, in combined standard errors, above which a history is not
+/// steady (with 3 degrees of freedom per half, |t| > 4 has a probability of about 1 % for a
+/// steady history).
+pub const STEADY_Z: f64 = 4.0;
+
+impl Checks {
+    /// Steady state of `samples` ([`halves_drift`]): suspect when the halves differ by more than
+    /// [`STEADY_Z`] standard errors and by more than `tolerance`; suspect too when there are too
+    /// few samples to tell.
+    pub fn steady(&mut self, check: &str, what: &str, samples: &[f64], tolerance: f64) {
+        match halves_drift(samples) {
+            None => self.fail(
+                check,
+                Verdict::Suspect,
+                samples.len() as f64,
+                (4 * STEADY_BLOCKS) as f64,
+                format!(
+                    "{what}: {} samples in the averaging window, too few to test a steady state (at least {})",
+                    samples.len(),
+                    4 * STEADY_BLOCKS
+                ),
+            ),
+            Some((d, z)) if z > STEADY_Z && d.abs() > tolerance => self.fail(
+                check,
+                Verdict::Suspect,
+                d,
+                tolerance,
+                format!(
+                    "{what} not steady over the averaging window: its second half differs from the first by {d:+.3e} ({z:.1} standard errors; limits {STEADY_Z} standard errors and {tolerance:.3e})"
+                ),
+            ),
+            Some(_) => {}
+        }
+    }
+}
+
+/// A result a run exports (a calibrated law) with its verdict.
+#[derive(Debug, Clone)]
+pub struct LawVerdict {
+    /// Law name (`janssen`, `mu-i`, …).
+    pub law: String,
+    /// The file written (`NAME_law.json` or `NAME_law.rejected.json`), if any.
+    pub file: Option<String>,
+    /// Its checks.
+    pub checks: Checks,
+}
+
+/// The verdict of a run: its own checks and its results'.
+#[derive(Debug, Clone, Default)]
+pub struct RunVerdict {
+    /// Checks of the run as a whole.
+    pub run: Checks,
+    /// The exported results.
+    pub laws: Vec<LawVerdict>,
+    /// Whether suspect laws were exported as laws (`--allow-suspect`).
+    pub allow_suspect: bool,
+}
+
+impl RunVerdict {
+    /// The worst of the run's checks and of its laws'.
+    pub fn verdict(&self) -> Verdict {
+        self.laws
+            .iter()
+            .map(|l| l.checks.verdict())
+            .chain(std::iter::once(self.run.verdict()))
+            .max()
+            .unwrap_or(Verdict::Ok)
+    }
+
+    /// Summary keys: `verdict`, `verdict_reasons` (the run's and every law's reasons, each once)
+    /// and `law_verdicts` (per law: `law`, `file`, `verdict`, `reasons`).
+    pub fn keys(&self, s: &mut Summary) {
+        let mut all: Vec<Value> = Vec::new();
+        for r in self
+            .run
+            .reasons
+            .iter()
+            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
+        {
+            let v = r.to_json();
+            if !all.contains(&v) {
+                all.push(v);
+            }
+        }
+        s.text("verdict", self.verdict().as_str())
+            .set("verdict_reasons", Value::Array(all))
+            .set(
+                "law_verdicts",
+                Value::Array(
+                    self.laws
+                        .iter()
+                        .map(|l| {
+                            json!({
+                                "law": l.law,
+                                "file": l.file,
+                                "verdict": l.checks.verdict().as_str(),
+                                "reasons": l.checks.reasons.iter().map(Reason::to_json).collect::<Vec<_>>(),
+                            })
+                        })
+                        .collect(),
+                ),
+            );
+    }
+
+    /// The block printed on stdout: `verdict: V`, one line per reason, one per law.
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = vec![format!("verdict: {}", self.verdict())];
+        let mut seen: Vec<(&str, &str)> = Vec::new();
+        for r in self
+            .run
+            .reasons
+            .iter()
+            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
+        {
+            let key = (r.check.as_str(), r.message.as_str());
+            if !seen.contains(&key) {
+                seen.push(key);
+                out.push(format!("  {:<8} {}: {}", r.verdict, r.check, r.message));
+            }
+        }
+        for l in &self.laws {
+            let v = l.checks.verdict();
+            let what = match (&l.file, v) {
+                (Some(f), Verdict::Ok) => format!("written to {f}"),
+                (Some(f), Verdict::Suspect) if self.allow_suspect => {
+                    format!("written to {f}, marked suspect (--allow-suspect)")
+                }
+                (Some(f), _) => format!("NOT exported as a calibrated law: written to {f}"),
+                (None, _) => "not written".into(),
+            };
+            out.push(format!("  law {}: {v}, {what}", l.law));
+        }
+        out
+    }
+
+    /// Whether the run's exit status is 0: everything ok, or suspect at worst with
+    /// `--allow-suspect`.
+    pub fn passes(&self) -> bool {
+        match self.verdict() {
+            Verdict::Ok => true,
+            Verdict::Suspect => self.allow_suspect,
+            Verdict::Refused => false,
+        }
+    }
+
+    /// One line saying what failed (for the exit-status message).
+    pub fn failure_line(&self) -> String {
+        let mut first: Vec<String> = Vec::new();
+        for r in self
+            .run
+            .reasons
+            .iter()
+            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
+        {
+            let t = format!("{} ({})", r.check, r.verdict);
+            if !first.contains(&t) {
+                first.push(t);
+            }
+        }
+        format!(
+            "verdict {}: {}",
+            self.verdict(),
+            if first.is_empty() {
+                "no reason recorded".into()
+            } else {
+                first.join(", ")
+            }
+        )
+    }
+}
+
+/// Writes the calibrated law `law` (named `name`, e.g. `janssen`) with the verdict of
+/// `checks` and records it in `verdict`: `NAME_law.json` when ok, or when suspect with
+/// `verdict.allow_suspect` (marked `"verdict": "suspect"` with its reasons); otherwise
+/// `NAME_law.rejected.json` (same schema, with the verdict and reasons), and a stale file of the
+/// other name from an earlier run in the directory is removed.
+pub fn export_law(
+    out: &mut OutputDir,
+    verdict: &mut RunVerdict,
+    name: &str,
+    law: &identify::CalibratedLaw,
+    checks: Checks,
+) -> Result<()> {
+    let v = checks.verdict();
+    let accepted = v == Verdict::Ok || (v == Verdict::Suspect && verdict.allow_suspect);
+    let (file, stale) = if accepted {
+        (
+            format!("{name}_law.json"),
+            format!("{name}_law.rejected.json"),
+        )
+    } else {
+        (
+            format!("{name}_law.rejected.json"),
+            format!("{name}_law.json"),
+        )
+    };
+    let mut law = law.clone();
+    law.verdict = Some(v.as_str().to_string());
+    law.verdict_reasons = checks.reasons.iter().map(Reason::to_json).collect();
+    let text = law.to_json_string()?;
+    out.write(&file, (text + "\n").as_bytes())?;
+    let stale = out.file(&stale);
+    if stale.exists() {
+        std::fs::remove_file(&stale).map_err(|e| crate::error::CliError::io(&stale, e))?;
+    }
+    verdict.laws.push(LawVerdict {
+        law: law.law.clone(),
+        file: Some(file),
+        checks,
+    });
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn worst_reason_wins_and_thresholds_are_strict() {
+        let mut c = Checks::new();
+        c.at_most("a", 0.01, 0.01, Some(0.25), |_| String::new());
+        assert_eq!(c.verdict(), Verdict::Ok, "at the threshold is ok");
+        c.at_most("a", 0.02, 0.01, Some(0.25), |_| String::new());
+        assert_eq!(c.verdict(), Verdict::Suspect);
+        c.at_most("b", f64::NAN, 0.01, None, |_| String::new());
+        assert_eq!(c.verdict(), Verdict::Refused, "a NaN measure is refused");
+        assert_eq!(c.reasons[1].threshold, 0.01);
+    }
+
+    #[test]
+    fn halves_of_a_linear_drift_and_of_noise() {
+        // A ramp 0 → 1 over 64 samples: halves' means differ by 0.5 (32 samples apart, slope
+        // 1/63 per sample → 32/63), with tiny block scatter: far beyond 4 standard errors.
+        let ramp: Vec<f64> = (0..64).map(|k| k as f64 / 63.0).collect();
+        let (d, z) = halves_drift(&ramp).unwrap();
+        assert!((d - 32.0 / 63.0).abs() < 1e-12, "Δ = {d}");
+        assert!(z > STEADY_Z, "z = {z}");
+        // An alternating sequence is steady: equal halves.
+        let flat: Vec<f64> = (0..64)
+            .map(|k| if k % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let (d, z) = halves_drift(&flat).unwrap();
+        assert_eq!(d, 0.0);
+        assert_eq!(z, 0.0);
+        assert!(halves_drift(&ramp[..15]).is_none());
+    }
+
+    #[test]
+    fn single_unconverged_step_is_judged_by_its_error() {
+        let w = WindowStats {
+            steps: 1,
+            unconverged: 1,
+            worst_error: 2e-6,
+            tolerance: 1e-6,
+            ..Default::default()
+        };
+        let mut c = Checks::new();
+        c.window("measured step", &w);
+        assert_eq!(c.verdict(), Verdict::Suspect);
+        let w = WindowStats {
+            worst_error: 2e-3,
+            ..w
+        };
+        let mut c = Checks::new();
+        c.window("measured step", &w);
+        assert_eq!(c.verdict(), Verdict::Refused);
+    }
+}
