@@ -15,6 +15,7 @@ pub mod floats;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod provenance;
 pub mod scenarios;
 
 pub use error::{CliError, Result};

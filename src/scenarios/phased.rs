@@ -68,6 +68,9 @@ pub struct RunControl {
     pub stop_after_steps: Option<u64>,
     /// Wall-clock seconds of earlier invocations (read from the checkpoint on resume).
     pub previous_wall_seconds: f64,
+    /// Start date and input hashes of the run, for the provenance of its laws (read from the
+    /// checkpoint on resume).
+    pub origin: crate::provenance::RunOrigin,
     started: Instant,
     last_checkpoint: Instant,
     steps_since_checkpoint: u64,
@@ -91,6 +94,7 @@ impl RunControl {
             resume: false,
             stop_after_steps: None,
             previous_wall_seconds: 0.0,
+            origin: Default::default(),
             started: now,
             last_checkpoint: now,
             steps_since_checkpoint: 0,
@@ -203,6 +207,7 @@ pub fn drive<P: PhasedRun>(
             });
         }
         ctl.previous_wall_seconds = cp.wall_seconds;
+        ctl.origin = cp.origin.clone();
         ctl.steps_total = cp.steps_total;
         (World::from_state(cp.world), cp.state, Some(cp.cursor))
     } else {
@@ -250,6 +255,7 @@ pub fn drive<P: PhasedRun>(
                         },
                         steps_total: ctl.steps_total,
                         wall_seconds: ctl.wall_seconds(),
+                        origin: ctl.origin.clone(),
                         world: w.state(),
                         state: &*st,
                     };
