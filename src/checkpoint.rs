@@ -116,6 +116,9 @@ pub struct RunCheckpoint<S> {
     pub steps_total: u64,
     /// Wall-clock seconds spent by the run so far, over every invocation (s).
     pub wall_seconds: f64,
+    /// The run's start date and input hashes, recorded in the laws it writes.
+    #[serde(default)]
+    pub origin: crate::provenance::RunOrigin,
     /// The world.
     pub world: WorldState,
     /// The scenario's state.

@@ -16,6 +16,7 @@ pub mod floats;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod provenance;
 pub mod scenarios;
 pub mod verdict;
 

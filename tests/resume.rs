@@ -18,7 +18,8 @@ const SCENARIO: &[&str] = &["run", "janssen", "--set", "grains=60", "-q"];
 
 fn grainlaw(args: &[&str], extra: &[&Path]) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_grainlaw"));
-    cmd.args(args);
+    // The laws record the date the run started: the same for every run compared.
+    cmd.env("SOURCE_DATE_EPOCH", "1767225600").args(args);
     for p in extra {
         cmd.arg(p);
     }
@@ -203,6 +204,7 @@ fn signal_stops_cleanly_and_the_run_resumes(signal: &str) {
     // Checkpoints every 20 steps: the first one shows that the run is stepping (the Ctrl-C
     // handler is installed before the first step).
     let mut child = Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .env("SOURCE_DATE_EPOCH", "1767225600")
         .args(SCENARIO)
         .args(["--checkpoint-every", "20", "--out"])
         .arg(&b)

@@ -1,21 +1,44 @@
-//! VTK files for ParaView: XML PolyData (`.vtp`, ASCII) per frame and `.pvd` collections that
-//! make them a time series.
+//! VTK files for ParaView: XML PolyData (`.vtp`) per frame, binary (base64 of zlib-compressed
+//! blocks), and `.pvd` collections that make them a time series.
+//!
+//! Every file is a `VTKFile` of version 1.0 with `byte_order="LittleEndian"`,
+//! `header_type="UInt64"` and `compressor="vtkZLibDataCompressor"`; every `DataArray` is
+//! `format="binary"`: the little-endian values are cut into blocks of 32 768 bytes, each block
+//! compressed with zlib (RFC 1950), and the array's text is the base64 (RFC 4648) of the header
+//! `[number of blocks, block size, size of the last block if partial (else 0), compressed size of
+//! each block]` (UInt64 words) followed by the base64 of the compressed blocks put end to end —
+//! the layout of VTK's `vtkXMLWriter` (VTK User's Guide, "VTK File Formats", XML binary data).
+//! Doubles are written as they are (Float64), so a reader gets the bits of the simulation.
+//!
+//! Identifiers: a grain's `id` is the index of its body in the world (walls are bodies too, so
+//! the first grain is not always 0); a wall's is `−1 − k`, `k` its index among the world's
+//! walls. Both appear as `id_a`, `id_b` on the contacts.
 //!
 //! Per frame, in `vtk/`:
-//! - `grains_NNNN.vtp`: one vertex per grain at its centre; point data `radius` (m),
-//!   `velocity` (m/s), `omega` (rad/s), `stress` (the grain's mean stress with inertia Σ_p, Pa,
-//!   tension positive, 3×3 with zero z row and column) and `inertia_ratio` (‖Σ_i‖/‖Σ_c‖);
-//!   show them with the "Point Gaussian" representation scaled by `radius`;
-//! - `contacts_NNNN.vtp`: one line per contact with a force, from body a's centre (a wall's
-//!   contact point) to body b's centre; cell data `normal_force`, `tangential_force` (N),
-//!   `force` (vector on b, N), `mobilisation` |f_t|/(μ f_n);
-//! - `walls_NNNN.vtp`: line and segment walls as lines, rough-wall disks as vertices with `radius`.
+//! - `grains_NNNN.vtp`: one vertex per grain at its centre; point data `id`, `radius` (m),
+//!   `mass` (kg per metre of thickness), `velocity` (m/s), `omega` (angular velocity, rad/s),
+//!   `angle` (rad), `stress` (the grain's mean stress with inertia Σ_p, Pa, tension positive,
+//!   3×3 with zero z row and column) and `inertia_ratio` (‖Σ_i‖/‖Σ_c‖); show them with the
+//!   "Point Gaussian" representation scaled by `radius`;
+//! - `contacts_NNNN.vtp`: one line per contact of the step (open ones included), from body a's
+//!   centre (a wall's contact point) to body b's centre; cell data `id_a`, `id_b`, `status`
+//!   (0 open, 1 stick, 2 slide), `contact_point` (m), `normal` (unit, from a to b), `gap` (m),
+//!   `normal_force`, `tangential_force` (N), `force` (vector on b, N), `mobilisation`
+//!   |f_t|/(μ f_n);
+//! - `walls_NNNN.vtp`: line and segment walls as lines, rough-wall disks as vertices; point
+//!   data `id` and `radius`.
 //!
 //! `grains.pvd`, `contacts.pvd`, `walls.pvd` list the frames with their times (s).
 
 use std::fmt::Write as _;
+use std::io::Write as _;
 
+use base64::engine::general_purpose::STANDARD as BASE64;
+use base64::Engine as _;
+use dem::local::ContactStatus;
 use dem::snapshot::{BodyKind, Snapshot, WallGeometry};
+use flate2::write::ZlibEncoder;
+use flate2::Compression;
 use homogenise::tensor::frobenius;
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
@@ -31,38 +54,72 @@ pub struct VtkSeries {
     prefix: String,
 }
 
-fn data_array(s: &mut String, name: &str, comps: usize, values: impl Iterator<Item = f64>) {
-    let _ = write!(
-        s,
-        "        <DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"ascii\">\n          "
-    );
-    for (i, v) in values.enumerate() {
-        let v = if v.is_finite() { v } else { 0.0 };
-        let _ = write!(s, "{v:e} ");
-        if i % 12 == 11 {
-            s.push_str("\n          ");
-        }
+/// Uncompressed size of one compressed block (bytes), VTK's default.
+pub const BLOCK_SIZE: usize = 1 << 15;
+
+/// The text of a `format="binary"` DataArray holding `raw` (little-endian values): base64 of the
+/// UInt64 compression header, then base64 of the zlib blocks (module documentation).
+pub fn encode_binary(raw: &[u8]) -> String {
+    let blocks = raw.len().div_ceil(BLOCK_SIZE);
+    let mut header: Vec<u64> = Vec::with_capacity(3 + blocks);
+    header.extend([
+        blocks as u64,
+        BLOCK_SIZE as u64,
+        (raw.len() % BLOCK_SIZE) as u64,
+    ]);
+    let mut data = Vec::new();
+    for chunk in raw.chunks(BLOCK_SIZE) {
+        let before = data.len();
+        let mut z = ZlibEncoder::new(&mut data, Compression::default());
+        // Writing into a Vec cannot fail.
+        let _ = z.write_all(chunk);
+        let _ = z.finish();
+        header.push((data.len() - before) as u64);
     }
-    s.push_str("\n        </DataArray>\n");
+    let head: Vec<u8> = header.iter().flat_map(|w| w.to_le_bytes()).collect();
+    let mut s = BASE64.encode(head);
+    s.push_str(&BASE64.encode(data));
+    s
 }
 
-fn int_array(s: &mut String, name: &str, values: impl Iterator<Item = usize>) {
-    let _ = write!(
+/// One `DataArray` element of VTK type `ty` (`Float64`, `Int64`, `UInt8`) holding `raw`.
+fn array_xml(s: &mut String, name: &str, ty: &str, comps: usize, raw: &[u8]) {
+    let _ = writeln!(
         s,
-        "        <DataArray type=\"Int64\" Name=\"{name}\" format=\"ascii\">\n          "
+        "        <DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"binary\">\n          {}\n        </DataArray>",
+        encode_binary(raw)
     );
-    for (i, v) in values.enumerate() {
-        let _ = write!(s, "{v} ");
-        if i % 20 == 19 {
-            s.push_str("\n          ");
-        }
-    }
-    s.push_str("\n        </DataArray>\n");
+}
+
+/// A Float64 array; values that are not finite are written as 0.
+fn data_array(s: &mut String, name: &str, comps: usize, values: impl Iterator<Item = f64>) {
+    let raw: Vec<u8> = values
+        .flat_map(|v| (if v.is_finite() { v } else { 0.0 }).to_le_bytes())
+        .collect();
+    array_xml(s, name, "Float64", comps, &raw);
+}
+
+/// An Int64 array of one component.
+fn int_array(s: &mut String, name: &str, values: impl Iterator<Item = i64>) {
+    let raw: Vec<u8> = values.flat_map(i64::to_le_bytes).collect();
+    array_xml(s, name, "Int64", 1, &raw);
+}
+
+/// Connectivity and offsets of `cells` cells of `per` consecutive points each, from point 0.
+fn cells(s: &mut String, tag: &str, first: &[usize], per: usize) {
+    let _ = writeln!(s, "      <{tag}>");
+    int_array(
+        s,
+        "connectivity",
+        first.iter().flat_map(|&k| (k..k + per).map(|p| p as i64)),
+    );
+    int_array(s, "offsets", (1..=first.len()).map(|k| (per * k) as i64));
+    let _ = writeln!(s, "      </{tag}>");
 }
 
 fn header(nverts: usize, nlines: usize, npoints: usize) -> String {
     format!(
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n    <Piece NumberOfPoints=\"{npoints}\" NumberOfVerts=\"{nverts}\" NumberOfLines=\"{nlines}\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n  <PolyData>\n    <Piece NumberOfPoints=\"{npoints}\" NumberOfVerts=\"{nverts}\" NumberOfLines=\"{nlines}\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
     )
 }
 
@@ -74,27 +131,53 @@ fn points(s: &mut String, p: &[Vector2<f64>]) {
     s.push_str("      </Points>\n");
 }
 
+/// The id of body `body` in the VTK files: its index for a grain, `−1 − k` for the `k`-th wall
+/// of the snapshot (module documentation).
+pub fn body_id(snap: &Snapshot, body: u32) -> i64 {
+    match snap.bodies.get(body as usize).map(|b| b.kind) {
+        Some(BodyKind::Grain) | None => i64::from(body),
+        Some(BodyKind::Wall) => snap
+            .walls
+            .iter()
+            .position(|w| w.body == body)
+            .map_or(i64::from(body), |k| -1 - k as i64),
+    }
+}
+
+/// Code of a contact status in the `status` array: 0 open, 1 stick, 2 slide.
+pub fn status_code(s: ContactStatus) -> u8 {
+    match s {
+        ContactStatus::Open => 0,
+        ContactStatus::Stick => 1,
+        ContactStatus::Slide => 2,
+    }
+}
+
 /// The grains of a snapshot as `.vtp` text.
 pub fn grains_vtp(snap: &Snapshot) -> Result<String> {
     let stresses = homogenise::grain_stresses(snap)?;
-    let grains: Vec<_> = snap
+    let grains: Vec<(usize, _)> = snap
         .bodies
         .iter()
-        .filter(|b| b.kind == BodyKind::Grain)
+        .enumerate()
+        .filter(|(_, b)| b.kind == BodyKind::Grain)
         .collect();
     let n = grains.len();
     let mut s = header(n, 0, n);
     s.push_str("      <PointData Scalars=\"radius\" Vectors=\"velocity\" Tensors=\"stress\">\n");
-    data_array(&mut s, "radius", 1, grains.iter().map(|b| b.radius));
+    int_array(&mut s, "id", grains.iter().map(|(i, _)| *i as i64));
+    data_array(&mut s, "radius", 1, grains.iter().map(|(_, b)| b.radius));
+    data_array(&mut s, "mass", 1, grains.iter().map(|(_, b)| b.mass));
     data_array(
         &mut s,
         "velocity",
         3,
         grains
             .iter()
-            .flat_map(|b| [b.velocity.x, b.velocity.y, 0.0]),
+            .flat_map(|(_, b)| [b.velocity.x, b.velocity.y, 0.0]),
     );
-    data_array(&mut s, "omega", 1, grains.iter().map(|b| b.omega));
+    data_array(&mut s, "omega", 1, grains.iter().map(|(_, b)| b.omega));
+    data_array(&mut s, "angle", 1, grains.iter().map(|(_, b)| b.angle));
     data_array(
         &mut s,
         "stress",
@@ -130,12 +213,9 @@ pub fn grains_vtp(snap: &Snapshot) -> Result<String> {
     s.push_str("      </PointData>\n");
     points(
         &mut s,
-        &grains.iter().map(|b| b.position).collect::<Vec<_>>(),
+        &grains.iter().map(|(_, b)| b.position).collect::<Vec<_>>(),
     );
-    s.push_str("      <Verts>\n");
-    int_array(&mut s, "connectivity", 0..n);
-    int_array(&mut s, "offsets", 1..=n);
-    s.push_str("      </Verts>\n");
+    cells(&mut s, "Verts", &(0..n).collect::<Vec<_>>(), 1);
     s.push_str(FOOTER);
     Ok(s)
 }
@@ -158,12 +238,29 @@ pub fn branch(snap: &Snapshot, c: &dem::snapshot::ContactState) -> (Vector2<f64>
     (pa, pb)
 }
 
-/// The contacts of a snapshot that carry a force, as `.vtp` text.
+/// The contacts of a snapshot (every contact of the step, open ones included) as `.vtp` text.
 pub fn contacts_vtp(snap: &Snapshot) -> String {
-    let cs: Vec<_> = snap.contacts.iter().filter(|c| c.force_n > 0.0).collect();
+    let cs = &snap.contacts;
     let n = cs.len();
     let mut s = header(0, n, 2 * n);
     s.push_str("      <CellData Scalars=\"normal_force\" Vectors=\"force\">\n");
+    int_array(&mut s, "id_a", cs.iter().map(|c| body_id(snap, c.body_a)));
+    int_array(&mut s, "id_b", cs.iter().map(|c| body_id(snap, c.body_b)));
+    let status: Vec<u8> = cs.iter().map(|c| status_code(c.status)).collect();
+    array_xml(&mut s, "status", "UInt8", 1, &status);
+    data_array(
+        &mut s,
+        "contact_point",
+        3,
+        cs.iter().flat_map(|c| [c.point.x, c.point.y, 0.0]),
+    );
+    data_array(
+        &mut s,
+        "normal",
+        3,
+        cs.iter().flat_map(|c| [c.normal.x, c.normal.y, 0.0]),
+    );
+    data_array(&mut s, "gap", 1, cs.iter().map(|c| c.gap));
     data_array(&mut s, "normal_force", 1, cs.iter().map(|c| c.force_n));
     data_array(&mut s, "tangential_force", 1, cs.iter().map(|c| c.force_t));
     data_array(
@@ -190,10 +287,12 @@ pub fn contacts_vtp(snap: &Snapshot) -> String {
         })
         .collect();
     points(&mut s, &pts);
-    s.push_str("      <Lines>\n");
-    int_array(&mut s, "connectivity", 0..2 * n);
-    int_array(&mut s, "offsets", (1..=n).map(|k| 2 * k));
-    s.push_str("      </Lines>\n");
+    cells(
+        &mut s,
+        "Lines",
+        &(0..n).map(|k| 2 * k).collect::<Vec<_>>(),
+        2,
+    );
     s.push_str(FOOTER);
     s
 }
@@ -247,49 +346,44 @@ pub fn walls_vtp(snap: &Snapshot) -> String {
     let ext = grain_extent(snap);
     let mut pts = Vec::new();
     let mut radius = Vec::new();
+    let mut ids = Vec::new();
     let mut lines = Vec::new();
     let mut verts = Vec::new();
-    for w in &snap.walls {
+    for (k, w) in snap.walls.iter().enumerate() {
+        let id = -1 - k as i64;
         match &w.geometry {
             WallGeometry::Line { point, normal } => {
                 if let Some((a, b)) = clip_line(*point, *normal, ext) {
                     lines.push(pts.len());
-                    pts.push(a);
-                    pts.push(b);
+                    pts.extend([a, b]);
                     radius.extend([0.0, 0.0]);
+                    ids.extend([id, id]);
                 }
             }
             WallGeometry::Segment { a, b } => {
                 lines.push(pts.len());
-                pts.push(*a);
-                pts.push(*b);
+                pts.extend([*a, *b]);
                 radius.extend([0.0, 0.0]);
+                ids.extend([id, id]);
             }
             WallGeometry::Clump { centres, radii } => {
                 for (c, r) in centres.iter().zip(radii) {
                     verts.push(pts.len());
                     pts.push(*c);
                     radius.push(*r);
+                    ids.push(id);
                 }
             }
         }
     }
     let mut s = header(verts.len(), lines.len(), pts.len());
     s.push_str("      <PointData Scalars=\"radius\">\n");
+    int_array(&mut s, "id", ids.into_iter());
     data_array(&mut s, "radius", 1, radius.into_iter());
     s.push_str("      </PointData>\n");
     points(&mut s, &pts);
-    s.push_str("      <Verts>\n");
-    int_array(&mut s, "connectivity", verts.iter().copied());
-    int_array(&mut s, "offsets", 1..=verts.len());
-    s.push_str("      </Verts>\n      <Lines>\n");
-    int_array(
-        &mut s,
-        "connectivity",
-        lines.iter().flat_map(|&k| [k, k + 1]),
-    );
-    int_array(&mut s, "offsets", (1..=lines.len()).map(|k| 2 * k));
-    s.push_str("      </Lines>\n");
+    cells(&mut s, "Verts", &verts, 1);
+    cells(&mut s, "Lines", &lines, 2);
     s.push_str(FOOTER);
     s
 }

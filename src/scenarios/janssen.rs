@@ -31,7 +31,6 @@ use identify::janssen::{
     fit_janssen, fit_janssen_full_mobilisation, JanssenFit, JanssenOptions, JanssenProfile,
     JanssenSetup,
 };
-use identify::law::Provenance;
 use identify::{CalibratedLaw, IdentifyError};
 use nalgebra::Vector2;
 
@@ -580,7 +579,10 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                     "τ_w < 0 in a depth bin of the fit window: Janssen fitted to σ_v and σ_h only",
                 );
             }
-            let law = CalibratedLaw::from_janssen(f, Provenance::new("janssen", Some(c.seed)));
+            let law = CalibratedLaw::from_janssen(
+                f,
+                crate::provenance::of_run(ctx, ctl, "janssen", c.seed),
+            );
             export_law(&mut ctx.out, &mut verdict, "janssen", &law, checks.clone())?;
             headline.push(format!(
                 "K    = {:.3}  (95 % CI {:.3} … {:.3})",

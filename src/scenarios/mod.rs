@@ -88,6 +88,7 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
     }
     if !ctl.resume {
         crate::checkpoint::remove(ctx.out.path())?;
+        ctl.origin = crate::provenance::RunOrigin::now(&ctx.loaded);
     }
     ctx.out
         .write("scenario.toml", ctx.loaded.effective_toml.as_bytes())?;

@@ -71,6 +71,9 @@ pub struct RunControl {
     /// `--allow-suspect`: suspect laws are exported as laws (marked suspect) and the run exits
     /// with 0 ([`crate::verdict`]); recorded in checkpoints.
     pub allow_suspect: bool,
+    /// Start date and input hashes of the run, for the provenance of its laws (read from the
+    /// checkpoint on resume).
+    pub origin: crate::provenance::RunOrigin,
     started: Instant,
     last_checkpoint: Instant,
     steps_since_checkpoint: u64,
@@ -95,6 +98,7 @@ impl RunControl {
             stop_after_steps: None,
             previous_wall_seconds: 0.0,
             allow_suspect: false,
+            origin: Default::default(),
             started: now,
             last_checkpoint: now,
             steps_since_checkpoint: 0,
@@ -210,6 +214,7 @@ pub fn drive<P: PhasedRun>(
             });
         }
         ctl.previous_wall_seconds = cp.wall_seconds;
+        ctl.origin = cp.origin.clone();
         ctl.steps_total = cp.steps_total;
         (World::from_state(cp.world), cp.state, Some(cp.cursor))
     } else {
@@ -257,6 +262,7 @@ pub fn drive<P: PhasedRun>(
                         },
                         steps_total: ctl.steps_total,
                         wall_seconds: ctl.wall_seconds(),
+                        origin: ctl.origin.clone(),
                         world: w.state(),
                         state: &*st,
                     };

@@ -15,7 +15,7 @@ use homogenise::kinematics::{velocity_gradient, VelocityWeight};
 use homogenise::state::solid_fraction;
 use homogenise::walls::{near_wall_profile, NearWallSpec};
 use homogenise::Region;
-use identify::law::{GrainScale, Provenance};
+use identify::law::GrainScale;
 use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use identify::wall_law::{select_wall_law, WallSlipSeries};
 use identify::{CalibratedLaw, FitOptions};
@@ -398,7 +398,8 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         pressure_pa: Some(rows.iter().map(|r| r[4]).collect()),
     };
     let opts = FitOptions::default();
-    let prov = || Provenance::new("shear-cell", Some(c.seed));
+    let provenance = crate::provenance::of_run(ctx, ctl, "shear-cell", c.seed);
+    let prov = || provenance.clone();
     let grain = GrainScale {
         diameter_m: d,
         density_kg_m3: c.grain.density,
