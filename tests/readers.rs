@@ -81,6 +81,8 @@ fn lammps_contact_stress_equals_lammps_pair_virial() {
         let l = lammps_stress_sum(s.step);
         let ours = [m[(0, 0)], m[(1, 1)], m[(1, 0)]];
         let scale = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let worst = (0..3).map(|k| (ours[k] - l[k]).abs()).fold(0.0, f64::max) / scale;
+        eprintln!("step {}: Σ V_p Σ_c = {ours:?} N·m, LAMMPS Σ S_i = {l:?}, relative difference {worst:.1e}", s.step);
         for k in 0..3 {
             assert!(
                 (ours[k] - l[k]).abs() <= 1e-9 * scale,
