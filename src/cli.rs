@@ -108,6 +108,9 @@ pub enum Command {
         /// Steps relaxing each engine deposit before the timed steps.
         #[arg(long, value_name = "STEPS", default_value_t = 30)]
         relax_steps: usize,
+        /// Grain counts of synthetic LAMMPS dumps read and homogenised (none by default).
+        #[arg(long, value_name = "N", num_args = 0..)]
+        homogenise_grains: Vec<usize>,
     },
 }
 
@@ -301,6 +304,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             columns,
             pour,
             relax_steps,
+            homogenise_grains,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
             engine_grains,
@@ -308,6 +312,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             columns,
             pour,
             relax_steps,
+            homogenise_grains,
         }),
     }
 }

@@ -103,7 +103,6 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
     walls.comments.push("wall index: the order of `walls` in summary.json".into());
     let mut vtk = VtkSeries::new();
     let mut wall_names: Vec<String> = Vec::new();
-    let counting = ContactCounting::default();
     let mut last_lines = Vec::new();
     let mut summary = Summary::new();
     summary
@@ -118,23 +117,10 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
         .set("accelerations", snaps.iter().map(|s| s.accelerations.name()).collect::<Vec<_>>().into());
     for ext in &snaps {
         let s = &ext.snapshot;
-        let grains = grain_stresses(s)?;
-        let whole = mean_stress(s, &grains, &Region::Whole)?;
-        let phi = solid_fraction(s, &Region::Whole)?;
-        let z = coordination(s, &Region::Whole, &counting)?;
-        let fab = fabric(s, &Region::Whole, &counting)?;
-        let inv = stress_invariants(&whole.total);
-        let mob: Vec<f64> = contact_mobilisations(s, &ContactClass::All)?.into_iter().map(|(_, m)| m).collect();
-        let ms = mobilisation_stats(&mob, 20, homogenise::mobilisation::COULOMB_LIMIT)?;
-        let mut row = vec![
-            s.step as f64, s.time, grains.len() as f64, s.contacts.len() as f64, phi, z.z,
-            z.z_without_rattlers, z.rattler_fraction, fab.anisotropy, fab.major_angle,
-        ];
-        row.extend(t4(&whole.total));
-        row.extend(t4(&whole.contact));
-        row.extend(t4(&whole.inertia));
-        row.extend([inv.pressure, inv.shear_stress, inv.friction.unwrap_or(f64::NAN),
-            ms.mean.unwrap_or(f64::NAN), ms.fraction_at_limit.unwrap_or(f64::NAN)]);
+        let (row, grains) = snapshot_row(ext)?;
+        let (phi, z) = (row[4], row[5]);
+        let whole_total = Tensor2::new(row[10], row[11], row[12], row[13]);
+        let inv = stress_invariants(&whole_total);
         table.push(row);
         let mut g = CsvTable::new(&[
             "id", "x_m", "y_m", "radius_m", "sigma_xx_Pa", "sigma_xy_Pa", "sigma_yx_Pa", "sigma_yy_Pa",
@@ -168,11 +154,11 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
         last_lines = vec![
             format!(
                 "step {} (t = {:.6} s): {} grains, {} contacts, φ = {:.4}, Z = {:.3}, accelerations: {}",
-                s.step, s.time, grains.len(), s.contacts.len(), phi, z.z, ext.accelerations.name()
+                s.step, s.time, grains.len(), s.contacts.len(), phi, z, ext.accelerations.name()
             ),
             format!(
                 "mean stress (Pa, tension > 0): σxx = {:.4e}, σyy = {:.4e}, σxy = {:.4e}; P = {:.4e}, τ/P = {}",
-                whole.total[(0, 0)], whole.total[(1, 1)], 0.5 * (whole.total[(0, 1)] + whole.total[(1, 0)]),
+                whole_total[(0, 0)], whole_total[(1, 1)], 0.5 * (whole_total[(0, 1)] + whole_total[(1, 0)]),
                 inv.pressure, inv.friction.map_or("-".into(), |f| format!("{f:.4}"))
             ),
         ];
@@ -199,6 +185,109 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
         lines.push(format!("wall {}: force ({:.6e}, {:.6e}) N", w.name, w.force.x, w.force.y));
     }
     Ok(lines)
+}
+
+/// The row of `snapshots.csv` of one snapshot (whole-sample means: solid fraction,
+/// coordination, fabric, mean stress and its parts, invariants, mobilisation) and the per-grain
+/// stresses.
+pub fn snapshot_row(ext: &ExternalSnapshot) -> Result<(Vec<f64>, Vec<homogenise::GrainStress>)> {
+    let s = &ext.snapshot;
+    let counting = ContactCounting::default();
+    let grains = grain_stresses(s)?;
+    let whole = mean_stress(s, &grains, &Region::Whole)?;
+    let phi = solid_fraction(s, &Region::Whole)?;
+    let z = coordination(s, &Region::Whole, &counting)?;
+    let fab = fabric(s, &Region::Whole, &counting)?;
+    let inv = stress_invariants(&whole.total);
+    let mob: Vec<f64> = contact_mobilisations(s, &ContactClass::All)?.into_iter().map(|(_, m)| m).collect();
+    let ms = mobilisation_stats(&mob, 20, homogenise::mobilisation::COULOMB_LIMIT)?;
+    let mut row = vec![
+        s.step as f64, s.time, grains.len() as f64, s.contacts.len() as f64, phi, z.z,
+        z.z_without_rattlers, z.rattler_fraction, fab.anisotropy, fab.major_angle,
+    ];
+    row.extend(t4(&whole.total));
+    row.extend(t4(&whole.contact));
+    row.extend(t4(&whole.inertia));
+    row.extend([inv.pressure, inv.shear_stress, inv.friction.unwrap_or(f64::NAN),
+        ms.mean.unwrap_or(f64::NAN), ms.fraction_at_limit.unwrap_or(f64::NAN)]);
+    Ok((row, grains))
+}
+
+/// A synthetic LAMMPS snapshot for the benchmark: `n` disks of radius 0.5 mm on a square
+/// lattice of spacing 0.999 mm (side `⌈√n⌉`), each in contact with its right and upper
+/// neighbours (about `2n` contacts), pseudo-random velocities and forces: the per-atom dump
+/// (with `fx fy tqz`) and the local dump, in the column names of `docs/formats.md` §7.1.
+pub fn synthetic_lammps_dump(n: usize) -> (String, String) {
+    use std::fmt::Write as _;
+    let side = (n as f64).sqrt().ceil().max(1.0) as usize;
+    let (r, a) = (5e-4, 9.99e-4);
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let mut rnd = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mass = 2500.0 * std::f64::consts::PI * r * r;
+    let mut atoms = format!(
+        "ITEM: TIMESTEP\n1000\nITEM: NUMBER OF ATOMS\n{n}\nITEM: BOX BOUNDS ff ff pp\n0 {l}\n0 {l}\n-0.0005 0.0005\nITEM: ATOMS id x y vx vy omegaz radius mass fx fy tqz\n",
+        l = side as f64 * a
+    );
+    for i in 0..n {
+        let (cx, cy) = ((i % side) as f64 * a + r, (i / side) as f64 * a + r);
+        let _ = writeln!(
+            atoms,
+            "{} {cx:.17e} {cy:.17e} {:.17e} {:.17e} {:.17e} {r:.17e} {mass:.17e} {:.17e} {:.17e} {:.17e}",
+            i + 1, 1e-3 * rnd(), 1e-3 * rnd(), 1e-1 * rnd(), 1e-2 * rnd(), 1e-2 * rnd(), 1e-6 * rnd()
+        );
+    }
+    let mut rows = String::new();
+    let mut count = 0usize;
+    for i in 0..n {
+        for j in [i + 1, i + side] {
+            if j >= n || (j == i + 1 && (i + 1) % side == 0) {
+                continue;
+            }
+            let (nx, ny) = if j == i + 1 { (-1.0, 0.0) } else { (0.0, -1.0) };
+            let fn_ = 1.0 + rnd().abs();
+            let ft = 0.3 * fn_ * rnd();
+            let _ = writeln!(
+                rows,
+                "{} {} {a:.17e} {:.17e} {:.17e} {:.17e} {:.17e} 0",
+                i + 1, j + 1, fn_ * nx, fn_ * ny, -ft * ny, ft * nx
+            );
+            count += 1;
+        }
+    }
+    let pairs = format!(
+        "ITEM: TIMESTEP\n1000\nITEM: NUMBER OF ENTRIES\n{count}\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.0005 0.0005\nITEM: ENTRIES c_ids[1] c_ids[2] c_pf[1] c_pf[2] c_pf[3] c_pf[4] c_pf[5] c_pf[6]\n{rows}"
+    );
+    (atoms, pairs)
+}
+
+/// Benchmark row: writes a synthetic dump of `n` grains (and about `2n` contacts) into `dir`,
+/// then times reading it ([`crate::readers::read_lammps`]) and homogenising it
+/// ([`snapshot_row`]: per-grain stresses, whole-sample means, fabric, coordination,
+/// mobilisation). Returns `(contacts, read seconds, homogenise seconds)`.
+pub fn bench_homogenise(n: usize, dir: &std::path::Path) -> Result<(usize, f64, f64)> {
+    let (atoms, pairs) = synthetic_lammps_dump(n);
+    let a = dir.join(format!("bench_atoms_{n}.dump"));
+    let p = dir.join(format!("bench_pairs_{n}.dump"));
+    std::fs::write(&a, atoms).map_err(|e| CliError::io(&a, e))?;
+    std::fs::write(&p, pairs).map_err(|e| CliError::io(&p, e))?;
+    let t0 = std::time::Instant::now();
+    let snaps = readers::read_lammps(&[a.clone(), p.clone()], &ReadOptions { mu: Some(0.5), ..Default::default() })
+        .map_err(|e| CliError::Usage(e.to_string()))?;
+    let t1 = std::time::Instant::now();
+    let mut contacts = 0;
+    for ext in &snaps {
+        snapshot_row(ext)?;
+        contacts += ext.snapshot.contacts.len();
+    }
+    let t2 = std::time::Instant::now();
+    let _ = std::fs::remove_file(&a);
+    let _ = std::fs::remove_file(&p);
+    Ok((contacts, (t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64()))
 }
 
 /// The outputs of the last snapshot: profiles, coarse fields, mobilisation, figures, summary keys.

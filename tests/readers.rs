@@ -286,3 +286,23 @@ fn homogenise_command_writes_the_outputs() {
     let phi = s["solid_fraction"].as_f64().unwrap();
     assert!(phi > 0.75 && phi < 0.91, "{phi}");
 }
+
+#[test]
+fn synthetic_benchmark_dump_reads_back() {
+    // the generator of `grainlaw bench --homogenise-grains`: a 20 × 20 square lattice has
+    // 2 · 20 · 19 = 760 neighbour contacts, and a lattice of spacing 0.999 d a solid fraction
+    // of π/4 / 0.999² inside its cells
+    let dir = tempfile::tempdir().unwrap();
+    let (c, read_s, hom_s) = grainlaw::homogenise_cmd::bench_homogenise(400, dir.path()).unwrap();
+    assert_eq!(c, 760);
+    assert!(read_s >= 0.0 && hom_s >= 0.0);
+    let (atoms, pairs) = grainlaw::homogenise_cmd::synthetic_lammps_dump(400);
+    let a = write(dir.path(), "a.dump", &atoms);
+    let p = write(dir.path(), "p.dump", &pairs);
+    let s = &readers::read_lammps(&[a, p], &ReadOptions::default()).unwrap()[0].snapshot;
+    let phi = homogenise::state::solid_fraction(s, &homogenise::Region::Whole).unwrap();
+    // the whole-sample box is the grains' extent, 19 spacings plus one diameter wide and high (in d)
+    let w = 19.0 * 0.999 + 1.0;
+    let expect = 400.0 * std::f64::consts::PI * 0.25 / (w * w);
+    assert!((phi - expect).abs() < 1e-9, "{phi} vs {expect}");
+}
