@@ -225,7 +225,10 @@ fn homogenise_rows(plan: &BenchPlan) -> Result<()> {
         return Ok(());
     }
     println!("\nread + homogenise a LAMMPS dump (synthetic, one snapshot, one thread):");
-    println!("{:>9} {:>9} {:>9} {:>12} {:>9}", "grains", "contacts", "read s", "homogenise s", "total s");
+    println!(
+        "{:>9} {:>9} {:>9} {:>12} {:>9}",
+        "grains", "contacts", "read s", "homogenise s", "total s"
+    );
     let dir = std::env::temp_dir();
     for &n in &plan.homogenise_grains {
         let (c, r, h) = crate::homogenise_cmd::bench_homogenise(n, &dir)?;

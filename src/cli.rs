@@ -235,7 +235,12 @@ pub struct HomogeniseArgs {
     #[arg(long)]
     pub dt: Option<f64>,
     /// Gravity `GX,GY` (m/s²).
-    #[arg(long, value_name = "GX,GY", default_value = "0,-9.81", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "GX,GY",
+        default_value = "0,-9.81",
+        allow_hyphen_values = true
+    )]
     pub gravity: String,
     /// Moment of inertia I = K m R² for LAMMPS (0.5 disks, 0.4 spheres).
     #[arg(long, value_name = "K", default_value_t = 0.5)]
@@ -264,7 +269,9 @@ fn homogenise_cmd(a: HomogeniseArgs) -> Result<()> {
     let plan = crate::homogenise_cmd::HomogenisePlan {
         format,
         files: a.files,
-        out: a.out.unwrap_or_else(|| PathBuf::from("grainlaw-out").join("homogenise")),
+        out: a
+            .out
+            .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("homogenise")),
         options: crate::readers::ReadOptions {
             gravity: [g[0], g[1]],
             mu: a.mu,

@@ -77,44 +77,100 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
     }
     if let Some(mu) = plan.options.mu {
         if !(mu.is_finite() && mu > 0.0) {
-            return Err(CliError::Usage(format!("--mu must be finite and > 0, got {mu}")));
+            return Err(CliError::Usage(format!(
+                "--mu must be finite and > 0, got {mu}"
+            )));
         }
     }
     if !(plan.options.inertia_factor.is_finite() && plan.options.inertia_factor > 0.0) {
-        return Err(CliError::Usage("--inertia-factor must be finite and > 0".into()));
+        return Err(CliError::Usage(
+            "--inertia-factor must be finite and > 0".into(),
+        ));
     }
     let snaps = readers::read(plan.format, &plan.files, &plan.options)
         .map_err(|e| CliError::Usage(e.to_string()))?;
     if plan.out.exists() && !plan.out.is_dir() {
-        return Err(CliError::Usage(format!("--out {}: is a file, not a directory", plan.out.display())));
+        return Err(CliError::Usage(format!(
+            "--out {}: is a file, not a directory",
+            plan.out.display()
+        )));
     }
     let mut out = OutputDir::create(&plan.out)?;
     let started = std::time::Instant::now();
     let mut table = CsvTable::new(&[
-        "step", "time_s", "grains", "contacts", "solid_fraction", "z", "z_without_rattlers",
-        "rattler_fraction", "fabric_anisotropy", "fabric_major_angle_rad", "sigma_xx_Pa",
-        "sigma_xy_Pa", "sigma_yx_Pa", "sigma_yy_Pa", "contact_sigma_xx_Pa", "contact_sigma_xy_Pa",
-        "contact_sigma_yx_Pa", "contact_sigma_yy_Pa", "inertia_sigma_xx_Pa", "inertia_sigma_xy_Pa",
-        "inertia_sigma_yx_Pa", "inertia_sigma_yy_Pa", "pressure_Pa", "shear_stress_Pa",
-        "stress_ratio", "mean_mobilisation", "fraction_at_limit",
+        "step",
+        "time_s",
+        "grains",
+        "contacts",
+        "solid_fraction",
+        "z",
+        "z_without_rattlers",
+        "rattler_fraction",
+        "fabric_anisotropy",
+        "fabric_major_angle_rad",
+        "sigma_xx_Pa",
+        "sigma_xy_Pa",
+        "sigma_yx_Pa",
+        "sigma_yy_Pa",
+        "contact_sigma_xx_Pa",
+        "contact_sigma_xy_Pa",
+        "contact_sigma_yx_Pa",
+        "contact_sigma_yy_Pa",
+        "inertia_sigma_xx_Pa",
+        "inertia_sigma_xy_Pa",
+        "inertia_sigma_yx_Pa",
+        "inertia_sigma_yy_Pa",
+        "pressure_Pa",
+        "shear_stress_Pa",
+        "stress_ratio",
+        "mean_mobilisation",
+        "fraction_at_limit",
     ]);
-    table.comments.push("whole-sample means per snapshot (grainlaw homogenise)".into());
-    let mut walls = CsvTable::new(&["step", "wall", "force_x_N", "force_y_N", "torque_Nm", "contacts"]);
-    walls.comments.push("wall index: the order of `walls` in summary.json".into());
+    table
+        .comments
+        .push("whole-sample means per snapshot (grainlaw homogenise)".into());
+    let mut walls = CsvTable::new(&[
+        "step",
+        "wall",
+        "force_x_N",
+        "force_y_N",
+        "torque_Nm",
+        "contacts",
+    ]);
+    walls
+        .comments
+        .push("wall index: the order of `walls` in summary.json".into());
     let mut vtk = VtkSeries::new();
     let mut wall_names: Vec<String> = Vec::new();
     let mut last_lines = Vec::new();
     let mut summary = Summary::new();
     summary
         .text("command", "homogenise")
-        .text("format", match plan.format {
-            Format::Lammps => "lammps",
-            Format::Lmgc90 => "lmgc90",
-            Format::Plain => "plain",
-        })
-        .set("files", plan.files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().into())
+        .text(
+            "format",
+            match plan.format {
+                Format::Lammps => "lammps",
+                Format::Lmgc90 => "lmgc90",
+                Format::Plain => "plain",
+            },
+        )
+        .set(
+            "files",
+            plan.files
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .into(),
+        )
         .int("snapshots", snaps.len() as u64)
-        .set("accelerations", snaps.iter().map(|s| s.accelerations.name()).collect::<Vec<_>>().into());
+        .set(
+            "accelerations",
+            snaps
+                .iter()
+                .map(|s| s.accelerations.name())
+                .collect::<Vec<_>>()
+                .into(),
+        );
     for ext in &snaps {
         let s = &ext.snapshot;
         let (row, grains) = snapshot_row(ext)?;
@@ -123,13 +179,28 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
         let inv = stress_invariants(&whole_total);
         table.push(row);
         let mut g = CsvTable::new(&[
-            "id", "x_m", "y_m", "radius_m", "sigma_xx_Pa", "sigma_xy_Pa", "sigma_yx_Pa", "sigma_yy_Pa",
-            "contact_sigma_xx_Pa", "contact_sigma_xy_Pa", "contact_sigma_yx_Pa", "contact_sigma_yy_Pa",
-            "inertia_sigma_xx_Pa", "inertia_sigma_xy_Pa", "inertia_sigma_yx_Pa", "inertia_sigma_yy_Pa",
+            "id",
+            "x_m",
+            "y_m",
+            "radius_m",
+            "sigma_xx_Pa",
+            "sigma_xy_Pa",
+            "sigma_yx_Pa",
+            "sigma_yy_Pa",
+            "contact_sigma_xx_Pa",
+            "contact_sigma_xy_Pa",
+            "contact_sigma_yx_Pa",
+            "contact_sigma_yy_Pa",
+            "inertia_sigma_xx_Pa",
+            "inertia_sigma_xy_Pa",
+            "inertia_sigma_yx_Pa",
+            "inertia_sigma_yy_Pa",
         ]);
         g.comments.push(format!(
             "per-grain mean stress at step {} (t = {} s), accelerations: {}",
-            s.step, s.time, ext.accelerations.name()
+            s.step,
+            s.time,
+            ext.accelerations.name()
         ));
         for (id, gs) in ext.grain_ids.iter().zip(&grains) {
             let mut r = vec![*id as f64, gs.position.x, gs.position.y, gs.radius];
@@ -147,8 +218,19 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
                     wall_names.len() - 1
                 }
             };
-            let nc = s.contacts.iter().filter(|c| c.body_a == w.body || c.body_b == w.body).count();
-            walls.push(vec![s.step as f64, k as f64, w.force.x, w.force.y, w.torque, nc as f64]);
+            let nc = s
+                .contacts
+                .iter()
+                .filter(|c| c.body_a == w.body || c.body_b == w.body)
+                .count();
+            walls.push(vec![
+                s.step as f64,
+                k as f64,
+                w.force.x,
+                w.force.y,
+                w.torque,
+                nc as f64,
+            ]);
         }
         vtk.add_frame(&mut out, s)?;
         last_lines = vec![
@@ -168,7 +250,9 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
         walls.write(&mut out, "walls.csv")?;
     }
     vtk.finish(&mut out)?;
-    let last = snaps.last().ok_or_else(|| CliError::Usage("homogenise: no snapshot read".into()))?;
+    let last = snaps
+        .last()
+        .ok_or_else(|| CliError::Usage("homogenise: no snapshot read".into()))?;
     last_outputs(&mut out, last, &mut summary)?;
     summary.set("walls", wall_names.clone().into());
     let s = &last.snapshot;
@@ -182,7 +266,10 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
     let mut lines = vec![format!("report: {}/", plan.out.display())];
     lines.extend(last_lines);
     for w in &s.walls {
-        lines.push(format!("wall {}: force ({:.6e}, {:.6e}) N", w.name, w.force.x, w.force.y));
+        lines.push(format!(
+            "wall {}: force ({:.6e}, {:.6e}) N",
+            w.name, w.force.x, w.force.y
+        ));
     }
     Ok(lines)
 }
@@ -199,17 +286,33 @@ pub fn snapshot_row(ext: &ExternalSnapshot) -> Result<(Vec<f64>, Vec<homogenise:
     let z = coordination(s, &Region::Whole, &counting)?;
     let fab = fabric(s, &Region::Whole, &counting)?;
     let inv = stress_invariants(&whole.total);
-    let mob: Vec<f64> = contact_mobilisations(s, &ContactClass::All)?.into_iter().map(|(_, m)| m).collect();
+    let mob: Vec<f64> = contact_mobilisations(s, &ContactClass::All)?
+        .into_iter()
+        .map(|(_, m)| m)
+        .collect();
     let ms = mobilisation_stats(&mob, 20, homogenise::mobilisation::COULOMB_LIMIT)?;
     let mut row = vec![
-        s.step as f64, s.time, grains.len() as f64, s.contacts.len() as f64, phi, z.z,
-        z.z_without_rattlers, z.rattler_fraction, fab.anisotropy, fab.major_angle,
+        s.step as f64,
+        s.time,
+        grains.len() as f64,
+        s.contacts.len() as f64,
+        phi,
+        z.z,
+        z.z_without_rattlers,
+        z.rattler_fraction,
+        fab.anisotropy,
+        fab.major_angle,
     ];
     row.extend(t4(&whole.total));
     row.extend(t4(&whole.contact));
     row.extend(t4(&whole.inertia));
-    row.extend([inv.pressure, inv.shear_stress, inv.friction.unwrap_or(f64::NAN),
-        ms.mean.unwrap_or(f64::NAN), ms.fraction_at_limit.unwrap_or(f64::NAN)]);
+    row.extend([
+        inv.pressure,
+        inv.shear_stress,
+        inv.friction.unwrap_or(f64::NAN),
+        ms.mean.unwrap_or(f64::NAN),
+        ms.fraction_at_limit.unwrap_or(f64::NAN),
+    ]);
     Ok((row, grains))
 }
 
@@ -254,7 +357,12 @@ pub fn synthetic_lammps_dump(n: usize) -> (String, String) {
             let _ = writeln!(
                 rows,
                 "{} {} {a:.17e} {:.17e} {:.17e} {:.17e} {:.17e} 0",
-                i + 1, j + 1, fn_ * nx, fn_ * ny, -ft * ny, ft * nx
+                i + 1,
+                j + 1,
+                fn_ * nx,
+                fn_ * ny,
+                -ft * ny,
+                ft * nx
             );
             count += 1;
         }
@@ -276,8 +384,14 @@ pub fn bench_homogenise(n: usize, dir: &std::path::Path) -> Result<(usize, f64, 
     std::fs::write(&a, atoms).map_err(|e| CliError::io(&a, e))?;
     std::fs::write(&p, pairs).map_err(|e| CliError::io(&p, e))?;
     let t0 = std::time::Instant::now();
-    let snaps = readers::read_lammps(&[a.clone(), p.clone()], &ReadOptions { mu: Some(0.5), ..Default::default() })
-        .map_err(|e| CliError::Usage(e.to_string()))?;
+    let snaps = readers::read_lammps(
+        &[a.clone(), p.clone()],
+        &ReadOptions {
+            mu: Some(0.5),
+            ..Default::default()
+        },
+    )
+    .map_err(|e| CliError::Usage(e.to_string()))?;
     let t1 = std::time::Instant::now();
     let mut contacts = 0;
     for ext in &snaps {
@@ -311,7 +425,11 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
         .num("rattler_fraction", z.rattler_fraction)
         .num("fabric_anisotropy", fab.anisotropy)
         .num("fabric_major_angle_rad", fab.major_angle);
-    for (name, t) in [("sigma", whole.total), ("contact_sigma", whole.contact), ("inertia_sigma", whole.inertia)] {
+    for (name, t) in [
+        ("sigma", whole.total),
+        ("contact_sigma", whole.contact),
+        ("inertia_sigma", whole.inertia),
+    ] {
         let [xx, xy, yx, yy] = t4(&t);
         summary
             .num(&format!("{name}_xx_Pa"), xx)
@@ -330,8 +448,18 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
         let k = ((y1 - y0) / h).ceil().max(1.0) as usize;
         let edges: Vec<f64> = (0..=k).map(|i| y0 + i as f64 * h).collect();
         let prof = slice_stress_profile(s, &grains, &edges)?;
-        let mut t = CsvTable::new(&["y_m", "sigma_xx_Pa", "sigma_xy_Pa", "sigma_yx_Pa", "sigma_yy_Pa", "solid_area_fraction"]);
-        t.comments.push(format!("mean stress in horizontal slices of {h:e} m, step {}", s.step));
+        let mut t = CsvTable::new(&[
+            "y_m",
+            "sigma_xx_Pa",
+            "sigma_xy_Pa",
+            "sigma_yx_Pa",
+            "sigma_yy_Pa",
+            "solid_area_fraction",
+        ]);
+        t.comments.push(format!(
+            "mean stress in horizontal slices of {h:e} m, step {}",
+            s.step
+        ));
         let mut pts = Vec::new();
         for (w, r) in edges.windows(2).zip(&prof) {
             let y = 0.5 * (w[0] + w[1]);
@@ -342,8 +470,17 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
             pts.push((-r.total[(1, 1)], y));
         }
         t.write(out, "stress_profile.csv")?;
-        let mut plot = XyPlot::new("vertical stress by slice", Axis::new("−σyy (Pa)"), Axis::new("y (m)"));
-        plot.series.push(Series::new("−σyy", Style::LinePoints, crate::plot::colormap::viridis(0.2), pts));
+        let mut plot = XyPlot::new(
+            "vertical stress by slice",
+            Axis::new("−σyy (Pa)"),
+            Axis::new("y (m)"),
+        );
+        plot.series.push(Series::new(
+            "−σyy",
+            Style::LinePoints,
+            crate::plot::colormap::viridis(0.2),
+            pts,
+        ));
         draw_xy(out, "stress_profile.png", &plot)?;
     }
     // wall stress profiles along walls not perpendicular to gravity
@@ -356,23 +493,46 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
                 if matches!(w.geometry, WallGeometry::Clump { .. }) {
                     continue;
                 }
-                let Ok(p) = wall_stress_profile(s, &w.name, &bins) else { continue };
-                let mut t = CsvTable::new(&["depth_m", "normal_stress_Pa", "shear_stress_Pa", "contacts", "mean_mobilisation"]);
-                t.comments.push(format!("wall `{}`, step {}, bins of {width:e} m along gravity", w.name, s.step));
+                let Ok(p) = wall_stress_profile(s, &w.name, &bins) else {
+                    continue;
+                };
+                let mut t = CsvTable::new(&[
+                    "depth_m",
+                    "normal_stress_Pa",
+                    "shear_stress_Pa",
+                    "contacts",
+                    "mean_mobilisation",
+                ]);
+                t.comments.push(format!(
+                    "wall `{}`, step {}, bins of {width:e} m along gravity",
+                    w.name, s.step
+                ));
                 for b in &p {
-                    t.push(vec![b.depth(), b.normal_stress, b.shear_stress, b.contacts as f64, b.mean_mobilisation.unwrap_or(f64::NAN)]);
+                    t.push(vec![
+                        b.depth(),
+                        b.normal_stress,
+                        b.shear_stress,
+                        b.contacts as f64,
+                        b.mean_mobilisation.unwrap_or(f64::NAN),
+                    ]);
                 }
                 t.write(out, &format!("wall_profile_{}.csv", sanitize(&w.name)))?;
             }
         }
     }
     // force polarisation: mobilisation of friction (needs a friction coefficient)
-    let mob: Vec<f64> = contact_mobilisations(s, &ContactClass::All)?.into_iter().map(|(_, m)| m).collect();
+    let mob: Vec<f64> = contact_mobilisations(s, &ContactClass::All)?
+        .into_iter()
+        .map(|(_, m)| m)
+        .collect();
     let ms = mobilisation_stats(&mob, 20, homogenise::mobilisation::COULOMB_LIMIT)?;
     summary
         .int("mobilisation_contacts", ms.contacts as u64)
         .num("mean_mobilisation", ms.mean.unwrap_or(f64::NAN))
-        .num("fraction_at_coulomb_limit", ms.fraction_at_limit.unwrap_or(f64::NAN));
+        .num(
+            "fraction_at_coulomb_limit",
+            ms.fraction_at_limit.unwrap_or(f64::NAN),
+        );
     if ms.contacts > 0 {
         let mut t = CsvTable::new(&["mobilisation_low", "mobilisation_high", "fraction"]);
         for (e, f) in ms.histogram.edges.windows(2).zip(ms.histogram.fractions()) {
@@ -385,13 +545,36 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
         let grid = Grid::covering(s, 0.5 * d, 5.0 * d)?;
         if grid.nx * grid.ny <= 4_000_000 {
             let f = coarse_grain(s, &grains, &grid, d, 5.0)?;
-            let mut t = CsvTable::new(&["x_m", "y_m", "density_kg_m3", "velocity_x_m_s", "velocity_y_m_s", "sigma_xx_Pa", "sigma_xy_Pa", "sigma_yx_Pa", "sigma_yy_Pa"]);
-            t.comments.push(format!("Gaussian coarse graining, width {d:e} m, cutoff 5 widths, step {}", s.step));
+            let mut t = CsvTable::new(&[
+                "x_m",
+                "y_m",
+                "density_kg_m3",
+                "velocity_x_m_s",
+                "velocity_y_m_s",
+                "sigma_xx_Pa",
+                "sigma_xy_Pa",
+                "sigma_yx_Pa",
+                "sigma_yy_Pa",
+            ]);
+            t.comments.push(format!(
+                "Gaussian coarse graining, width {d:e} m, cutoff 5 widths, step {}",
+                s.step
+            ));
             for j in 0..grid.ny {
                 for i in 0..grid.nx {
                     let x = grid.node(i, j);
                     let st = f.stress.at(i, j);
-                    t.push(vec![x.x, x.y, f.density[[j, i]], f.velocity_x[[j, i]], f.velocity_y[[j, i]], st[(0, 0)], st[(0, 1)], st[(1, 0)], st[(1, 1)]]);
+                    t.push(vec![
+                        x.x,
+                        x.y,
+                        f.density[[j, i]],
+                        f.velocity_x[[j, i]],
+                        f.velocity_y[[j, i]],
+                        st[(0, 0)],
+                        st[(0, 1)],
+                        st[(1, 0)],
+                        st[(1, 1)],
+                    ]);
                 }
             }
             t.write(out, "coarse.csv")?;
@@ -408,7 +591,11 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
             title: format!("step {}: grain pressure and contact forces", s.step),
             fill: GrainFill::Values {
                 values: p,
-                scale: Scale { min: 0.0, max: if hi > 0.0 { hi } else { 1.0 }, log: false },
+                scale: Scale {
+                    min: 0.0,
+                    max: if hi > 0.0 { hi } else { 1.0 },
+                    log: false,
+                },
                 label: "grain pressure −tr Σp/2 (Pa)".into(),
             },
             forces: true,
@@ -421,8 +608,17 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
 
 fn grain_extent(s: &Snapshot) -> Option<(f64, f64, f64, f64)> {
     let mut e: Option<(f64, f64, f64, f64)> = None;
-    for b in s.bodies.iter().filter(|b| b.kind == dem::snapshot::BodyKind::Grain) {
-        let (x0, x1, y0, y1) = (b.position.x - b.radius, b.position.x + b.radius, b.position.y - b.radius, b.position.y + b.radius);
+    for b in s
+        .bodies
+        .iter()
+        .filter(|b| b.kind == dem::snapshot::BodyKind::Grain)
+    {
+        let (x0, x1, y0, y1) = (
+            b.position.x - b.radius,
+            b.position.x + b.radius,
+            b.position.y - b.radius,
+            b.position.y + b.radius,
+        );
         e = Some(match e {
             None => (x0, x1, y0, y1),
             Some(a) => (a.0.min(x0), a.1.max(x1), a.2.min(y0), a.3.max(y1)),
@@ -432,5 +628,13 @@ fn grain_extent(s: &Snapshot) -> Option<(f64, f64, f64, f64)> {
 }
 
 fn sanitize(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }

@@ -13,14 +13,21 @@ use homogenise::tensor::Tensor2;
 use nalgebra::Vector2;
 
 fn data(dir: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/external").join(dir)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("datasets/external")
+        .join(dir)
 }
 
 fn lammps_files() -> Vec<PathBuf> {
     let d = data("lammps");
     [400000, 400001, 400002]
         .iter()
-        .flat_map(|s| [d.join(format!("atoms.{s}.dump.gz")), d.join(format!("pairs.{s}.dump.gz"))])
+        .flat_map(|s| {
+            [
+                d.join(format!("atoms.{s}.dump.gz")),
+                d.join(format!("pairs.{s}.dump.gz")),
+            ]
+        })
         .collect()
 }
 
@@ -31,7 +38,13 @@ fn thermo() -> Vec<(u64, Vec<f64>)> {
         .filter_map(|l| {
             let t: Vec<&str> = l.split_whitespace().collect();
             let step = t.first()?.parse::<u64>().ok()?;
-            Some((step, t.iter().skip(4).map(|v| v.parse::<f64>().unwrap()).collect()))
+            Some((
+                step,
+                t.iter()
+                    .skip(4)
+                    .map(|v| v.parse::<f64>().unwrap())
+                    .collect(),
+            ))
         })
         .collect()
 }
@@ -73,7 +86,13 @@ fn lammps_contact_stress_equals_lammps_pair_virial() {
     let th = thermo();
     for ext in &snaps {
         let s = &ext.snapshot;
-        assert_eq!(s.bodies.iter().filter(|b| b.kind == BodyKind::Grain).count(), 152);
+        assert_eq!(
+            s.bodies
+                .iter()
+                .filter(|b| b.kind == BodyKind::Grain)
+                .count(),
+            152
+        );
         // LAMMPS' stress/atom is −(virial) per atom, `−½ Σ_j (x_i − x_j) ⊗ F_ij` in N·m for
         // 2D SI units: tension positive like grainlaw, first index the branch: its xy is
         // grainlaw's yx (grainlaw's first index is the force).
@@ -114,13 +133,26 @@ fn lammps_wall_loads_equal_lammps_wall_forces() {
             // LAMMPS reports the force of the wall on the atoms; the wall receives the opposite
             let lammps = Vector2::new(-t[2 * k], -t[2 * k + 1]);
             let err = (w.force - lammps).norm();
-            assert!(err <= 1e-12 * lammps.norm().max(1.0), "{name}: {} vs {}", w.force, lammps);
+            assert!(
+                err <= 1e-12 * lammps.norm().max(1.0),
+                "{name}: {} vs {}",
+                w.force,
+                lammps
+            );
         }
         // the walls carry the weight of 152 disks (75.249 N) to within the slight residual
         // acceleration of the settling column (kinetic energy 6e-8 J)
-        let weight: f64 = s.bodies.iter().filter(|b| b.kind == BodyKind::Grain).map(|b| b.mass * 9.81).sum();
+        let weight: f64 = s
+            .bodies
+            .iter()
+            .filter(|b| b.kind == BodyKind::Grain)
+            .map(|b| b.mass * 9.81)
+            .sum();
         let carried: f64 = s.walls.iter().map(|w| -w.force.y).sum();
-        assert!((carried - weight).abs() < 0.02 * weight, "{carried} vs {weight}");
+        assert!(
+            (carried - weight).abs() < 0.02 * weight,
+            "{carried} vs {weight}"
+        );
     }
 }
 
@@ -136,7 +168,11 @@ fn lammps_forces_give_accelerations_and_symmetric_stress() {
             let skew = 0.5 * (g.total[(0, 1)] - g.total[(1, 0)]).abs();
             let norm = g.contact.norm();
             if norm > 0.0 {
-                assert!(skew <= 1e-3 * norm, "grain {}: skew {skew} of {norm}", g.body);
+                assert!(
+                    skew <= 1e-3 * norm,
+                    "grain {}: skew {skew} of {norm}",
+                    g.body
+                );
             }
         }
     }
@@ -149,21 +185,35 @@ fn lammps_forces_give_accelerations_and_symmetric_stress() {
     assert!((h - 2e-6).abs() < 1e-15);
     let mut worst: f64 = 0.0;
     let mut scale: f64 = 0.0;
-    for (b1, b0) in s1.bodies.iter().zip(&s0.bodies).filter(|(b, _)| b.kind == BodyKind::Grain) {
+    for (b1, b0) in s1
+        .bodies
+        .iter()
+        .zip(&s0.bodies)
+        .filter(|(b, _)| b.kind == BodyKind::Grain)
+    {
         let fd = (b1.velocity - b0.velocity) / h;
         worst = worst.max((fd - b1.acceleration).norm());
         scale = scale.max(b1.acceleration.norm());
     }
-    assert!(worst < 0.05 * scale, "finite difference {worst} vs f/m scale {scale}");
+    assert!(
+        worst < 0.05 * scale,
+        "finite difference {worst} vs f/m scale {scale}"
+    );
 }
 
 #[test]
 fn lmgc90_hand_written_sample() {
     let d = data("lmgc90");
-    let files: Vec<PathBuf> = ["BODIES.DAT", "DOF.OUT.1", "DOF.OUT.2", "Vloc_Rloc.OUT.1", "Vloc_Rloc.OUT.2"]
-        .iter()
-        .map(|f| d.join(f))
-        .collect();
+    let files: Vec<PathBuf> = [
+        "BODIES.DAT",
+        "DOF.OUT.1",
+        "DOF.OUT.2",
+        "Vloc_Rloc.OUT.1",
+        "Vloc_Rloc.OUT.2",
+    ]
+    .iter()
+    .map(|f| d.join(f))
+    .collect();
     let opts = ReadOptions {
         density: Some(1000.0),
         mu: Some(0.5),
@@ -171,8 +221,14 @@ fn lmgc90_hand_written_sample() {
     };
     let snaps = readers::read_lmgc90(&files, &opts).unwrap();
     assert_eq!(snaps.len(), 2);
-    assert_eq!(snaps[0].accelerations, AccelerationSource::ForwardDifference);
-    assert_eq!(snaps[1].accelerations, AccelerationSource::BackwardDifference);
+    assert_eq!(
+        snaps[0].accelerations,
+        AccelerationSource::ForwardDifference
+    );
+    assert_eq!(
+        snaps[1].accelerations,
+        AccelerationSource::BackwardDifference
+    );
     let s = &snaps[1].snapshot;
     let (r, v) = (0.1, std::f64::consts::PI * 0.01);
     let g = grain_stresses(s).unwrap();
@@ -230,7 +286,10 @@ fn plain_disk_on_a_floor_and_finite_differences() {
     assert!((gs[0].contact[(1, 1)] - expect).abs() < 1e-12 * expect.abs());
     assert!((s.walls[0].force - Vector2::new(0.0, -m * g)).norm() < 1e-12);
     // a = Δv/Δt = −0.2 m/s², backward for the second, forward for the first
-    assert_eq!(snaps[1].accelerations, AccelerationSource::BackwardDifference);
+    assert_eq!(
+        snaps[1].accelerations,
+        AccelerationSource::BackwardDifference
+    );
     assert!((s.bodies[0].acceleration.y + 0.2).abs() < 1e-12);
     assert!((snaps[0].snapshot.bodies[0].acceleration.y + 0.2).abs() < 1e-12);
     // a single snapshot without accelerations: zero, and said so
@@ -246,17 +305,27 @@ fn errors_name_the_file_and_line() {
         "bad.dump",
         "ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ATOMS id x y vx vy omegaz radius mass\n1 0.5 0.5 0 0 0 0.1 1\n2 0.5 0.x 0 0 0 0.1 1\n",
     );
-    let e = readers::read_lammps(&[p.clone()], &ReadOptions::default()).unwrap_err().to_string();
+    let e = readers::read_lammps(std::slice::from_ref(&p), &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("bad.dump:11:") && e.contains("0.x"), "{e}");
     let q = write(
         dir.path(),
         "nomass.dump",
         "ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ATOMS id x y vx vy omegaz radius\n1 0.5 0.5 0 0 0 0.1\n",
     );
-    let e = readers::read_lammps(&[q], &ReadOptions::default()).unwrap_err().to_string();
+    let e = readers::read_lammps(&[q], &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("nomass.dump:9:") && e.contains("`mass`"), "{e}");
     // the command line: one line, exit code 2
-    let code = grainlaw::cli::main_with_args(["grainlaw", "homogenise", "--from", "lammps", p.to_str().unwrap()]);
+    let code = grainlaw::cli::main_with_args([
+        "grainlaw",
+        "homogenise",
+        "--from",
+        "lammps",
+        p.to_str().unwrap(),
+    ]);
     assert_eq!(code, 2);
     assert_eq!("lmgc90".parse::<Format>().unwrap(), Format::Lmgc90);
     assert!("vasp".parse::<Format>().is_err());
@@ -266,17 +335,38 @@ fn errors_name_the_file_and_line() {
 fn homogenise_command_writes_the_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let mut args: Vec<String> = ["grainlaw", "homogenise", "--from", "lammps", "--mu", "0.5", "-q", "--out"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let mut args: Vec<String> = [
+        "grainlaw",
+        "homogenise",
+        "--from",
+        "lammps",
+        "--mu",
+        "0.5",
+        "-q",
+        "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     args.push(out.display().to_string());
     args.extend(lammps_files().iter().map(|p| p.display().to_string()));
     assert_eq!(grainlaw::cli::main_with_args(args), 0);
-    for f in ["summary.json", "snapshots.csv", "walls.csv", "grains_400002.csv", "stress_profile.csv", "coarse.csv", "mobilisation.csv", "grains.png", "grains.pvd", "wall_profile_left.csv"] {
+    for f in [
+        "summary.json",
+        "snapshots.csv",
+        "walls.csv",
+        "grains_400002.csv",
+        "stress_profile.csv",
+        "coarse.csv",
+        "mobilisation.csv",
+        "grains.png",
+        "grains.pvd",
+        "wall_profile_left.csv",
+    ] {
         assert!(out.join(f).exists(), "{f} missing");
     }
-    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(s["snapshots"], 3);
     assert_eq!(s["acceleration_source"], "file");
     // the bottom wall carries most of the weight (75.25 N)

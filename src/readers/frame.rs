@@ -16,9 +16,7 @@
 use std::collections::HashMap;
 
 use dem::local::ContactStatus;
-use dem::snapshot::{
-    BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState,
-};
+use dem::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
 use nalgebra::Vector2;
 
 use super::{AccelerationSource, ExternalSnapshot, ReadError, ReadOptions};
@@ -119,6 +117,9 @@ fn min_image(mut d: Vector2<f64>, periodic_x: Option<[f64; 2]>) -> Vector2<f64> 
     d
 }
 
+/// Per grain, the acceleration (m/s²) and angular acceleration (rad/s²).
+type Accelerations = Vec<(Vector2<f64>, f64)>;
+
 /// The time of each frame: the file's, else `step · dt`.
 fn times(frames: &[Frame], opts: &ReadOptions) -> Result<Vec<Option<f64>>, ReadError> {
     Ok(frames
@@ -139,12 +140,15 @@ pub fn build_snapshots(
     let times = times(&frames, opts)?;
     let n = frames.len();
     // Accelerations: file, else finite differences by id, else zero.
-    let mut acc: Vec<(Vec<(Vector2<f64>, f64)>, AccelerationSource)> = Vec::with_capacity(n);
+    let mut acc: Vec<(Accelerations, AccelerationSource)> = Vec::with_capacity(n);
     for k in 0..n {
         let f = &frames[k];
         if f.grains.iter().all(|g| g.acceleration.is_some()) && !f.grains.is_empty() {
             acc.push((
-                f.grains.iter().map(|g| g.acceleration.unwrap_or_default()).collect(),
+                f.grains
+                    .iter()
+                    .map(|g| g.acceleration.unwrap_or_default())
+                    .collect(),
                 AccelerationSource::File,
             ));
             continue;
@@ -171,7 +175,7 @@ pub fn build_snapshots(
             }
         };
         let h = t1 - t0;
-        if !(h > 0.0) {
+        if h.is_nan() || h <= 0.0 {
             return Err(content(
                 &f.source,
                 format!(
@@ -242,9 +246,16 @@ fn build_one(
     let mut bodies = Vec::with_capacity(f.grains.len() + f.walls.len());
     for (g, (a, w)) in f.grains.iter().zip(&acc) {
         if index.insert(g.id, bodies.len() as u32).is_some() {
-            return Err(content(&f.source, format!("grain id {} appears twice", g.id)));
+            return Err(content(
+                &f.source,
+                format!("grain id {} appears twice", g.id),
+            ));
         }
-        for (what, v) in [("radius", g.radius), ("mass", g.mass), ("inertia", g.inertia)] {
+        for (what, v) in [
+            ("radius", g.radius),
+            ("mass", g.mass),
+            ("inertia", g.inertia),
+        ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(content(
                     &f.source,
@@ -292,17 +303,29 @@ fn build_one(
     let mut wall_force = vec![(Vector2::zeros(), 0.0); f.walls.len()];
     for c in &f.contacts {
         let ib = *index.get(&c.b).ok_or_else(|| {
-            content(&f.source, format!("a contact names grain {}, which is not in the snapshot", c.b))
+            content(
+                &f.source,
+                format!(
+                    "a contact names grain {}, which is not in the snapshot",
+                    c.b
+                ),
+            )
         })?;
         let gb = &bodies[ib as usize];
         let (cb, rb) = (gb.position, gb.radius);
         let (ia, normal, gap, point) = match c.a {
             Other::Grain(id) => {
                 let ia = *index.get(&id).ok_or_else(|| {
-                    content(&f.source, format!("a contact names grain {id}, which is not in the snapshot"))
+                    content(
+                        &f.source,
+                        format!("a contact names grain {id}, which is not in the snapshot"),
+                    )
                 })?;
                 if ia == ib {
-                    return Err(content(&f.source, format!("grain {id} in contact with itself")));
+                    return Err(content(
+                        &f.source,
+                        format!("grain {id} in contact with itself"),
+                    ));
                 }
                 let ga = &bodies[ia as usize];
                 let d = min_image(cb - ga.position, f.periodic_x);
@@ -323,7 +346,10 @@ fn build_one(
             }
             Other::Wall(k) => {
                 let w = f.walls.get(k).ok_or_else(|| {
-                    content(&f.source, format!("a contact names wall {k}, which does not exist"))
+                    content(
+                        &f.source,
+                        format!("a contact names wall {k}, which does not exist"),
+                    )
                 })?;
                 let (n, gap) = match (&w.geometry, c.normal) {
                     (_, Some(n)) => (n, f64::NAN),
@@ -337,12 +363,18 @@ fn build_one(
                         let d = cb - (a + e * t);
                         let dist = d.norm();
                         if dist == 0.0 {
-                            return Err(content(&f.source, format!("grain {} centred on wall `{}`", c.b, w.name)));
+                            return Err(content(
+                                &f.source,
+                                format!("grain {} centred on wall `{}`", c.b, w.name),
+                            ));
                         }
                         (d / dist, dist - rb)
                     }
                     (WallGeometry::Clump { .. }, None) => {
-                        return Err(content(&f.source, "clump walls need the contact normal".into()))
+                        return Err(content(
+                            &f.source,
+                            "clump walls need the contact normal".into(),
+                        ))
                     }
                 };
                 let x = c.point.unwrap_or(cb - n * rb);
@@ -350,7 +382,10 @@ fn build_one(
             }
         };
         if (normal.norm() - 1.0).abs() > 1e-6 {
-            return Err(content(&f.source, format!("contact on grain {}: the normal is not a unit vector", c.b)));
+            return Err(content(
+                &f.source,
+                format!("contact on grain {}: the normal is not a unit vector", c.b),
+            ));
         }
         let t = Vector2::new(-normal.y, normal.x);
         let (fn_, ft) = (c.force.dot(&normal), c.force.dot(&t));

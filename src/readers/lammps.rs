@@ -60,11 +60,7 @@ struct Block {
 
 impl Block {
     fn rows(&self) -> usize {
-        if self.cols == 0 {
-            0
-        } else {
-            self.values.len() / self.cols
-        }
+        self.values.len().checked_div(self.cols).unwrap_or(0)
     }
     fn col(&self, names: &[&str]) -> Option<usize> {
         names
@@ -87,7 +83,10 @@ fn parse_blocks(path: &Path, text: &str) -> Result<Vec<Block>, ReadError> {
             continue;
         }
         let Some(item) = line.strip_prefix("ITEM:") else {
-            return Err(err(ln, format!("expected an `ITEM:` line, got `{}`", short(line))));
+            return Err(err(
+                ln,
+                format!("expected an `ITEM:` line, got `{}`", short(line)),
+            ));
         };
         let item = item.trim();
         let mut next_line = |what: &str| {
@@ -97,43 +96,72 @@ fn parse_blocks(path: &Path, text: &str) -> Result<Vec<Block>, ReadError> {
         };
         if item == "TIMESTEP" {
             let (l, t) = next_line("time step")?;
-            step = Some(t.trim().parse().map_err(|_| err(l, format!("time step `{}` is not an integer", short(t))))?);
+            step = Some(
+                t.trim()
+                    .parse()
+                    .map_err(|_| err(l, format!("time step `{}` is not an integer", short(t))))?,
+            );
         } else if item == "TIME" {
             let (l, t) = next_line("time")?;
             time = Some(number(path, l + 1, "time", t)?);
         } else if item.starts_with("NUMBER OF") {
             let (l, t) = next_line("count")?;
-            count = Some(t.trim().parse().map_err(|_| err(l, format!("count `{}` is not an integer", short(t))))?);
+            count = Some(
+                t.trim()
+                    .parse()
+                    .map_err(|_| err(l, format!("count `{}` is not an integer", short(t))))?,
+            );
         } else if let Some(flags) = item.strip_prefix("BOX BOUNDS") {
-            let flags: Vec<&str> = flags.split_whitespace().filter(|f| f.len() == 2 && f.chars().all(|c| "pfsm".contains(c))).collect();
+            let flags: Vec<&str> = flags
+                .split_whitespace()
+                .filter(|f| f.len() == 2 && f.chars().all(|c| "pfsm".contains(c)))
+                .collect();
             let (l, t) = next_line("box bounds")?;
             let xs: Vec<&str> = t.split_whitespace().collect();
             if xs.len() < 2 {
                 return Err(err(l, "box bounds need two numbers".into()));
             }
-            let (lo, hi) = (number(path, l + 1, "xlo", xs[0])?, number(path, l + 1, "xhi", xs[1])?);
+            let (lo, hi) = (
+                number(path, l + 1, "xlo", xs[0])?,
+                number(path, l + 1, "xhi", xs[1])?,
+            );
             periodic_x = (flags.first() == Some(&"pp")).then_some([lo, hi]);
             next_line("box bounds")?;
             next_line("box bounds")?;
-        } else if let Some(cols) = item.strip_prefix("ATOMS").or_else(|| item.strip_prefix("ENTRIES")) {
-            let kind = if item.starts_with("ATOMS") { Kind::Atoms } else { Kind::Entries };
+        } else if let Some(cols) = item
+            .strip_prefix("ATOMS")
+            .or_else(|| item.strip_prefix("ENTRIES"))
+        {
+            let kind = if item.starts_with("ATOMS") {
+                Kind::Atoms
+            } else {
+                Kind::Entries
+            };
             let header: Vec<String> = cols.split_whitespace().map(String::from).collect();
             let s = step.ok_or_else(|| err(ln, "no `ITEM: TIMESTEP` before the data".into()))?;
-            let n = count.ok_or_else(|| err(ln, "no `ITEM: NUMBER OF ...` before the data".into()))?;
+            let n =
+                count.ok_or_else(|| err(ln, "no `ITEM: NUMBER OF ...` before the data".into()))?;
             let ncols = header.len();
             let mut values = Vec::with_capacity(n * ncols);
             for r in 0..n {
                 let (l, row) = lines.next().ok_or_else(|| {
-                    err(ln, format!("the block announces {n} rows, the file ends after {r}"))
+                    err(
+                        ln,
+                        format!("the block announces {n} rows, the file ends after {r}"),
+                    )
                 })?;
                 let before = values.len();
                 for tok in row.split_ascii_whitespace() {
-                    values.push(fast_number(tok).ok_or_else(|| {
-                        err(l, format!("`{}` is not a number", short(tok)))
-                    })?);
+                    values.push(
+                        fast_number(tok)
+                            .ok_or_else(|| err(l, format!("`{}` is not a number", short(tok))))?,
+                    );
                 }
                 if values.len() - before != ncols {
-                    return Err(err(l, format!("{} values for {ncols} columns", values.len() - before)));
+                    return Err(err(
+                        l,
+                        format!("{} values for {ncols} columns", values.len() - before),
+                    ));
                 }
             }
             blocks.push(Block {
@@ -174,7 +202,11 @@ fn require(path: &Path, b: &Block, names: &[&str]) -> Result<usize, ReadError> {
         ReadError::parse(
             path,
             b.first_line - 1,
-            format!("no column `{}` in the header ({})", names[0], b.header.join(" ")),
+            format!(
+                "no column `{}` in the header ({})",
+                names[0],
+                b.header.join(" ")
+            ),
         )
     })
 }
@@ -183,7 +215,9 @@ fn require(path: &Path, b: &Block, names: &[&str]) -> Result<usize, ReadError> {
 fn wall_columns(b: &Block) -> Vec<(String, [Option<usize>; 8])> {
     let mut groups: BTreeMap<String, [Option<usize>; 8]> = BTreeMap::new();
     for (i, h) in b.header.iter().enumerate() {
-        let Some(rest) = h.strip_prefix("f_") else { continue };
+        let Some(rest) = h.strip_prefix("f_") else {
+            continue;
+        };
         let Some((name, k)) = rest.strip_suffix(']').and_then(|r| r.split_once('[')) else {
             continue;
         };
@@ -229,11 +263,19 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
         let line = b.first_line + row;
         let gid = v[id];
         if gid < 0.0 || gid.fract() != 0.0 {
-            return Err(ReadError::parse(path, line, format!("atom id {gid} is not a non-negative integer")));
+            return Err(ReadError::parse(
+                path,
+                line,
+                format!("atom id {gid} is not a non-negative integer"),
+            ));
         }
         let (mass, radius) = (v[m], v[r]);
         if !(mass > 0.0 && radius > 0.0) {
-            return Err(ReadError::parse(path, line, format!("atom {gid}: mass {mass} and radius {radius} must be > 0")));
+            return Err(ReadError::parse(
+                path,
+                line,
+                format!("atom {gid}: mass {mass} and radius {radius} must be > 0"),
+            ));
         }
         let inertia = k * mass * radius * radius;
         let pos = Vector2::new(v[x], v[y]);
@@ -246,7 +288,8 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
             radius,
             mass,
             inertia,
-            acceleration: forces.map(|(fx, fy, tq)| (Vector2::new(v[fx], v[fy]) / mass, v[tq] / inertia)),
+            acceleration: forces
+                .map(|(fx, fy, tq)| (Vector2::new(v[fx], v[fy]) / mass, v[tq] / inertia)),
         });
         for (w, (_, c)) in walls.iter().enumerate() {
             let col = |k: usize| c[k].map_or(0.0, |i| v[i]);
@@ -256,7 +299,11 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
             let p = Vector2::new(col(4), col(5));
             let d = pos - p;
             if d.norm() == 0.0 {
-                return Err(ReadError::parse(path, line, format!("atom {gid}: its centre is on wall `{}`", walls[w].0)));
+                return Err(ReadError::parse(
+                    path,
+                    line,
+                    format!("atom {gid}: its centre is on wall `{}`", walls[w].0),
+                ));
             }
             let f = Vector2::new(col(1), col(2));
             wall_acc[w].0 += p;
@@ -309,7 +356,11 @@ fn local_columns(
                 path,
                 format!(
                     "unknown column key `{key}`: expected one of {}",
-                    LOCAL_KEYS.iter().map(|k| k.0).collect::<Vec<_>>().join(", ")
+                    LOCAL_KEYS
+                        .iter()
+                        .map(|k| k.0)
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             ));
         }
@@ -318,7 +369,14 @@ fn local_columns(
         let given = opts.columns.iter().rev().find(|(k, _)| k == key);
         let col = match given {
             Some((_, h)) => Some(b.col(&[h.as_str()]).ok_or_else(|| {
-                ReadError::parse(path, b.first_line - 1, format!("no column `{h}` (given for `{key}`) in the header ({})", b.header.join(" ")))
+                ReadError::parse(
+                    path,
+                    b.first_line - 1,
+                    format!(
+                        "no column `{h}` (given for `{key}`) in the header ({})",
+                        b.header.join(" ")
+                    ),
+                )
             })?),
             None => b.col(defaults),
         };
@@ -339,12 +397,20 @@ fn local_columns(
         }
     }
     if map.contains_key("cx") != map.contains_key("cy") {
-        return Err(ReadError::content(path, "the contact point needs both `cx` and `cy`"));
+        return Err(ReadError::content(
+            path,
+            "the contact point needs both `cx` and `cy`",
+        ));
     }
     Ok(map)
 }
 
-fn add_pairs(path: &Path, b: &Block, frame: &mut Frame, opts: &ReadOptions) -> Result<(), ReadError> {
+fn add_pairs(
+    path: &Path,
+    b: &Block,
+    frame: &mut Frame,
+    opts: &ReadOptions,
+) -> Result<(), ReadError> {
     let c = local_columns(path, b, opts)?;
     let get = |v: &[f64], k: &str| c.get(k).map_or(0.0, |&i| v[i]);
     for row in 0..b.rows() {
@@ -355,13 +421,19 @@ fn add_pairs(path: &Path, b: &Block, frame: &mut Frame, opts: &ReadOptions) -> R
         }
         let (i1, i2) = (get(v, "id1"), get(v, "id2"));
         if i1 < 0.0 || i2 < 0.0 || i1.fract() != 0.0 || i2.fract() != 0.0 {
-            return Err(ReadError::parse(path, b.first_line + row, "atom ids must be non-negative integers"));
+            return Err(ReadError::parse(
+                path,
+                b.first_line + row,
+                "atom ids must be non-negative integers",
+            ));
         }
         frame.contacts.push(ContactRecord {
             a: Other::Grain(i2 as u64),
             b: i1 as u64,
             force: f,
-            point: c.contains_key("cx").then(|| Vector2::new(get(v, "cx"), get(v, "cy"))),
+            point: c
+                .contains_key("cx")
+                .then(|| Vector2::new(get(v, "cx"), get(v, "cy"))),
             normal: None,
         });
     }
@@ -371,21 +443,30 @@ fn add_pairs(path: &Path, b: &Block, frame: &mut Frame, opts: &ReadOptions) -> R
 /// Reads LAMMPS/LIGGGHTS dumps: per-atom files and pair-force local files in any order (the
 /// kind of each block is told by its `ITEM: ATOMS` or `ITEM: ENTRIES` line), gzip or plain.
 /// One snapshot per per-atom block, with the local block of the same time step.
-pub fn read_lammps(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<ExternalSnapshot>, ReadError> {
+pub fn read_lammps(
+    files: &[PathBuf],
+    opts: &ReadOptions,
+) -> Result<Vec<ExternalSnapshot>, ReadError> {
     let mut frames: BTreeMap<u64, Frame> = BTreeMap::new();
     let mut locals: Vec<(PathBuf, Block)> = Vec::new();
     for path in files {
         let text = read_text(path)?;
         let blocks = parse_blocks(path, &text)?;
         if blocks.is_empty() {
-            return Err(ReadError::content(path, "no dump block (`ITEM: TIMESTEP` … `ITEM: ATOMS`/`ENTRIES`)"));
+            return Err(ReadError::content(
+                path,
+                "no dump block (`ITEM: TIMESTEP` … `ITEM: ATOMS`/`ENTRIES`)",
+            ));
         }
         for b in blocks {
             match b.kind {
                 Kind::Atoms => {
                     let f = atoms_frame(path, &b, opts)?;
                     if frames.insert(b.step, f).is_some() {
-                        return Err(ReadError::content(path, format!("a second per-atom snapshot of step {}", b.step)));
+                        return Err(ReadError::content(
+                            path,
+                            format!("a second per-atom snapshot of step {}", b.step),
+                        ));
                     }
                 }
                 Kind::Entries => locals.push((path.clone(), b)),
@@ -394,17 +475,30 @@ pub fn read_lammps(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<External
     }
     if frames.is_empty() {
         return Err(ReadError::Content {
-            file: files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
+            file: files
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
             reason: "no per-atom dump (`ITEM: ATOMS`): the grains are needed".into(),
         });
     }
     let mut seen = std::collections::HashSet::new();
     for (path, b) in &locals {
         let f = frames.get_mut(&b.step).ok_or_else(|| {
-            ReadError::content(path, format!("local dump of step {} has no per-atom dump of the same step", b.step))
+            ReadError::content(
+                path,
+                format!(
+                    "local dump of step {} has no per-atom dump of the same step",
+                    b.step
+                ),
+            )
         })?;
         if !seen.insert(b.step) {
-            return Err(ReadError::content(path, format!("a second local dump of step {}", b.step)));
+            return Err(ReadError::content(
+                path,
+                format!("a second local dump of step {}", b.step),
+            ));
         }
         add_pairs(path, b, f, opts)?;
         f.source = format!("{} + {}", f.source, path.display());

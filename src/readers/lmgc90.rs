@@ -32,17 +32,20 @@ fn labeled<'a>(line: &'a str, label: &str) -> Option<&'a str> {
 }
 
 fn labeled_number(path: &Path, ln: usize, line: &str, label: &str) -> Result<f64, ReadError> {
-    let v = labeled(line, label).ok_or_else(|| {
-        ReadError::parse(path, ln, format!("no `{}` on the line", label.trim()))
-    })?;
+    let v = labeled(line, label)
+        .ok_or_else(|| ReadError::parse(path, ln, format!("no `{}` on the line", label.trim())))?;
     number(path, ln, label.trim_end_matches(['=', ' ']), v)
 }
 
 #[derive(Debug, Clone)]
 enum Tactor {
-    Disk { radius: f64 },
+    Disk {
+        radius: f64,
+    },
     /// A rounded rectangle of half-length `ax1` (its half-thickness `ax2` is checked, unused).
-    Jonc { ax1: f64 },
+    Jonc {
+        ax1: f64,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -75,8 +78,18 @@ fn parse_bodies(path: &Path, text: &str) -> Result<BTreeMap<u64, Body>, ReadErro
                     if toks.len() < 2 || toks[0] != "RBDY2" {
                         return Err(ReadError::parse(path, ln + 1, format!("expected ` RBDY2  number`, got `{}` (only 2D rigid bodies are read)", next.trim())));
                     }
-                    let id = toks[1].parse::<u64>().map_err(|_| ReadError::parse(path, ln + 1, "body number is not an integer"))?;
-                    current = Some((id, Body { cooref: [0.0; 3], avrd: 0.0, gyrd: 0.0, tactor: None }));
+                    let id = toks[1].parse::<u64>().map_err(|_| {
+                        ReadError::parse(path, ln + 1, "body number is not an integer")
+                    })?;
+                    current = Some((
+                        id,
+                        Body {
+                            cooref: [0.0; 3],
+                            avrd: 0.0,
+                            gyrd: 0.0,
+                            tactor: None,
+                        },
+                    ));
                     i += 1;
                     "bdyty"
                 }
@@ -93,7 +106,9 @@ fn parse_bodies(path: &Path, text: &str) -> Result<BTreeMap<u64, Body>, ReadErro
             };
             continue;
         }
-        let Some((id, body)) = current.as_mut() else { continue };
+        let Some((id, body)) = current.as_mut() else {
+            continue;
+        };
         match section {
             "blmty" if t.starts_with("PLAIN") => {
                 body.avrd = labeled_number(path, ln, line, "avrd=")?;
@@ -119,7 +134,11 @@ fn parse_bodies(path: &Path, text: &str) -> Result<BTreeMap<u64, Body>, ReadErro
                     }
                 };
                 if body.tactor.is_some() {
-                    return Err(ReadError::parse(path, ln, format!("body {id}: more than one contactor (clusters are not read)")));
+                    return Err(ReadError::parse(
+                        path,
+                        ln,
+                        format!("body {id}: more than one contactor (clusters are not read)"),
+                    ));
                 }
                 body.tactor = Some(tactor);
             }
@@ -157,7 +176,11 @@ fn parse_dof(path: &Path, text: &str) -> Result<Vec<(u64, f64, Dof)>, ReadError>
             out.push((s, time, HashMap::new()));
         } else if t == "$bdyty" {
             let Some(cur) = out.last_mut() else {
-                return Err(ReadError::parse(path, ln, "`$bdyty` before any `$steps` header"));
+                return Err(ReadError::parse(
+                    path,
+                    ln,
+                    "`$bdyty` before any `$steps` header",
+                ));
             };
             let head = lines.get(i).copied().unwrap_or("");
             let id = head
@@ -212,24 +235,42 @@ fn parse_vloc(path: &Path, text: &str) -> Result<Vec<(u64, Vec<LmgcContact>)>, R
         } else if let Some(rest) = t.strip_prefix("$icdan") {
             let kind = rest.split_whitespace().next().unwrap_or("");
             if kind != "DKDKx" && kind != "DKJCx" {
-                return Err(ReadError::parse(path, ln, format!("contact type `{kind}` is not read (DKDKx and DKJCx only)")));
+                return Err(ReadError::parse(
+                    path,
+                    ln,
+                    format!("contact type `{kind}` is not read (DKDKx and DKJCx only)"),
+                ));
             }
             if out.is_empty() {
                 out.push((0, Vec::new()));
             }
             // header line, values line, then labelled lines up to a blank line
-            let vals: Vec<&str> = lines.get(i + 1).copied().unwrap_or("").split_whitespace().collect();
+            let vals: Vec<&str> = lines
+                .get(i + 1)
+                .copied()
+                .unwrap_or("")
+                .split_whitespace()
+                .collect();
             if vals.len() < 9 {
-                return Err(ReadError::parse(path, ln + 2, "expected `cdbdy numbr cdtac numbr behav anbdy numbr antac numbr ...`"));
+                return Err(ReadError::parse(
+                    path,
+                    ln + 2,
+                    "expected `cdbdy numbr cdtac numbr behav anbdy numbr antac numbr ...`",
+                ));
             }
             let int = |s: &str, what: &str| {
-                s.parse::<u64>().map_err(|_| ReadError::parse(path, ln + 2, format!("{what} `{s}` is not an integer")))
+                s.parse::<u64>().map_err(|_| {
+                    ReadError::parse(path, ln + 2, format!("{what} `{s}` is not an integer"))
+                })
             };
             let candidate = int(vals[1], "candidate body")?;
             let antagonist = int(vals[6], "antagonist body")?;
             let mut block = String::new();
             let mut j = i + 2;
-            while j < lines.len() && !lines[j].trim().is_empty() && !lines[j].trim().starts_with('$') {
+            while j < lines.len()
+                && !lines[j].trim().is_empty()
+                && !lines[j].trim().starts_with('$')
+            {
                 block.push_str(lines[j]);
                 block.push(' ');
                 j += 1;
@@ -240,24 +281,24 @@ fn parse_vloc(path: &Path, text: &str) -> Result<Vec<(u64, Vec<LmgcContact>)>, R
                         return labeled_number(path, ln, &block, l);
                     }
                 }
-                Err(ReadError::parse(path, ln, format!("contact without `{}`", labels[0])))
+                Err(ReadError::parse(
+                    path,
+                    ln,
+                    format!("contact without `{}`", labels[0]),
+                ))
             };
-            out.last_mut().map(|o| {
-                o.1.push(LmgcContact {
-                    candidate,
-                    antagonist,
-                    antagonist_is_wall: kind == "DKJCx",
-                    rt: 0.0,
-                    rn: 0.0,
-                    n: Vector2::zeros(),
-                    point: Vector2::zeros(),
-                })
-            });
-            let c = out.last_mut().and_then(|o| o.1.last_mut()).expect("pushed above");
-            c.rt = get(&["rlt/H", "rlt  "])?;
-            c.rn = get(&["rln/H", "rln  "])?;
-            c.n = Vector2::new(get(&["n(1)="])?, get(&["n(2)="])?);
-            c.point = Vector2::new(get(&["coo1="])?, get(&["coo2="])?);
+            let contact = LmgcContact {
+                candidate,
+                antagonist,
+                antagonist_is_wall: kind == "DKJCx",
+                rt: get(&["rlt/H", "rlt  "])?,
+                rn: get(&["rln/H", "rln  "])?,
+                n: Vector2::new(get(&["n(1)="])?, get(&["n(2)="])?),
+                point: Vector2::new(get(&["coo1="])?, get(&["coo2="])?),
+            };
+            if let Some(o) = out.last_mut() {
+                o.1.push(contact);
+            }
             i = j;
         }
     }
@@ -267,9 +308,19 @@ fn parse_vloc(path: &Path, text: &str) -> Result<Vec<(u64, Vec<LmgcContact>)>, R
 /// Reads LMGC90 2D files: one `BODIES.DAT`, one or more `DOF.OUT` and (optionally) the
 /// `Vloc_Rloc.OUT` of the same steps; the kind of each file is told by its name (`BODIES`,
 /// `DOF`, `Vloc_Rloc`), gzip or plain. Needs [`ReadOptions::density`].
-pub fn read_lmgc90(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<ExternalSnapshot>, ReadError> {
-    let all = files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-    let content = |reason: String| ReadError::Content { file: all.clone(), reason };
+pub fn read_lmgc90(
+    files: &[PathBuf],
+    opts: &ReadOptions,
+) -> Result<Vec<ExternalSnapshot>, ReadError> {
+    let all = files
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let content = |reason: String| ReadError::Content {
+        file: all.clone(),
+        reason,
+    };
     let density = opts.density.filter(|d| d.is_finite() && *d > 0.0).ok_or_else(|| {
         content("LMGC90 files do not hold the grains' density: give --density RHO (kg/m³, the Umas of BULK_BEHAV.DAT)".into())
     })?;
@@ -277,7 +328,10 @@ pub fn read_lmgc90(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<External
     let mut dofs: Vec<(PathBuf, u64, f64, Dof)> = Vec::new();
     let mut vlocs: HashMap<u64, (PathBuf, Vec<LmgcContact>)> = HashMap::new();
     for path in files {
-        let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_uppercase()).unwrap_or_default();
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_ascii_uppercase())
+            .unwrap_or_default();
         let text = read_text(path)?;
         if name.contains("BODIES") {
             if bodies.is_some() {
@@ -293,7 +347,10 @@ pub fn read_lmgc90(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<External
                 vlocs.insert(s, (path.clone(), c));
             }
         } else {
-            return Err(ReadError::content(path, "not an LMGC90 file this reader knows (BODIES.DAT, DOF.OUT, Vloc_Rloc.OUT)"));
+            return Err(ReadError::content(
+                path,
+                "not an LMGC90 file this reader knows (BODIES.DAT, DOF.OUT, Vloc_Rloc.OUT)",
+            ));
         }
     }
     let (bpath, bodies) = bodies.ok_or_else(|| content("no BODIES.DAT among the files".into()))?;
@@ -332,13 +389,19 @@ pub fn read_lmgc90(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<External
                     wall_of.insert(*id, frame.walls.len());
                     frame.walls.push(WallRecord {
                         name: format!("body{id}"),
-                        geometry: WallGeometry::Segment { a: c - e * ax1, b: c + e * ax1 },
+                        geometry: WallGeometry::Segment {
+                            a: c - e * ax1,
+                            b: c + e * ax1,
+                        },
                         position: c,
                         velocity: Vector2::new(v[0], v[1]),
                     });
                 }
                 None => {
-                    return Err(ReadError::content(&bpath, format!("body {id} has no contactor")));
+                    return Err(ReadError::content(
+                        &bpath,
+                        format!("body {id} has no contactor"),
+                    ));
                 }
             }
         }
@@ -347,7 +410,13 @@ pub fn read_lmgc90(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<External
             for c in contacts {
                 let a = if c.antagonist_is_wall {
                     Other::Wall(*wall_of.get(&c.antagonist).ok_or_else(|| {
-                        ReadError::content(vpath, format!("DKJCx contact with body {}, which is not a JONCx wall", c.antagonist))
+                        ReadError::content(
+                            vpath,
+                            format!(
+                                "DKJCx contact with body {}, which is not a JONCx wall",
+                                c.antagonist
+                            ),
+                        )
                     })?)
                 } else {
                     Other::Grain(c.antagonist)
@@ -362,7 +431,10 @@ pub fn read_lmgc90(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<External
                 });
             }
         } else if !vlocs.is_empty() {
-            return Err(ReadError::content(&dpath, format!("no Vloc_Rloc file of step {step}")));
+            return Err(ReadError::content(
+                &dpath,
+                format!("no Vloc_Rloc file of step {step}"),
+            ));
         }
         frames.push(frame);
     }

@@ -227,7 +227,15 @@ pub(crate) fn number(file: &Path, line: usize, what: &str, text: &str) -> Result
     };
     match v {
         Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(ReadError::parse(file, line, format!("{what} is not finite: `{t}`"))),
-        Err(_) => Err(ReadError::parse(file, line, format!("{what}: `{t}` is not a number"))),
+        Ok(_) => Err(ReadError::parse(
+            file,
+            line,
+            format!("{what} is not finite: `{t}`"),
+        )),
+        Err(_) => Err(ReadError::parse(
+            file,
+            line,
+            format!("{what}: `{t}` is not a number"),
+        )),
     }
 }

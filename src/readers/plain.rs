@@ -111,15 +111,29 @@ fn v2(a: [f64; 2]) -> Vector2<f64> {
 }
 
 /// Reads plain snapshots, one JSON file each (plain or `.gz`).
-pub fn read_plain(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<ExternalSnapshot>, ReadError> {
+pub fn read_plain(
+    files: &[PathBuf],
+    opts: &ReadOptions,
+) -> Result<Vec<ExternalSnapshot>, ReadError> {
     let mut frames = Vec::with_capacity(files.len());
     for path in files {
         let text = read_text(path)?;
         let p: PlainSnapshot = serde_json::from_str(&text).map_err(|e| {
-            ReadError::parse(path, e.line(), format!("{e}").split(" at line").next().unwrap_or("").to_string())
+            ReadError::parse(
+                path,
+                e.line(),
+                format!("{e}")
+                    .split(" at line")
+                    .next()
+                    .unwrap_or("")
+                    .to_string(),
+            )
         })?;
         if p.format != PLAIN_FORMAT {
-            return Err(ReadError::content(path, format!("format is `{}`, expected `{PLAIN_FORMAT}`", p.format)));
+            return Err(ReadError::content(
+                path,
+                format!("format is `{}`, expected `{PLAIN_FORMAT}`", p.format),
+            ));
         }
         let mut frame = Frame {
             step: p.step,
@@ -146,15 +160,24 @@ pub fn read_plain(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<ExternalS
                 (Some(p), Some(n), None, None) => {
                     let n = v2(n);
                     if (n.norm() - 1.0).abs() > 1e-9 {
-                        return Err(ReadError::content(path, format!("wall `{}`: normal is not a unit vector", w.name)));
+                        return Err(ReadError::content(
+                            path,
+                            format!("wall `{}`: normal is not a unit vector", w.name),
+                        ));
                     }
-                    WallGeometry::Line { point: v2(p), normal: n }
+                    WallGeometry::Line {
+                        point: v2(p),
+                        normal: n,
+                    }
                 }
                 (None, None, Some(a), Some(b)) => WallGeometry::Segment { a: v2(a), b: v2(b) },
                 _ => {
                     return Err(ReadError::content(
                         path,
-                        format!("wall `{}`: give `point` and `normal` (a line) or `a` and `b` (a segment)", w.name),
+                        format!(
+                        "wall `{}`: give `point` and `normal` (a line) or `a` and `b` (a segment)",
+                        w.name
+                    ),
                     ))
                 }
             };
@@ -174,11 +197,19 @@ pub fn read_plain(files: &[PathBuf], opts: &ReadOptions) -> Result<Vec<ExternalS
             let a = match (&c.a, &c.wall) {
                 (Some(id), None) => Other::Grain(*id),
                 (None, Some(name)) => Other::Wall(
-                    p.walls.iter().position(|w| &w.name == name).ok_or_else(|| {
-                        ReadError::content(path, format!("contact {k}: no wall named `{name}`"))
-                    })?,
+                    p.walls
+                        .iter()
+                        .position(|w| &w.name == name)
+                        .ok_or_else(|| {
+                            ReadError::content(path, format!("contact {k}: no wall named `{name}`"))
+                        })?,
                 ),
-                _ => return Err(ReadError::content(path, format!("contact {k}: give either `a` (a grain id) or `wall`"))),
+                _ => {
+                    return Err(ReadError::content(
+                        path,
+                        format!("contact {k}: give either `a` (a grain id) or `wall`"),
+                    ))
+                }
             };
             frame.contacts.push(ContactRecord {
                 a,
