@@ -396,3 +396,55 @@ fn synthetic_benchmark_dump_reads_back() {
     let expect = 400.0 * std::f64::consts::PI * 0.25 / (w * w);
     assert!((phi - expect).abs() < 1e-9, "{phi} vs {expect}");
 }
+
+#[test]
+fn liggghts_wall_contacts_from_wall_gran_local() {
+    // LIGGGHTS `compute wgl all wall/gran/local pos id force` dumped as c_wgl[1..12]:
+    // contact point (3), particle centre (3), mesh id, triangle id, particle id, force (3).
+    // Two disks of radius 0.01 m pressed 0.1 mm into the floor y = 0.
+    let dir = tempfile::tempdir().unwrap();
+    let atoms = write(
+        dir.path(),
+        "atoms.dump",
+        "ITEM: TIMESTEP\n100\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ATOMS id x y vx vy omegaz radius mass\n1 0.1 0.0099 0 0 0 0.01 0.5\n2 0.3 0.0099 0 0 0 0.01 0.5\n",
+    );
+    let walls = write(
+        dir.path(),
+        "walls.dump",
+        "ITEM: TIMESTEP\n100\nITEM: NUMBER OF ENTRIES\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ENTRIES c_wgl[1] c_wgl[2] c_wgl[3] c_wgl[4] c_wgl[5] c_wgl[6] c_wgl[7] c_wgl[8] c_wgl[9] c_wgl[10] c_wgl[11] c_wgl[12]\n0.1 0 0 0.1 0.0099 0 4 17 1 0.2 5.0 0\n0.3 0 0 0.3 0.0099 0 4 18 2 -0.1 3.0 0\n",
+    );
+    let columns = [
+        ("wall.wall", 7),
+        ("wall.id", 9),
+        ("wall.fx", 10),
+        ("wall.fy", 11),
+        ("wall.cx", 1),
+        ("wall.cy", 2),
+    ]
+    .iter()
+    .map(|(k, c)| (k.to_string(), format!("c_wgl[{c}]")))
+    .collect();
+    let opts = ReadOptions {
+        columns,
+        dt: Some(1e-5),
+        ..Default::default()
+    };
+    let s = &readers::read_lammps(&[atoms, walls], &opts).unwrap()[0].snapshot;
+    assert_eq!(s.walls.len(), 1);
+    let w = &s.walls[0];
+    assert_eq!(w.name, "wall4");
+    // the wall receives minus the forces on the particles
+    assert!((w.force - Vector2::new(-0.1, -8.0)).norm() < 1e-12);
+    // grain 1: 5 N up and 0.2 N along x at the contact point 9.9 mm below its centre
+    let g = grain_stresses(s).unwrap();
+    let v = std::f64::consts::PI * 1e-4;
+    assert!((g[0].contact[(1, 1)] + 5.0 * 0.0099 / v).abs() < 1e-9);
+    assert!((g[0].contact[(0, 1)] + 0.2 * 0.0099 / v).abs() < 1e-9);
+    // the wall is the line y = 0 with its normal up
+    match &w.geometry {
+        dem::snapshot::WallGeometry::Line { point, normal } => {
+            assert!(point.y.abs() < 1e-15 && (normal - Vector2::new(0.0, 1.0)).norm() < 1e-12);
+        }
+        other => panic!("{other:?}"),
+    }
+}

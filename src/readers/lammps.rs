@@ -12,6 +12,10 @@
 //!   `cx cy`. LAMMPS names these columns after the computes (`c_pf[2]`): the defaults follow the
 //!   commands of `docs/formats.md`, and [`ReadOptions::columns`] maps other names.
 //!   Rows whose force is zero (neighbours not in contact) are left out.
+//! - `dump local` files of wall contacts (LIGGGHTS `compute wall/gran/local pos id force`):
+//!   the keys `wall.wall` (wall or mesh id), `wall.id` (particle), `wall.fx`, `wall.fy` (force on
+//!   the particle), `wall.cx`, `wall.cy` (contact point), mapped with `--column wall.KEY=HEADER`;
+//!   each wall id makes a wall `wallN`.
 //!
 //! The moment of inertia is `I = k m R²` with `k` = [`ReadOptions::inertia_factor`] (1/2 for
 //! disks, `fix nve/sphere disc`). A dump file may hold several snapshots; per-atom and local
@@ -36,6 +40,17 @@ const LOCAL_KEYS: &[(&str, &[&str])] = &[
     ("fty", &["fty", "p2", "c_pf[5]"]),
     ("cx", &["cx", "contactpoint_x"]),
     ("cy", &["cy", "contactpoint_y"]),
+];
+
+/// Keys of wall-contact local columns (LIGGGHTS `compute wall/gran/local`), given with
+/// `--column wall.KEY=HEADER`; a local block with a `wall.wall` column is a wall block.
+const WALL_KEYS: &[(&str, &[&str])] = &[
+    ("wall.wall", &["wall_id", "mesh_id"]),
+    ("wall.id", &["particle_id"]),
+    ("wall.fx", &[]),
+    ("wall.fy", &[]),
+    ("wall.cx", &[]),
+    ("wall.cy", &[]),
 ];
 
 #[derive(Debug, PartialEq, Clone, Copy)]
@@ -348,16 +363,19 @@ fn local_columns(
     path: &Path,
     b: &Block,
     opts: &ReadOptions,
+    keys: &[(&'static str, &[&str])],
+    required: &[&str],
 ) -> Result<HashMap<&'static str, usize>, ReadError> {
     let mut map = HashMap::new();
     for (key, _) in &opts.columns {
-        if !LOCAL_KEYS.iter().any(|(k, _)| k == key) {
+        if !LOCAL_KEYS.iter().chain(WALL_KEYS).any(|(k, _)| k == key) {
             return Err(ReadError::content(
                 path,
                 format!(
                     "unknown column key `{key}`: expected one of {}",
                     LOCAL_KEYS
                         .iter()
+                        .chain(WALL_KEYS)
                         .map(|k| k.0)
                         .collect::<Vec<_>>()
                         .join(", ")
@@ -365,7 +383,7 @@ fn local_columns(
             ));
         }
     }
-    for (key, defaults) in LOCAL_KEYS {
+    for (key, defaults) in keys {
         let given = opts.columns.iter().rev().find(|(k, _)| k == key);
         let col = match given {
             Some((_, h)) => Some(b.col(&[h.as_str()]).ok_or_else(|| {
@@ -384,7 +402,7 @@ fn local_columns(
             map.insert(*key, c);
         }
     }
-    for key in ["id1", "id2", "fx", "fy"] {
+    for key in required {
         if !map.contains_key(key) {
             return Err(ReadError::parse(
                 path,
@@ -411,7 +429,7 @@ fn add_pairs(
     frame: &mut Frame,
     opts: &ReadOptions,
 ) -> Result<(), ReadError> {
-    let c = local_columns(path, b, opts)?;
+    let c = local_columns(path, b, opts, LOCAL_KEYS, &["id1", "id2", "fx", "fy"])?;
     let get = |v: &[f64], k: &str| c.get(k).map_or(0.0, |&i| v[i]);
     for row in 0..b.rows() {
         let v = &b.values[row * b.cols..(row + 1) * b.cols];
@@ -436,6 +454,116 @@ fn add_pairs(
                 .then(|| Vector2::new(get(v, "cx"), get(v, "cy"))),
             normal: None,
         });
+    }
+    Ok(())
+}
+
+/// Whether a local block holds wall contacts (a `wall.wall` column by name or by mapping).
+fn is_wall_block(b: &Block, opts: &ReadOptions) -> bool {
+    match opts.columns.iter().rev().find(|(k, _)| k == "wall.wall") {
+        Some((_, h)) => b.col(&[h.as_str()]).is_some(),
+        None => b.col(WALL_KEYS[0].1).is_some(),
+    }
+}
+
+/// Wall contacts of a local block (LIGGGHTS `compute wall/gran/local pos id force`): per row
+/// the wall (mesh) id, the particle id, the force on the particle and the contact point. Each
+/// wall id becomes a wall `wallN`: the line through the mean contact point with the mean unit
+/// normal from the contact points to the particles' centres.
+fn add_walls(
+    path: &Path,
+    b: &Block,
+    frame: &mut Frame,
+    opts: &ReadOptions,
+) -> Result<(), ReadError> {
+    let c = local_columns(
+        path,
+        b,
+        opts,
+        WALL_KEYS,
+        &[
+            "wall.wall",
+            "wall.id",
+            "wall.fx",
+            "wall.fy",
+            "wall.cx",
+            "wall.cy",
+        ],
+    )?;
+    let centre: HashMap<u64, Vector2<f64>> =
+        frame.grains.iter().map(|g| (g.id, g.position)).collect();
+    let mut walls: BTreeMap<
+        i64,
+        (
+            Vector2<f64>,
+            Vector2<f64>,
+            Vec<(u64, Vector2<f64>, Vector2<f64>, Vector2<f64>)>,
+        ),
+    > = BTreeMap::new();
+    for row in 0..b.rows() {
+        let v = &b.values[row * b.cols..(row + 1) * b.cols];
+        let line = b.first_line + row;
+        let (w, id) = (v[c["wall.wall"]], v[c["wall.id"]]);
+        if w.fract() != 0.0 || id < 0.0 || id.fract() != 0.0 {
+            return Err(ReadError::parse(
+                path,
+                line,
+                "wall and particle ids must be integers",
+            ));
+        }
+        let x = Vector2::new(v[c["wall.cx"]], v[c["wall.cy"]]);
+        let cp = *centre.get(&(id as u64)).ok_or_else(|| {
+            ReadError::parse(
+                path,
+                line,
+                format!(
+                    "particle {id} is not in the per-atom dump of step {}",
+                    b.step
+                ),
+            )
+        })?;
+        let d = cp - x;
+        if d.norm() == 0.0 {
+            return Err(ReadError::parse(
+                path,
+                line,
+                format!("particle {id}: contact point at its centre"),
+            ));
+        }
+        let n = d / d.norm();
+        let e = walls
+            .entry(w as i64)
+            .or_insert((Vector2::zeros(), Vector2::zeros(), Vec::new()));
+        e.0 += x;
+        e.1 += n;
+        e.2.push((
+            id as u64,
+            Vector2::new(v[c["wall.fx"]], v[c["wall.fy"]]),
+            x,
+            n,
+        ));
+    }
+    for (w, (ps, ns, contacts)) in walls {
+        let k = frame.walls.len();
+        let point = ps / contacts.len() as f64;
+        frame.walls.push(WallRecord {
+            name: format!("wall{w}"),
+            geometry: WallGeometry::Line {
+                point,
+                normal: ns.try_normalize(0.0).unwrap_or(Vector2::new(0.0, 1.0)),
+            },
+            position: point,
+            velocity: Vector2::zeros(),
+        });
+        for (id, f, x, n) in contacts {
+            frame.contacts.push(ContactRecord {
+                a: Other::Wall(k),
+                b: id,
+                force: f,
+                point: Some(x),
+                normal: Some(n),
+            });
+        }
     }
     Ok(())
 }
@@ -494,6 +622,11 @@ pub fn read_lammps(
                 ),
             )
         })?;
+        if is_wall_block(b, opts) {
+            add_walls(path, b, f, opts)?;
+            f.source = format!("{} + {}", f.source, path.display());
+            continue;
+        }
         if !seen.insert(b.step) {
             return Err(ReadError::content(
                 path,
@@ -503,7 +636,7 @@ pub fn read_lammps(
         add_pairs(path, b, f, opts)?;
         f.source = format!("{} + {}", f.source, path.display());
     }
-    if !locals.is_empty() {
+    if locals.iter().any(|(_, b)| !is_wall_block(b, opts)) {
         if let Some(step) = frames.keys().find(|s| !seen.contains(s)) {
             return Err(ReadError::Content {
                 file: frames[step].source.clone(),
