@@ -176,9 +176,8 @@ fn lammps_forces_give_accelerations_and_symmetric_stress() {
             }
         }
     }
-    // Finite differences of the dumped velocities agree with f/m to the change of f over a step
-    // (h = 2e-6 s): read the per-atom dumps with the force columns ignored through the plain
-    // route is not needed: compare a_fd = Δv/h with the two f/m.
+    // The finite difference of the dumped velocities over one step (h = 2e-6 s) agrees with
+    // the dumped f/m up to the change of f over the step (velocity Verlet averages it).
     let s1 = &snaps[1].snapshot;
     let s0 = &snaps[0].snapshot;
     let h = s1.time - s0.time;
