@@ -35,6 +35,8 @@ pub struct BenchPlan {
     pub pour: Vec<usize>,
     /// Steps that relax each engine deposit before the timed steps.
     pub relax_steps: usize,
+    /// Grain counts of the read-and-homogenise rows (synthetic LAMMPS dumps); none by default.
+    pub homogenise_grains: Vec<usize>,
 }
 
 /// Reference wall seconds (range) of a soft-contact DEM code for a settled column of `n` grains
@@ -195,6 +197,7 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
     run_fc(&plan.fc_dir)?;
     engine_rows(plan)?;
     columns(plan)?;
+    homogenise_rows(plan)?;
     let mem = dem::bench::MemoryFootprint::current(4);
     println!(
         "\nmemory: {} B per grain, {} B per contact; at 2 contacts per grain, 24 GiB hold about {:.1e} grains",
@@ -213,6 +216,24 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
         extra.per_contact,
         both.largest_sample(24 << 30, 2.0) as f64
     );
+    Ok(())
+}
+
+/// Reading and homogenising synthetic LAMMPS dumps ([`crate::homogenise_cmd::bench_homogenise`]).
+fn homogenise_rows(plan: &BenchPlan) -> Result<()> {
+    if plan.homogenise_grains.is_empty() {
+        return Ok(());
+    }
+    println!("\nread + homogenise a LAMMPS dump (synthetic, one snapshot, one thread):");
+    println!(
+        "{:>9} {:>9} {:>9} {:>12} {:>9}",
+        "grains", "contacts", "read s", "homogenise s", "total s"
+    );
+    let dir = std::env::temp_dir();
+    for &n in &plan.homogenise_grains {
+        let (c, r, h) = crate::homogenise_cmd::bench_homogenise(n, &dir)?;
+        println!("{n:>9} {c:>9} {r:>9.3} {h:>12.3} {:>9.3}", r + h);
+    }
     Ok(())
 }
 

@@ -107,6 +107,9 @@ pub enum Command {
         #[arg(long, value_name = "J")]
         jobs: Option<usize>,
     },
+    /// Homogenise snapshots of another DEM code (LAMMPS/LIGGGHTS dumps, LMGC90 files, plain
+    /// grainlaw-snapshot-v1 JSON): stresses, fabric, wall loads, profiles, figures, VTK.
+    Homogenise(HomogeniseArgs),
     /// Solve the reference frictional-contact problems and compare with Siconos' times.
     Bench {
         /// Directory of the reference problems (default: the repository's
@@ -128,6 +131,9 @@ pub enum Command {
         /// Steps relaxing each engine deposit before the timed steps.
         #[arg(long, value_name = "STEPS", default_value_t = 30)]
         relax_steps: usize,
+        /// Grain counts of synthetic LAMMPS dumps read and homogenised (none by default).
+        #[arg(long, value_name = "N", num_args = 0..)]
+        homogenise_grains: Vec<usize>,
     },
 }
 
@@ -239,9 +245,85 @@ impl Default for RunArgs {
     }
 }
 
+/// The options of `grainlaw homogenise` (`docs/cli.md`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct HomogeniseArgs {
+    /// Input format: lammps (also liggghts), lmgc90 or plain.
+    #[arg(long, value_name = "FORMAT")]
+    pub from: String,
+    /// The files (per-atom and local dumps; BODIES.DAT, DOF.OUT, Vloc_Rloc.OUT; JSON), plain or .gz.
+    #[arg(required = true, value_name = "FILES")]
+    pub files: Vec<PathBuf>,
+    /// Output directory (default `grainlaw-out/homogenise`).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Friction coefficient of the contacts, for the mobilisation |f_t|/(μ f_n).
+    #[arg(long)]
+    pub mu: Option<f64>,
+    /// Time step (s): times of LAMMPS dumps without ITEM: TIME are step × dt.
+    #[arg(long)]
+    pub dt: Option<f64>,
+    /// Gravity `GX,GY` (m/s²).
+    #[arg(
+        long,
+        value_name = "GX,GY",
+        default_value = "0,-9.81",
+        allow_hyphen_values = true
+    )]
+    pub gravity: String,
+    /// Moment of inertia I = K m R² for LAMMPS (0.5 disks, 0.4 spheres).
+    #[arg(long, value_name = "K", default_value_t = 0.5)]
+    pub inertia_factor: f64,
+    /// Grain density (kg/m³) for LMGC90 (Umas of BULK_BEHAV.DAT).
+    #[arg(long)]
+    pub density: Option<f64>,
+    /// LAMMPS local-dump column of a key: `id1=c_ids[1]`, `fx=c_pf[2]`, ... (repeatable).
+    #[arg(long = "column", value_name = "KEY=HEADER")]
+    pub columns: Vec<String>,
+    /// No report on stdout.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn homogenise_cmd(a: HomogeniseArgs) -> Result<()> {
+    let format = a.from.parse().map_err(CliError::Usage)?;
+    let g: Vec<f64> = a
+        .gravity
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .ok()
+        .filter(|v: &Vec<f64>| v.len() == 2 && v.iter().all(|x| x.is_finite()))
+        .ok_or_else(|| CliError::Usage(format!("--gravity `{}`: expected GX,GY", a.gravity)))?;
+    let plan = crate::homogenise_cmd::HomogenisePlan {
+        format,
+        files: a.files,
+        out: a
+            .out
+            .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("homogenise")),
+        options: crate::readers::ReadOptions {
+            gravity: [g[0], g[1]],
+            mu: a.mu,
+            dt: a.dt,
+            inertia_factor: a.inertia_factor,
+            density: a.density,
+            columns: crate::homogenise_cmd::parse_columns(&a.columns)?,
+        },
+        quiet: a.quiet,
+    };
+    let lines = crate::homogenise_cmd::homogenise(&plan)?;
+    if !plan.quiet {
+        for l in lines {
+            println!("{l}");
+        }
+    }
+    Ok(())
+}
+
 fn dispatch(cmd: Option<Command>) -> Result<()> {
     match cmd.unwrap_or(Command::Run(RunArgs::default())) {
         Command::Run(args) => run(args),
+        Command::Homogenise(args) => homogenise_cmd(args),
         Command::Scenarios { show } => scenarios_cmd(show.as_deref()),
         Command::Fit { law, data, out } => crate::fit_cmd::fit(&law, &data, out.as_deref()),
         Command::Campaign {
@@ -273,6 +355,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             columns,
             pour,
             relax_steps,
+            homogenise_grains,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
             engine_grains,
@@ -280,6 +363,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             columns,
             pour,
             relax_steps,
+            homogenise_grains,
         }),
     }
 }

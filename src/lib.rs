@@ -13,10 +13,12 @@ pub mod error;
 pub mod fc_cmd;
 pub mod fit_cmd;
 pub mod floats;
+pub mod homogenise_cmd;
 pub mod output;
 pub mod plot;
 pub mod progress;
 pub mod provenance;
+pub mod readers;
 pub mod scenarios;
 pub mod verdict;
 

@@ -1,0 +1,448 @@
+//! The code-neutral content of one snapshot, and how it becomes a [`Snapshot`].
+//!
+//! Contact geometry, for a contact whose force on grain `b` is `F` (N):
+//! - grain–grain (`a`, `b` grains, centres `c_a`, `c_b`, radii `R_a`, `R_b`): normal
+//!   `n = (c_b − c_a)/|c_b − c_a|` (nearest periodic image), gap `g = |c_b − c_a| − R_a − R_b`;
+//!   contact point the one the file gives, else the middle of the overlap on the line of centres,
+//!   `x = c_b − (R_b + g/2) n`, so that the levers satisfy `(x − c_a) − (x − c_b) = c_b − c_a`
+//!   and the Love–Weber sum `Σ_p Σ_α r_α ⊗ (x_α − c_p)` over the two grains is
+//!   `−F ⊗ (c_b − c_a)`, the pair virial of the other code, whatever the point;
+//! - wall–grain (a line wall through `p` with unit normal `n` pointing to the grain): gap
+//!   `g = (c_b − p)·n − R_b`, contact point the file's, else `x = c_b − R_b n` (the point
+//!   where codes such as LAMMPS apply the torque).
+//!
+//! `f_n = F·n`, `f_t = F·t` with `t = (−n_y, n_x)` ([`dem::snapshot::ContactState`]).
+
+use std::collections::HashMap;
+
+use dem::local::ContactStatus;
+use dem::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
+use nalgebra::Vector2;
+
+use super::{AccelerationSource, ExternalSnapshot, ReadError, ReadOptions};
+
+/// One grain as a file describes it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GrainRecord {
+    /// The code's id.
+    pub id: u64,
+    /// Centre (m).
+    pub position: Vector2<f64>,
+    /// Rotation angle (rad), 0 when the file has none.
+    pub angle: f64,
+    /// Velocity (m/s).
+    pub velocity: Vector2<f64>,
+    /// Angular velocity (rad/s).
+    pub omega: f64,
+    /// Radius (m).
+    pub radius: f64,
+    /// Mass (kg, per the thickness).
+    pub mass: f64,
+    /// Moment of inertia (kg·m²).
+    pub inertia: f64,
+    /// Acceleration and angular acceleration when the file gives them (or forces and torques
+    /// that give them).
+    pub acceleration: Option<(Vector2<f64>, f64)>,
+}
+
+/// A wall: a line through `point` with unit `normal` pointing to the grains, or a segment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WallRecord {
+    /// Name (the LAMMPS fix id, the LMGC90 body number, the plain file's name).
+    pub name: String,
+    /// Geometry.
+    pub geometry: WallGeometry,
+    /// Reference point (m): the body's centre, where its lever arms start.
+    pub position: Vector2<f64>,
+    /// Velocity (m/s).
+    pub velocity: Vector2<f64>,
+}
+
+/// The other body of a contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Other {
+    /// A grain, by the code's id.
+    Grain(u64),
+    /// A wall, by its index in [`Frame::walls`].
+    Wall(usize),
+}
+
+/// A contact: the force `force` (N) that body `a` exerts on grain `b`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactRecord {
+    /// Body `a`.
+    pub a: Other,
+    /// Grain `b`, by id.
+    pub b: u64,
+    /// Force on `b` (N); `a` receives the opposite.
+    pub force: Vector2<f64>,
+    /// Contact point (m) when the file gives it.
+    pub point: Option<Vector2<f64>>,
+    /// Unit normal from `a` to `b` when the file gives it (else from the geometry).
+    pub normal: Option<Vector2<f64>>,
+}
+
+/// One snapshot as a reader found it.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Frame {
+    /// Step index.
+    pub step: u64,
+    /// Time (s) when known.
+    pub time: Option<f64>,
+    /// Periodic cell along x, if any.
+    pub periodic_x: Option<[f64; 2]>,
+    /// The grains.
+    pub grains: Vec<GrainRecord>,
+    /// The walls.
+    pub walls: Vec<WallRecord>,
+    /// The contacts.
+    pub contacts: Vec<ContactRecord>,
+    /// The file(s) read, for messages.
+    pub source: String,
+}
+
+fn content(source: &str, reason: String) -> ReadError {
+    ReadError::Content {
+        file: source.to_string(),
+        reason,
+    }
+}
+
+/// `d` mapped to the nearest periodic image along x.
+fn min_image(mut d: Vector2<f64>, periodic_x: Option<[f64; 2]>) -> Vector2<f64> {
+    if let Some([a, b]) = periodic_x {
+        let l = b - a;
+        d.x -= l * (d.x / l).round();
+    }
+    d
+}
+
+/// Per grain, the acceleration (m/s²) and angular acceleration (rad/s²).
+type Accelerations = Vec<(Vector2<f64>, f64)>;
+
+/// The time of each frame: the file's, else `step · dt`.
+fn times(frames: &[Frame], opts: &ReadOptions) -> Result<Vec<Option<f64>>, ReadError> {
+    Ok(frames
+        .iter()
+        .map(|f| f.time.or_else(|| opts.dt.map(|dt| f.step as f64 * dt)))
+        .collect())
+}
+
+/// Makes the snapshots of `frames` (sorted by step): bodies (grains in the frame's order,
+/// then walls), contacts with their normal, tangential and normal force parts and levers,
+/// accelerations from the file or by finite differences (see the module documentation of
+/// [`crate::readers`]).
+pub fn build_snapshots(
+    mut frames: Vec<Frame>,
+    opts: &ReadOptions,
+) -> Result<Vec<ExternalSnapshot>, ReadError> {
+    frames.sort_by_key(|f| f.step);
+    let times = times(&frames, opts)?;
+    let n = frames.len();
+    // Accelerations: file, else finite differences by id, else zero.
+    let mut acc: Vec<(Accelerations, AccelerationSource)> = Vec::with_capacity(n);
+    for k in 0..n {
+        let f = &frames[k];
+        if f.grains.iter().all(|g| g.acceleration.is_some()) && !f.grains.is_empty() {
+            acc.push((
+                f.grains
+                    .iter()
+                    .map(|g| g.acceleration.unwrap_or_default())
+                    .collect(),
+                AccelerationSource::File,
+            ));
+            continue;
+        }
+        if n < 2 {
+            acc.push((
+                vec![(Vector2::zeros(), 0.0); f.grains.len()],
+                AccelerationSource::Zero,
+            ));
+            continue;
+        }
+        let (j0, j1, src) = if k > 0 {
+            (k - 1, k, AccelerationSource::BackwardDifference)
+        } else {
+            (0, 1, AccelerationSource::ForwardDifference)
+        };
+        let (t0, t1) = match (times[j0], times[j1]) {
+            (Some(a), Some(b)) => (a, b),
+            _ => {
+                return Err(content(
+                    &f.source,
+                    "accelerations by finite difference need the snapshots' times: the file has none (LAMMPS: `dump_modify ID time yes`), give --dt".into(),
+                ))
+            }
+        };
+        let h = t1 - t0;
+        if h.is_nan() || h <= 0.0 {
+            return Err(content(
+                &f.source,
+                format!(
+                    "snapshots at steps {} and {} have the same time: no finite difference",
+                    frames[j0].step, frames[j1].step
+                ),
+            ));
+        }
+        let before: HashMap<u64, &GrainRecord> =
+            frames[j0].grains.iter().map(|g| (g.id, g)).collect();
+        let mut a = Vec::with_capacity(f.grains.len());
+        for g in &frames[j1].grains {
+            let p = before.get(&g.id).ok_or_else(|| {
+                content(
+                    &frames[j1].source,
+                    format!(
+                        "grain {} is not in the snapshot of step {}: no finite difference",
+                        g.id, frames[j0].step
+                    ),
+                )
+            })?;
+            a.push(((g.velocity - p.velocity) / h, (g.omega - p.omega) / h));
+        }
+        if k == 0 {
+            // forward difference: a of frame 1 computed above, keyed by frame 1's order
+            let by_id: HashMap<u64, (Vector2<f64>, f64)> = frames[1]
+                .grains
+                .iter()
+                .zip(&a)
+                .map(|(g, v)| (g.id, *v))
+                .collect();
+            a = f
+                .grains
+                .iter()
+                .map(|g| by_id.get(&g.id).copied().unwrap_or_default())
+                .collect();
+        }
+        acc.push((a, src));
+    }
+    let dt_all = opts.dt.or_else(|| {
+        // the time step from consecutive snapshots' times and steps
+        (n >= 2)
+            .then(|| match (times[0], times[1]) {
+                (Some(a), Some(b)) if frames[1].step > frames[0].step => {
+                    Some((b - a) / (frames[1].step - frames[0].step) as f64)
+                }
+                _ => None,
+            })
+            .flatten()
+    });
+    frames
+        .into_iter()
+        .zip(acc)
+        .zip(times)
+        .map(|((f, (a, src)), t)| build_one(f, a, src, t, dt_all, opts))
+        .collect()
+}
+
+fn build_one(
+    f: Frame,
+    acc: Vec<(Vector2<f64>, f64)>,
+    src: AccelerationSource,
+    time: Option<f64>,
+    dt: Option<f64>,
+    opts: &ReadOptions,
+) -> Result<ExternalSnapshot, ReadError> {
+    let mut index: HashMap<u64, u32> = HashMap::with_capacity(f.grains.len());
+    let mut bodies = Vec::with_capacity(f.grains.len() + f.walls.len());
+    for (g, (a, w)) in f.grains.iter().zip(&acc) {
+        if index.insert(g.id, bodies.len() as u32).is_some() {
+            return Err(content(
+                &f.source,
+                format!("grain id {} appears twice", g.id),
+            ));
+        }
+        for (what, v) in [
+            ("radius", g.radius),
+            ("mass", g.mass),
+            ("inertia", g.inertia),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(content(
+                    &f.source,
+                    format!("grain {}: {what} must be > 0, got {v}", g.id),
+                ));
+            }
+        }
+        let thickness = 1.0;
+        bodies.push(BodyState {
+            kind: BodyKind::Grain,
+            name: String::new(),
+            position: g.position,
+            angle: g.angle,
+            velocity: g.velocity,
+            omega: g.omega,
+            acceleration: *a,
+            angular_acceleration: *w,
+            mass: g.mass,
+            inertia: g.inertia,
+            radius: g.radius,
+            density: g.mass / (std::f64::consts::PI * g.radius * g.radius * thickness),
+            thickness,
+        });
+    }
+    let first_wall = bodies.len();
+    for w in &f.walls {
+        bodies.push(BodyState {
+            kind: BodyKind::Wall,
+            name: w.name.clone(),
+            position: w.position,
+            angle: 0.0,
+            velocity: w.velocity,
+            omega: 0.0,
+            acceleration: Vector2::zeros(),
+            angular_acceleration: 0.0,
+            mass: f64::INFINITY,
+            inertia: f64::INFINITY,
+            radius: 0.0,
+            density: 0.0,
+            thickness: 1.0,
+        });
+    }
+    let mu = opts.mu.unwrap_or(0.0);
+    let mut contacts = Vec::with_capacity(f.contacts.len());
+    let mut wall_force = vec![(Vector2::zeros(), 0.0); f.walls.len()];
+    for c in &f.contacts {
+        let ib = *index.get(&c.b).ok_or_else(|| {
+            content(
+                &f.source,
+                format!(
+                    "a contact names grain {}, which is not in the snapshot",
+                    c.b
+                ),
+            )
+        })?;
+        let gb = &bodies[ib as usize];
+        let (cb, rb) = (gb.position, gb.radius);
+        let (ia, normal, gap, point) = match c.a {
+            Other::Grain(id) => {
+                let ia = *index.get(&id).ok_or_else(|| {
+                    content(
+                        &f.source,
+                        format!("a contact names grain {id}, which is not in the snapshot"),
+                    )
+                })?;
+                if ia == ib {
+                    return Err(content(
+                        &f.source,
+                        format!("grain {id} in contact with itself"),
+                    ));
+                }
+                let ga = &bodies[ia as usize];
+                let d = min_image(cb - ga.position, f.periodic_x);
+                let dist = d.norm();
+                let n = match c.normal {
+                    Some(n) => n,
+                    None if dist > 0.0 => d / dist,
+                    None => {
+                        return Err(content(
+                            &f.source,
+                            format!("grains {id} and {} have the same centre: no normal", c.b),
+                        ))
+                    }
+                };
+                let gap = dist - ga.radius - rb;
+                let x = c.point.unwrap_or(cb - n * (rb + 0.5 * gap));
+                (ia, n, gap, x)
+            }
+            Other::Wall(k) => {
+                let w = f.walls.get(k).ok_or_else(|| {
+                    content(
+                        &f.source,
+                        format!("a contact names wall {k}, which does not exist"),
+                    )
+                })?;
+                let (n, gap) = match (&w.geometry, c.normal) {
+                    (_, Some(n)) => (n, f64::NAN),
+                    (WallGeometry::Line { point, normal }, None) => {
+                        let s = (cb - point).dot(normal);
+                        (normal * s.signum(), s.abs() - rb)
+                    }
+                    (WallGeometry::Segment { a, b }, None) => {
+                        let e = b - a;
+                        let t = ((cb - a).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
+                        let d = cb - (a + e * t);
+                        let dist = d.norm();
+                        if dist == 0.0 {
+                            return Err(content(
+                                &f.source,
+                                format!("grain {} centred on wall `{}`", c.b, w.name),
+                            ));
+                        }
+                        (d / dist, dist - rb)
+                    }
+                    (WallGeometry::Clump { .. }, None) => {
+                        return Err(content(
+                            &f.source,
+                            "clump walls need the contact normal".into(),
+                        ))
+                    }
+                };
+                let x = c.point.unwrap_or(cb - n * rb);
+                ((first_wall + k) as u32, n, gap, x)
+            }
+        };
+        if (normal.norm() - 1.0).abs() > 1e-6 {
+            return Err(content(
+                &f.source,
+                format!("contact on grain {}: the normal is not a unit vector", c.b),
+            ));
+        }
+        let t = Vector2::new(-normal.y, normal.x);
+        let (fn_, ft) = (c.force.dot(&normal), c.force.dot(&t));
+        let ca = bodies[ia as usize].position;
+        let lever_a = min_image(point - ca, f.periodic_x);
+        let lever_b = min_image(point - cb, f.periodic_x);
+        let status = if fn_ == 0.0 && ft == 0.0 {
+            ContactStatus::Open
+        } else if mu > 0.0 && ft.abs() >= 0.999 * mu * fn_ {
+            ContactStatus::Slide
+        } else {
+            ContactStatus::Stick
+        };
+        if let Other::Wall(k) = c.a {
+            wall_force[k].0 -= c.force;
+            wall_force[k].1 -= lever_a.x * c.force.y - lever_a.y * c.force.x;
+        }
+        contacts.push(ContactState {
+            body_a: ia,
+            body_b: ib,
+            point,
+            normal,
+            force_n: fn_,
+            force_t: ft,
+            gap: if gap.is_finite() { gap } else { 0.0 },
+            mu,
+            status,
+            lever_a,
+            lever_b,
+        });
+    }
+    let walls = f
+        .walls
+        .iter()
+        .enumerate()
+        .map(|(k, w)| WallState {
+            body: (first_wall + k) as u32,
+            name: w.name.clone(),
+            geometry: w.geometry.clone(),
+            force: wall_force[k].0,
+            torque: wall_force[k].1,
+        })
+        .collect();
+    let grain_ids = f.grains.iter().map(|g| g.id).collect();
+    Ok(ExternalSnapshot {
+        snapshot: Snapshot {
+            step: f.step,
+            time: time.unwrap_or(f.step as f64),
+            dt: dt.filter(|d| *d > 0.0 && d.is_finite()).unwrap_or(1.0),
+            gravity: Vector2::new(opts.gravity[0], opts.gravity[1]),
+            periodic_x: f.periodic_x,
+            bodies,
+            contacts,
+            walls,
+        },
+        grain_ids,
+        accelerations: src,
+        source: f.source,
+    })
+}

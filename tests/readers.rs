@@ -1,0 +1,449 @@
+//! Readers of other codes' snapshots (`grainlaw::readers`) and `grainlaw homogenise`:
+//! LAMMPS dumps of a real 2D run (`datasets/external/lammps`, made with the LAMMPS of Debian
+//! 12, see its README) checked against LAMMPS' own stress and wall forces; LMGC90 files written
+//! by hand in LMGC90's layout (`datasets/external/lmgc90`); the plain format against analytic
+//! answers; errors naming file and line.
+
+use std::path::{Path, PathBuf};
+
+use dem::snapshot::BodyKind;
+use grainlaw::readers::{self, AccelerationSource, Format, ReadOptions};
+use homogenise::grain_stresses;
+use homogenise::tensor::Tensor2;
+use nalgebra::Vector2;
+
+fn data(dir: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("datasets/external")
+        .join(dir)
+}
+
+fn lammps_files() -> Vec<PathBuf> {
+    let d = data("lammps");
+    [400000, 400001, 400002]
+        .iter()
+        .flat_map(|s| {
+            [
+                d.join(format!("atoms.{s}.dump.gz")),
+                d.join(format!("pairs.{s}.dump.gz")),
+            ]
+        })
+        .collect()
+}
+
+/// LAMMPS' thermo lines: step → values (c_wall[1..6], c_spair[1..3] at the end).
+fn thermo() -> Vec<(u64, Vec<f64>)> {
+    let text = std::fs::read_to_string(data("lammps").join("thermo.txt")).unwrap();
+    text.lines()
+        .filter_map(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            let step = t.first()?.parse::<u64>().ok()?;
+            Some((
+                step,
+                t.iter()
+                    .skip(4)
+                    .map(|v| v.parse::<f64>().unwrap())
+                    .collect(),
+            ))
+        })
+        .collect()
+}
+
+/// Σ_i S_i of LAMMPS' `compute stress/atom NULL pair` columns (xx, yy, xy) of a per-atom dump.
+fn lammps_stress_sum(step: u64) -> [f64; 3] {
+    let text = readers::read_text(&data("lammps").join(format!("atoms.{step}.dump.gz"))).unwrap();
+    let mut lines = text.lines().skip_while(|l| !l.starts_with("ITEM: ATOMS"));
+    let header: Vec<&str> = lines.next().unwrap().split_whitespace().skip(2).collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    let (xx, yy, xy) = (col("c_s[1]"), col("c_s[2]"), col("c_s[4]"));
+    let mut s = [0.0; 3];
+    for l in lines {
+        let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+        s[0] += v[xx];
+        s[1] += v[yy];
+        s[2] += v[xy];
+    }
+    s
+}
+
+/// `Σ_p V_p Σ_c,p` over the grains, counting grain–grain contacts only (N·m).
+fn pair_moment(s: &dem::Snapshot) -> Tensor2 {
+    let mut pairs = s.clone();
+    pairs.contacts.retain(|c| {
+        s.bodies[c.body_a as usize].kind == BodyKind::Grain
+            && s.bodies[c.body_b as usize].kind == BodyKind::Grain
+    });
+    grain_stresses(&pairs)
+        .unwrap()
+        .iter()
+        .fold(Tensor2::zeros(), |m, g| m + g.contact * g.volume)
+}
+
+#[test]
+fn lammps_contact_stress_equals_lammps_pair_virial() {
+    let snaps = readers::read_lammps(&lammps_files(), &ReadOptions::default()).unwrap();
+    assert_eq!(snaps.len(), 3);
+    let th = thermo();
+    for ext in &snaps {
+        let s = &ext.snapshot;
+        assert_eq!(
+            s.bodies
+                .iter()
+                .filter(|b| b.kind == BodyKind::Grain)
+                .count(),
+            152
+        );
+        // LAMMPS' stress/atom is −(virial) per atom, `−½ Σ_j (x_i − x_j) ⊗ F_ij` in N·m for
+        // 2D SI units: tension positive like grainlaw, first index the branch: its xy is
+        // grainlaw's yx (grainlaw's first index is the force).
+        let m = pair_moment(s);
+        let l = lammps_stress_sum(s.step);
+        let ours = [m[(0, 0)], m[(1, 1)], m[(1, 0)]];
+        let scale = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let worst = (0..3).map(|k| (ours[k] - l[k]).abs()).fold(0.0, f64::max) / scale;
+        eprintln!("step {}: Σ V_p Σ_c = {ours:?} N·m, LAMMPS Σ S_i = {l:?}, relative difference {worst:.1e}", s.step);
+        for k in 0..3 {
+            assert!(
+                (ours[k] - l[k]).abs() <= 1e-9 * scale,
+                "step {} component {k}: grainlaw {} LAMMPS {}",
+                s.step,
+                ours[k],
+                l[k]
+            );
+        }
+        // the same against the reduce of the thermo output
+        let t = &th.iter().find(|(st, _)| *st == s.step).unwrap().1;
+        for k in 0..3 {
+            assert!((ours[k] - t[6 + k]).abs() <= 1e-9 * scale, "thermo {k}");
+        }
+        // compression: the pair stress moment is negative on the diagonal
+        assert!(m[(0, 0)] < 0.0 && m[(1, 1)] < 0.0);
+    }
+}
+
+#[test]
+fn lammps_wall_loads_equal_lammps_wall_forces() {
+    let snaps = readers::read_lammps(&lammps_files(), &ReadOptions::default()).unwrap();
+    let th = thermo();
+    for ext in &snaps {
+        let s = &ext.snapshot;
+        let t = &th.iter().find(|(st, _)| *st == s.step).unwrap().1;
+        for (k, name) in ["left", "right", "bottom"].iter().enumerate() {
+            let w = s.walls.iter().find(|w| &w.name == name).unwrap();
+            // LAMMPS reports the force of the wall on the atoms; the wall receives the opposite
+            let lammps = Vector2::new(-t[2 * k], -t[2 * k + 1]);
+            let err = (w.force - lammps).norm();
+            assert!(
+                err <= 1e-12 * lammps.norm().max(1.0),
+                "{name}: {} vs {}",
+                w.force,
+                lammps
+            );
+        }
+        // the walls carry the weight of 152 disks (75.249 N) to within the slight residual
+        // acceleration of the settling column (kinetic energy 6e-8 J)
+        let weight: f64 = s
+            .bodies
+            .iter()
+            .filter(|b| b.kind == BodyKind::Grain)
+            .map(|b| b.mass * 9.81)
+            .sum();
+        let carried: f64 = s.walls.iter().map(|w| -w.force.y).sum();
+        assert!(
+            (carried - weight).abs() < 0.02 * weight,
+            "{carried} vs {weight}"
+        );
+    }
+}
+
+#[test]
+fn lammps_forces_give_accelerations_and_symmetric_stress() {
+    let snaps = readers::read_lammps(&lammps_files(), &ReadOptions::default()).unwrap();
+    for ext in &snaps {
+        assert_eq!(ext.accelerations, AccelerationSource::File);
+        // ω̇ = τ/I from the dump's torque: the inertia term cancels the skew part of the contact
+        // term up to the lever difference of LAMMPS (torque at R) and the mid-overlap contact
+        // point (R − δ/2), δ/R ~ 1e-4 here.
+        for g in grain_stresses(&ext.snapshot).unwrap() {
+            let skew = 0.5 * (g.total[(0, 1)] - g.total[(1, 0)]).abs();
+            let norm = g.contact.norm();
+            if norm > 0.0 {
+                assert!(
+                    skew <= 1e-3 * norm,
+                    "grain {}: skew {skew} of {norm}",
+                    g.body
+                );
+            }
+        }
+    }
+    // The finite difference of the dumped velocities over one step (h = 2e-6 s) agrees with
+    // the dumped f/m up to the change of f over the step (velocity Verlet averages it).
+    let s1 = &snaps[1].snapshot;
+    let s0 = &snaps[0].snapshot;
+    let h = s1.time - s0.time;
+    assert!((h - 2e-6).abs() < 1e-15);
+    let mut worst: f64 = 0.0;
+    let mut scale: f64 = 0.0;
+    for (b1, b0) in s1
+        .bodies
+        .iter()
+        .zip(&s0.bodies)
+        .filter(|(b, _)| b.kind == BodyKind::Grain)
+    {
+        let fd = (b1.velocity - b0.velocity) / h;
+        worst = worst.max((fd - b1.acceleration).norm());
+        scale = scale.max(b1.acceleration.norm());
+    }
+    assert!(
+        worst < 0.05 * scale,
+        "finite difference {worst} vs f/m scale {scale}"
+    );
+}
+
+#[test]
+fn lmgc90_hand_written_sample() {
+    let d = data("lmgc90");
+    let files: Vec<PathBuf> = [
+        "BODIES.DAT",
+        "DOF.OUT.1",
+        "DOF.OUT.2",
+        "Vloc_Rloc.OUT.1",
+        "Vloc_Rloc.OUT.2",
+    ]
+    .iter()
+    .map(|f| d.join(f))
+    .collect();
+    let opts = ReadOptions {
+        density: Some(1000.0),
+        mu: Some(0.5),
+        ..Default::default()
+    };
+    let snaps = readers::read_lmgc90(&files, &opts).unwrap();
+    assert_eq!(snaps.len(), 2);
+    assert_eq!(
+        snaps[0].accelerations,
+        AccelerationSource::ForwardDifference
+    );
+    assert_eq!(
+        snaps[1].accelerations,
+        AccelerationSource::BackwardDifference
+    );
+    let s = &snaps[1].snapshot;
+    let (r, v) = (0.1, std::f64::consts::PI * 0.01);
+    let g = grain_stresses(s).unwrap();
+    // upper disk (body 2): 300 N up at its bottom (lever −R ŷ): σ_yy = −300 R / V
+    assert!((g[1].contact[(1, 1)] + 300.0 * r / v).abs() < 1e-9 * 300.0 * r / v);
+    // lower disk (body 1): 300 N down at its top, 600 N up at its bottom, and the wall's
+    // tangential 30 N along LMGC90's t = (n_y, −n_x) = +x̂ at lever −R ŷ: σ_xy = −30 R / V
+    assert!((g[0].contact[(1, 1)] + 900.0 * r / v).abs() < 1e-9 * 900.0 * r / v);
+    assert!((g[0].contact[(0, 1)] + 30.0 * r / v).abs() < 1e-9 * 30.0 * r / v);
+    assert!(g[0].contact[(1, 0)].abs() < 1e-9);
+    // finite difference: ω of body 1 goes 0 → 0.5 rad/s in 1 ms: ω̇ = 500 rad/s²; the inertia
+    // term's xy is (I/(2V)) ω̇ with I = m gyrd², m = ρ π avrd²
+    let m = 1000.0 * v;
+    let i = m * 0.07071068f64.powi(2);
+    assert!((s.bodies[0].angular_acceleration - 500.0).abs() < 1e-9);
+    let expect = i / (2.0 * v) * 500.0;
+    assert!((g[0].inertia[(0, 1)] - expect).abs() < 1e-9 * expect);
+    assert!((s.bodies[1].acceleration.y + 1.0).abs() < 1e-9);
+    // the floor (JONCx body 3) receives (−30, −600) N
+    let w = &s.walls[0];
+    assert_eq!(w.name, "body3");
+    assert!((w.force - Vector2::new(-30.0, -600.0)).norm() < 1e-9);
+    // mobilisation of the wall contact: 30 / (0.5 · 600) = 0.1
+    let wc = s.contacts.iter().find(|c| c.body_a == w.body).unwrap();
+    assert!((wc.mobilisation().unwrap() - 0.1).abs() < 1e-12);
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn plain_disk_on_a_floor_and_finite_differences() {
+    let dir = tempfile::tempdir().unwrap();
+    // a disk of radius R, mass m at rest on the floor y = 0: the floor pushes m g up at the
+    // disk's bottom. σ_yy = −m g R / (π R²), the floor receives −m g ŷ.
+    let (r, m, g) = (0.01, 0.2, 9.81);
+    let snap = |step: u64, t: f64, vy: f64| {
+        format!(
+            r#"{{"format": "grainlaw-snapshot-v1", "step": {step}, "time": {t},
+  "grains": [{{"id": 7, "x": 0.5, "y": {r}, "vx": 0, "vy": {vy}, "omega": 0, "radius": {r}, "mass": {m}}}],
+  "walls": [{{"name": "floor", "point": [0, 0], "normal": [0, 1]}}],
+  "contacts": [{{"wall": "floor", "b": 7, "force": [0, {f}]}}]}}"#,
+            f = m * g
+        )
+    };
+    let a = write(dir.path(), "s0.json", &snap(0, 0.0, 0.0));
+    let b = write(dir.path(), "s1.json", &snap(10, 0.01, -0.002));
+    let snaps = readers::read_plain(&[a.clone(), b], &ReadOptions::default()).unwrap();
+    let s = &snaps[1].snapshot;
+    let gs = grain_stresses(s).unwrap();
+    let expect = -m * g * r / (std::f64::consts::PI * r * r);
+    assert!((gs[0].contact[(1, 1)] - expect).abs() < 1e-12 * expect.abs());
+    assert!((s.walls[0].force - Vector2::new(0.0, -m * g)).norm() < 1e-12);
+    // a = Δv/Δt = −0.2 m/s², backward for the second, forward for the first
+    assert_eq!(
+        snaps[1].accelerations,
+        AccelerationSource::BackwardDifference
+    );
+    assert!((s.bodies[0].acceleration.y + 0.2).abs() < 1e-12);
+    assert!((snaps[0].snapshot.bodies[0].acceleration.y + 0.2).abs() < 1e-12);
+    // a single snapshot without accelerations: zero, and said so
+    let one = readers::read_plain(&[a], &ReadOptions::default()).unwrap();
+    assert_eq!(one[0].accelerations, AccelerationSource::Zero);
+}
+
+#[test]
+fn errors_name_the_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "bad.dump",
+        "ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ATOMS id x y vx vy omegaz radius mass\n1 0.5 0.5 0 0 0 0.1 1\n2 0.5 0.x 0 0 0 0.1 1\n",
+    );
+    let e = readers::read_lammps(std::slice::from_ref(&p), &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.dump:11:") && e.contains("0.x"), "{e}");
+    let q = write(
+        dir.path(),
+        "nomass.dump",
+        "ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ATOMS id x y vx vy omegaz radius\n1 0.5 0.5 0 0 0 0.1\n",
+    );
+    let e = readers::read_lammps(&[q], &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("nomass.dump:9:") && e.contains("`mass`"), "{e}");
+    // the command line: one line, exit code 2
+    let code = grainlaw::cli::main_with_args([
+        "grainlaw",
+        "homogenise",
+        "--from",
+        "lammps",
+        p.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert_eq!("lmgc90".parse::<Format>().unwrap(), Format::Lmgc90);
+    assert!("vasp".parse::<Format>().is_err());
+}
+
+#[test]
+fn homogenise_command_writes_the_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let mut args: Vec<String> = [
+        "grainlaw",
+        "homogenise",
+        "--from",
+        "lammps",
+        "--mu",
+        "0.5",
+        "-q",
+        "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    args.push(out.display().to_string());
+    args.extend(lammps_files().iter().map(|p| p.display().to_string()));
+    assert_eq!(grainlaw::cli::main_with_args(args), 0);
+    for f in [
+        "summary.json",
+        "snapshots.csv",
+        "walls.csv",
+        "grains_400002.csv",
+        "stress_profile.csv",
+        "coarse.csv",
+        "mobilisation.csv",
+        "grains.png",
+        "grains.pvd",
+        "wall_profile_left.csv",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["snapshots"], 3);
+    assert_eq!(s["acceleration_source"], "file");
+    // the bottom wall carries most of the weight (75.25 N)
+    let fy = s["wall_bottom_force_y_N"].as_f64().unwrap();
+    assert!(fy < -70.0 && fy > -80.0, "{fy}");
+    // settled packing: solid fraction of a 2D disk packing
+    let phi = s["solid_fraction"].as_f64().unwrap();
+    assert!(phi > 0.75 && phi < 0.91, "{phi}");
+}
+
+#[test]
+fn synthetic_benchmark_dump_reads_back() {
+    // the generator of `grainlaw bench --homogenise-grains`: a 20 × 20 square lattice has
+    // 2 · 20 · 19 = 760 neighbour contacts, and a lattice of spacing 0.999 d a solid fraction
+    // of π/4 / 0.999² inside its cells
+    let dir = tempfile::tempdir().unwrap();
+    let (c, read_s, hom_s) = grainlaw::homogenise_cmd::bench_homogenise(400, dir.path()).unwrap();
+    assert_eq!(c, 760);
+    assert!(read_s >= 0.0 && hom_s >= 0.0);
+    let (atoms, pairs) = grainlaw::homogenise_cmd::synthetic_lammps_dump(400);
+    let a = write(dir.path(), "a.dump", &atoms);
+    let p = write(dir.path(), "p.dump", &pairs);
+    let s = &readers::read_lammps(&[a, p], &ReadOptions::default()).unwrap()[0].snapshot;
+    let phi = homogenise::state::solid_fraction(s, &homogenise::Region::Whole).unwrap();
+    // the whole-sample box is the grains' extent, 19 spacings plus one diameter wide and high (in d)
+    let w = 19.0 * 0.999 + 1.0;
+    let expect = 400.0 * std::f64::consts::PI * 0.25 / (w * w);
+    assert!((phi - expect).abs() < 1e-9, "{phi} vs {expect}");
+}
+
+#[test]
+fn liggghts_wall_contacts_from_wall_gran_local() {
+    // LIGGGHTS `compute wgl all wall/gran/local pos id force` dumped as c_wgl[1..12]:
+    // contact point (3), particle centre (3), mesh id, triangle id, particle id, force (3).
+    // Two disks of radius 0.01 m pressed 0.1 mm into the floor y = 0.
+    let dir = tempfile::tempdir().unwrap();
+    let atoms = write(
+        dir.path(),
+        "atoms.dump",
+        "ITEM: TIMESTEP\n100\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ATOMS id x y vx vy omegaz radius mass\n1 0.1 0.0099 0 0 0 0.01 0.5\n2 0.3 0.0099 0 0 0 0.01 0.5\n",
+    );
+    let walls = write(
+        dir.path(),
+        "walls.dump",
+        "ITEM: TIMESTEP\n100\nITEM: NUMBER OF ENTRIES\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n-0.5 0.5\nITEM: ENTRIES c_wgl[1] c_wgl[2] c_wgl[3] c_wgl[4] c_wgl[5] c_wgl[6] c_wgl[7] c_wgl[8] c_wgl[9] c_wgl[10] c_wgl[11] c_wgl[12]\n0.1 0 0 0.1 0.0099 0 4 17 1 0.2 5.0 0\n0.3 0 0 0.3 0.0099 0 4 18 2 -0.1 3.0 0\n",
+    );
+    let columns = [
+        ("wall.wall", 7),
+        ("wall.id", 9),
+        ("wall.fx", 10),
+        ("wall.fy", 11),
+        ("wall.cx", 1),
+        ("wall.cy", 2),
+    ]
+    .iter()
+    .map(|(k, c)| (k.to_string(), format!("c_wgl[{c}]")))
+    .collect();
+    let opts = ReadOptions {
+        columns,
+        dt: Some(1e-5),
+        ..Default::default()
+    };
+    let s = &readers::read_lammps(&[atoms, walls], &opts).unwrap()[0].snapshot;
+    assert_eq!(s.walls.len(), 1);
+    let w = &s.walls[0];
+    assert_eq!(w.name, "wall4");
+    // the wall receives minus the forces on the particles
+    assert!((w.force - Vector2::new(-0.1, -8.0)).norm() < 1e-12);
+    // grain 1: 5 N up and 0.2 N along x at the contact point 9.9 mm below its centre
+    let g = grain_stresses(s).unwrap();
+    let v = std::f64::consts::PI * 1e-4;
+    assert!((g[0].contact[(1, 1)] + 5.0 * 0.0099 / v).abs() < 1e-9);
+    assert!((g[0].contact[(0, 1)] + 0.2 * 0.0099 / v).abs() < 1e-9);
+    // the wall is the line y = 0 with its normal up
+    match &w.geometry {
+        dem::snapshot::WallGeometry::Line { point, normal } => {
+            assert!(point.y.abs() < 1e-15 && (normal - Vector2::new(0.0, 1.0)).norm() < 1e-12);
+        }
+        other => panic!("{other:?}"),
+    }
+}
