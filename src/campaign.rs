@@ -700,14 +700,25 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
         .collect();
     if !left_out.is_empty() {
         println!(
-            "left out of the merged tables (a result refused or suspect): {}",
+            "runs with a result refused or suspect (their points that passed their own checks are merged): {}",
             abbreviate(&left_out)
         );
     }
     let mut refused = Vec::new();
     for (table, laws) in MERGED {
-        let files: Vec<(usize, PathBuf)> = passed
+        // A table with a `point_verdict` column is judged row by row: its passed rows are
+        // merged from every run that completed (exit 0 or 3); another table only from the runs
+        // that passed as a whole.
+        let files: Vec<(usize, PathBuf)> = done
             .iter()
+            .filter(|f| {
+                let p = run_dir(out, f.spec.index).join(table);
+                if has_point_verdict(&p) {
+                    matches!(f.code, None | Some(0) | Some(3))
+                } else {
+                    passed.iter().any(|q| q.spec.index == f.spec.index)
+                }
+            })
             .map(|f| (f.spec.index, run_dir(out, f.spec.index).join(table)))
             .filter(|(_, p)| p.is_file())
             .collect();
@@ -850,6 +861,18 @@ pub fn mean_and_std_error(xs: &[f64]) -> (f64, Option<f64>) {
     (mean, Some((var / n).sqrt()))
 }
 
+/// Whether a grainlaw CSV table has a `point_verdict` column (its header line).
+fn has_point_verdict(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+                .map(|h| h.split(',').any(|c| c.trim() == "point_verdict"))
+        })
+        .unwrap_or(false)
+}
+
 /// A `# key = value` metadata line (`key` an identifier, as `grainlaw fit` reads it), or None
 /// for a comment.
 fn metadata_line(line: &str) -> Option<(String, String)> {
@@ -877,6 +900,7 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
     let mut metas: Vec<(PathBuf, Vec<(String, String)>)> = Vec::new();
     let mut header: Option<String> = None;
     let mut rows = Vec::new();
+    let mut dropped = 0usize;
     for (index, path) in files {
         let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
             path: path.display().to_string(),
@@ -884,6 +908,7 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
         })?;
         let mut meta = Vec::new();
         let mut this_header = None;
+        let mut verdict_col = None;
         for line in text.lines() {
             let t = line.trim();
             if t.is_empty() {
@@ -897,8 +922,16 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
             }
             if this_header.is_none() {
                 this_header = Some(t.to_string());
+                verdict_col = t.split(',').position(|h| h.trim() == "point_verdict");
             } else {
-                rows.push(format!("{t},{index}"));
+                let passed = verdict_col.is_none_or(|j| {
+                    t.split(',').nth(j).and_then(|v| v.trim().parse::<f64>().ok()) == Some(0.0)
+                });
+                if passed {
+                    rows.push(format!("{t},{index}"));
+                } else {
+                    dropped += 1;
+                }
             }
         }
         match &header {
@@ -958,7 +991,9 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
             }
         }
     }
-    let mut text = String::from("# merged by grainlaw campaign: the rows of every run that passed its checks; column `run` is the run's index; numeric metadata are the means over the runs\n");
+    let mut text = format!(
+        "# merged by grainlaw campaign: the rows that passed their checks ({dropped} left out); column `run` is the run's index; numeric metadata are the means over the runs\n"
+    );
     for m in merged_meta {
         text.push_str(&m);
         text.push('\n');

@@ -314,13 +314,17 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     let mut phi_checks = Checks::new();
     let phi_bound = max_solid_fraction(c.grain.radius_spread);
     let mut windows = WindowStats::default();
+    // Each point (one inertial number) is also judged on its own checks: `point_verdict` in
+    // rheology.csv, so that a campaign merges the points that passed from every seed.
+    let mut point_verdicts = Vec::with_capacity(run_checks.len());
     for rc in &run_checks {
         let label = format!("I = {}", rc.i_target);
-        common.window(&format!("{label}, averaging window"), &rc.window);
+        let (mut pc, mut pm, mut pp) = (Checks::new(), Checks::new(), Checks::new());
+        pc.window(&format!("{label}, averaging window"), &rc.window);
         windows.merge(&rc.window);
         let ratio = rc.i_measured / rc.i_target;
         let factor = if ratio >= 1.0 { ratio } else { 1.0 / ratio };
-        common.at_most(
+        pc.at_most(
             "shear_cell.inertial_number_factor",
             factor,
             I_FACTOR_SUSPECT,
@@ -332,25 +336,29 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 )
             },
         );
-        mu_checks.steady(
+        pm.steady(
             "shear_cell.steady_mu",
             &format!("{label}: μ"),
             &rc.mu,
             STEADY_MU_TOLERANCE,
         );
-        phi_checks.steady(
+        pp.steady(
             "shear_cell.steady_phi",
             &format!("{label}: φ"),
             &rc.phi,
             STEADY_PHI_TOLERANCE,
         );
         let phi = rc.phi.iter().sum::<f64>() / rc.phi.len().max(1) as f64;
-        phi_checks.solid_fraction(
+        pp.solid_fraction(
             "shear_cell.solid_fraction",
             &format!("{label}: the bulk"),
             phi,
             phi_bound,
         );
+        point_verdicts.push(pc.verdict().max(pm.verdict()).max(pp.verdict()));
+        common.extend(&pc);
+        mu_checks.extend(&pm);
+        phi_checks.extend(&pp);
     }
     mu_checks.extend(&common);
     phi_checks.extend(&common);
@@ -378,12 +386,20 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         "slip_velocity_top_m_s",
         "mu_eff_top",
         "samples",
+        "point_verdict",
     ];
     let mut table = CsvTable::new(&headers);
-    for r in &rows {
-        table.push(r.clone());
+    for (k, r) in rows.iter().enumerate() {
+        let mut r = r.clone();
+        r.push(match point_verdicts.get(k) {
+            Some(Verdict::Ok) => 0.0,
+            Some(Verdict::Suspect) => 1.0,
+            Some(Verdict::Refused) | None => 2.0,
+        });
+        table.push(r);
     }
     table.comments.push("steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip; fit again with grainlaw fit mu-i rheology.csv".into());
+    table.comments.push("point_verdict: the point's own checks (averaging-window numerics, I against its target, steady state, solid fraction): 0 ok, 1 suspect, 2 refused".into());
     table.metadata = vec![
         ("grain_diameter_m".into(), d),
         ("grain_density_kg_m3".into(), c.grain.density),
