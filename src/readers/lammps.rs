@@ -458,6 +458,14 @@ fn add_pairs(
     Ok(())
 }
 
+/// Per wall id: the sums of the contact points and of the unit normals, and the contacts
+/// (particle id, force on it, contact point, unit normal).
+type WallSums = (
+    Vector2<f64>,
+    Vector2<f64>,
+    Vec<(u64, Vector2<f64>, Vector2<f64>, Vector2<f64>)>,
+);
+
 /// Whether a local block holds wall contacts (a `wall.wall` column by name or by mapping).
 fn is_wall_block(b: &Block, opts: &ReadOptions) -> bool {
     match opts.columns.iter().rev().find(|(k, _)| k == "wall.wall") {
@@ -492,14 +500,7 @@ fn add_walls(
     )?;
     let centre: HashMap<u64, Vector2<f64>> =
         frame.grains.iter().map(|g| (g.id, g.position)).collect();
-    let mut walls: BTreeMap<
-        i64,
-        (
-            Vector2<f64>,
-            Vector2<f64>,
-            Vec<(u64, Vector2<f64>, Vector2<f64>, Vector2<f64>)>,
-        ),
-    > = BTreeMap::new();
+    let mut walls: BTreeMap<i64, WallSums> = BTreeMap::new();
     for row in 0..b.rows() {
         let v = &b.values[row * b.cols..(row + 1) * b.cols];
         let line = b.first_line + row;
