@@ -20,4 +20,4 @@ law.save("mu_i_law.json")  # schema 2, readable by grainlaw.load_law and continu
 try:  # a narrow range of I does not resolve the saturation: refused, with the simpler form
     grainlaw.fit_mu_i(I[:8], 0.3 + 0.5 * I[:8], grain_diameter=1e-3, grain_density=2500.0)
 except grainlaw.FitRefused as e:
-    print(f"refused: {e.reason}\n  try: {e.suggestion}")
+    print(f"refused: {e.reason}\n  suggestion: {e.suggestion}")

@@ -34,6 +34,6 @@ def test_mu_i_fit_prints_the_law_and_the_refusal(tmp_path):
     # generated with μ_s = 0.38, μ_2 = 0.64, I_0 = 0.28 and noise 0.004
     assert abs(float(values["mu_s"]) - 0.38) < 0.02
     assert abs(float(values["mu_2"]) - 0.64) < 0.05
-    assert "refused:" in out and "try:" in out
+    assert "refused:" in out and "suggestion: use mu-i-linear" in out
     law = grainlaw.load_law(tmp_path / "mu_i_law.json")
     assert law.name == "mu-i"

@@ -101,8 +101,10 @@ def test_bad_input_raises_input_error_naming_the_problem():
         )
     with pytest.raises(grainlaw.InputError, match="unknown law"):
         grainlaw.fit("hooke", {"x": [1.0, 2.0]})
+    I = np.geomspace(1e-3, 1.0, 20)
+    mu = mu_i_law(I, 0.38, 0.64, 0.279) + 0.004 * wiggle(I.size)
     with pytest.raises(grainlaw.InputError, match="grain_density_kg_m3"):
-        grainlaw.fit("mu-i", {"I": [0.1, 0.2, 0.3, 0.4, 0.5], "mu": [0.4, 0.45, 0.5, 0.52, 0.55]}, {"grain_diameter_m": 1e-3})
+        grainlaw.fit("mu-i", {"I": I, "mu": mu}, {"grain_diameter_m": 1e-3})
 
 
 def test_law_json_round_trip_and_formula_evaluation(tmp_path):
