@@ -106,9 +106,6 @@ pub fn out_tensors<'py>(
 }
 
 /// One 2×2 tensor as a `(2, 2)` float64 array.
-pub fn out_tensor<'py>(
-    py: Python<'py>,
-    t: &nalgebra::Matrix2<f64>,
-) -> PyResult<Bound<'py, PyAny>> {
+pub fn out_tensor<'py>(py: Python<'py>, t: &nalgebra::Matrix2<f64>) -> PyResult<Bound<'py, PyAny>> {
     out_tensors(py, std::slice::from_ref(t))?.get_item(0)
 }

@@ -125,7 +125,10 @@ pub fn panic_err(payload: Box<dyn std::any::Any + Send>) -> PyErr {
         .map(|s| s.to_string())
         .or_else(|| payload.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".into());
-    GrainlawError::new_err(format!("internal error (a bug in grainlaw): {}", one_line(&msg)))
+    GrainlawError::new_err(format!(
+        "internal error (a bug in grainlaw): {}",
+        one_line(&msg)
+    ))
 }
 
 /// Runs of whitespace folded to one space.

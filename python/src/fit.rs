@@ -52,7 +52,9 @@ pub fn fit(
         )));
     }
     if !(confidence > 0.0 && confidence < 1.0) {
-        return Err(input(format!("`confidence` must be in (0, 1), got {confidence}")));
+        return Err(input(format!(
+            "`confidence` must be in (0, 1), got {confidence}"
+        )));
     }
     if !min_r_squared.is_finite() {
         return Err(input("`min_r_squared` must be finite"));
@@ -163,10 +165,7 @@ pub struct Law {
     pub inner: CalibratedLaw,
 }
 
-fn estimate_dict<'py>(
-    py: Python<'py>,
-    e: &identify::Estimate,
-) -> PyResult<Bound<'py, PyDict>> {
+fn estimate_dict<'py>(py: Python<'py>, e: &identify::Estimate) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("value", e.value)?;
     d.set_item("unit", &e.unit)?;
@@ -281,7 +280,9 @@ impl Law {
             Some(c) => {
                 let n = c.order.len();
                 let flat: Vec<f64> = c.matrix.iter().flatten().copied().collect();
-                Ok(Some(PyArray1::from_vec(py, flat).reshape([n, n])?.into_any()))
+                Ok(Some(
+                    PyArray1::from_vec(py, flat).reshape([n, n])?.into_any(),
+                ))
             }
         }
     }
@@ -342,13 +343,20 @@ impl Law {
         let arr = np.getattr("asarray")?.call1((x, np.getattr("float64")?))?;
         let shape = arr.getattr("shape")?;
         let flat = vec1(&arr.call_method1("reshape", (-1i64,))?, "x")?;
-        let y = self.inner.evaluate(&flat).map_err(|e| identify_err(py, e))?;
+        let y = self
+            .inner
+            .evaluate(&flat)
+            .map_err(|e| identify_err(py, e))?;
         out1(py, y).call_method1("reshape", (shape,))
     }
 
     /// evaluate_formula(x): the JSON's formula text evaluated at each x with the parameters and
     /// constants (what a solver reading only the expression computes); equal to ``evaluate``.
-    fn evaluate_formula<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn evaluate_formula<'py>(
+        &self,
+        py: Python<'py>,
+        x: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let x = vec1(x, "x")?;
         let y = self
             .inner
@@ -358,7 +366,11 @@ impl Law {
     }
 
     /// in_validity_range(x): True where x lies in the calibrated range of the input variable.
-    fn in_validity_range<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    fn in_validity_range<'py>(
+        &self,
+        py: Python<'py>,
+        x: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<bool>>> {
         let x = vec1(x, "x")?;
         Ok(PyArray1::from_vec(
             py,
@@ -373,7 +385,11 @@ impl Law {
 
     /// save(path): writes the JSON (schema 2) to `path`, atomically.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        let text = self.inner.to_json_string().map_err(|e| identify_err(py, e))? + "\n";
+        let text = self
+            .inner
+            .to_json_string()
+            .map_err(|e| identify_err(py, e))?
+            + "\n";
         grainlaw::output::dir::write_atomic(&path, text.as_bytes())
             .map_err(|e| crate::errors::cli_err(py, e))
     }

@@ -16,7 +16,10 @@ use crate::world::Snapshot;
 
 /// `region` = None (the whole sample: the grains' bounding box) or `(x_min, y_min, x_max,
 /// y_max)` (m); `y_slice` = `(y_min, y_max)`: the horizontal slice across the sample.
-fn region_of(region: Option<(f64, f64, f64, f64)>, y_slice: Option<(f64, f64)>) -> PyResult<Region> {
+fn region_of(
+    region: Option<(f64, f64, f64, f64)>,
+    y_slice: Option<(f64, f64)>,
+) -> PyResult<Region> {
     match (region, y_slice) {
         (None, None) => Ok(Region::Whole),
         (Some((x0, y0, x1, y1)), None) => Ok(Region::Rectangle {
@@ -28,7 +31,11 @@ fn region_of(region: Option<(f64, f64, f64, f64)>, y_slice: Option<(f64, f64)>) 
     }
 }
 
-fn counting(force_threshold: f64, count_wall_contacts: bool, min_contacts: usize) -> ContactCounting {
+fn counting(
+    force_threshold: f64,
+    count_wall_contacts: bool,
+    min_contacts: usize,
+) -> ContactCounting {
     ContactCounting {
         force_threshold,
         count_wall_contacts,

@@ -17,7 +17,12 @@ use crate::fit::Law;
 /// of those.
 fn toml_value(v: &Bound<'_, PyAny>, key: &str) -> PyResult<String> {
     if v.is_instance_of::<PyBool>() {
-        Ok(if v.extract::<bool>()? { "true" } else { "false" }.into())
+        Ok(if v.extract::<bool>()? {
+            "true"
+        } else {
+            "false"
+        }
+        .into())
     } else if v.is_instance_of::<PyInt>() {
         Ok(v.str()?.to_string())
     } else if v.is_instance_of::<PyFloat>() {
@@ -90,8 +95,7 @@ fn run_released(
         // The receiver is moved into each detached wait and back (it is Send, not Sync).
         let mut rx = rx;
         loop {
-            let (got, back) =
-                py.detach(move || (rx.recv_timeout(Duration::from_millis(100)), rx));
+            let (got, back) = py.detach(move || (rx.recv_timeout(Duration::from_millis(100)), rx));
             rx = back;
             match got {
                 Ok(r) => break (Some(r), interrupt),
@@ -154,7 +158,10 @@ fn collect<'py>(
             .and_then(|s| s.to_str())
             .unwrap_or_default()
             .to_string();
-        let name = path.file_name().and_then(|s| s.to_str()).unwrap_or_default();
+        let name = path
+            .file_name()
+            .and_then(|s| s.to_str())
+            .unwrap_or_default();
         if name.ends_with(".csv") {
             let t = grainlaw::api::read_csv_table(&path).map_err(|e| cli_err(py, e))?;
             let cols = PyDict::new(py);
@@ -168,8 +175,7 @@ fn collect<'py>(
             }
             constants.set_item(&stem, k)?;
         } else if name.ends_with("_law.json") {
-            let law =
-                identify::CalibratedLaw::load(&path).map_err(|e| identify_err(py, e))?;
+            let law = identify::CalibratedLaw::load(&path).map_err(|e| identify_err(py, e))?;
             laws.set_item(&stem, Law { inner: law })?;
         }
     }

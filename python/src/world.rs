@@ -140,7 +140,9 @@ impl World {
             return Err(input("`materials`: at least one material name"));
         }
         if !(friction.is_finite() && friction >= 0.0) {
-            return Err(input(format!("`friction` must be finite and ≥ 0, got {friction}")));
+            return Err(input(format!(
+                "`friction` must be finite and ≥ 0, got {friction}"
+            )));
         }
         let params = WorldParams {
             dt,
@@ -321,7 +323,13 @@ impl World {
     ///
     /// Adds a fixed segment wall from `a` to `b` (m); returns its body index.
     #[pyo3(signature = (a, b, name="wall", material="wall"))]
-    fn add_segment(&mut self, a: (f64, f64), b: (f64, f64), name: &str, material: &str) -> PyResult<i64> {
+    fn add_segment(
+        &mut self,
+        a: (f64, f64),
+        b: (f64, f64),
+        name: &str,
+        material: &str,
+    ) -> PyResult<i64> {
         let mat = self.material(material)?;
         let id = self
             .world
@@ -514,7 +522,10 @@ pub struct Snapshot {
     pub inner: dem::Snapshot,
 }
 
-fn body_rows(s: &dem::Snapshot, f: impl Fn(&dem::snapshot::BodyState) -> [f64; 2]) -> Vec<[f64; 2]> {
+fn body_rows(
+    s: &dem::Snapshot,
+    f: impl Fn(&dem::snapshot::BodyState) -> [f64; 2],
+) -> Vec<[f64; 2]> {
     s.bodies.iter().map(f).collect()
 }
 
@@ -564,12 +575,18 @@ impl Snapshot {
     /// Centres (m), (n, 2).
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        out2(py, &body_rows(&self.inner, |b| [b.position.x, b.position.y]))
+        out2(
+            py,
+            &body_rows(&self.inner, |b| [b.position.x, b.position.y]),
+        )
     }
     /// Velocities (m/s), (n, 2).
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        out2(py, &body_rows(&self.inner, |b| [b.velocity.x, b.velocity.y]))
+        out2(
+            py,
+            &body_rows(&self.inner, |b| [b.velocity.x, b.velocity.y]),
+        )
     }
     /// Accelerations over the last step (m/s²), (n, 2).
     #[getter]
@@ -607,23 +624,47 @@ impl Snapshot {
     /// First body of each contact (int64), (m,).
     #[getter]
     fn contact_a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        PyArray1::from_vec(py, self.inner.contacts.iter().map(|c| i64::from(c.body_a)).collect())
+        PyArray1::from_vec(
+            py,
+            self.inner
+                .contacts
+                .iter()
+                .map(|c| i64::from(c.body_a))
+                .collect(),
+        )
     }
     /// Second body of each contact (int64), (m,); the normal points from a to b.
     #[getter]
     fn contact_b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        PyArray1::from_vec(py, self.inner.contacts.iter().map(|c| i64::from(c.body_b)).collect())
+        PyArray1::from_vec(
+            py,
+            self.inner
+                .contacts
+                .iter()
+                .map(|c| i64::from(c.body_b))
+                .collect(),
+        )
     }
     /// Contact points (m), (m, 2).
     #[getter]
     fn contact_points<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        let rows: Vec<[f64; 2]> = self.inner.contacts.iter().map(|c| [c.point.x, c.point.y]).collect();
+        let rows: Vec<[f64; 2]> = self
+            .inner
+            .contacts
+            .iter()
+            .map(|c| [c.point.x, c.point.y])
+            .collect();
         out2(py, &rows)
     }
     /// Unit normals from body a to body b, (m, 2).
     #[getter]
     fn contact_normals<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        let rows: Vec<[f64; 2]> = self.inner.contacts.iter().map(|c| [c.normal.x, c.normal.y]).collect();
+        let rows: Vec<[f64; 2]> = self
+            .inner
+            .contacts
+            .iter()
+            .map(|c| [c.normal.x, c.normal.y])
+            .collect();
         out2(py, &rows)
     }
     /// Normal force on b (N, ≥ 0, compressive), (m,).
@@ -663,7 +704,12 @@ impl Snapshot {
     /// Status of each contact: "open", "stick" or "slide" (numpy array of str), (m,).
     #[getter]
     fn statuses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let names: Vec<&str> = self.inner.contacts.iter().map(|c| c.status.name()).collect();
+        let names: Vec<&str> = self
+            .inner
+            .contacts
+            .iter()
+            .map(|c| c.status.name())
+            .collect();
         py.import("numpy")?.getattr("asarray")?.call1((names, "U5"))
     }
     /// Walls: ``{name: {"body": index, "force": (fx, fy) N, "torque": N·m}}``, the force the
