@@ -4,7 +4,10 @@ tables and laws as arrays and Law objects."""
 import json
 import os
 import shutil
+import signal
 import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -92,3 +95,22 @@ def test_bad_scenario_and_override_are_input_errors():
 def test_scenarios_lists_the_builtins():
     names = grainlaw.scenarios()
     assert {"janssen", "rolling", "shear-cell"} <= set(names)
+
+
+def test_ctrl_c_stops_the_run_after_a_step_with_a_checkpoint(tmp_path):
+    out = tmp_path / "janssen"
+    code = f"import grainlaw; grainlaw.run('janssen', out={str(out)!r})"
+    proc = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    # scenario.toml is written before the first step
+    while not (out / "scenario.toml").exists():
+        assert proc.poll() is None, proc.stderr.read()
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode != 0
+    assert "KeyboardInterrupt" in err and "--resume" in err, err
+    assert (out / "checkpoint" / "run.json.gz").exists()
+    assert not (out / "summary.json").exists()
