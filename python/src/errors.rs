@@ -10,7 +10,9 @@
 //! ```
 //!
 //! A run stopped by Ctrl-C raises `KeyboardInterrupt` (a checkpoint is left in the output
-//! directory). A panic inside Rust (a bug) becomes a `GrainlawError` naming it, never a crash.
+//! directory). A panic inside Rust (a bug) never crashes the interpreter: in `run` and
+//! `World.step`, the long computations, it is caught and raised as a `GrainlawError` naming it;
+//! elsewhere pyo3 raises it as `pyo3_runtime.PanicException`.
 
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
