@@ -69,6 +69,9 @@ def main():
             f"   {statistics.median(cpu):8.3f} {min(cpu):8.3f}"
         )
     print("(run alone: the summary's wall_seconds, the run without process start and read-back)")
+    for name, t, inner in (("CLI", cli_t, cli_in), ("Python", py_t, py_in)):
+        layer = statistics.median([a - b for a, b in zip(t, inner)])
+        print(f"{name}: outside the run (process start, arguments, reading the files back): {layer:.3f} s")
     over_med = statistics.median(py_t) / statistics.median(cli_t) - 1
     over_min = min(py_t) / min(cli_t) - 1
     over_cpu = min(py_cpu) / min(cli_cpu) - 1
