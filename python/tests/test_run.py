@@ -68,12 +68,11 @@ def test_run_returns_tables_and_the_calibrated_law(small_run):
     assert n > 0 and all(v.shape == (n,) for v in prof.values())
     # depths increase down the column, and σ_v is compressive (positive) there
     assert np.all(np.diff(prof["z_m"]) > 0)
-    law = result["laws"].get("janssen_law")
-    if law is not None:
-        # the law written by the run is the one summarised
-        assert law["K"] == s["janssen_K"]
-        lo, hi = law.intervals["K"]
-        assert lo == s["janssen_K_ci_low"] and hi == s["janssen_K_ci_high"]
+    # the law written by the run is the one summarised, read back exactly
+    law = result["laws"]["janssen_law"]
+    assert law["K"] == s["janssen_K"]
+    lo, hi = law.intervals["K"]
+    assert lo == s["janssen_K_ci_low"] and hi == s["janssen_K_ci_high"]
 
 
 def test_run_without_out_uses_a_removed_temporary_directory():
