@@ -5,6 +5,7 @@
 //! ([`plot`]), CSV, VTK and `summary.json` ([`output`]). The scenarios and generators are in
 //! [`datasets`]; the runners in [`scenarios`]; the command line in [`cli`].
 
+pub mod api;
 pub mod bench_cmd;
 pub mod campaign;
 pub mod checkpoint;
