@@ -743,7 +743,10 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
                         fitted = true;
                         break;
                     }
-                    Err(e @ CliError::FitRefused { .. }) => {
+                    // On merged data a fit that cannot be made (too few points passed their
+                    // checks, a column left empty) is a refusal of the campaign's result, not
+                    // bad input.
+                    Err(e @ (CliError::FitRefused { .. } | CliError::Input { .. })) => {
                         println!("{l}: refused: {}", e.one_line());
                     }
                     Err(e) => return Err(e),
@@ -925,7 +928,10 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
                 verdict_col = t.split(',').position(|h| h.trim() == "point_verdict");
             } else {
                 let passed = verdict_col.is_none_or(|j| {
-                    t.split(',').nth(j).and_then(|v| v.trim().parse::<f64>().ok()) == Some(0.0)
+                    t.split(',')
+                        .nth(j)
+                        .and_then(|v| v.trim().parse::<f64>().ok())
+                        == Some(0.0)
                 });
                 if passed {
                     rows.push(format!("{t},{index}"));

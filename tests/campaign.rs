@@ -186,8 +186,9 @@ fn bad_plans_are_refused_before_any_run() {
     assert!(text(&o).contains("another plan"), "{}", text(&o));
 }
 
-/// Two seeds of a short shear cell merged into one μ(I) table: every row of both runs, a `run`
-/// column, and the grain diameter of the merged table the mean of the runs' (to 1e-12).
+/// Two seeds of a short shear cell merged into one μ(I) table: the points that passed their own
+/// checks (`point_verdict` 0) of both runs and no other, a `run` column, and the grain diameter
+/// of the merged table the mean of the runs' (to 1e-12).
 #[test]
 fn shear_cell_seeds_are_merged_and_fitted() {
     let dir = tempfile::tempdir().unwrap();
@@ -220,11 +221,29 @@ fn shear_cell_seeds_are_merged_and_fitted() {
         (dm - 0.5 * (d0 + d1)).abs() <= 1e-12 * dm,
         "{dm} vs {d0}, {d1}"
     );
-    let merged = std::fs::read_to_string(c.join("rheology.csv")).unwrap();
-    let data: Vec<&str> = merged.lines().filter(|l| !l.starts_with('#')).collect();
-    assert!(data[0].ends_with(",run"));
-    assert_eq!(data.len(), 1 + 6, "{merged}");
-    assert_eq!(data.iter().filter(|l| l.ends_with(",1")).count(), 3);
+    // rows of a table, and the value of its `point_verdict` column
+    let rows = |p: &Path| -> Vec<(String, f64)> {
+        let s = std::fs::read_to_string(p).unwrap();
+        let mut lines = s.lines().filter(|l| !l.starts_with('#'));
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let j = head.iter().position(|h| *h == "point_verdict").unwrap();
+        lines
+            .map(|l| (l.to_string(), l.split(',').nth(j).unwrap().parse().unwrap()))
+            .collect()
+    };
+    let mut expect = Vec::new();
+    for k in 0..2 {
+        for (l, v) in rows(&c.join(format!("runs/{k:04}/rheology.csv"))) {
+            if v == 0.0 {
+                expect.push(format!("{l},{k}"));
+            }
+        }
+    }
+    let merged: Vec<String> = rows(&c.join("rheology.csv"))
+        .into_iter()
+        .map(|r| r.0)
+        .collect();
+    assert_eq!(merged, expect);
     assert!(
         c.join("mu_i_law.json").is_file()
             || c.join("mu_i_linear_law.json").is_file()
