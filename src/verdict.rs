@@ -197,7 +197,7 @@ impl Checks {
 
     /// The solid fraction `phi` (named `what`) must lie in (0, `bound`): refused otherwise.
     pub fn solid_fraction(&mut self, check: &str, what: &str, phi: f64, bound: f64) {
-        if !(phi > 0.0) {
+        if phi.is_nan() || phi <= 0.0 {
             self.fail(
                 check,
                 Verdict::Refused,
