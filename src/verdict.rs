@@ -628,6 +628,21 @@ pub fn export_law(
     Ok(())
 }
 
+/// Removes `NAME_law.json` and `NAME_law.rejected.json` left in the directory by an earlier
+/// run, when this run fitted no law `NAME`: a stale law must not look like this run's.
+pub fn remove_stale_law(out: &OutputDir, name: &str) -> Result<()> {
+    for f in [
+        format!("{name}_law.json"),
+        format!("{name}_law.rejected.json"),
+    ] {
+        let p = out.file(&f);
+        if p.exists() {
+            std::fs::remove_file(&p).map_err(|e| crate::error::CliError::io(&p, e))?;
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
