@@ -197,7 +197,7 @@ impl Checks {
 
     /// The solid fraction `phi` (named `what`) must lie in (0, `bound`): refused otherwise.
     pub fn solid_fraction(&mut self, check: &str, what: &str, phi: f64, bound: f64) {
-        if !(phi > 0.0) {
+        if phi.is_nan() || phi <= 0.0 {
             self.fail(
                 check,
                 Verdict::Refused,
@@ -625,6 +625,21 @@ pub fn export_law(
         file: Some(file),
         checks,
     });
+    Ok(())
+}
+
+/// Removes `NAME_law.json` and `NAME_law.rejected.json` left in the directory by an earlier
+/// run, when this run fitted no law `NAME`: a stale law must not look like this run's.
+pub fn remove_stale_law(out: &OutputDir, name: &str) -> Result<()> {
+    for f in [
+        format!("{name}_law.json"),
+        format!("{name}_law.rejected.json"),
+    ] {
+        let p = out.file(&f);
+        if p.exists() {
+            std::fs::remove_file(&p).map_err(|e| crate::error::CliError::io(&p, e))?;
+        }
+    }
     Ok(())
 }
 

@@ -613,6 +613,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             }
             s.text("janssen_fit_error", &e.to_string());
             headline.push(format!("Janssen fit failed: {e}"));
+            crate::verdict::remove_stale_law(&ctx.out, "janssen")?;
             verdict.run.fail(
                 "janssen.fit",
                 Verdict::Refused,

@@ -520,6 +520,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 Err(e2) => {
                     warn(&format!("linear μ(I) fit failed too: {e2}"));
                     s.text("mu_i_linear_fit_error", &e2.to_string());
+                    crate::verdict::remove_stale_law(&ctx.out, "mu_i")?;
                     verdict.run.fail(
                         "shear_cell.mu_i_fit",
                         Verdict::Refused,
@@ -576,6 +577,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         Err(e) => {
             warn(&format!("φ(I) fit failed: {e}"));
             s.text("phi_i_fit_error", &e.to_string());
+            crate::verdict::remove_stale_law(&ctx.out, "phi_i")?;
             verdict.run.fail(
                 "shear_cell.phi_i_fit",
                 Verdict::Refused,
@@ -666,6 +668,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             warn(&format!("wall-law fit failed: {e}"));
             s.text("wall_law_fit_error", &e.to_string());
             headline.push(format!("wall law not identified: {e}"));
+            crate::verdict::remove_stale_law(&ctx.out, "wall")?;
             verdict.run.fail(
                 "shear_cell.wall_law_fit",
                 Verdict::Refused,
