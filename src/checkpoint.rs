@@ -19,14 +19,15 @@
 //! (without `--resume`) removes a stale one when it starts.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{self, BufReader, Write};
 use std::path::{Path, PathBuf};
 
 use datasets::phases::PhaseProgress;
 use dem::checkpoint::WorldState;
-use flate2::read::GzDecoder;
+use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
 use flate2::Compression;
+use rayon::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
@@ -35,6 +36,82 @@ use crate::scenarios::common::Stop;
 
 /// Format tag of run checkpoints.
 pub const FORMAT: &str = "grainlaw-run-checkpoint-v1";
+
+/// Buffer between the gzip stream and the JSON deserialiser (bytes).
+const BUFFER: usize = 1 << 20;
+
+/// Uncompressed bytes per gzip member of a checkpoint.
+const MEMBER: usize = 4 << 20;
+
+/// A gzip writer that compresses on every thread: the stream is cut into members of
+/// [`MEMBER`] bytes, compressed in parallel by batches (rayon) at level 1 and written in order.
+/// A file of several members is one gzip file (RFC 1952 §2.2: a gzip file is a series of
+/// members); `gzip -d` and [`MultiGzDecoder`] read it whole. Serde's small writes land in a
+/// buffer, never in the compressor one by one (which is slow: flate2 compresses on every write).
+struct ParallelGz<W: Write> {
+    out: W,
+    current: Vec<u8>,
+    batch: Vec<Vec<u8>>,
+    members: usize,
+}
+
+impl<W: Write> ParallelGz<W> {
+    fn new(out: W) -> Self {
+        ParallelGz {
+            out,
+            current: Vec::with_capacity(MEMBER),
+            batch: Vec::new(),
+            members: 0,
+        }
+    }
+
+    /// Compresses the batch (in parallel) and writes it.
+    fn flush_batch(&mut self) -> io::Result<()> {
+        let batch = std::mem::take(&mut self.batch);
+        let compressed: Vec<io::Result<Vec<u8>>> = batch
+            .par_iter()
+            .map(|chunk| {
+                let mut gz =
+                    GzEncoder::new(Vec::with_capacity(chunk.len() / 3), Compression::fast());
+                gz.write_all(chunk)?;
+                gz.finish()
+            })
+            .collect();
+        for c in compressed {
+            self.out.write_all(&c?)?;
+            self.members += 1;
+        }
+        Ok(())
+    }
+
+    /// Writes what is left (at least one member, so that an empty stream is a gzip file too).
+    fn finish(mut self) -> io::Result<()> {
+        if !self.current.is_empty() || self.members + self.batch.len() == 0 {
+            let last = std::mem::take(&mut self.current);
+            self.batch.push(last);
+        }
+        self.flush_batch()?;
+        self.out.flush()
+    }
+}
+
+impl<W: Write> Write for ParallelGz<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.current.extend_from_slice(buf);
+        if self.current.len() >= MEMBER {
+            let full = std::mem::replace(&mut self.current, Vec::with_capacity(MEMBER));
+            self.batch.push(full);
+            if self.batch.len() >= 2 * rayon::current_num_threads() {
+                self.flush_batch()?;
+            }
+        }
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
 
 /// Checkpoint directory inside the output directory.
 pub const DIR: &str = "checkpoint";
@@ -136,9 +213,9 @@ pub fn write<S: Serialize>(path: &Path, cp: &RunCheckpoint<S>) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
     }
     dem::atomic::write_atomic(path, |w| {
-        let mut gz = GzEncoder::new(w, Compression::fast());
+        let mut gz = ParallelGz::new(w);
         serde_json::to_writer(&mut gz, cp).map_err(std::io::Error::other)?;
-        gz.finish().map(|_| ())
+        gz.finish()
     })
     .map_err(|e| bad(path, format!("cannot write the checkpoint ({e})")))
 }
@@ -163,8 +240,12 @@ pub fn read<S: DeserializeOwned>(out: &Path) -> Result<RunCheckpoint<S>> {
             bad(&path, e)
         }
     })?;
-    let cp: RunCheckpoint<S> = serde_json::from_reader(GzDecoder::new(BufReader::new(f)))
-        .map_err(|e| bad(&path, format!("not a readable checkpoint ({e})")))?;
+    // serde_json reads byte by byte: buffer the decompressed stream, not only the file.
+    let cp: RunCheckpoint<S> = serde_json::from_reader(BufReader::with_capacity(
+        BUFFER,
+        MultiGzDecoder::new(BufReader::new(f)),
+    ))
+    .map_err(|e| bad(&path, format!("not a readable checkpoint ({e})")))?;
     if cp.format != FORMAT {
         return Err(bad(
             &path,

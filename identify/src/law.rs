@@ -622,12 +622,9 @@ impl Provenance {
         self
     }
 
-    /// Records now as the date (UTC, `YYYY-MM-DDTHH:MM:SSZ`).
+    /// Records now ([`epoch_seconds`]) as the date (UTC, `YYYY-MM-DDTHH:MM:SSZ`).
     pub fn with_date_now(mut self) -> Self {
-        let secs = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_secs());
-        self.date = Some(utc_date(secs));
+        self.date = Some(utc_date(epoch_seconds()));
         self
     }
 
@@ -639,6 +636,23 @@ impl Provenance {
         });
         self
     }
+}
+
+/// Environment variable that fixes the date recorded in provenances (seconds since
+/// 1970-01-01T00:00:00Z), the reproducible-builds convention.
+pub const SOURCE_DATE_EPOCH: &str = "SOURCE_DATE_EPOCH";
+
+/// Seconds since the epoch to record as "now": the value of `SOURCE_DATE_EPOCH` when it is set
+/// to an integer, else the system clock.
+pub fn epoch_seconds() -> u64 {
+    std::env::var(SOURCE_DATE_EPOCH)
+        .ok()
+        .and_then(|s| s.trim().parse::<u64>().ok())
+        .unwrap_or_else(|| {
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs())
+        })
 }
 
 /// SHA-256 of `bytes` as lowercase hex (FIPS 180-4).
