@@ -275,3 +275,91 @@ pub fn remove(out: &Path) -> Result<()> {
         Err(e) => Err(CliError::io(&dir, e)),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::ser::{Error as _, SerializeSeq};
+
+    /// A scenario state whose serialisation fails after `bytes` bytes of numbers, as a full disk
+    /// or a bug in a state's serialiser would, half-way through a checkpoint.
+    struct FailsAfter(usize);
+
+    impl Serialize for FailsAfter {
+        fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+            let mut seq = s.serialize_seq(None)?;
+            for k in 0..self.0 / 8 {
+                seq.serialize_element(&(k as u32 % 10_000_000 + 10_000_000))?;
+            }
+            Err(S::Error::custom("the state cannot be written"))
+        }
+    }
+
+    fn checkpoint<S>(state: S) -> RunCheckpoint<S> {
+        let world = dem::World::new(
+            dem::WorldParams::default(),
+            dem::ContactLaws::new(&["grain"], 0.3),
+        );
+        RunCheckpoint {
+            format: FORMAT.into(),
+            grainlaw_version: env!("CARGO_PKG_VERSION").into(),
+            scenario: ScenarioRecord {
+                name: "t".into(),
+                source: "test".into(),
+                effective_toml: String::new(),
+                sets: vec!["grains=3".into()],
+            },
+            cursor: Cursor {
+                phase: 0,
+                plan: PhasePlan {
+                    name: "p".into(),
+                    stop: Stop::Steps(1),
+                },
+                progress: PhaseProgress::default(),
+            },
+            steps_total: 7,
+            wall_seconds: 1.5,
+            origin: Default::default(),
+            world: world.state(),
+            state,
+        }
+    }
+
+    /// A write that fails half-way (after several gzip members were compressed and written)
+    /// returns the error, removes its temporary file and leaves the previous checkpoint whole.
+    #[test]
+    fn a_failed_write_keeps_the_previous_checkpoint_and_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = file_of(dir.path());
+        write(&path, &checkpoint(vec![1u32, 2, 3])).unwrap();
+        let e = write(&path, &checkpoint(FailsAfter(5 * 8 * MEMBER))).unwrap_err();
+        assert!(e.to_string().contains("the state cannot be written"), "{e}");
+        let names: Vec<String> = std::fs::read_dir(dir_of(dir.path()))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        assert_eq!(names, vec![FILE.to_string()], "no temporary file left");
+        let back: RunCheckpoint<Vec<u32>> = read(dir.path()).unwrap();
+        assert_eq!(back.state, vec![1, 2, 3]);
+        assert_eq!(back.steps_total, 7);
+    }
+
+    /// A checkpoint of many members reads back whole, and is one gzip stream for `gzip -d`
+    /// (members concatenated: RFC 1952 §2.2).
+    #[test]
+    fn a_checkpoint_of_several_members_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = file_of(dir.path());
+        let state: Vec<u64> = (0..3 * MEMBER as u64 / 8).collect();
+        write(&path, &checkpoint(state.clone())).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let members = bytes
+            .windows(3)
+            .filter(|w| w == &[0x1f, 0x8b, 0x08])
+            .count();
+        assert!(members >= 2, "{members} gzip members");
+        let back: RunCheckpoint<Vec<u64>> = read(dir.path()).unwrap();
+        assert_eq!(back.state, state);
+        assert_eq!(back.scenario.sets, vec!["grains=3".to_string()]);
+    }
+}
