@@ -265,6 +265,27 @@ pub fn read<S: DeserializeOwned>(out: &Path) -> Result<RunCheckpoint<S>> {
     Ok(cp)
 }
 
+/// Removes the temporary files this process may be writing in output directory `out` (in
+/// `out`, `out/vtk` and `out/checkpoint`: `.NAME.tmp-PID` of [`dem::atomic`], `.NAME.PID.partial.EXT`
+/// of [`crate::output::OutputDir::temp_path`]), for a stop at once (a second Ctrl-C) that does
+/// not let the writers clean up. A file being renamed into place at that moment is either
+/// complete under its name or removed here; errors are ignored (nothing to remove).
+pub fn remove_temporaries(out: &Path) {
+    let pid = std::process::id();
+    let (tmp, partial) = (format!(".tmp-{pid}"), format!(".{pid}.partial."));
+    for dir in [out.to_path_buf(), out.join("vtk"), dir_of(out)] {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().to_string();
+            if name.starts_with('.') && (name.ends_with(&tmp) || name.contains(&partial)) {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
 /// Removes the checkpoint directory of `out` (after a finished run, or a stale one before a
 /// new run); a missing directory is not an error.
 pub fn remove(out: &Path) -> Result<()> {
@@ -342,6 +363,36 @@ mod tests {
         let back: RunCheckpoint<Vec<u32>> = read(dir.path()).unwrap();
         assert_eq!(back.state, vec![1, 2, 3]);
         assert_eq!(back.steps_total, 7);
+    }
+
+    /// A stop at once removes this process's temporary files (and only those).
+    #[test]
+    fn temporaries_of_this_process_are_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path();
+        let cp = file_of(out);
+        std::fs::create_dir_all(dir_of(out)).unwrap();
+        std::fs::create_dir_all(out.join("vtk")).unwrap();
+        let mine = [
+            dem::atomic::temporary_path(&cp).unwrap(),
+            dem::atomic::temporary_path(&out.join("vtk/grains_0001.vtp")).unwrap(),
+            out.join(format!(".figure.{}.partial.png", std::process::id())),
+        ];
+        let kept = [
+            cp.clone(),
+            out.join("summary.json"),
+            dir_of(out).join(".run.json.gz.tmp-1"),
+        ];
+        for p in mine.iter().chain(&kept) {
+            std::fs::write(p, b"x").unwrap();
+        }
+        remove_temporaries(out);
+        for p in &mine {
+            assert!(!p.exists(), "{} left", p.display());
+        }
+        for p in &kept {
+            assert!(p.exists(), "{} removed", p.display());
+        }
     }
 
     /// A checkpoint of many members reads back whole, and is one gzip stream for `gzip -d`
