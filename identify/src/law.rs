@@ -19,7 +19,7 @@
 //! - `dimension` (`2D, per unit thickness`) and `geometry` (what set-up the law assumes);
 //! - `validity`, `fit` (n, dof, R², AIC, BIC, confidence), `model_selection`;
 //! - `provenance`: scenario, every override, seed, grainlaw version, date, and the SHA-256 of
-//!   each input file (`grainlaw fit` fills its CSV's).
+//!   each input file (`grainlaw fit` fills its CSV's, a scenario run its `scenario.toml`).
 //!
 //! Example (`mu-i`, abridged):
 //! ```json
@@ -589,9 +589,10 @@ pub struct Provenance {
     pub seed: Option<u64>,
     /// grainlaw version.
     pub grainlaw_version: String,
-    /// UTC date and time of the fit (ISO 8601), when recorded: `grainlaw fit` records it; a
-    /// scenario records none, so that a resumed run writes the same bytes as an uninterrupted
-    /// one.
+    /// UTC date and time (ISO 8601), when recorded: `grainlaw fit` records the time of the fit,
+    /// a scenario run the time it started (kept in its checkpoint, so that a resumed run writes
+    /// the law an uninterrupted one would have); `SOURCE_DATE_EPOCH` overrides both
+    /// ([`epoch_seconds`]).
     #[serde(default)]
     pub date: Option<String>,
     /// Input files with their SHA-256.
