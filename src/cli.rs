@@ -430,6 +430,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let interrupted = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupted.clone();
+        let out_dir = dir.clone();
         // The first Ctrl-C, SIGTERM (what batch schedulers send before they kill a job) or
         // SIGHUP asks for a checkpoint and a clean stop after the current step, and says so at
         // once; a second one stops at once (files are written atomically: nothing half-written
@@ -438,6 +439,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         let _ = ctrlc::set_handler(move || {
             if flag.swap(true, Ordering::SeqCst) {
                 eprintln!("error: interrupted twice: stopped at once (the last checkpoint, if any, is kept)");
+                checkpoint::remove_temporaries(&out_dir);
                 std::process::exit(130);
             }
             eprintln!(

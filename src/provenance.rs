@@ -10,13 +10,10 @@
 //! were made.
 
 use datasets::LoadedScenario;
-use identify::law::{sha256_hex, utc_date, InputFile, Provenance};
+use identify::law::{epoch_seconds, sha256_hex, utc_date, InputFile, Provenance};
 use serde::{Deserialize, Serialize};
 
 use crate::scenarios::{RunContext, RunControl};
-
-/// Environment variable that fixes the recorded date (seconds since the epoch).
-pub const SOURCE_DATE_EPOCH: &str = "SOURCE_DATE_EPOCH";
 
 /// What a run records about its start: the date and the input files with their SHA-256.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -26,18 +23,6 @@ pub struct RunOrigin {
     /// Input files: `scenario.toml` (the scenario as run, the file written in the output
     /// directory) and, for a scenario given as a file, that file as read when the run started.
     pub inputs: Vec<InputFile>,
-}
-
-/// Seconds since the epoch: `SOURCE_DATE_EPOCH` when set to an integer, else now.
-pub fn epoch_seconds() -> u64 {
-    std::env::var(SOURCE_DATE_EPOCH)
-        .ok()
-        .and_then(|s| s.trim().parse::<u64>().ok())
-        .unwrap_or_else(|| {
-            std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map_or(0, |d| d.as_secs())
-        })
 }
 
 impl RunOrigin {

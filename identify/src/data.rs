@@ -1,6 +1,7 @@
 //! User tables read from CSV.
 //!
-//! Format: comma-separated, one header line, one row per observation, blank lines ignored.
+//! Format: comma-separated, one header line, one row per observation, blank lines ignored;
+//! lines may end in `\n` or `\r\n`, and a UTF-8 byte-order mark at the start is skipped.
 //! Column headers carry their unit as a suffix (`z_m`, `sigma_v_Pa`); they are matched
 //! case-insensitively after trimming, except the scaled units, which are read only as spelt
 //! here: a column asked for in Pa is also read from `_kPa` (×10³) or `_MPa` (×10⁶), one in m
@@ -65,6 +66,8 @@ impl Table {
 
     /// Parses CSV text; `source` names it in errors.
     pub fn parse_csv(text: &str, source: &str) -> Result<Table> {
+        // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first header.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut metadata = BTreeMap::new();
         let mut metadata_lines = BTreeMap::new();
         let mut text_metadata = Vec::new();

@@ -19,7 +19,7 @@
 //! - `dimension` (`2D, per unit thickness`) and `geometry` (what set-up the law assumes);
 //! - `validity`, `fit` (n, dof, R², AIC, BIC, confidence), `model_selection`;
 //! - `provenance`: scenario, every override, seed, grainlaw version, date, and the SHA-256 of
-//!   each input file (`grainlaw fit` fills its CSV's).
+//!   each input file (`grainlaw fit` fills its CSV's, a scenario run its `scenario.toml`).
 //!
 //! Example (`mu-i`, abridged):
 //! ```json
@@ -589,9 +589,10 @@ pub struct Provenance {
     pub seed: Option<u64>,
     /// grainlaw version.
     pub grainlaw_version: String,
-    /// UTC date and time of the fit (ISO 8601), when recorded: `grainlaw fit` records it; a
-    /// scenario records none, so that a resumed run writes the same bytes as an uninterrupted
-    /// one.
+    /// UTC date and time (ISO 8601), when recorded: `grainlaw fit` records the time of the fit,
+    /// a scenario run the time it started (kept in its checkpoint, so that a resumed run writes
+    /// the law an uninterrupted one would have); `SOURCE_DATE_EPOCH` overrides both
+    /// ([`epoch_seconds`]).
     #[serde(default)]
     pub date: Option<String>,
     /// Input files with their SHA-256.
@@ -622,12 +623,9 @@ impl Provenance {
         self
     }
 
-    /// Records now as the date (UTC, `YYYY-MM-DDTHH:MM:SSZ`).
+    /// Records now ([`epoch_seconds`]) as the date (UTC, `YYYY-MM-DDTHH:MM:SSZ`).
     pub fn with_date_now(mut self) -> Self {
-        let secs = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_secs());
-        self.date = Some(utc_date(secs));
+        self.date = Some(utc_date(epoch_seconds()));
         self
     }
 
@@ -639,6 +637,23 @@ impl Provenance {
         });
         self
     }
+}
+
+/// Environment variable that fixes the date recorded in provenances (seconds since
+/// 1970-01-01T00:00:00Z), the reproducible-builds convention.
+pub const SOURCE_DATE_EPOCH: &str = "SOURCE_DATE_EPOCH";
+
+/// Seconds since the epoch to record as "now": the value of `SOURCE_DATE_EPOCH` when it is set
+/// to an integer, else the system clock.
+pub fn epoch_seconds() -> u64 {
+    std::env::var(SOURCE_DATE_EPOCH)
+        .ok()
+        .and_then(|s| s.trim().parse::<u64>().ok())
+        .unwrap_or_else(|| {
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs())
+        })
 }
 
 /// SHA-256 of `bytes` as lowercase hex (FIPS 180-4).

@@ -114,8 +114,9 @@ pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<C
             "stream did not contain valid UTF-8",
         ),
     })?;
-    let table = Table::parse_csv(&text, &source)?;
-    let header = header_line(&text);
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let table = Table::parse_csv(text, &source)?;
+    let header = header_line(text);
     check_unique_headers(&table, header)?;
     if table.rows() == 0 {
         return Err(IdentifyError::Csv {
