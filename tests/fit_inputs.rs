@@ -94,7 +94,12 @@ fn every_fit_input_a_scenario_writes_is_fitted_as_written() {
         let mut args = vec!["run", scenario, "-q", "--out", out.to_str().unwrap()];
         args.extend_from_slice(sets);
         let o = grainlaw(d, &args);
-        assert!(o.status.success(), "{scenario}: {}", stderr(&o));
+        // 3: the run's verdict refused a result (short runs often are); its CSVs are written
+        assert!(
+            matches!(o.status.code(), Some(0) | Some(3)),
+            "{scenario}: {}",
+            stderr(&o)
+        );
         let text = std::fs::read_to_string(out.join(file)).unwrap();
         assert!(
             text.contains(&format!("grainlaw fit {} {file}", laws[0])),

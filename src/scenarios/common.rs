@@ -311,6 +311,51 @@ pub fn fit_keys(s: &mut Summary, prefix: &str, parameters: &[identify::Estimate]
     }
 }
 
+/// The printed lines of a fit: `title (R² = …)`, then one line per parameter with its 95 %
+/// interval, so that no fitted number reaches stdout without its interval.
+pub fn parameter_lines(
+    title: &str,
+    r_squared: f64,
+    parameters: &[identify::Estimate],
+) -> Vec<String> {
+    let mut lines = vec![format!("{title} (R² = {r_squared:.3})")];
+    let width = parameters
+        .iter()
+        .map(|e| e.name.chars().count())
+        .max()
+        .unwrap_or(0);
+    for e in parameters {
+        lines.push(format!(
+            "  {:<width$} = {}  (95 % CI {} … {}){}",
+            e.name,
+            short_number(e.value),
+            short_number(e.ci_low),
+            short_number(e.ci_high),
+            if e.unit == "1" || e.unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {}", e.unit)
+            }
+        ));
+    }
+    lines
+}
+
+/// Four significant digits: fixed notation between 10⁻² and 10⁴, scientific elsewhere.
+pub fn short_number(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || (1e-2..1e4).contains(&a) {
+        let digits = if a == 0.0 {
+            3
+        } else {
+            (3 - a.log10().floor() as i32).clamp(0, 6) as usize
+        };
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 /// Adds a fitted curve and its 95 % confidence band (from [`delta_band`]) to `plot`.
 pub fn add_fitted_curve(
     plot: &mut crate::plot::xy::XyPlot,
@@ -331,4 +376,19 @@ pub fn add_fitted_curve(
         line_color,
         band.iter().map(|b| (b.0, b.1)).collect(),
     ));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fitted_parameters_print_with_their_intervals() {
+        let e = identify::Estimate::new("mu_s", "1", 0.3812, 0.01, 2.0);
+        let lines = parameter_lines("μ(I)", 0.9, &[e]);
+        assert_eq!(lines[0], "μ(I) (R² = 0.900)");
+        assert_eq!(lines[1], "  mu_s = 0.3812  (95 % CI 0.3612 … 0.4012)");
+        assert_eq!(short_number(1.2345e-5), "1.234e-5");
+        assert_eq!(short_number(1234.5), "1234");
+    }
 }

@@ -25,7 +25,8 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{
-    add_fitted_curve, delta_band, fit_keys, mean_diameter, solver_keys, Stop, VtkFrames,
+    add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, solver_keys, Stop,
+    VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::{PhaseEnv, RunContext, RunOutcome};
@@ -474,9 +475,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             fit_keys(&mut s, "mu_i", &f.report.parameters);
             s.text("mu_i_form", "mu-i")
                 .num("mu_i_r_squared", f.report.r_squared);
-            headline.push(format!(
-                "μ(I): μ_s = {:.3}, μ₂ = {:.3}, I₀ = {:.3} (R² = {:.3})",
-                f.law.mu_s, f.law.mu_2, f.law.i0, f.report.r_squared
+            headline.extend(parameter_lines(
+                "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                f.report.r_squared,
+                &f.report.parameters,
             ));
             export_law(
                 &mut ctx.out,
@@ -505,9 +507,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                     fit_keys(&mut s, "mu_i", &f.report.parameters);
                     s.text("mu_i_form", "mu-i-linear")
                         .num("mu_i_r_squared", f.report.r_squared);
-                    headline.push(format!(
-                        "μ(I) (linear): μ_s = {:.3}, b = {:.3}",
-                        f.law.mu_s, f.law.slope
+                    headline.extend(parameter_lines(
+                        "μ(I) = μ_s + b I (linear form)",
+                        f.report.r_squared,
+                        &f.report.parameters,
                     ));
                     export_law(
                         &mut ctx.out,
@@ -562,9 +565,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 &band,
             );
             fit_keys(&mut s, "phi_i", &f.report.parameters);
-            headline.push(format!(
-                "φ(I): φ_max = {:.3}, φ_min = {:.3}",
-                f.law.phi_max, f.law.phi_min
+            headline.extend(parameter_lines(
+                "φ(I) = φ_max − (φ_max − φ_min) I",
+                f.report.r_squared,
+                &f.report.parameters,
             ));
             export_law(
                 &mut ctx.out,
@@ -655,7 +659,11 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             );
             s.text("wall_law_form", form.law_name());
             fit_keys(&mut s, "wall_law", &best.report.parameters);
-            headline.push(format!("wall law: {} chosen by AIC", form.law_name()));
+            headline.extend(parameter_lines(
+                &format!("wall law: {} chosen by AIC", form.law_name()),
+                best.report.r_squared,
+                &best.report.parameters,
+            ));
             export_law(
                 &mut ctx.out,
                 &mut verdict,
