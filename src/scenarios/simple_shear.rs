@@ -239,7 +239,7 @@ impl PhasedRun for Shear<'_> {
             table.push(row.clone());
         }
         table.comments.push(format!(
-            "simple shear at I_target = {target}: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s), p = -tr(sigma)/2, q, solid fraction, coordination Z and fabric over force-carrying contacts, I = gamma_dot d / sqrt(-sigma_yy/rho), mu = |sigma_xy|/(-sigma_yy), cell_corrections = re-solves of the step by the cell control"
+            "simple shear at target I {target}: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s), p is -tr(sigma)/2, q, solid fraction, coordination Z and fabric over force-carrying contacts, I is gamma_dot d / sqrt(-sigma_yy/rho), mu is |sigma_xy|/(-sigma_yy), cell_corrections counts the re-solves of the step by the cell control"
         ));
         table.write(out, &format!("history_I{k}.csv"))?;
         let tail = &st.history[st.history.len() - (st.run.avg_steps as usize).min(st.history.len())..];
@@ -378,7 +378,7 @@ pub fn run(c: &SimpleShearConfig, ctx: &mut RunContext, ctl: &mut RunControl) ->
     for r in &rows {
         table.push(r.clone());
     }
-    table.comments.push("Lees-Edwards simple shear at imposed sigma_yy = -P: means over the last average_strain with block-averaged standard errors; P = -sigma_yy, I = gamma_dot d / sqrt(P/rho), mu = |sigma_xy|/P; fit again with grainlaw fit mu-i rheology.csv".into());
+    table.comments.push("Lees-Edwards simple shear at imposed normal stress: means over the last average_strain with block-averaged standard errors; P is -sigma_yy, I is gamma_dot d / sqrt(P/rho), mu is |sigma_xy|/P; fit again with grainlaw fit mu-i rheology.csv".into());
     table.metadata = vec![
         ("grain_diameter_m".into(), d),
         ("grain_density_kg_m3".into(), c.grain.density),
