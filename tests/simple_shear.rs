@@ -73,7 +73,11 @@ fn bad_inputs_are_refused_with_one_line() {
         let err = stderr(&o);
         let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
         assert_eq!(lines.len(), 1, "{set}: {err}");
-        assert!(lines[0].contains(&format!("`{key}`")), "{set}: {}", lines[0]);
+        assert!(
+            lines[0].contains(&format!("`{key}`")),
+            "{set}: {}",
+            lines[0]
+        );
     }
 }
 

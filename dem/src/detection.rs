@@ -605,11 +605,11 @@ impl Detector {
     /// image `x_b + h k` carries the image's shift vector `h k` and affine velocity `L h k`
     /// ([`crate::contact::ContactRow::affine`]).
     ///
-    /// The swept margin of a disk is `m = dt (|v − L (x − c)| + dt |a| + |ω| ρ) + dt ‖L‖ (R_max
-    /// + g_d/2)`: its velocity relative to the affine field, plus half the affine velocity
-    /// difference across the largest pair, so that `m_a + m_b` bounds the pair's relative travel.
-    /// Only disk grains are allowed (no walls in a periodic cell); the cell must be at least 3
-    /// cut-offs wide across both pairs of faces.
+    /// The swept margin of a disk is `m = dt (|v − L (x − c)| + dt |a| + |ω| ρ) + dt ‖L‖ r`
+    /// with `r = R_max + g_d/2`: its velocity relative to the affine field, plus half the affine
+    /// velocity difference across the largest pair, so that `m_a + m_b` bounds the pair's
+    /// relative travel. Only disk grains are allowed (no walls in a periodic cell); the cell
+    /// must be at least 3 cut-offs wide across both pairs of faces.
     #[allow(clippy::too_many_arguments)]
     pub fn detect_cell(
         &mut self,

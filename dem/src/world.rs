@@ -314,7 +314,11 @@ impl World {
             mom += (b.velocity - cell.l * (b.position - c)) * b.mass;
             thickness = b.thickness;
         }
-        let mean = if mass > 0.0 { mom / mass } else { Vect::zeros() };
+        let mean = if mass > 0.0 {
+            mom / mass
+        } else {
+            Vect::zeros()
+        };
         let j = Mat::new(0.0, -1.0, 1.0, 0.0);
         for b in self.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
             let v = b.velocity - cell.l * (b.position - c) - mean;
@@ -564,8 +568,7 @@ impl World {
             if p.periodic_x.is_some() {
                 return Err(perr(
                     "periodic_x",
-                    "must be unset with a biperiodic cell (the cell is periodic in x and y)"
-                        .into(),
+                    "must be unset with a biperiodic cell (the cell is periodic in x and y)".into(),
                 ));
             }
         }
@@ -887,7 +890,7 @@ impl World {
                 .fold(f64::INFINITY, f64::min);
             hi = 0.0;
             lo = -(ctl.max_rate + l_min);
-            if !(lo < 0.0) {
+            if lo.is_nan() || lo >= 0.0 {
                 return Ok(first);
             }
             let f = attempt(self, lo, &mut tries)?;

@@ -76,7 +76,10 @@ fn minimum_image_matches_brute_force() {
         let (xi, xj) = (p(&mut rng), p(&mut rng));
         for x in [xi, xj] {
             let s = cell.reduced(&x);
-            assert!((0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y), "{s:?}");
+            assert!(
+                (0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y),
+                "{s:?}"
+            );
         }
         let (d, k) = cell.min_image(&(xj - xi));
         assert!((d - (xj - xi + cell.shift_vector(&k))).norm() < 1e-15);
@@ -111,7 +114,11 @@ fn pair(cell: Cell, xa: Vect, xb: Vect, va: Vect, vb: Vect) -> World {
 #[test]
 fn contact_across_the_corner_equals_inside() {
     let gd = 5.0;
-    let cell = Cell::new(Mat::new(0.02, 0.004, 0.0, 0.02), Mat::new(0.0, gd, 0.0, 0.0)).unwrap();
+    let cell = Cell::new(
+        Mat::new(0.02, 0.004, 0.0, 0.02),
+        Mat::new(0.0, gd, 0.0, 0.0),
+    )
+    .unwrap();
     // Branch from a to b: (1.4, 1.3) mm, overlapping gap −0.0... closed within the step.
     let branch = Vect::new(1.45e-3, 1.35e-3);
     let fluct_a = Vect::new(0.02, 0.01);
@@ -151,7 +158,10 @@ fn contact_across_the_corner_equals_inside() {
     let affine = cell.l * branch;
     let rel_c = dv_c - cell.image_velocity(&k) - affine;
     let rel_m = dv_m - affine;
-    assert!((rel_c - rel_m).norm() < 1e-12 * rel_m.norm().max(1e-3), "{rel_c} vs {rel_m}");
+    assert!(
+        (rel_c - rel_m).norm() < 1e-12 * rel_m.norm().max(1e-3),
+        "{rel_c} vs {rel_m}"
+    );
 }
 
 /// A basis change of a cell tilted beyond half a period keeps every pair distance (shortest
@@ -217,7 +227,8 @@ fn packing(n_side: usize, seed: u64, mu: f64) -> World {
             w.add_grain(x, r, 2500.0, 0);
         }
     }
-    w.set_cell(Some(Cell::rectangle(side, side).unwrap())).unwrap();
+    w.set_cell(Some(Cell::rectangle(side, side).unwrap()))
+        .unwrap();
     w.validate(0.0).unwrap();
     w
 }
@@ -233,7 +244,11 @@ fn stress_control_reaches_its_target() {
     let mut w = packing(6, 3, 0.3);
     let (rho, d): (f64, f64) = (2500.0, 2e-3);
     let gd = 0.05 * (p / rho).sqrt() / d;
-    let area: f64 = w.bodies.iter().map(|b| std::f64::consts::PI * b.radius * b.radius).sum();
+    let area: f64 = w
+        .bodies
+        .iter()
+        .map(|b| std::f64::consts::PI * b.radius * b.radius)
+        .sum();
     let mut worst = 0.0f64;
     let mut step = |w: &mut World| {
         let probe = dem::energy::EnergyProbe::before(w);
@@ -269,5 +284,8 @@ fn stress_control_reaches_its_target() {
     }
     let syy = syy / k as f64;
     assert!((syy + p).abs() < 0.1 * p, "σ_yy = {syy} Pa, target {}", -p);
-    assert!(worst < 1e-6, "energy residual / kinetic energy up to {worst:e}");
+    assert!(
+        worst < 1e-6,
+        "energy residual / kinetic energy up to {worst:e}"
+    );
 }

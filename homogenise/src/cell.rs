@@ -57,10 +57,12 @@ pub struct CellState {
 /// The whole-cell measures of a snapshot taken in a biperiodic cell; an error when the
 /// snapshot has no cell.
 pub fn cell_state(snapshot: &Snapshot) -> Result<CellState> {
-    let cell = snapshot.cell.ok_or_else(|| HomogeniseError::InvalidParameter {
-        name: "snapshot",
-        reason: "has no biperiodic cell".into(),
-    })?;
+    let cell = snapshot
+        .cell
+        .ok_or_else(|| HomogeniseError::InvalidParameter {
+            name: "snapshot",
+            reason: "has no biperiodic cell".into(),
+        })?;
     let gs = grain_stresses(snapshot)?;
     let thickness = gs.first().map_or(1.0, |g| g.thickness);
     let volume = cell.volume() * thickness;
@@ -118,7 +120,11 @@ pub fn cell_state(snapshot: &Snapshot) -> Result<CellState> {
         deviator: (0.25 * (stress[(0, 0)] - stress[(1, 1)]).powi(2) + stress[(0, 1)].powi(2))
             .sqrt(),
         solid_fraction: area / cell.volume(),
-        coordination: if n > 0 { 2.0 * nc as f64 / n as f64 } else { 0.0 },
+        coordination: if n > 0 {
+            2.0 * nc as f64 / n as f64
+        } else {
+            0.0
+        },
         fabric,
         grains: n,
     })

@@ -197,7 +197,11 @@ impl PhasedRun for Shear<'_> {
         } else {
             f64::NAN
         };
-        let mu = if pn > 0.0 { s[(0, 1)].abs() / pn } else { f64::NAN };
+        let mu = if pn > 0.0 {
+            s[(0, 1)].abs() / pn
+        } else {
+            f64::NAN
+        };
         st.history.push(vec![
             w.time,
             st.run.gamma_dot * st.run.dt * st.run.n as f64,
@@ -242,7 +246,8 @@ impl PhasedRun for Shear<'_> {
             "simple shear at target I {target}: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s), p is -tr(sigma)/2, q, solid fraction, coordination Z and fabric over force-carrying contacts, I is gamma_dot d / sqrt(-sigma_yy/rho), mu is |sigma_xy|/(-sigma_yy), cell_corrections counts the re-solves of the step by the cell control"
         ));
         table.write(out, &format!("history_I{k}.csv"))?;
-        let tail = &st.history[st.history.len() - (st.run.avg_steps as usize).min(st.history.len())..];
+        let tail =
+            &st.history[st.history.len() - (st.run.avg_steps as usize).min(st.history.len())..];
         let col = |j: usize| -> Vec<f64> { tail.iter().map(|r| r[j]).collect() };
         let avg = |j: usize| -> Result<(f64, f64)> {
             let a = block_average(&col(j), MIN_BLOCKS)?;
@@ -316,14 +321,17 @@ fn build(c: &SimpleShearConfig) -> Result<dem::World> {
         w.add_grain(x, r, c.grain.density, 0);
     }
     let cell = Cell::rectangle(side, side)?;
-    w.set_cell(Some(cell))
-        ?;
+    w.set_cell(Some(cell))?;
     w.validate(1e-12)?;
     Ok(w)
 }
 
 /// Runs the scenario.
-pub fn run(c: &SimpleShearConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+pub fn run(
+    c: &SimpleShearConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
     let mut targets = c.inertial_numbers.clone();
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
@@ -333,7 +341,10 @@ pub fn run(c: &SimpleShearConfig, ctx: &mut RunContext, ctl: &mut RunControl) ->
             + shear
                 .targets
                 .iter()
-                .map(|i| c.strain * c.grain.radius_mean * 2.0 / (i * (c.pressure / c.grain.density).sqrt()))
+                .map(|i| {
+                    c.strain * c.grain.radius_mean * 2.0
+                        / (i * (c.pressure / c.grain.density).sqrt())
+                })
                 .sum::<f64>();
         Ok((
             world,
@@ -437,15 +448,27 @@ pub fn run(c: &SimpleShearConfig, ctx: &mut RunContext, ctl: &mut RunControl) ->
     match fit_mu_i(&series, &opts) {
         Ok(f) => {
             let p = f.report.values();
-            let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| {
-                identify::laws::mu_i::MuILaw {
-                    mu_s: p[0],
-                    mu_2: p[1],
-                    i0: p[2],
-                }
-                .mu(i)
-            });
-            add_fitted_curve(&mut pmu, "μ_s + (μ₂ − μ_s)/(1 + I₀/I)", PALETTE[0], PALETTE[1], &band);
+            let band = delta_band(
+                &p,
+                &f.report.covariance,
+                f.report.t_critical,
+                &xs,
+                |p, i| {
+                    identify::laws::mu_i::MuILaw {
+                        mu_s: p[0],
+                        mu_2: p[1],
+                        i0: p[2],
+                    }
+                    .mu(i)
+                },
+            );
+            add_fitted_curve(
+                &mut pmu,
+                "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                PALETTE[0],
+                PALETTE[1],
+                &band,
+            );
             fit_keys(&mut s, "mu_i", &f.report.parameters);
             s.text("mu_i_form", "mu-i")
                 .num("mu_i_r_squared", f.report.r_squared);
@@ -453,18 +476,27 @@ pub fn run(c: &SimpleShearConfig, ctx: &mut RunContext, ctl: &mut RunControl) ->
                 "μ(I): μ_s = {:.3}, μ₂ = {:.3}, I₀ = {:.3} (R² = {:.3})",
                 f.law.mu_s, f.law.mu_2, f.law.i0, f.report.r_squared
             ));
-            write_law(&mut ctx.out, "mu_i_law.json", &CalibratedLaw::from_mu_i(&f, grain, prov()))?;
+            write_law(
+                &mut ctx.out,
+                "mu_i_law.json",
+                &CalibratedLaw::from_mu_i(&f, grain, prov()),
+            )?;
         }
         Err(e) => {
-            warn(&format!("μ(I) fit refused ({e}); fitting the linear form μ_s + b I"));
+            warn(&format!(
+                "μ(I) fit refused ({e}); fitting the linear form μ_s + b I"
+            ));
             s.text("mu_i_fit_error", &e.to_string());
             match fit_mu_i_linear(&series, &opts) {
                 Ok(f) => {
                     let p = f.report.values();
-                    let band =
-                        delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| {
-                            p[0] + p[1] * i
-                        });
+                    let band = delta_band(
+                        &p,
+                        &f.report.covariance,
+                        f.report.t_critical,
+                        &xs,
+                        |p, i| p[0] + p[1] * i,
+                    );
                     add_fitted_curve(&mut pmu, "μ_s + b I", PALETTE[0], PALETTE[1], &band);
                     fit_keys(&mut s, "mu_i", &f.report.parameters);
                     s.text("mu_i_form", "mu-i-linear")
@@ -502,16 +534,30 @@ pub fn run(c: &SimpleShearConfig, ctx: &mut RunContext, ctl: &mut RunControl) ->
     match fit_phi_i(&series, &opts) {
         Ok(f) => {
             let p = f.report.values();
-            let band = delta_band(&p, &f.report.covariance, f.report.t_critical, &xs, |p, i| {
-                p[0] - (p[0] - p[1]) * i
-            });
-            add_fitted_curve(&mut pphi, "φ_max − (φ_max − φ_min) I", PALETTE[2], PALETTE[1], &band);
+            let band = delta_band(
+                &p,
+                &f.report.covariance,
+                f.report.t_critical,
+                &xs,
+                |p, i| p[0] - (p[0] - p[1]) * i,
+            );
+            add_fitted_curve(
+                &mut pphi,
+                "φ_max − (φ_max − φ_min) I",
+                PALETTE[2],
+                PALETTE[1],
+                &band,
+            );
             fit_keys(&mut s, "phi_i", &f.report.parameters);
             headline.push(format!(
                 "φ(I): φ_max = {:.3}, φ_min = {:.3}",
                 f.law.phi_max, f.law.phi_min
             ));
-            write_law(&mut ctx.out, "phi_i_law.json", &CalibratedLaw::from_phi_i(&f, grain, prov()))?;
+            write_law(
+                &mut ctx.out,
+                "phi_i_law.json",
+                &CalibratedLaw::from_phi_i(&f, grain, prov()),
+            )?;
         }
         Err(e) => {
             warn(&format!("φ(I) fit refused: {e}"));

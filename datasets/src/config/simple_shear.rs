@@ -63,7 +63,10 @@ impl SimpleShearConfig {
         if !(self.pressure.is_finite() && self.pressure > 0.0) {
             return Err(DatasetError::invalid(
                 "pressure",
-                format!("must be a positive pressure in Pa, got {}", num(self.pressure)),
+                format!(
+                    "must be a positive pressure in Pa, got {}",
+                    num(self.pressure)
+                ),
             ));
         }
         limits::pressure("pressure", self.pressure)?;
