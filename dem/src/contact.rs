@@ -50,8 +50,7 @@ impl ContactRow {
         let dx = vb[0] - va[0];
         let dy = vb[1] - va[1];
         [
-            nx * dx + ny * dy + self.k[2] * vb[2] - self.k[0] * va[2] + self.shift
-                + self.affine[0],
+            nx * dx + ny * dy + self.k[2] * vb[2] - self.k[0] * va[2] + self.shift + self.affine[0],
             -ny * dx + nx * dy + self.k[3] * vb[2] - self.k[1] * va[2] + self.affine[1],
         ]
     }
