@@ -578,7 +578,13 @@ fn push_contact(
         k,
         w,
         shift: 0.0,
-        affine: [n.dot(&image.velocity), t.dot(&image.velocity)],
+        // −0.0 without an image: `x + (−0.0)` is `x` bit for bit (also for x = −0.0), so the
+        // relative velocities of walls and the x-periodic cell are unchanged by the term.
+        affine: if image.shift == Vector2::zeros() {
+            [-0.0, -0.0]
+        } else {
+            [n.dot(&image.velocity), t.dot(&image.velocity)]
+        },
         mu: laws.friction(ca.material, cb.material),
         r: [0.0, 0.0],
     });

@@ -13,15 +13,12 @@
 
 use datasets::config::SimpleShearConfig;
 use datasets::phases::PhaseStats;
-use dem::cell::{Cell, CellControl, Imposed, Mat};
+use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
 use homogenise::cell::cell_state;
 use identify::law::{GrainScale, Provenance};
 use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use identify::{CalibratedLaw, FitOptions};
-use nalgebra::Vector2;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::common::{
@@ -293,39 +290,6 @@ impl PhasedRun for Shear<'_> {
     }
 }
 
-/// The initial loose packing: `grains` disks (radii from `[grain]`, seeded) on a jittered
-/// square lattice in a square cell at the solid fraction `initial_solid_fraction` (lower if the
-/// lattice needs it: spacing at least 2 % above the largest diameter), at rest.
-fn build(c: &SimpleShearConfig) -> Result<dem::World> {
-    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
-    let radii = datasets::generators::uniform_radii(&mut rng, c.grains, &c.grain);
-    let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
-    let n_side = (c.grains as f64).sqrt().ceil() as usize;
-    let r_max = radii.iter().cloned().fold(0.0, f64::max);
-    let spacing = ((area / c.initial_solid_fraction).sqrt() / n_side as f64).max(2.04 * r_max);
-    let side = spacing * n_side as f64;
-    let params = dem::WorldParams {
-        dt: c.dt_max,
-        gravity: Vector2::zeros(),
-        detection_gap: 0.1 * c.grain.radius_min(),
-        solver: c.solver.params(),
-        ..Default::default()
-    };
-    let laws = dem::ContactLaws::new(&["grain"], c.friction.grain_grain);
-    let mut w = dem::World::new(params, laws);
-    let slack = 0.5 * (spacing - 2.0 * r_max) * 0.9;
-    for (k, &r) in radii.iter().enumerate() {
-        let (i, j) = (k % n_side, k / n_side);
-        let jitter = Vector2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)) * slack;
-        let x = Vector2::new(i as f64 + 0.5, j as f64 + 0.5) * spacing + jitter;
-        w.add_grain(x, r, c.grain.density, 0);
-    }
-    let cell = Cell::rectangle(side, side)?;
-    w.set_cell(Some(cell))?;
-    w.validate(1e-12)?;
-    Ok(w)
-}
-
 /// Runs the scenario.
 pub fn run(
     c: &SimpleShearConfig,
@@ -336,7 +300,7 @@ pub fn run(
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
     let fresh = || -> Result<(dem::World, State)> {
-        let world = build(c)?;
+        let world = datasets::build_cell::simple_shear(c)?;
         let t_total = c.compression_time
             + shear
                 .targets
