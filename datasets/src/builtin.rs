@@ -12,7 +12,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scenario, the default (`janssen`) first.
-pub const BUILTINS: [Builtin; 6] = [
+pub const BUILTINS: [Builtin; 7] = [
     Builtin {
         name: "janssen",
         description: "350 grains deposited in a column, relaxed, released: wall stress vs depth, Janssen fit (Fig. 7)",
@@ -42,6 +42,11 @@ pub const BUILTINS: [Builtin; 6] = [
         name: "shear-cell",
         description: "plane shear at imposed pressure over several inertial numbers: mu(I), phi(I), wall law",
         toml: include_str!("../scenarios/shear-cell.toml"),
+    },
+    Builtin {
+        name: "simple-shear",
+        description: "Lees-Edwards shear of a biperiodic cell at imposed normal stress over several inertial numbers: mu(I), phi(I)",
+        toml: include_str!("../scenarios/simple-shear.toml"),
     },
 ];
 

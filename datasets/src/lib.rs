@@ -16,6 +16,7 @@
 
 pub mod benchmarks;
 pub mod build;
+pub mod build_cell;
 pub mod builtin;
 pub mod config;
 pub mod error;

@@ -9,7 +9,7 @@ use toml::{Table, Value};
 use crate::builtin::{builtin, builtin_names};
 use crate::config::{
     ArrangementsConfig, InclinedFlowConfig, JanssenConfig, RollingConfig, ShearCellConfig,
-    StickSlipConfig,
+    SimpleShearConfig, StickSlipConfig,
 };
 use crate::error::{DatasetError, Result};
 use crate::overrides::{apply_override, parse_override};
@@ -29,6 +29,8 @@ pub enum Scenario {
     InclinedFlow(InclinedFlowConfig),
     /// Plane shear at imposed pressure.
     ShearCell(ShearCellConfig),
+    /// Lees–Edwards shear of a biperiodic cell at imposed normal stress.
+    SimpleShear(SimpleShearConfig),
 }
 
 impl Scenario {
@@ -41,6 +43,7 @@ impl Scenario {
             Scenario::StickSlip(_) => "stick-slip",
             Scenario::InclinedFlow(_) => "inclined-flow",
             Scenario::ShearCell(_) => "shear-cell",
+            Scenario::SimpleShear(_) => "simple-shear",
         }
     }
 
@@ -53,6 +56,7 @@ impl Scenario {
             Scenario::StickSlip(c) => c.seed,
             Scenario::InclinedFlow(c) => c.seed,
             Scenario::ShearCell(c) => c.seed,
+            Scenario::SimpleShear(c) => c.seed,
         }
     }
 }
@@ -253,6 +257,11 @@ pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Resul
             let c: ShearCellConfig = typed(table, source)?;
             c.validate().map_err(|e| e.in_source(source))?;
             Scenario::ShearCell(c)
+        }
+        "simple-shear" => {
+            let c: SimpleShearConfig = typed(table, source)?;
+            c.validate().map_err(|e| e.in_source(source))?;
+            Scenario::SimpleShear(c)
         }
         other => {
             return Err(DatasetError::invalid(

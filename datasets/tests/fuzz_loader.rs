@@ -224,6 +224,7 @@ fn build(s: &Scenario) -> Result<(), DatasetError> {
         }
         Scenario::InclinedFlow(c) => inclined_flow(c).map(drop),
         Scenario::ShearCell(c) => shear_cell(c).map(drop),
+        Scenario::SimpleShear(c) => datasets::build_cell::simple_shear(c).map(drop),
     }
 }
 
@@ -235,6 +236,7 @@ fn grains(s: &Scenario) -> usize {
         Scenario::StickSlip(c) => c.grains,
         Scenario::InclinedFlow(c) => c.grains,
         Scenario::ShearCell(c) => c.grains,
+        Scenario::SimpleShear(c) => c.grains,
     }
 }
 

@@ -48,6 +48,15 @@ pub struct WorldState {
     /// Back-off of the `auto` solver's Newton stage.
     #[serde(default)]
     pub newton_backoff: crate::solver::NewtonBackoff,
+    /// The biperiodic deformable cell, if any ([`crate::cell`]).
+    #[serde(default)]
+    pub cell: Option<crate::cell::Cell>,
+    /// Its mixed stress/strain-rate control, if any.
+    #[serde(default)]
+    pub cell_control: Option<crate::cell::CellControl>,
+    /// The cell's mean stress after the last step (Pa).
+    #[serde(default)]
+    pub cell_stress: Option<crate::cell::Mat>,
 }
 
 #[derive(Serialize, Deserialize)]

@@ -6,14 +6,15 @@ use serde::{Deserialize, Serialize};
 
 use crate::local::{ContactStatus, Delassus2};
 
-/// What the solver reads and writes for one contact (hot data, 15 words).
+/// What the solver reads and writes for one contact (hot data, 17 words).
 ///
 /// Kinematics with `t = (−n_y, n_x)` and lever arms `ρ_a = x − c_a`, `ρ_b = x − c_b`:
 /// ```text
-/// u_n = n·(v_b − v_a) + (ρ_b×n) ω_b − (ρ_a×n) ω_a + shift
-/// u_t = t·(v_b − v_a) + (ρ_b×t) ω_b − (ρ_a×t) ω_a
+/// u_n = n·(v_b − v_a) + (ρ_b×n) ω_b − (ρ_a×n) ω_a + shift + affine_n
+/// u_t = t·(v_b − v_a) + (ρ_b×t) ω_b − (ρ_a×t) ω_a + affine_t
 /// ```
-/// which is `u = H v + shift`; the impulse `R = r_n n + r_t t` acts on `b` and `−R` on `a`.
+/// which is `u = H v + shift + affine`; `affine` is the velocity `L h k` of the image of `b`
+/// that `a` touches across a deformable periodic cell ([`crate::cell`]), 0 otherwise; the impulse `R = r_n n + r_t t` acts on `b` and `−R` on `a`.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[repr(C)]
 pub struct ContactRow {
@@ -30,6 +31,10 @@ pub struct ContactRow {
     /// Constant shift of the normal velocity (m/s): `max(g,0)/(hθ)` lets an open gap close
     /// within the step; `e u_n⁻` adds Newton restitution on impacts.
     pub shift: f64,
+    /// Affine velocity of the periodic image of `b` in the contact frame, `(n·L h k, t·L h k)`
+    /// (m/s), with `h k` the image's shift vector ([`crate::cell`]); zero inside the cell.
+    #[serde(default)]
+    pub affine: [f64; 2],
     /// Friction coefficient μ.
     pub mu: f64,
     /// Impulse `(r_n, r_t)` (N·s).
@@ -37,15 +42,16 @@ pub struct ContactRow {
 }
 
 impl ContactRow {
-    /// Local relative velocity `u = H v + (shift, 0)` from body velocities `[v_x, v_y, ω]`.
+    /// Local relative velocity `u = H v + (shift, 0) + affine` from body velocities
+    /// `[v_x, v_y, ω]`.
     #[inline(always)]
     pub fn velocity(&self, va: &[f64; 3], vb: &[f64; 3]) -> [f64; 2] {
         let [nx, ny] = self.n;
         let dx = vb[0] - va[0];
         let dy = vb[1] - va[1];
         [
-            nx * dx + ny * dy + self.k[2] * vb[2] - self.k[0] * va[2] + self.shift,
-            -ny * dx + nx * dy + self.k[3] * vb[2] - self.k[1] * va[2],
+            nx * dx + ny * dy + self.k[2] * vb[2] - self.k[0] * va[2] + self.shift + self.affine[0],
+            -ny * dx + nx * dy + self.k[3] * vb[2] - self.k[1] * va[2] + self.affine[1],
         ]
     }
 
@@ -126,6 +132,10 @@ pub struct ContactGeometry {
     /// radius of the pair.
     #[serde(default)]
     pub closed_gap: f64,
+    /// Shift vector `h k` (m) of the periodic image of `b` that `a` touches across a
+    /// deformable cell ([`crate::cell`]); zero inside the cell or without one.
+    #[serde(default)]
+    pub image: [f64; 2],
 }
 
 /// A gap below this fraction of the smaller radius counts as closed: no gap-closing velocity is

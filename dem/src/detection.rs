@@ -10,7 +10,8 @@
 
 use nalgebra::Vector2;
 
-use crate::body::Body;
+use crate::body::{Body, BodyKind};
+use crate::cell::{Cell, Vect};
 use crate::collider::{rotate, Collider, Shape};
 use crate::contact::{ContactGeometry, ContactRow, ContactSet, CLOSED_GAP};
 use crate::error::DemError;
@@ -59,6 +60,7 @@ pub struct Detector {
     neighbours: Vec<(u32, u32)>,
     fill: Vec<u32>,
     fast: Vec<u32>,
+    reduced: Vec<[f64; 2]>,
 }
 
 /// A line or segment in world coordinates.
@@ -416,6 +418,7 @@ impl Detector {
             lever_b,
             gap,
             CLOSED_GAP * ra.min(rb),
+            Image::NONE,
         );
     }
 
@@ -510,6 +513,7 @@ impl Detector {
             lever_b,
             gap,
             CLOSED_GAP * r,
+            Image::NONE,
         );
     }
 }
@@ -520,6 +524,21 @@ fn disk_offset(b: &Body, c: &Collider) -> Vector2<f64> {
         Shape::Disk { offset, .. } => rotate(offset, b.angle),
         _ => Vector2::zeros(),
     }
+}
+
+/// The periodic image of `b` a contact sees: its shift vector `h k` (m) and the affine
+/// velocity `L h k` (m/s) it moves with relative to `b` ([`crate::cell`]).
+#[derive(Debug, Clone, Copy)]
+struct Image {
+    shift: Vector2<f64>,
+    velocity: Vector2<f64>,
+}
+
+impl Image {
+    const NONE: Image = Image {
+        shift: Vector2::new(0.0, 0.0),
+        velocity: Vector2::new(0.0, 0.0),
+    };
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -540,6 +559,7 @@ fn push_contact(
     lever_b: Vector2<f64>,
     gap: f64,
     closed_gap: f64,
+    image: Image,
 ) {
     let t = Vector2::new(-n.y, n.x);
     let cross = |r: Vector2<f64>, v: Vector2<f64>| r.x * v.y - r.y * v.x;
@@ -558,6 +578,13 @@ fn push_contact(
         k,
         w,
         shift: 0.0,
+        // −0.0 without an image: `x + (−0.0)` is `x` bit for bit (also for x = −0.0), so the
+        // relative velocities of walls and the x-periodic cell are unchanged by the term.
+        affine: if image.shift == Vector2::zeros() {
+            [-0.0, -0.0]
+        } else {
+            [n.dot(&image.velocity), t.dot(&image.velocity)]
+        },
         mu: laws.friction(ca.material, cb.material),
         r: [0.0, 0.0],
     });
@@ -569,6 +596,270 @@ fn push_contact(
         lever_b: [lever_b.x, lever_b.y],
         restitution: laws.restitution(ca.material, cb.material),
         closed_gap,
+        image: [image.shift.x, image.shift.y],
     });
     out.status.push(ContactStatus::Open);
+}
+
+impl Detector {
+    /// Detection in a biperiodic deformable cell ([`crate::cell`]), in O(N): every disk is
+    /// wrapped into the cell and binned on a grid of `n₁ × n₂` bins in reduced coordinates,
+    /// `n_d = ⌊w_d / c⌋` with `w_d` the cell's width across faces ([`Cell::widths`]) and `c`
+    /// the cut-off (largest diameter, detection gap and swept margins), so that two disks within
+    /// `c` of each other (through any image) lie in neighbouring bins, the grid wrapping in both
+    /// directions; each pair takes its shortest image ([`Cell::min_image`]). A contact with an
+    /// image `x_b + h k` carries the image's shift vector `h k` and affine velocity `L h k`
+    /// ([`crate::contact::ContactRow::affine`]).
+    ///
+    /// The swept margin of a disk is `m = dt (|v − L (x − c)| + dt |a| + |ω| ρ) + dt ‖L‖ r`
+    /// with `r = R_max + g_d/2`: its velocity relative to the affine field, plus half the affine
+    /// velocity difference across the largest pair, so that `m_a + m_b` bounds the pair's
+    /// relative travel. Only disk grains are allowed (no walls in a periodic cell); the cell
+    /// must be at least 3 cut-offs wide across both pairs of faces.
+    #[allow(clippy::too_many_arguments)]
+    pub fn detect_cell(
+        &mut self,
+        bodies: &[Body],
+        inv_mass: &[[f64; 3]],
+        colliders: &[Collider],
+        laws: &ContactLaws,
+        cell: &Cell,
+        detection_gap: f64,
+        dt: f64,
+        out: &mut ContactSet,
+    ) -> Result<(), DemError> {
+        out.clear();
+        self.disk_collider.clear();
+        self.centre.clear();
+        self.radius.clear();
+        self.margin.clear();
+        self.reduced.clear();
+        let inv = cell.inverse();
+        let l_norm = cell.l.norm();
+        let mut r_max = 0.0f64;
+        for col in colliders {
+            match col.shape {
+                Shape::Disk { radius, .. } => r_max = r_max.max(radius),
+                _ => {
+                    return Err(DemError::Parameter {
+                        name: "cell".into(),
+                        reason: format!(
+                            "a biperiodic cell holds disk grains only; body {} (`{}`) is a wall",
+                            col.body, bodies[col.body as usize].name
+                        ),
+                    })
+                }
+            }
+            if bodies[col.body as usize].kind != BodyKind::Grain {
+                return Err(DemError::Parameter {
+                    name: "cell".into(),
+                    reason: format!(
+                        "a biperiodic cell holds grains only; body {} (`{}`) is a wall",
+                        col.body, bodies[col.body as usize].name
+                    ),
+                });
+            }
+        }
+        let pair_affine = dt * l_norm * (r_max + 0.5 * detection_gap.max(0.0));
+        for (ci, col) in colliders.iter().enumerate() {
+            if let Shape::Disk { radius, offset } = col.shape {
+                let b = &bodies[col.body as usize];
+                let c = b.position + rotate(offset, b.angle);
+                let (c, _) = cell.wrap(&c);
+                let mut sr = inv * c;
+                for d in 0..2 {
+                    if !(0.0..1.0).contains(&sr[d]) {
+                        sr[d] = sr[d].rem_euclid(1.0);
+                        if sr[d] >= 1.0 {
+                            sr[d] = 0.0;
+                        }
+                    }
+                }
+                self.disk_collider.push(ci as u32);
+                self.centre.push([c.x, c.y]);
+                self.reduced.push([sr.x, sr.y]);
+                self.radius.push(radius);
+                let f = if b.mass > 0.0 && b.mass.is_finite() {
+                    b.applied_force.norm() / b.mass
+                } else {
+                    0.0
+                };
+                let fluct = b.velocity - cell.affine_velocity(&c);
+                self.margin.push(
+                    dt * (fluct.norm() + dt * f + b.omega.abs() * offset.norm()) + pair_affine,
+                );
+            }
+        }
+        let nd = self.centre.len();
+        let max_d = 2.0 * r_max;
+        let max_m = self.margin.iter().cloned().fold(0.0f64, f64::max);
+        let margin_cap = max_m.min(max_d);
+        let cut = max_d + detection_gap.max(0.0) + 2.0 * margin_cap;
+        self.fast.clear();
+        self.fast
+            .extend((0..nd as u32).filter(|&d| self.margin[d as usize] > margin_cap));
+        let widths = cell.widths();
+        let cap = (4 * nd + 64) as f64;
+        let mut n = [0usize; 2];
+        for d in 0..2 {
+            let k = (widths[d] / cut).floor();
+            if k.is_nan() || k < 3.0 {
+                return Err(DemError::Parameter {
+                    name: "cell".into(),
+                    reason: format!(
+                        "the cell is {:.4e} m wide across faces {}, less than 3 times the largest \
+                         diameter plus the detection gap and swept margins ({:.4e} m)",
+                        widths[d],
+                        d + 1,
+                        cut
+                    ),
+                });
+            }
+            n[d] = k.min(cap.sqrt().max(3.0)) as usize;
+        }
+        let (n1, n2) = (n[0], n[1]);
+        let ncells = n1 * n2;
+        self.cell_of.clear();
+        self.cell_start.clear();
+        self.cell_start.resize(ncells + 1, 0);
+        for s in &self.reduced {
+            let i1 = ((s[0] * n1 as f64) as usize).min(n1 - 1);
+            let i2 = ((s[1] * n2 as f64) as usize).min(n2 - 1);
+            let id = (i2 * n1 + i1) as u32;
+            self.cell_of.push(id);
+            self.cell_start[id as usize + 1] += 1;
+        }
+        for i in 0..ncells {
+            self.cell_start[i + 1] += self.cell_start[i];
+        }
+        self.cell_items.clear();
+        self.cell_items.resize(nd, 0);
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.cell_start[..ncells]);
+        for (d, &cid) in self.cell_of.iter().enumerate() {
+            self.cell_items[self.fill[cid as usize] as usize] = d as u32;
+            self.fill[cid as usize] += 1;
+        }
+        for d in 0..nd {
+            let ci = self.disk_collider[d];
+            self.neighbours.clear();
+            if self.fast.binary_search(&(d as u32)).is_ok() {
+                for e in d + 1..nd {
+                    self.neighbours.push((self.disk_collider[e], e as u32));
+                }
+            } else {
+                for &e in &self.fast {
+                    if e as usize > d {
+                        self.neighbours.push((self.disk_collider[e as usize], e));
+                    }
+                }
+            }
+            let cid = self.cell_of[d] as usize;
+            let (i1, i2) = ((cid % n1) as isize, (cid / n1) as isize);
+            for d2 in -1isize..=1 {
+                let j2 = (i2 + d2).rem_euclid(n2 as isize) as usize;
+                for d1 in -1isize..=1 {
+                    let j1 = (i1 + d1).rem_euclid(n1 as isize) as usize;
+                    let c2 = j2 * n1 + j1;
+                    for &e in &self.cell_items
+                        [self.cell_start[c2] as usize..self.cell_start[c2 + 1] as usize]
+                    {
+                        if (e as usize) > d {
+                            self.neighbours.push((self.disk_collider[e as usize], e));
+                        }
+                    }
+                }
+            }
+            self.neighbours.sort_unstable();
+            self.neighbours.dedup();
+            for k in 0..self.neighbours.len() {
+                let (cj, e) = self.neighbours[k];
+                self.disk_disk_cell(
+                    bodies,
+                    inv_mass,
+                    colliders,
+                    laws,
+                    cell,
+                    detection_gap,
+                    ci,
+                    d,
+                    cj,
+                    e as usize,
+                    out,
+                );
+            }
+        }
+        Ok(())
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn disk_disk_cell(
+        &self,
+        bodies: &[Body],
+        inv_mass: &[[f64; 3]],
+        colliders: &[Collider],
+        laws: &ContactLaws,
+        cell: &Cell,
+        gap_max: f64,
+        ci: u32,
+        di: usize,
+        cj: u32,
+        dj: usize,
+        out: &mut ContactSet,
+    ) {
+        let (ca, cb) = (&colliders[ci as usize], &colliders[cj as usize]);
+        if ca.body == cb.body {
+            return;
+        }
+        let (ba, bb) = (ca.body as usize, cb.body as usize);
+        let (pa, pb) = (self.centre[di], self.centre[dj]);
+        let raw = Vect::new(pb[0] - pa[0], pb[1] - pa[1]);
+        let (branch, k) = cell.min_image(&raw);
+        let (ra, rb) = (self.radius[di], self.radius[dj]);
+        let reach = ra + rb + gap_max + self.margin[di] + self.margin[dj];
+        let d2 = branch.norm_squared();
+        if d2 > reach * reach {
+            return;
+        }
+        let dist = d2.sqrt();
+        let n = if dist > 0.0 {
+            branch / dist
+        } else {
+            Vector2::new(0.0, 1.0)
+        };
+        let gap = dist - ra - rb;
+        let off_a = disk_offset(&bodies[ba], ca);
+        let off_b = disk_offset(&bodies[bb], cb);
+        let lever_b = -n * rb + off_b;
+        let lever_a = branch - n * rb + off_a;
+        // The point is given near b (inside the cell); the image is that of b seen from a.
+        let point = Vector2::new(pb[0], pb[1]) - n * rb;
+        let image = if k == crate::cell::Shift::zeros() {
+            Image::NONE
+        } else {
+            Image {
+                shift: cell.shift_vector(&k),
+                velocity: cell.image_velocity(&k),
+            }
+        };
+        push_contact(
+            out,
+            inv_mass,
+            laws,
+            ca,
+            cb,
+            ci,
+            cj,
+            ba,
+            bb,
+            n,
+            point,
+            lever_a,
+            lever_b,
+            gap,
+            CLOSED_GAP * ra.min(rb),
+            image,
+        );
+    }
 }

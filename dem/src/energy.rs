@@ -77,10 +77,11 @@ impl EnergyProbe {
         }
     }
 
-    /// The residual `δ = ΔK − W_ext − W_drive` (J) of the step that took the world from the
-    /// probed state to `after` (module documentation): `W_ext = h[(1 − θ) Σ f·v⁻ + θ Σ f·v⁺]`,
+    /// The residual `δ = ΔK − W_ext − W_drive − W_cell` (J) of the step that took the world from
+    /// the probed state to `after` (module documentation): `W_ext = h[(1 − θ) Σ f·v⁻ + θ Σ f·v⁺]`,
     /// `W_drive = −h Σ F_c·v` over imposed degrees of freedom, `F_c` the contact force received
-    /// during the step. At most round-off for θ = 1 and an exact solve. The position correction
+    /// during the step, `W_cell` the work of a deformable periodic cell
+    /// (`StepReport::cell_work`). At most round-off for θ = 1 and an exact solve. The position correction
     /// of the step moves no velocity and is not in δ; its work is in
     /// `StepReport::position_correction.load_work`.
     pub fn residual(&self, after: &World) -> f64 {
@@ -101,7 +102,9 @@ impl EnergyProbe {
                 }
             }
         }
-        after.kinetic_energy() - self.kinetic - w_ext - w_drive
+        // The work of a deformable periodic cell (0 without one).
+        let w_cell = after.last_report().cell_work;
+        after.kinetic_energy() - self.kinetic - w_ext - w_drive - w_cell
     }
 }
 

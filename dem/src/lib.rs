@@ -19,6 +19,9 @@
 //! the impulses of a packing generated at rest, [`world::World::prime_with_weight`]) and
 //! [`step_control`] (a time step adapted to the solver's convergence).
 //!
+//! Boundaries: walls, a periodic x direction ([`detection::Periodic`]), or a biperiodic
+//! deformable cell with mixed stress/strain-rate control ([`cell`], [`world::World::cell`]).
+//!
 //! The same local law solves standalone frictional-contact problems given by `W`, `q`, `μ`
 //! ([`fc`]).
 
@@ -28,6 +31,7 @@ pub mod atomic;
 pub mod bench;
 pub mod blocked;
 pub mod body;
+pub mod cell;
 pub mod checkpoint;
 pub mod collider;
 pub mod colouring;
@@ -49,6 +53,7 @@ pub mod step_control;
 pub mod world;
 
 pub use body::{Body, BodyKind, Dof};
+pub use cell::{Cell, CellControl, Imposed};
 pub use error::DemError;
 pub use local::ContactStatus;
 pub use material::ContactLaws;

@@ -166,6 +166,11 @@ pub struct Snapshot {
     pub gravity: Vector2<f64>,
     /// Periodic cell along x, `[x_min, x_max)` (m), if any.
     pub periodic_x: Option<[f64; 2]>,
+    /// Biperiodic deformable cell (matrix `h`, velocity gradient `L`), if any
+    /// ([`crate::cell`]): grain positions are then inside it, velocities are total velocities
+    /// (affine field `L (x − c)` included), and contact points are given near body `b`.
+    #[serde(default)]
+    pub cell: Option<crate::cell::Cell>,
     /// All bodies, grains and walls, in the world's order.
     pub bodies: Vec<BodyState>,
     /// Contacts of the step (including open ones, with zero force).

@@ -35,6 +35,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::blocked::BlockLayout;
 use crate::body::{Body, Dof};
+use crate::cell::{Cell, CellControl, Mat, Vect};
 use crate::checkpoint::WorldState;
 use crate::collider::{rotate, Collider, Shape};
 use crate::colouring::ContactColouring;
@@ -130,6 +131,16 @@ pub struct StepReport {
     /// off or found nothing to correct.
     #[serde(default)]
     pub position_correction: CorrectionReport,
+    /// Work done on the grains by a deformable periodic cell during the step (J): the impulses
+    /// against the affine velocities of the images, `−Σ_α R_α·(L h k)_α`, plus the kinetic
+    /// energy changed by wrapping grains back into the cell (`v ← v + L h k`) and by the
+    /// control's homogeneous velocity change (`v ← v + ΔL (x − c)`). 0 without a cell.
+    #[serde(default)]
+    pub cell_work: f64,
+    /// Re-solves of the step by the implicit correction of a stress-controlled cell
+    /// ([`crate::cell::CellControl::tolerance`]); 0 when the explicit law sufficed.
+    #[serde(default)]
+    pub cell_corrections: u32,
 }
 
 /// A 2D granular world.
@@ -169,6 +180,17 @@ pub struct World {
     /// to a file (`grainlaw run --dump-problems`). Costs one assembly of `W` per step.
     pub record_problems: bool,
     last_problem: Option<FcProblem>,
+    /// Biperiodic deformable cell ([`crate::cell`]); `None`: walls and `periodic_x` only.
+    /// Set it with [`World::set_cell`].
+    cell: Option<Cell>,
+    /// Mixed stress/strain-rate control of the cell, applied after every step.
+    pub cell_control: Option<CellControl>,
+    /// Mean stress of the cell after the last step (Pa), [`World::cell_stress`].
+    cell_sigma: Option<Mat>,
+    /// Fluctuating displacements of the last step (cell only), for the outran check.
+    fluct_displacement: Vec<[f64; 3]>,
+    /// Kinetic energy changed by wraps during the position correction (J).
+    last_wrap_energy: f64,
 }
 
 impl World {
@@ -200,7 +222,142 @@ impl World {
             last: StepReport::default(),
             record_problems: false,
             last_problem: None,
+            cell: None,
+            cell_control: None,
+            cell_sigma: None,
+            fluct_displacement: Vec::new(),
+            last_wrap_energy: 0.0,
         }
+    }
+
+    /// The biperiodic deformable cell, if any.
+    pub fn cell(&self) -> Option<&Cell> {
+        self.cell.as_ref()
+    }
+
+    /// Makes the world a biperiodic deformable cell ([`crate::cell`]; grains only, no walls,
+    /// `periodic_x` must be `None`) and wraps the grains into it; `None` removes it. The grains'
+    /// velocities are left as they are (total velocities): see [`World::set_velocity_gradient`]
+    /// to give them the affine field.
+    pub fn set_cell(&mut self, cell: Option<Cell>) -> Result<(), DemError> {
+        if let Some(c) = &cell {
+            c.check()?;
+        }
+        self.cell = cell;
+        self.cell_sigma = None;
+        self.wrap_grains();
+        Ok(())
+    }
+
+    /// Sets the cell's velocity gradient to `l` (1/s) and adds the change of the affine field to
+    /// every grain, `v ← v + (l − L)(x − c)` (a homogeneous deformation rate: YADE's
+    /// `homoDeform`), so that the grains follow the cell at once instead of by waves from its
+    /// boundaries. Returns the kinetic energy this added (J). No-op without a cell.
+    pub fn set_velocity_gradient(&mut self, l: Mat) -> f64 {
+        let Some(cell) = self.cell.as_mut() else {
+            return 0.0;
+        };
+        let dl = l - cell.l;
+        cell.l = l;
+        let c = cell.centre();
+        let mut de = 0.0;
+        for b in self.bodies.iter_mut() {
+            if b.kind != BodyKind::Grain {
+                continue;
+            }
+            let dv = dl * (b.position - c);
+            let before = b.velocity;
+            for d in 0..2 {
+                if b.dofs[d] == Dof::Free {
+                    b.velocity[d] += dv[d];
+                }
+            }
+            de += 0.5 * b.mass * (b.velocity.norm_squared() - before.norm_squared());
+        }
+        de
+    }
+
+    /// Mean stress of the cell after the last step (Pa, tension positive, symmetric part):
+    ///
+    /// `Σ = (1/V) [ Σ_α f_α ⊗ (ρ_b − ρ_a)_α + Σ_p (I_p/2)(−ω̇_p j + ω_p² 𝟙) − Σ_p m_p ṽ_p ⊗ ṽ_p ]`,
+    ///
+    /// `V = det h` × thickness, `f_α` the force on `b`, `ρ` the lever arms (`ρ_b − ρ_a` is
+    /// minus the branch vector to the image of `b`), `ṽ_p = v_p − L (x_p − c)` minus its mass
+    /// mean. The first two terms are `Σ_p V_p Σ_p` of the seed paper's grain stress with
+    /// inertia (`homogenise::stress`, `docs/physics.md` §2.1), computed here because the
+    /// engine's cell control needs it every step; the last is the kinetic (Reynolds) stress of
+    /// the velocity fluctuations. `None` without a cell or before the first step.
+    pub fn cell_stress(&self) -> Option<Mat> {
+        self.cell_sigma
+    }
+
+    fn measure_cell_stress(&self, cell: &Cell) -> Mat {
+        let h = self.impulse_dt();
+        let mut m = Mat::zeros();
+        for (row, geo) in self.contacts.rows.iter().zip(&self.contacts.geometry) {
+            if row.r == [0.0, 0.0] {
+                continue;
+            }
+            let [nx, ny] = row.n;
+            let f = Vect::new(row.r[0] * nx - row.r[1] * ny, row.r[0] * ny + row.r[1] * nx) / h;
+            let l = Vect::new(
+                geo.lever_b[0] - geo.lever_a[0],
+                geo.lever_b[1] - geo.lever_a[1],
+            );
+            m += f * l.transpose();
+        }
+        let c = cell.centre();
+        let (mut mass, mut mom) = (0.0, Vect::zeros());
+        let mut thickness: f64 = 1.0;
+        for b in self.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
+            mass += b.mass;
+            mom += (b.velocity - cell.l * (b.position - c)) * b.mass;
+            thickness = b.thickness;
+        }
+        let mean = if mass > 0.0 {
+            mom / mass
+        } else {
+            Vect::zeros()
+        };
+        let j = Mat::new(0.0, -1.0, 1.0, 0.0);
+        for b in self.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
+            let v = b.velocity - cell.l * (b.position - c) - mean;
+            m -= v * v.transpose() * b.mass;
+            m += (j * (-b.angular_acceleration) + Mat::identity() * (b.omega * b.omega))
+                * (0.5 * b.inertia);
+        }
+        let s = m / (cell.volume() * thickness);
+        (s + s.transpose()) * 0.5
+    }
+
+    /// Wraps every grain into the cell (`x ← x + h k`) with `v ← v + L h k`; returns the kinetic
+    /// energy change (J). Without a cell, wraps x into `periodic_x`.
+    fn wrap_grains(&mut self) -> f64 {
+        let Some(cell) = self.cell else {
+            if let Some(p) = self.periodic() {
+                for b in self.bodies.iter_mut() {
+                    if b.kind == BodyKind::Grain {
+                        b.position.x = p.wrap(b.position.x);
+                    }
+                }
+            }
+            return 0.0;
+        };
+        let mut de = 0.0;
+        for b in self.bodies.iter_mut() {
+            if b.kind != BodyKind::Grain {
+                continue;
+            }
+            let (x, k) = cell.wrap(&b.position);
+            if k == crate::cell::Shift::zeros() {
+                continue;
+            }
+            b.position = x;
+            let before = b.velocity;
+            b.velocity += cell.image_velocity(&k);
+            de += 0.5 * b.mass * (b.velocity.norm_squared() - before.norm_squared());
+        }
+        de
     }
 
     /// The frictional-contact problem of the last step (`u = W r + q` in the contacts' order,
@@ -311,7 +468,7 @@ impl World {
         id
     }
 
-    /// The periodic cell, if any.
+    /// The periodic x direction, if any (see [`World::cell`] for a biperiodic cell).
     pub fn periodic(&self) -> Option<Periodic> {
         self.params.periodic_x.map(|[a, b]| Periodic {
             x_min: a,
@@ -405,6 +562,18 @@ impl World {
                     format!("needs x_min < x_max, got [{a}, {b}]"),
                 ));
             }
+        }
+        if let Some(cell) = &self.cell {
+            cell.check()?;
+            if p.periodic_x.is_some() {
+                return Err(perr(
+                    "periodic_x",
+                    "must be unset with a biperiodic cell (the cell is periodic in x and y)".into(),
+                ));
+            }
+        }
+        if let Some(c) = &self.cell_control {
+            c.check()?;
         }
         if !(p.solver.tolerance.is_finite() && p.solver.tolerance > 0.0) {
             return Err(perr(
@@ -587,6 +756,18 @@ impl World {
         g: f64,
         set: &mut ContactSet,
     ) -> Result<(), DemError> {
+        if let Some(cell) = self.cell {
+            return self.detector.detect_cell(
+                &self.bodies,
+                &self.inv,
+                &self.colliders,
+                &self.laws,
+                &cell,
+                gap,
+                h,
+                set,
+            );
+        }
         let periodic = self.periodic();
         self.detector.detect(
             &self.bodies,
@@ -649,7 +830,97 @@ impl World {
         }
     }
 
+    /// A step, with the implicit correction of a stress-controlled cell
+    /// ([`CellControl::tolerance`]): when the step ends with a mean stress error beyond the
+    /// tolerance (more compressive: typically a rigid packing asked to deform faster than it
+    /// can, whose impulses then grow without bound; or more tensile), the step is done again
+    /// from its start with the stress-controlled components of `L` changed by a common `δ`,
+    /// found by bracketing and bisection on the mean signed error `Σ (σ_ij − σ*_ij)/n` (which
+    /// grows with `δ`), until that error is within the tolerance or
+    /// [`CellControl::max_corrections`] re-solves are spent. On the tensile side `δ ≥ −ε̇_max`
+    /// (a loose packing cannot be brought to its stress within one step).
     fn step_in_pool(&mut self) -> Result<StepReport, DemError> {
+        let (Some(ctl), Some(_)) = (self.cell_control, self.cell) else {
+            return self.step_plain();
+        };
+        if ctl.tolerance <= 0.0 || ctl.max_corrections == 0 {
+            return self.step_plain();
+        }
+        let backup = self.clone();
+        let first = self.step_plain()?;
+        let f0 = ctl.signed_error(&self.cell_sigma.unwrap_or_else(Mat::zeros));
+        if f0.abs() <= ctl.tolerance {
+            return Ok(first);
+        }
+        let l0 = backup.cell.map_or_else(Mat::zeros, |c| c.l);
+        let mut tries = 0u32;
+        let attempt = |w: &mut World, delta: f64, tries: &mut u32| -> Result<f64, DemError> {
+            *w = backup.clone();
+            let e = w.set_velocity_gradient(l0 + ctl.direction() * delta);
+            let mut r = w.step_plain()?;
+            r.cell_work += e;
+            *tries += 1;
+            r.cell_corrections = *tries;
+            w.last = r;
+            Ok(ctl.signed_error(&w.cell_sigma.unwrap_or_else(Mat::zeros)))
+        };
+        // Bracket the root of f(δ) (f grows with δ): [lo, hi] with f(lo) < 0 < f(hi).
+        let (mut lo, mut hi);
+        if f0 < 0.0 {
+            // Too compressive: open faster, doubling the step (a rigid packing can need it).
+            lo = 0.0;
+            hi = ctl.max_rate;
+            let mut f = attempt(self, hi, &mut tries)?;
+            while f < -ctl.tolerance && (tries as usize) < ctl.max_corrections / 2 {
+                lo = hi;
+                hi *= 2.0;
+                f = attempt(self, hi, &mut tries)?;
+            }
+            if f.abs() <= ctl.tolerance || f < 0.0 {
+                return Ok(self.last);
+            }
+        } else {
+            // Too tensile: close, but no component faster than ε̇_max (a loose packing cannot
+            // be brought to its stress within one step; no rigidity to overcome this way).
+            let dir = ctl.direction();
+            let l_min = (0..2)
+                .flat_map(|i| (0..2).map(move |j| (i, j)))
+                .filter(|&ij| dir[ij] != 0.0)
+                .map(|ij| l0[ij])
+                .fold(f64::INFINITY, f64::min);
+            hi = 0.0;
+            lo = -(ctl.max_rate + l_min);
+            if lo.is_nan() || lo >= 0.0 {
+                return Ok(first);
+            }
+            let f = attempt(self, lo, &mut tries)?;
+            if f >= -ctl.tolerance {
+                return Ok(self.last);
+            }
+        }
+        let mut last_ok = true;
+        while (tries as usize) < ctl.max_corrections {
+            let mid = 0.5 * (lo + hi);
+            let f = attempt(self, mid, &mut tries)?;
+            if f.abs() <= ctl.tolerance {
+                return Ok(self.last);
+            }
+            if f < 0.0 {
+                lo = mid;
+                last_ok = false;
+            } else {
+                hi = mid;
+                last_ok = true;
+            }
+        }
+        // Out of re-solves: end on the bracket's side that is not too compressive.
+        if !last_ok {
+            attempt(self, hi, &mut tries)?;
+        }
+        Ok(self.last)
+    }
+
+    fn step_plain(&mut self) -> Result<StepReport, DemError> {
         let h = self.params.dt;
         let theta = self.params.theta;
         let g = self.params.gravity;
@@ -813,14 +1084,76 @@ impl World {
             }
         }
 
-        // 5. Position correction (velocities untouched).
+        // 4b. The deformable cell: h ← exp(L h) h, a basis change when it tilts beyond half a
+        //     period, grains wrapped back with v ← v + L h k.
+        let mut cell_work = 0.0;
+        let mut cell_gap_shift = Vec::new();
+        if let Some(mut cell) = self.cell {
+            let (h_old, l) = (cell.h, cell.l);
+            // Affine part of the step's displacements, for the outran check.
+            let c = cell.centre();
+            self.fluct_displacement.clear();
+            for (b, d) in self.bodies.iter().zip(&self.displacement) {
+                let x_old = b.position - Vect::new(d[0], d[1]);
+                let a = l * (x_old - c) * h;
+                self.fluct_displacement.push([d[0] - a.x, d[1] - a.y, d[2]]);
+            }
+            cell.advance(h);
+            // Gap change of each image contact from the cell's deformation, n·(Δh k).
+            let dh = (cell.h - h_old) * cell_inverse(&h_old);
+            for (row, geo) in self.contacts.rows.iter().zip(&self.contacts.geometry) {
+                if geo.image != [0.0, 0.0] {
+                    let u = dh * Vect::new(geo.image[0], geo.image[1]);
+                    cell_gap_shift.push(row.n[0] * u.x + row.n[1] * u.y);
+                } else {
+                    cell_gap_shift.push(0.0);
+                }
+            }
+            cell.remap();
+            self.cell = Some(cell);
+            cell_work += self.wrap_grains();
+            // Work of the impulses against the images' affine velocities.
+            for row in &self.contacts.rows {
+                cell_work -= row.r[0] * row.affine[0] + row.r[1] * row.affine[1];
+            }
+        }
+
+        // 5. Position correction (velocities untouched but for the wraps of 4b).
+        self.last_wrap_energy = 0.0;
         let correction = if self.params.position_correction {
-            self.correct_positions()
+            if cell_gap_shift.is_empty() {
+                self.correct_positions()
+            } else {
+                // The projection predicts g⁺ = g⁻ + H_n Δq: add the images' affine part.
+                let saved: Vec<f64> = self.contacts.geometry.iter().map(|g| g.gap).collect();
+                for (g, s) in self.contacts.geometry.iter_mut().zip(&cell_gap_shift) {
+                    g.gap += s;
+                }
+                let r = self.correct_positions();
+                for (g, s) in self.contacts.geometry.iter_mut().zip(saved) {
+                    g.gap = s;
+                }
+                r
+            }
         } else {
             CorrectionReport::default()
         };
 
+        cell_work += self.last_wrap_energy;
         let active = self.refresh_body_forces();
+
+        // 6. Cell control: the mean stress of the step, then the new velocity gradient with
+        //    the homogeneous change of the grains' velocities.
+        if let Some(cell) = self.cell {
+            let sigma = self.measure_cell_stress(&cell);
+            self.cell_sigma = Some(sigma);
+            if let Some(ctl) = self.cell_control {
+                let l = ctl.update(&cell.l, &sigma, h);
+                if l != cell.l {
+                    cell_work += self.set_velocity_gradient(l);
+                }
+            }
+        }
 
         self.step_index += 1;
         self.time += h;
@@ -832,6 +1165,8 @@ impl World {
             solver: report,
             max_penetration: max_pen,
             position_correction: correction,
+            cell_work,
+            cell_corrections: 0,
         };
         Ok(self.last)
     }
@@ -854,7 +1189,12 @@ impl World {
         // step knew: detect again at the corrected positions (nothing moves now, so no swept
         // margin; pairs up to a quarter of the smallest radius apart, which the projection can
         // push into contact) and project the actual gaps.
-        if self.detector.outran(&self.colliders, &self.displacement) {
+        let moved = if self.cell.is_some() {
+            &self.fluct_displacement
+        } else {
+            &self.displacement
+        };
+        if self.detector.outran(&self.colliders, moved) {
             let mut fresh = std::mem::take(&mut self.fresh);
             let reach = 0.25 * self.smallest_radius().unwrap_or(0.0);
             let detected = self.detect_into(reach, 0.0, 0.0, &mut fresh);
@@ -909,6 +1249,11 @@ impl World {
                 }
             }
         }
+        if self.cell.is_some() {
+            // A correction is a few 10⁻⁴ R: a grain it moves across a face keeps the velocity
+            // of its image, as in the step.
+            self.last_wrap_energy += self.wrap_grains();
+        }
         work
     }
 
@@ -955,6 +1300,9 @@ impl World {
             contacts: self.contacts.clone(),
             last: self.last,
             newton_backoff: self.work.backoff,
+            cell: self.cell,
+            cell_control: self.cell_control,
+            cell_stress: self.cell_sigma,
         }
     }
 
@@ -969,8 +1317,11 @@ impl World {
         w.contacts = s.contacts;
         w.last = s.last;
         w.work.backoff = s.newton_backoff;
+        w.cell = s.cell;
+        w.cell_control = s.cell_control;
         w.refresh_inverse_mass();
         w.refresh_body_forces();
+        w.cell_sigma = s.cell_stress;
         w
     }
 
@@ -1066,9 +1417,15 @@ impl World {
             dt: h,
             gravity: self.params.gravity,
             periodic_x: self.params.periodic_x,
+            cell: self.cell,
             bodies,
             contacts,
             walls,
         }
     }
+}
+
+/// `h⁻¹` of a cell matrix (`det h > 0` for a cell).
+fn cell_inverse(h: &Mat) -> Mat {
+    h.try_inverse().unwrap_or_else(Mat::zeros)
 }

@@ -19,6 +19,7 @@
 //! `(a ⊗ b)_ij = a_i b_j` ([`tensor`]).
 
 pub mod averaging;
+pub mod cell;
 pub mod coarse;
 pub mod column;
 pub mod depth;

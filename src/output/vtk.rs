@@ -376,6 +376,17 @@ pub fn walls_vtp(snap: &Snapshot) -> String {
             }
         }
     }
+    if let Some(cell) = &snap.cell {
+        // The biperiodic cell's four edges.
+        let (a1, a2) = (cell.h.column(0).into_owned(), cell.h.column(1).into_owned());
+        let corners = [Vector2::zeros(), a1, a1 + a2, a2];
+        for k in 0..4 {
+            lines.push(pts.len());
+            pts.push(corners[k]);
+            pts.push(corners[(k + 1) % 4]);
+            radius.extend([0.0, 0.0]);
+        }
+    }
     let mut s = header(verts.len(), lines.len(), pts.len());
     s.push_str("      <PointData Scalars=\"radius\">\n");
     int_array(&mut s, "id", ids.into_iter());

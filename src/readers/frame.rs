@@ -437,6 +437,7 @@ fn build_one(
             dt: dt.filter(|d| *d > 0.0 && d.is_finite()).unwrap_or(1.0),
             gravity: Vector2::new(opts.gravity[0], opts.gravity[1]),
             periodic_x: f.periodic_x,
+            cell: None,
             bodies,
             contacts,
             walls,

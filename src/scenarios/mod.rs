@@ -10,6 +10,7 @@ pub mod janssen;
 pub mod phased;
 pub mod rolling;
 pub mod shear_cell;
+pub mod simple_shear;
 pub mod stick_slip;
 
 use std::sync::atomic::AtomicBool;
@@ -100,6 +101,7 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
         Scenario::StickSlip(c) => stick_slip::run(c, ctx, ctl)?,
         Scenario::InclinedFlow(c) => inclined_flow::run(c, ctx, ctl)?,
         Scenario::ShearCell(c) => shear_cell::run(c, ctx, ctl)?,
+        Scenario::SimpleShear(c) => simple_shear::run(c, ctx, ctl)?,
     };
     let mut head = Summary::new();
     head.text("scenario", scenario.kind())

@@ -56,19 +56,100 @@ struct RunAverages {
     phi_samples: Vec<f64>,
 }
 
-/// What the checks of one run need (crate::verdict).
+/// What the checks of one run (one point of μ(I), φ(I)) need (crate::verdict); shared with
+/// the `simple-shear` scenario.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
-struct RunCheckData {
+pub(crate) struct RunCheckData {
+    /// Target inertial number.
     #[serde(with = "dem::serde_float")]
-    i_target: f64,
+    pub(crate) i_target: f64,
+    /// Measured inertial number.
     #[serde(with = "dem::serde_float")]
-    i_measured: f64,
+    pub(crate) i_measured: f64,
     /// Numerics of the averaging window.
-    window: WindowStats,
+    pub(crate) window: WindowStats,
+    /// Samples of μ over the window.
     #[serde(with = "crate::floats::vec")]
-    mu: Vec<f64>,
+    pub(crate) mu: Vec<f64>,
+    /// Samples of φ over the window.
     #[serde(with = "crate::floats::vec")]
-    phi: Vec<f64>,
+    pub(crate) phi: Vec<f64>,
+}
+
+/// The checks of the points of a rheology: those common to both laws (window numerics, `I`
+/// against its target), those of μ(I) (steady μ) and of φ(I) (steady φ, φ below `phi_bound`),
+/// each point's own verdict, and the merged window statistics.
+pub(crate) struct PointJudgement {
+    pub(crate) common: Checks,
+    pub(crate) mu: Checks,
+    pub(crate) phi: Checks,
+    pub(crate) points: Vec<Verdict>,
+    pub(crate) windows: WindowStats,
+}
+
+/// Judges every point of a rheology ([`PointJudgement`]).
+pub(crate) fn judge_points(run_checks: &[RunCheckData], phi_bound: f64) -> PointJudgement {
+    let mut j = PointJudgement {
+        common: Checks::new(),
+        mu: Checks::new(),
+        phi: Checks::new(),
+        points: Vec::with_capacity(run_checks.len()),
+        windows: WindowStats::default(),
+    };
+    for rc in run_checks {
+        let label = format!("I = {}", rc.i_target);
+        let (mut pc, mut pm, mut pp) = (Checks::new(), Checks::new(), Checks::new());
+        pc.window(&format!("{label}, averaging window"), &rc.window);
+        j.windows.merge(&rc.window);
+        let ratio = rc.i_measured / rc.i_target;
+        let factor = if ratio >= 1.0 { ratio } else { 1.0 / ratio };
+        pc.at_most(
+            "shear_cell.inertial_number_factor",
+            factor,
+            I_FACTOR_SUSPECT,
+            Some(I_FACTOR_REFUSED),
+            |t| {
+                format!(
+                    "{label}: measured I = {:.3e} is {factor:.2} times off its target (limit {t}×)",
+                    rc.i_measured
+                )
+            },
+        );
+        pm.steady(
+            "shear_cell.steady_mu",
+            &format!("{label}: μ"),
+            &rc.mu,
+            STEADY_MU_TOLERANCE,
+        );
+        pp.steady(
+            "shear_cell.steady_phi",
+            &format!("{label}: φ"),
+            &rc.phi,
+            STEADY_PHI_TOLERANCE,
+        );
+        let phi = rc.phi.iter().sum::<f64>() / rc.phi.len().max(1) as f64;
+        pp.solid_fraction(
+            "shear_cell.solid_fraction",
+            &format!("{label}: the bulk"),
+            phi,
+            phi_bound,
+        );
+        j.points
+            .push(pc.verdict().max(pm.verdict()).max(pp.verdict()));
+        j.common.extend(&pc);
+        j.mu.extend(&pm);
+        j.phi.extend(&pp);
+    }
+    j
+}
+
+/// The `point_verdict` column value of a point: 0 ok, 1 suspect, 2 refused (or unjudged).
+pub(crate) fn point_verdict_code(v: Option<&Verdict>) -> f64 {
+    match v {
+        Some(Verdict::Ok) => 0.0,
+        Some(Verdict::Suspect) => 1.0,
+        Some(Verdict::Refused) | None => 2.0,
+    }
 }
 
 /// Measured inertial number over its target (or the inverse) above which a run is suspect: the
@@ -310,57 +391,13 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     // Checks (crate::verdict): per run, the numerics of its averaging window and the measured
     // I against its target (all laws); the steady state of μ (μ(I)) and of φ with its bound
     // (φ(I)).
-    let mut common = Checks::new();
-    let mut mu_checks = Checks::new();
-    let mut phi_checks = Checks::new();
-    let phi_bound = max_solid_fraction(c.grain.radius_spread);
-    let mut windows = WindowStats::default();
-    // Each point (one inertial number) is also judged on its own checks: `point_verdict` in
-    // rheology.csv, so that a campaign merges the points that passed from every seed.
-    let mut point_verdicts = Vec::with_capacity(run_checks.len());
-    for rc in &run_checks {
-        let label = format!("I = {}", rc.i_target);
-        let (mut pc, mut pm, mut pp) = (Checks::new(), Checks::new(), Checks::new());
-        pc.window(&format!("{label}, averaging window"), &rc.window);
-        windows.merge(&rc.window);
-        let ratio = rc.i_measured / rc.i_target;
-        let factor = if ratio >= 1.0 { ratio } else { 1.0 / ratio };
-        pc.at_most(
-            "shear_cell.inertial_number_factor",
-            factor,
-            I_FACTOR_SUSPECT,
-            Some(I_FACTOR_REFUSED),
-            |t| {
-                format!(
-                    "{label}: measured I = {:.3e} is {factor:.2} times off its target (limit {t}×)",
-                    rc.i_measured
-                )
-            },
-        );
-        pm.steady(
-            "shear_cell.steady_mu",
-            &format!("{label}: μ"),
-            &rc.mu,
-            STEADY_MU_TOLERANCE,
-        );
-        pp.steady(
-            "shear_cell.steady_phi",
-            &format!("{label}: φ"),
-            &rc.phi,
-            STEADY_PHI_TOLERANCE,
-        );
-        let phi = rc.phi.iter().sum::<f64>() / rc.phi.len().max(1) as f64;
-        pp.solid_fraction(
-            "shear_cell.solid_fraction",
-            &format!("{label}: the bulk"),
-            phi,
-            phi_bound,
-        );
-        point_verdicts.push(pc.verdict().max(pm.verdict()).max(pp.verdict()));
-        common.extend(&pc);
-        mu_checks.extend(&pm);
-        phi_checks.extend(&pp);
-    }
+    let PointJudgement {
+        common,
+        mu: mut mu_checks,
+        phi: mut phi_checks,
+        points: point_verdicts,
+        windows,
+    } = judge_points(&run_checks, max_solid_fraction(c.grain.radius_spread));
     mu_checks.extend(&common);
     phi_checks.extend(&common);
     let mut verdict = RunVerdict {
@@ -392,11 +429,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     let mut table = CsvTable::new(&headers);
     for (k, r) in rows.iter().enumerate() {
         let mut r = r.clone();
-        r.push(match point_verdicts.get(k) {
-            Some(Verdict::Ok) => 0.0,
-            Some(Verdict::Suspect) => 1.0,
-            Some(Verdict::Refused) | None => 2.0,
-        });
+        r.push(point_verdict_code(point_verdicts.get(k)));
         table.push(r);
     }
     table.comments.push("steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip; fit again with grainlaw fit mu-i rheology.csv".into());

@@ -8,6 +8,7 @@ pub mod inclined_flow;
 pub mod janssen;
 pub mod rolling;
 pub mod shear_cell;
+pub mod simple_shear;
 pub mod stick_slip;
 
 pub use arrangements::ArrangementsConfig;
@@ -17,4 +18,5 @@ pub use inclined_flow::InclinedFlowConfig;
 pub use janssen::{JanssenAnalysis, JanssenConfig, ReleaseSpec};
 pub use rolling::RollingConfig;
 pub use shear_cell::ShearCellConfig;
+pub use simple_shear::{CellFriction, SimpleShearConfig};
 pub use stick_slip::{StickSlipCases, StickSlipConfig};

@@ -36,6 +36,7 @@ impl Builder {
                 dt: 1e-3,
                 gravity,
                 periodic_x: None,
+                cell: None,
                 bodies: Vec::new(),
                 contacts: Vec::new(),
                 walls: Vec::new(),

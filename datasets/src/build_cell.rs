@@ -1,0 +1,45 @@
+//! The world of the `simple-shear` scenario: a loose packing in a biperiodic deformable cell
+//! (`dem::cell`), no walls, no gravity.
+
+use dem::cell::Cell;
+use dem::World;
+use nalgebra::Vector2;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::config::SimpleShearConfig;
+use crate::error::Result;
+use crate::generators::uniform_radii;
+
+/// The initial loose packing: `grains` disks (radii from `[grain]`, seeded) on a jittered
+/// square lattice in a square cell at the solid fraction `initial_solid_fraction` (lower if the
+/// lattice needs it: spacing at least 2 % above the largest diameter), at rest.
+pub fn simple_shear(c: &SimpleShearConfig) -> Result<World> {
+    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
+    let radii = uniform_radii(&mut rng, c.grains, &c.grain);
+    let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
+    let n_side = (c.grains as f64).sqrt().ceil() as usize;
+    let r_max = radii.iter().cloned().fold(0.0, f64::max);
+    let spacing = ((area / c.initial_solid_fraction).sqrt() / n_side as f64).max(2.04 * r_max);
+    let side = spacing * n_side as f64;
+    let params = dem::WorldParams {
+        dt: c.dt_max,
+        gravity: Vector2::zeros(),
+        detection_gap: 0.1 * c.grain.radius_min(),
+        solver: c.solver.params(),
+        ..Default::default()
+    };
+    let laws = dem::ContactLaws::new(&["grain"], c.friction.grain_grain);
+    let mut w = World::new(params, laws);
+    let slack = 0.5 * (spacing - 2.0 * r_max) * 0.9;
+    for (k, &r) in radii.iter().enumerate() {
+        let (i, j) = (k % n_side, k / n_side);
+        let jitter = Vector2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)) * slack;
+        let x = Vector2::new(i as f64 + 0.5, j as f64 + 0.5) * spacing + jitter;
+        w.add_grain(x, r, c.grain.density, 0);
+    }
+    let cell = Cell::rectangle(side, side)?;
+    w.set_cell(Some(cell))?;
+    w.validate(1e-12)?;
+    Ok(w)
+}

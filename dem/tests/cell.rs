@@ -1,0 +1,291 @@
+//! The biperiodic deformable cell (`dem::cell`): its kinematics against closed forms, the
+//! minimum image against a brute-force search, contacts across the corner of the cell, the
+//! basis change, the energy balance and the mixed stress control.
+
+use dem::cell::{Cell, CellControl, Imposed, Mat, Shift, Vect};
+use dem::{ContactLaws, SolverParams, World, WorldParams};
+use nalgebra::Vector2;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn params(dt: f64) -> WorldParams {
+    WorldParams {
+        dt,
+        gravity: Vector2::zeros(),
+        detection_gap: 1e-5,
+        solver: SolverParams {
+            tolerance: 1e-12,
+            max_iterations: 20_000,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// Constant `L = [[a, γ], [0, b]]`: `h(t) = exp(L t) h₀` with
+/// `exp(L t) = [[e^{at}, γ (e^{at} − e^{bt})/(a − b)], [0, e^{bt}]]`; 1000 steps of
+/// `h ← exp(L Δt) h` agree with it to 10⁻¹² (relative to the cell size).
+#[test]
+fn empty_cell_deforms_as_l_says() {
+    let (a, g, b) = (0.3, 1.7, -0.2);
+    let h0 = Mat::new(0.02, 0.005, 0.0, 0.03);
+    let mut cell = Cell::new(h0, Mat::new(a, g, 0.0, b)).unwrap();
+    let (dt, n) = (1e-3, 1000);
+    for _ in 0..n {
+        cell.advance(dt);
+    }
+    let t = dt * n as f64;
+    let e = Mat::new(
+        (a * t).exp(),
+        g * ((a * t).exp() - (b * t).exp()) / (a - b),
+        0.0,
+        (b * t).exp(),
+    );
+    let exact = e * h0;
+    let err = (cell.h - exact).abs().max() / h0.abs().max();
+    assert!(err < 1e-12, "relative error {err:e}");
+    // Simple shear: L nilpotent, the tilt grows by exactly γ̇ t (Lees–Edwards offset).
+    let mut le = Cell::new(Mat::new(0.02, 0.0, 0.0, 0.03), Mat::new(0.0, 2.0, 0.0, 0.0)).unwrap();
+    for _ in 0..100 {
+        le.advance(1e-3);
+    }
+    assert!((le.h[(0, 1)] - 2.0 * 0.1 * 0.03).abs() < 1e-12 * 0.03);
+    assert!((le.volume() - 0.02 * 0.03).abs() < 1e-12 * 0.02 * 0.03);
+}
+
+/// A random reduced cell: sides in [0.5, 2], tilt in [−½, ½], a small rotation.
+fn random_cell(rng: &mut ChaCha8Rng) -> Cell {
+    let (lx, ly) = (rng.random_range(0.5..2.0), rng.random_range(0.5..2.0));
+    let tilt = rng.random_range(-0.5..0.5);
+    let h = Mat::new(lx, tilt * lx, 0.0, ly);
+    Cell::new(h, Mat::zeros()).unwrap()
+}
+
+/// The minimum image across both boundaries of a sheared cell is the shortest of the 9 images
+/// `x_j − x_i + h k`, k ∈ {−1, 0, 1}², of points wrapped into the cell: same length to 10⁻¹²
+/// (1000 random cells and pairs).
+#[test]
+fn minimum_image_matches_brute_force() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for _ in 0..1000 {
+        let cell = random_cell(&mut rng);
+        let p = |rng: &mut ChaCha8Rng| {
+            let x = cell.h * Vect::new(rng.random_range(-1.5..2.5), rng.random_range(-1.5..2.5));
+            cell.wrap(&x).0
+        };
+        let (xi, xj) = (p(&mut rng), p(&mut rng));
+        for x in [xi, xj] {
+            let s = cell.reduced(&x);
+            assert!(
+                (0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y),
+                "{s:?}"
+            );
+        }
+        let (d, k) = cell.min_image(&(xj - xi));
+        assert!((d - (xj - xi + cell.shift_vector(&k))).norm() < 1e-15);
+        let mut best = f64::INFINITY;
+        for i in -1..=1 {
+            for j in -1..=1 {
+                best = best.min((xj - xi + cell.shift_vector(&Shift::new(i, j))).norm());
+            }
+        }
+        assert!(
+            (d.norm() - best).abs() < 1e-12,
+            "min image {} vs brute force {best}",
+            d.norm()
+        );
+    }
+}
+
+/// Two equal disks of a cell `cell`, `a` at `xa`, `b` at `xb`, with velocities `va`, `vb`.
+fn pair(cell: Cell, xa: Vect, xb: Vect, va: Vect, vb: Vect) -> World {
+    let mut w = World::new(params(1e-4), ContactLaws::new(&["g"], 0.4));
+    let a = w.add_grain(xa, 1e-3, 2500.0, 0) as usize;
+    let b = w.add_grain(xb, 1e-3, 2500.0, 0) as usize;
+    w.bodies[a].velocity = va;
+    w.bodies[b].velocity = vb;
+    w.set_cell(Some(cell)).unwrap();
+    w
+}
+
+/// Two grains colliding across the corner of a sheared cell (their contact crosses both
+/// boundaries) get the same impulse and velocities after the step as the same pair inside the
+/// cell, with the same velocities relative to the affine field: to 10⁻¹² relative.
+#[test]
+fn contact_across_the_corner_equals_inside() {
+    let gd = 5.0;
+    let cell = Cell::new(
+        Mat::new(0.02, 0.004, 0.0, 0.02),
+        Mat::new(0.0, gd, 0.0, 0.0),
+    )
+    .unwrap();
+    // Branch from a to b: (1.4, 1.3) mm, overlapping gap −0.0... closed within the step.
+    let branch = Vect::new(1.45e-3, 1.35e-3);
+    let fluct_a = Vect::new(0.02, 0.01);
+    let fluct_b = Vect::new(-0.03, -0.02);
+    let run = |xa: Vect| {
+        let xb = xa + branch;
+        let va = fluct_a + cell.affine_velocity(&xa);
+        // The image of b at xb moves with the affine velocity at xb.
+        let vb = fluct_b + cell.affine_velocity(&xb);
+        let (xbw, k) = cell.wrap(&xb);
+        let mut w = pair(cell, xa, xbw, va, vb + cell.image_velocity(&k));
+        w.step().unwrap();
+        let c = w.contacts();
+        assert_eq!(c.len(), 1);
+        let r = c.rows[0].r;
+        let dv = w.bodies[1].velocity - w.bodies[0].velocity;
+        (r, k, dv, c.geometry[0].gap)
+    };
+    // Near the upper-right corner of the tilted cell: b's centre lies beyond both faces.
+    let corner = cell.h * Vect::new(0.98, 0.97);
+    let (r_corner, k, dv_c, gap_c) = run(corner);
+    assert_eq!(k, Shift::new(-1, -1), "the pair must cross both boundaries");
+    let middle = cell.h * Vect::new(0.4, 0.4);
+    let (r_mid, k0, dv_m, gap_m) = run(middle);
+    assert_eq!(k0, Shift::zeros());
+    assert!(r_mid[0] > 0.0, "the pair must collide: {r_mid:?}");
+    let scale = r_mid[0].abs().max(r_mid[1].abs());
+    for d in 0..2 {
+        assert!(
+            (r_corner[d] - r_mid[d]).abs() < 1e-12 * scale,
+            "impulse {r_corner:?} vs {r_mid:?}"
+        );
+    }
+    assert!((gap_c - gap_m).abs() < 1e-15);
+    // Relative velocity after the step, minus the affine one across the branch (the corner
+    // pair's b velocity is that of the wrapped grain, L h k higher).
+    let affine = cell.l * branch;
+    let rel_c = dv_c - cell.image_velocity(&k) - affine;
+    let rel_m = dv_m - affine;
+    assert!(
+        (rel_c - rel_m).norm() < 1e-12 * rel_m.norm().max(1e-3),
+        "{rel_c} vs {rel_m}"
+    );
+}
+
+/// A basis change of a cell tilted beyond half a period keeps every pair distance (shortest
+/// image) to 10⁻¹² of the cell size, and every grain inside the new cell.
+#[test]
+fn remap_preserves_pair_distances() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let mut cell = Cell::new(Mat::new(1.0, 0.0, 0.0, 1.2), Mat::new(0.0, 1.0, 0.0, 0.0)).unwrap();
+    let pts: Vec<Vect> = (0..60)
+        .map(|_| cell.h * Vect::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)))
+        .collect();
+    // Shear to a tilt of 0.84 (beyond ½), moving the points affinely.
+    let h0 = cell.h;
+    cell.advance(0.7);
+    let f = cell.h * h0.try_inverse().unwrap();
+    let pts: Vec<Vect> = pts.iter().map(|x| f * x).collect();
+    let brute = |c: &Cell, a: &Vect, b: &Vect| {
+        let mut best = f64::INFINITY;
+        for i in -3..=3 {
+            for j in -3..=3 {
+                best = best.min((b - a + c.shift_vector(&Shift::new(i, j))).norm());
+            }
+        }
+        best
+    };
+    let before: Vec<f64> = pts
+        .iter()
+        .enumerate()
+        .flat_map(|(i, a)| pts[i + 1..].iter().map(move |b| (a, b)))
+        .map(|(a, b)| brute(&cell, a, b))
+        .collect();
+    assert!((cell.tilt() - 0.84).abs() < 1e-12);
+    assert_eq!(cell.remap(), 1);
+    assert!(cell.tilt().abs() <= 0.5);
+    let wrapped: Vec<Vect> = pts.iter().map(|x| cell.wrap(x).0).collect();
+    let after: Vec<f64> = wrapped
+        .iter()
+        .enumerate()
+        .flat_map(|(i, a)| wrapped[i + 1..].iter().map(move |b| (a, b)))
+        .map(|(a, b)| cell.min_image(&(b - a)).0.norm())
+        .collect();
+    for (x, y) in before.iter().zip(&after) {
+        assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+    }
+    for x in &wrapped {
+        let s = cell.reduced(x);
+        assert!((0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y));
+    }
+}
+
+/// A loose polydisperse packing of `n` disks (radius 1 mm ± 20 %) on a jittered square lattice
+/// in a square cell, at rest.
+fn packing(n_side: usize, seed: u64, mu: f64) -> World {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let spacing = 2.6e-3;
+    let side = spacing * n_side as f64;
+    let mut w = World::new(params(2e-4), ContactLaws::new(&["g"], mu));
+    for i in 0..n_side {
+        for j in 0..n_side {
+            let r = 1e-3 * rng.random_range(0.8..1.2);
+            let jit = Vect::new(rng.random_range(-0.1..0.1), rng.random_range(-0.1..0.1)) * 1e-3;
+            let x = Vect::new(i as f64 + 0.5, j as f64 + 0.5) * spacing + jit;
+            w.add_grain(x, r, 2500.0, 0);
+        }
+    }
+    w.set_cell(Some(Cell::rectangle(side, side).unwrap()))
+        .unwrap();
+    w.validate(0.0).unwrap();
+    w
+}
+
+/// Lees–Edwards shear under mixed control of 36 grains: a loose packing is first compressed at
+/// an imposed strain rate to φ = 0.74, then sheared at γ̇ (I ≈ 0.05) to a strain of 1 with σ_yy = −P
+/// imposed and L_xx = 0: the mean σ_yy over the last half of the shear is within 10 % of −P, and the
+/// energy balance with the cell's work (`StepReport::cell_work`) has no step gaining more than
+/// 10⁻⁶ of the kinetic energy.
+#[test]
+fn stress_control_reaches_its_target() {
+    let p = 100.0;
+    let mut w = packing(6, 3, 0.3);
+    let (rho, d): (f64, f64) = (2500.0, 2e-3);
+    let gd = 0.05 * (p / rho).sqrt() / d;
+    let area: f64 = w
+        .bodies
+        .iter()
+        .map(|b| std::f64::consts::PI * b.radius * b.radius)
+        .sum();
+    let mut worst = 0.0f64;
+    let mut step = |w: &mut World| {
+        let probe = dem::energy::EnergyProbe::before(w);
+        w.step().unwrap();
+        let e = w.kinetic_energy().max(probe.kinetic).max(1e-300);
+        worst = worst.max(probe.residual(w) / e);
+    };
+    // Compression at an imposed rate, stopped at φ = 0.74.
+    w.set_velocity_gradient(Mat::new(-gd, 0.0, 0.0, -gd));
+    while area / w.cell().unwrap().volume() < 0.74 {
+        step(&mut w);
+    }
+    w.set_velocity_gradient(Mat::new(0.0, gd, 0.0, 0.0));
+    w.cell_control = Some(CellControl {
+        xx: Imposed::Rate(0.0),
+        yy: Imposed::Stress(-p),
+        xy: Imposed::Rate(gd),
+        gain: 0.3 * w.params.dt / (rho * d * d),
+        max_rate: gd,
+        relaxation: 0.0,
+        tolerance: 0.5 * p,
+        max_corrections: 12,
+    });
+    w.validate(1e-4 * d).unwrap();
+    let steps = (1.0 / (gd * w.params.dt)) as usize;
+    let (mut syy, mut k) = (0.0, 0);
+    for s in 0..steps {
+        step(&mut w);
+        if s >= steps / 2 {
+            syy += w.cell_stress().unwrap()[(1, 1)];
+            k += 1;
+        }
+    }
+    let syy = syy / k as f64;
+    assert!((syy + p).abs() < 0.1 * p, "σ_yy = {syy} Pa, target {}", -p);
+    assert!(
+        worst < 1e-6,
+        "energy residual / kinetic energy up to {worst:e}"
+    );
+}

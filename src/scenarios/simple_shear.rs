@@ -1,0 +1,633 @@
+//! The `simple-shear` scenario: a representative volume without walls or gravity, a
+//! biperiodic deformable cell (`dem::cell`, Lees–Edwards 1972 / Parrinello–Rahman 1981). A
+//! loose polydisperse packing is compressed isotropically under stress control
+//! (σ_xx = σ_yy = −P), then sheared at the imposed rate `γ̇ = I √(P/ρ)/d` of each target
+//! inertial number (lowest first, each from the previous state) with σ_yy = −P imposed and
+//! L_xx = 0 (`docs/physics.md` §6).
+//!
+//! Per run, the whole-cell state (`homogenise::cell`) is recorded every step into
+//! `history_I{k}.csv`; over the last `average_strain`, the means and block-averaged standard
+//! errors of μ = |Σ_xy|/(−Σ_yy), φ, p_n = −Σ_yy give the run's point
+//! `I = γ̇ d / √(p_n/ρ)`. μ(I) and φ(I) are fitted by `identify::mu_i` (which refuses what the
+//! data cannot support).
+
+use datasets::config::SimpleShearConfig;
+use datasets::phases::PhaseStats;
+use dem::cell::{CellControl, Imposed, Mat};
+use homogenise::averaging::block_average;
+use homogenise::cell::cell_state;
+use identify::law::GrainScale;
+use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
+use identify::{CalibratedLaw, FitOptions};
+use serde::{Deserialize, Serialize};
+
+use super::common::{
+    add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, solver_keys, Stop,
+    VtkFrames,
+};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::shear_cell::{judge_points, point_verdict_code, PointJudgement, RunCheckData};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
+use crate::error::Result;
+use crate::output::{CsvTable, OutputDir, Summary};
+use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
+use crate::plot::PALETTE;
+use crate::progress::warn;
+use crate::verdict::{export_law, max_solid_fraction, RunVerdict, Verdict, WindowStats};
+
+/// Columns of `history_I{k}.csv`.
+const HISTORY: [&str; 18] = [
+    "t_s",
+    "shear_strain",
+    "sigma_xx_Pa",
+    "sigma_yy_Pa",
+    "sigma_xy_Pa",
+    "D_xx_1_s",
+    "D_yy_1_s",
+    "D_xy_1_s",
+    "p_Pa",
+    "q_Pa",
+    "phi",
+    "Z",
+    "fabric_xx",
+    "fabric_yy",
+    "fabric_xy",
+    "I",
+    "mu",
+    "cell_corrections",
+];
+
+/// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
+const GAIN_FRACTION: f64 = 0.3;
+/// Tolerance of the implicit correction of the cell control, as a fraction of P.
+const CONTROL_TOLERANCE: f64 = 0.5;
+/// Re-solves of a step at most by the implicit correction.
+const MAX_CORRECTIONS: usize = 8;
+/// Blocks of the block-averaged standard errors (at least).
+const MIN_BLOCKS: usize = 4;
+
+/// The plan of the current shear run.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+struct RunPlan {
+    gamma_dot: f64,
+    dt: f64,
+    steps: u64,
+    avg_steps: u64,
+    n: u64,
+}
+
+/// What the phases collect.
+#[derive(Serialize, Deserialize)]
+struct State {
+    all: PhaseStats,
+    /// One row per run: `rheology.csv`.
+    #[serde(with = "crate::floats::table")]
+    rows: Vec<Vec<f64>>,
+    /// The current run's history.
+    #[serde(with = "crate::floats::table")]
+    history: Vec<Vec<f64>>,
+    /// Strain histories of μ of the finished runs, for the figure: (I, [(γ, μ)]).
+    curves: Vec<(f64, Vec<(f64, f64)>)>,
+    run: RunPlan,
+    frames: VtkFrames,
+    /// Numerics of the current run's averaging window.
+    #[serde(default)]
+    window: WindowStats,
+    /// The checks of the finished runs (crate::verdict).
+    #[serde(default)]
+    checks: Vec<RunCheckData>,
+}
+
+struct Shear<'a> {
+    c: &'a SimpleShearConfig,
+    targets: Vec<f64>,
+}
+
+impl Shear<'_> {
+    /// The control of the cell for time step `dt`, shear rate `gamma_dot` (None: the
+    /// isotropic compression), with the diameter `d`.
+    fn control(&self, dt: f64, d: f64, gamma_dot: Option<f64>) -> CellControl {
+        let c = self.c;
+        let (p, rho) = (c.pressure, c.grain.density);
+        let rate_cap = c.control_inertial_number * (p / rho).sqrt() / d;
+        let (xx, xy, max_rate) = match gamma_dot {
+            None => (Imposed::Stress(-p), Imposed::Rate(0.0), rate_cap),
+            // A sheared packing dilates at up to about γ̇: the cap must allow it.
+            Some(g) => (Imposed::Rate(0.0), Imposed::Rate(g), rate_cap.max(g)),
+        };
+        CellControl {
+            xx,
+            yy: Imposed::Stress(-p),
+            xy,
+            gain: GAIN_FRACTION * dt / (rho * d * d),
+            max_rate,
+            relaxation: 0.0,
+            tolerance: CONTROL_TOLERANCE * p,
+            max_corrections: MAX_CORRECTIONS,
+        }
+    }
+}
+
+impl PhasedRun for Shear<'_> {
+    type State = State;
+
+    fn phase_count(&self) -> usize {
+        1 + self.targets.len()
+    }
+
+    fn enter(
+        &self,
+        k: usize,
+        _env: &PhaseEnv,
+        world: &mut dem::World,
+        st: &mut State,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        let c = self.c;
+        let d = mean_diameter(world);
+        if k == 0 {
+            world.params.dt = c.dt_max;
+            world.cell_control = Some(self.control(c.dt_max, d, None));
+            world.validate(1e-9)?;
+            return Ok(Some(PhasePlan {
+                name: "compress".into(),
+                stop: Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
+            }));
+        }
+        let i = self.targets[k - 1];
+        let gamma_dot = i * (c.pressure / c.grain.density).sqrt() / d;
+        let dt = c
+            .dt_max
+            .min(c.travel_per_step * c.grain.radius_mean / (gamma_dot * d));
+        let steps = (c.strain / (gamma_dot * dt)).ceil() as u64;
+        let avg_steps = ((c.average_strain / (gamma_dot * dt)).ceil() as u64).min(steps);
+        world.params.dt = dt;
+        let l = world.cell().map_or_else(Mat::zeros, |cell| cell.l);
+        world.set_velocity_gradient(Mat::new(0.0, gamma_dot, 0.0, l[(1, 1)]));
+        world.cell_control = Some(self.control(dt, d, Some(gamma_dot)));
+        st.run = RunPlan {
+            gamma_dot,
+            dt,
+            steps,
+            avg_steps,
+            n: 0,
+        };
+        st.history.clear();
+        st.window.reset();
+        Ok(Some(PhasePlan {
+            name: format!("I={i}"),
+            stop: Stop::Steps(steps),
+        }))
+    }
+
+    fn step(
+        &self,
+        k: usize,
+        st: &mut State,
+        out: &mut OutputDir,
+        w: &dem::World,
+        r: &dem::StepReport,
+        p: &datasets::phases::PhaseProgress,
+    ) -> Result<()> {
+        st.frames.maybe(out, w)?;
+        if k == 0 {
+            return Ok(());
+        }
+        st.run.n += 1;
+        st.window
+            .step(st.run.n + st.run.avg_steps > st.run.steps, w, r, &p.stats);
+        let snap = w.snapshot();
+        let cs = cell_state(&snap)?;
+        let s = cs.stress;
+        let d = mean_diameter(w);
+        let pn = -s[(1, 1)];
+        let i = if pn > 0.0 {
+            st.run.gamma_dot * d / (pn / self.c.grain.density).sqrt()
+        } else {
+            f64::NAN
+        };
+        let mu = if pn > 0.0 {
+            s[(0, 1)].abs() / pn
+        } else {
+            f64::NAN
+        };
+        st.history.push(vec![
+            w.time,
+            st.run.gamma_dot * st.run.dt * st.run.n as f64,
+            s[(0, 0)],
+            s[(1, 1)],
+            s[(0, 1)],
+            cs.strain_rate[(0, 0)],
+            cs.strain_rate[(1, 1)],
+            cs.strain_rate[(0, 1)],
+            cs.pressure,
+            cs.deviator,
+            cs.solid_fraction,
+            cs.coordination,
+            cs.fabric[(0, 0)],
+            cs.fabric[(1, 1)],
+            cs.fabric[(0, 1)],
+            i,
+            mu,
+            r.cell_corrections as f64,
+        ]);
+        Ok(())
+    }
+
+    fn leave(
+        &self,
+        k: usize,
+        st: &mut State,
+        out: &mut OutputDir,
+        world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        st.all.merge(stats);
+        if k == 0 {
+            return Ok(());
+        }
+        let target = self.targets[k - 1];
+        let mut table = CsvTable::new(&HISTORY);
+        for row in &st.history {
+            table.push(row.clone());
+        }
+        table.comments.push(format!(
+            "simple shear at target I {target}: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s), p is -tr(sigma)/2, q, solid fraction, coordination Z and fabric over force-carrying contacts, I is gamma_dot d / sqrt(-sigma_yy/rho), mu is |sigma_xy|/(-sigma_yy), cell_corrections counts the re-solves of the step by the cell control"
+        ));
+        table.write(out, &format!("history_I{k}.csv"))?;
+        let tail =
+            &st.history[st.history.len() - (st.run.avg_steps as usize).min(st.history.len())..];
+        let col = |j: usize| -> Vec<f64> { tail.iter().map(|r| r[j]).collect() };
+        let avg = |j: usize| -> Result<(f64, f64)> {
+            let a = block_average(&col(j), MIN_BLOCKS)?;
+            Ok((a.mean, a.std_error))
+        };
+        let (syy, syy_se) = avg(3)?;
+        let (mu, mu_se) = avg(16)?;
+        let (phi, phi_se) = avg(10)?;
+        let (p, _) = avg(8)?;
+        let (z, _) = avg(11)?;
+        let pn = -syy;
+        let d = mean_diameter(world);
+        let gd = st.run.gamma_dot;
+        let i = gd * d / (pn / self.c.grain.density).sqrt();
+        let i_se = 0.5 * i * syy_se / pn;
+        let corrections: f64 = col(17).iter().sum();
+        st.checks.push(RunCheckData {
+            i_target: target,
+            i_measured: i,
+            window: st.window,
+            mu: col(16),
+            phi: col(10),
+        });
+        st.rows.push(vec![
+            target,
+            i,
+            i_se,
+            mu,
+            mu_se,
+            phi,
+            phi_se,
+            pn,
+            syy_se,
+            p,
+            z,
+            gd,
+            st.run.dt,
+            tail.len() as f64,
+            corrections / tail.len().max(1) as f64,
+        ]);
+        st.curves.push((
+            i,
+            st.history
+                .iter()
+                .step_by((st.history.len() / 200).max(1))
+                .map(|r| (r[1], r[16]))
+                .collect(),
+        ));
+        Ok(())
+    }
+}
+
+/// Runs the scenario.
+pub fn run(
+    c: &SimpleShearConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    let mut targets = c.inertial_numbers.clone();
+    targets.sort_by(f64::total_cmp);
+    let shear = Shear { c, targets };
+    let fresh = || -> Result<(dem::World, State)> {
+        let world = datasets::build_cell::simple_shear(c)?;
+        let t_total = c.compression_time
+            + shear
+                .targets
+                .iter()
+                .map(|i| {
+                    c.strain * c.grain.radius_mean * 2.0
+                        / (i * (c.pressure / c.grain.density).sqrt())
+                })
+                .sum::<f64>();
+        Ok((
+            world,
+            State {
+                all: PhaseStats::default(),
+                rows: Vec::new(),
+                history: Vec::new(),
+                curves: Vec::new(),
+                run: RunPlan::default(),
+                frames: VtkFrames::new(t_total / 40.0, 41),
+                window: WindowStats::default(),
+                checks: Vec::new(),
+            },
+        ))
+    };
+    let (world, state) = drive(ctx, ctl, &shear, fresh)?;
+    let State {
+        all,
+        rows,
+        curves,
+        frames,
+        checks: run_checks,
+        ..
+    } = state;
+    // Checks (crate::verdict), as in the shear cell: per point, the numerics of its averaging
+    // window, I against its target, steady μ and φ, φ below its bound.
+    let PointJudgement {
+        common,
+        mu: mu_checks,
+        phi: phi_checks,
+        points: point_verdicts,
+        windows,
+    } = judge_points(&run_checks, max_solid_fraction(c.grain.radius_spread));
+    let mu_checks = {
+        let mut m = mu_checks;
+        m.extend(&common);
+        m
+    };
+    let phi_checks = {
+        let mut p = phi_checks;
+        p.extend(&common);
+        p
+    };
+    let mut verdict = RunVerdict {
+        run: common.clone(),
+        allow_suspect: ctl.allow_suspect,
+        ..Default::default()
+    };
+    verdict.run.extend(&mu_checks);
+    verdict.run.extend(&phi_checks);
+    frames.finish(&mut ctx.out, &world)?;
+    let d = mean_diameter(&world);
+    let headers = [
+        "I_target",
+        "I",
+        "I_std_error",
+        "mu",
+        "mu_std_error",
+        "phi",
+        "phi_std_error",
+        "P_Pa",
+        "P_std_error_Pa",
+        "p_mean_Pa",
+        "Z",
+        "shear_rate_1_s",
+        "dt_s",
+        "samples",
+        "cell_corrections_per_step",
+        "point_verdict",
+    ];
+    let mut table = CsvTable::new(&headers);
+    for (k, r) in rows.iter().enumerate() {
+        let mut r = r.clone();
+        r.push(point_verdict_code(point_verdicts.get(k)));
+        table.push(r);
+    }
+    table.comments.push("point_verdict: the point's own checks (averaging-window numerics, I against its target, steady state, solid fraction): 0 ok, 1 suspect, 2 refused".into());
+    table.comments.push("Lees-Edwards simple shear at imposed normal stress: means over the last average_strain with block-averaged standard errors; P is -sigma_yy, I is gamma_dot d / sqrt(P/rho), mu is |sigma_xy|/P; fit again with grainlaw fit mu-i rheology.csv".into());
+    table.metadata = vec![
+        ("grain_diameter_m".into(), d),
+        ("grain_density_kg_m3".into(), c.grain.density),
+    ];
+    table.write(&mut ctx.out, "rheology.csv")?;
+
+    let series = RheologySeries {
+        inertial_number: rows.iter().map(|r| r[1]).collect(),
+        mu: Some(rows.iter().map(|r| r[3]).collect()),
+        phi: Some(rows.iter().map(|r| r[5]).collect()),
+        pressure_pa: Some(rows.iter().map(|r| r[7]).collect()),
+    };
+    let opts = FitOptions::default();
+    let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
+    let prov = || provenance.clone();
+    let grain = GrainScale {
+        diameter_m: d,
+        density_kg_m3: c.grain.density,
+    };
+    let mut s = Summary::new();
+    let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+    let imin = is.iter().cloned().fold(f64::MAX, f64::min);
+    let imax = is.iter().cloned().fold(f64::MIN, f64::max);
+    s.int("grains", c.grains as u64)
+        .num("pressure_Pa", c.pressure)
+        .num("mean_diameter_m", d)
+        .int("runs", rows.len() as u64)
+        .num("I_min", imin)
+        .num("I_max", imax)
+        .num(
+            "cell_corrections_per_step",
+            rows.iter().map(|r| r[14]).sum::<f64>() / rows.len().max(1) as f64,
+        );
+    for (k, r) in rows.iter().enumerate() {
+        s.num(&format!("run{}_I", k + 1), r[1])
+            .num(&format!("run{}_mu", k + 1), r[3])
+            .num(&format!("run{}_mu_std_error", k + 1), r[4])
+            .num(&format!("run{}_phi", k + 1), r[5])
+            .num(&format!("run{}_phi_std_error", k + 1), r[6])
+            .num(&format!("run{}_P_Pa", k + 1), r[7]);
+    }
+    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
+    let xs: Vec<f64> = (0..=80)
+        .map(|k| imin * 0.7 * (imax * 1.4 / (imin * 0.7)).powf(k as f64 / 80.0))
+        .collect();
+    let mut pmu = XyPlot::new(
+        "Friction law μ(I), biperiodic cell",
+        Axis::new("inertial number I").log(),
+        Axis::new("μ = |σ_xy| / P"),
+    );
+    pmu.series.push(Series::new(
+        "DEM (Lees–Edwards)",
+        Style::Points,
+        PALETTE[0],
+        rows.iter().map(|r| (r[1], r[3])).collect(),
+    ));
+    match fit_mu_i(&series, &opts) {
+        Ok(f) => {
+            let p = f.report.values();
+            let band = delta_band(
+                &p,
+                &f.report.covariance,
+                f.report.t_critical,
+                &xs,
+                |p, i| {
+                    identify::laws::mu_i::MuILaw {
+                        mu_s: p[0],
+                        mu_2: p[1],
+                        i0: p[2],
+                    }
+                    .mu(i)
+                },
+            );
+            add_fitted_curve(
+                &mut pmu,
+                "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                PALETTE[0],
+                PALETTE[1],
+                &band,
+            );
+            fit_keys(&mut s, "mu_i", &f.report.parameters);
+            s.text("mu_i_form", "mu-i")
+                .num("mu_i_r_squared", f.report.r_squared);
+            headline.extend(parameter_lines(
+                "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                f.report.r_squared,
+                &f.report.parameters,
+            ));
+            export_law(
+                &mut ctx.out,
+                &mut verdict,
+                "mu_i",
+                &CalibratedLaw::from_mu_i(&f, grain, prov()),
+                mu_checks.clone(),
+            )?;
+        }
+        Err(e) => {
+            warn(&format!(
+                "μ(I) fit refused ({e}); fitting the linear form μ_s + b I"
+            ));
+            s.text("mu_i_fit_error", &e.to_string());
+            match fit_mu_i_linear(&series, &opts) {
+                Ok(f) => {
+                    let p = f.report.values();
+                    let band = delta_band(
+                        &p,
+                        &f.report.covariance,
+                        f.report.t_critical,
+                        &xs,
+                        |p, i| p[0] + p[1] * i,
+                    );
+                    add_fitted_curve(&mut pmu, "μ_s + b I", PALETTE[0], PALETTE[1], &band);
+                    fit_keys(&mut s, "mu_i", &f.report.parameters);
+                    s.text("mu_i_form", "mu-i-linear")
+                        .num("mu_i_r_squared", f.report.r_squared);
+                    headline.extend(parameter_lines(
+                        "μ(I) = μ_s + b I (linear form)",
+                        f.report.r_squared,
+                        &f.report.parameters,
+                    ));
+                    export_law(
+                        &mut ctx.out,
+                        &mut verdict,
+                        "mu_i",
+                        &CalibratedLaw::from_mu_i_linear(&f, grain, prov()),
+                        mu_checks.clone(),
+                    )?;
+                }
+                Err(e2) => {
+                    warn(&format!("linear μ(I) fit refused too: {e2}"));
+                    s.text("mu_i_linear_fit_error", &e2.to_string());
+                    headline.push(format!("μ(I) not identified: {e2}"));
+                    crate::verdict::remove_stale_law(&ctx.out, "mu_i")?;
+                    verdict.run.fail(
+                        "simple_shear.mu_i_fit",
+                        Verdict::Refused,
+                        f64::NAN,
+                        f64::NAN,
+                        format!("no μ(I) law could be fitted: {e2}"),
+                    );
+                }
+            }
+        }
+    }
+    pmu.legend = LegendAt::UpperLeft;
+    let mut pphi = XyPlot::new(
+        "Solid fraction φ(I), biperiodic cell",
+        Axis::new("inertial number I").log(),
+        Axis::new("solid fraction φ"),
+    );
+    pphi.series.push(Series::new(
+        "DEM (Lees–Edwards)",
+        Style::Points,
+        PALETTE[2],
+        rows.iter().map(|r| (r[1], r[5])).collect(),
+    ));
+    match fit_phi_i(&series, &opts) {
+        Ok(f) => {
+            let p = f.report.values();
+            let band = delta_band(
+                &p,
+                &f.report.covariance,
+                f.report.t_critical,
+                &xs,
+                |p, i| p[0] - (p[0] - p[1]) * i,
+            );
+            add_fitted_curve(
+                &mut pphi,
+                "φ_max − (φ_max − φ_min) I",
+                PALETTE[2],
+                PALETTE[1],
+                &band,
+            );
+            fit_keys(&mut s, "phi_i", &f.report.parameters);
+            headline.extend(parameter_lines(
+                "φ(I) = φ_max − (φ_max − φ_min) I",
+                f.report.r_squared,
+                &f.report.parameters,
+            ));
+            export_law(
+                &mut ctx.out,
+                &mut verdict,
+                "phi_i",
+                &CalibratedLaw::from_phi_i(&f, grain, prov()),
+                phi_checks.clone(),
+            )?;
+        }
+        Err(e) => {
+            warn(&format!("φ(I) fit refused: {e}"));
+            s.text("phi_i_fit_error", &e.to_string());
+            crate::verdict::remove_stale_law(&ctx.out, "phi_i")?;
+            verdict.run.fail(
+                "simple_shear.phi_i_fit",
+                Verdict::Refused,
+                f64::NAN,
+                f64::NAN,
+                format!("no φ(I) law could be fitted: {e}"),
+            );
+        }
+    }
+    pphi.legend = LegendAt::UpperRight;
+    let mut ph = XyPlot::new(
+        "Stress ratio during each run",
+        Axis::new("shear strain γ"),
+        Axis::new("μ = |σ_xy| / (−σ_yy)"),
+    );
+    for (k, (i, pts)) in curves.iter().enumerate() {
+        ph.series.push(Series::new(
+            &format!("I = {i:.3}"),
+            Style::Line,
+            PALETTE[k % PALETTE.len()],
+            pts.iter().filter(|p| p.1.is_finite()).cloned().collect(),
+        ));
+    }
+    ph.legend = LegendAt::UpperRight;
+    draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, ph], (1950, 650))?;
+    solver_keys(&mut s, &all);
+    windows.keys(&mut s, "window");
+    Ok(RunOutcome {
+        summary: s,
+        headline,
+        verdict,
+    })
+}
