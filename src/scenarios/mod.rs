@@ -8,6 +8,7 @@ pub mod dump;
 pub mod inclined_flow;
 pub mod janssen;
 pub mod phased;
+pub mod rheology_fit;
 pub mod rolling;
 pub mod shear_cell;
 pub mod simple_shear;

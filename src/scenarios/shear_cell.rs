@@ -16,7 +16,7 @@ use homogenise::state::solid_fraction;
 use homogenise::walls::{near_wall_profile, NearWallSpec};
 use homogenise::Region;
 use identify::law::GrainScale;
-use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
+use identify::mu_i::RheologySeries;
 use identify::wall_law::{select_wall_law, WallSlipSeries};
 use identify::{CalibratedLaw, FitOptions};
 use nalgebra::Vector2;
@@ -463,168 +463,22 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         .num("I_max", rows.iter().map(|r| r[1]).fold(f64::MIN, f64::max));
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
     let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
-    let (imin, imax) = (
-        is.iter().cloned().fold(f64::MAX, f64::min),
-        is.iter().cloned().fold(f64::MIN, f64::max),
-    );
-    let xs: Vec<f64> = (0..=80)
-        .map(|k| imin * 0.7 * (imax * 1.4 / (imin * 0.7)).powf(k as f64 / 80.0))
-        .collect();
-    let mut pmu = XyPlot::new(
-        "Friction law μ(I)",
-        Axis::new("inertial number I").log(),
-        Axis::new("μ = |σ_xy| / P"),
-    );
-    pmu.series.push(Series::new(
-        "DEM",
-        Style::Points,
-        PALETTE[0],
-        rows.iter().map(|r| (r[1], r[2])).collect(),
-    ));
-    match fit_mu_i(&series, &opts) {
-        Ok(f) => {
-            let p = f.report.values();
-            let band = delta_band(
-                &p,
-                &f.report.covariance,
-                f.report.t_critical,
-                &xs,
-                |p, i| {
-                    identify::laws::mu_i::MuILaw {
-                        mu_s: p[0],
-                        mu_2: p[1],
-                        i0: p[2],
-                    }
-                    .mu(i)
-                },
-            );
-            add_fitted_curve(
-                &mut pmu,
-                "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                PALETTE[0],
-                PALETTE[1],
-                &band,
-            );
-            fit_keys(&mut s, "mu_i", &f.report.parameters);
-            s.text("mu_i_form", "mu-i")
-                .num("mu_i_r_squared", f.report.r_squared);
-            headline.extend(parameter_lines(
-                "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                f.report.r_squared,
-                &f.report.parameters,
-            ));
-            export_law(
-                &mut ctx.out,
-                &mut verdict,
-                "mu_i",
-                &CalibratedLaw::from_mu_i(&f, grain, prov()),
-                mu_checks.clone(),
-            )?;
-        }
-        Err(e) => {
-            warn(&format!(
-                "μ(I) fit failed ({e}); fitting the linear form μ_s + b I"
-            ));
-            s.text("mu_i_fit_error", &e.to_string());
-            match fit_mu_i_linear(&series, &opts) {
-                Ok(f) => {
-                    let p = f.report.values();
-                    let band = delta_band(
-                        &p,
-                        &f.report.covariance,
-                        f.report.t_critical,
-                        &xs,
-                        |p, i| p[0] + p[1] * i,
-                    );
-                    add_fitted_curve(&mut pmu, "μ_s + b I", PALETTE[0], PALETTE[1], &band);
-                    fit_keys(&mut s, "mu_i", &f.report.parameters);
-                    s.text("mu_i_form", "mu-i-linear")
-                        .num("mu_i_r_squared", f.report.r_squared);
-                    headline.extend(parameter_lines(
-                        "μ(I) = μ_s + b I (linear form)",
-                        f.report.r_squared,
-                        &f.report.parameters,
-                    ));
-                    export_law(
-                        &mut ctx.out,
-                        &mut verdict,
-                        "mu_i",
-                        &CalibratedLaw::from_mu_i_linear(&f, grain, prov()),
-                        mu_checks.clone(),
-                    )?;
-                }
-                Err(e2) => {
-                    warn(&format!("linear μ(I) fit failed too: {e2}"));
-                    s.text("mu_i_linear_fit_error", &e2.to_string());
-                    crate::verdict::remove_stale_law(&ctx.out, "mu_i")?;
-                    verdict.run.fail(
-                        "shear_cell.mu_i_fit",
-                        Verdict::Refused,
-                        f64::NAN,
-                        f64::NAN,
-                        format!("no μ(I) law could be fitted: {e2}"),
-                    );
-                }
-            }
-        }
-    }
-    pmu.legend = LegendAt::UpperLeft;
-    let mut pphi = XyPlot::new(
-        "Solid fraction φ(I)",
-        Axis::new("inertial number I").log(),
-        Axis::new("solid fraction φ"),
-    );
-    pphi.series.push(Series::new(
-        "DEM",
-        Style::Points,
-        PALETTE[2],
-        rows.iter().map(|r| (r[1], r[3])).collect(),
-    ));
-    match fit_phi_i(&series, &opts) {
-        Ok(f) => {
-            let p = f.report.values();
-            let band = delta_band(
-                &p,
-                &f.report.covariance,
-                f.report.t_critical,
-                &xs,
-                |p, i| p[0] - (p[0] - p[1]) * i,
-            );
-            add_fitted_curve(
-                &mut pphi,
-                "φ_max − (φ_max − φ_min) I",
-                PALETTE[2],
-                PALETTE[1],
-                &band,
-            );
-            fit_keys(&mut s, "phi_i", &f.report.parameters);
-            headline.extend(parameter_lines(
-                "φ(I) = φ_max − (φ_max − φ_min) I",
-                f.report.r_squared,
-                &f.report.parameters,
-            ));
-            export_law(
-                &mut ctx.out,
-                &mut verdict,
-                "phi_i",
-                &CalibratedLaw::from_phi_i(&f, grain, prov()),
-                phi_checks.clone(),
-            )?;
-        }
-        Err(e) => {
-            warn(&format!("φ(I) fit failed: {e}"));
-            s.text("phi_i_fit_error", &e.to_string());
-            crate::verdict::remove_stale_law(&ctx.out, "phi_i")?;
-            verdict.run.fail(
-                "shear_cell.phi_i_fit",
-                Verdict::Refused,
-                f64::NAN,
-                f64::NAN,
-                format!("the φ(I) fit failed: {e}"),
-            );
-        }
-    }
-    pphi.legend = LegendAt::UpperRight;
+    let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
+        &mut ctx.out,
+        &series,
+        &super::rheology_fit::RheologyFit {
+            check_prefix: "shear_cell",
+            title_suffix: "",
+            dem_label: "DEM",
+            grain,
+            provenance: prov(),
+            mu_checks: mu_checks.clone(),
+            phi_checks: phi_checks.clone(),
+        },
+        &mut verdict,
+        &mut s,
+        &mut headline,
+    )?;
     // Wall law from both walls.
     let mut vs = Vec::new();
     let mut mus = Vec::new();

@@ -17,14 +17,11 @@ use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
 use homogenise::cell::cell_state;
 use identify::law::GrainScale;
-use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
-use identify::{CalibratedLaw, FitOptions};
+use identify::mu_i::RheologySeries;
+
 use serde::{Deserialize, Serialize};
 
-use super::common::{
-    add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, solver_keys, Stop,
-    VtkFrames,
-};
+use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
 use super::shear_cell::{judge_points, point_verdict_code, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
@@ -33,8 +30,7 @@ use crate::error::Result;
 use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::progress::warn;
-use crate::verdict::{export_law, max_solid_fraction, RunVerdict, Verdict, WindowStats};
+use crate::verdict::{max_solid_fraction, RunVerdict, WindowStats};
 
 /// Columns of `history_I{k}.csv`.
 const HISTORY: [&str; 18] = [
@@ -419,7 +415,6 @@ pub fn run(
         phi: Some(rows.iter().map(|r| r[5]).collect()),
         pressure_pa: Some(rows.iter().map(|r| r[7]).collect()),
     };
-    let opts = FitOptions::default();
     let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
     let prov = || provenance.clone();
     let grain = GrainScale {
@@ -449,165 +444,22 @@ pub fn run(
             .num(&format!("run{}_P_Pa", k + 1), r[7]);
     }
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
-    let xs: Vec<f64> = (0..=80)
-        .map(|k| imin * 0.7 * (imax * 1.4 / (imin * 0.7)).powf(k as f64 / 80.0))
-        .collect();
-    let mut pmu = XyPlot::new(
-        "Friction law μ(I), biperiodic cell",
-        Axis::new("inertial number I").log(),
-        Axis::new("μ = |σ_xy| / P"),
-    );
-    pmu.series.push(Series::new(
-        "DEM (Lees–Edwards)",
-        Style::Points,
-        PALETTE[0],
-        rows.iter().map(|r| (r[1], r[3])).collect(),
-    ));
-    match fit_mu_i(&series, &opts) {
-        Ok(f) => {
-            let p = f.report.values();
-            let band = delta_band(
-                &p,
-                &f.report.covariance,
-                f.report.t_critical,
-                &xs,
-                |p, i| {
-                    identify::laws::mu_i::MuILaw {
-                        mu_s: p[0],
-                        mu_2: p[1],
-                        i0: p[2],
-                    }
-                    .mu(i)
-                },
-            );
-            add_fitted_curve(
-                &mut pmu,
-                "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                PALETTE[0],
-                PALETTE[1],
-                &band,
-            );
-            fit_keys(&mut s, "mu_i", &f.report.parameters);
-            s.text("mu_i_form", "mu-i")
-                .num("mu_i_r_squared", f.report.r_squared);
-            headline.extend(parameter_lines(
-                "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                f.report.r_squared,
-                &f.report.parameters,
-            ));
-            export_law(
-                &mut ctx.out,
-                &mut verdict,
-                "mu_i",
-                &CalibratedLaw::from_mu_i(&f, grain, prov()),
-                mu_checks.clone(),
-            )?;
-        }
-        Err(e) => {
-            warn(&format!(
-                "μ(I) fit refused ({e}); fitting the linear form μ_s + b I"
-            ));
-            s.text("mu_i_fit_error", &e.to_string());
-            match fit_mu_i_linear(&series, &opts) {
-                Ok(f) => {
-                    let p = f.report.values();
-                    let band = delta_band(
-                        &p,
-                        &f.report.covariance,
-                        f.report.t_critical,
-                        &xs,
-                        |p, i| p[0] + p[1] * i,
-                    );
-                    add_fitted_curve(&mut pmu, "μ_s + b I", PALETTE[0], PALETTE[1], &band);
-                    fit_keys(&mut s, "mu_i", &f.report.parameters);
-                    s.text("mu_i_form", "mu-i-linear")
-                        .num("mu_i_r_squared", f.report.r_squared);
-                    headline.extend(parameter_lines(
-                        "μ(I) = μ_s + b I (linear form)",
-                        f.report.r_squared,
-                        &f.report.parameters,
-                    ));
-                    export_law(
-                        &mut ctx.out,
-                        &mut verdict,
-                        "mu_i",
-                        &CalibratedLaw::from_mu_i_linear(&f, grain, prov()),
-                        mu_checks.clone(),
-                    )?;
-                }
-                Err(e2) => {
-                    warn(&format!("linear μ(I) fit refused too: {e2}"));
-                    s.text("mu_i_linear_fit_error", &e2.to_string());
-                    headline.push(format!("μ(I) not identified: {e2}"));
-                    crate::verdict::remove_stale_law(&ctx.out, "mu_i")?;
-                    verdict.run.fail(
-                        "simple_shear.mu_i_fit",
-                        Verdict::Refused,
-                        f64::NAN,
-                        f64::NAN,
-                        format!("no μ(I) law could be fitted: {e2}"),
-                    );
-                }
-            }
-        }
-    }
-    pmu.legend = LegendAt::UpperLeft;
-    let mut pphi = XyPlot::new(
-        "Solid fraction φ(I), biperiodic cell",
-        Axis::new("inertial number I").log(),
-        Axis::new("solid fraction φ"),
-    );
-    pphi.series.push(Series::new(
-        "DEM (Lees–Edwards)",
-        Style::Points,
-        PALETTE[2],
-        rows.iter().map(|r| (r[1], r[5])).collect(),
-    ));
-    match fit_phi_i(&series, &opts) {
-        Ok(f) => {
-            let p = f.report.values();
-            let band = delta_band(
-                &p,
-                &f.report.covariance,
-                f.report.t_critical,
-                &xs,
-                |p, i| p[0] - (p[0] - p[1]) * i,
-            );
-            add_fitted_curve(
-                &mut pphi,
-                "φ_max − (φ_max − φ_min) I",
-                PALETTE[2],
-                PALETTE[1],
-                &band,
-            );
-            fit_keys(&mut s, "phi_i", &f.report.parameters);
-            headline.extend(parameter_lines(
-                "φ(I) = φ_max − (φ_max − φ_min) I",
-                f.report.r_squared,
-                &f.report.parameters,
-            ));
-            export_law(
-                &mut ctx.out,
-                &mut verdict,
-                "phi_i",
-                &CalibratedLaw::from_phi_i(&f, grain, prov()),
-                phi_checks.clone(),
-            )?;
-        }
-        Err(e) => {
-            warn(&format!("φ(I) fit refused: {e}"));
-            s.text("phi_i_fit_error", &e.to_string());
-            crate::verdict::remove_stale_law(&ctx.out, "phi_i")?;
-            verdict.run.fail(
-                "simple_shear.phi_i_fit",
-                Verdict::Refused,
-                f64::NAN,
-                f64::NAN,
-                format!("no φ(I) law could be fitted: {e}"),
-            );
-        }
-    }
-    pphi.legend = LegendAt::UpperRight;
+    let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
+        &mut ctx.out,
+        &series,
+        &super::rheology_fit::RheologyFit {
+            check_prefix: "simple_shear",
+            title_suffix: ", biperiodic cell",
+            dem_label: "DEM (Lees–Edwards)",
+            grain,
+            provenance: prov(),
+            mu_checks: mu_checks.clone(),
+            phi_checks: phi_checks.clone(),
+        },
+        &mut verdict,
+        &mut s,
+        &mut headline,
+    )?;
     let mut ph = XyPlot::new(
         "Stress ratio during each run",
         Axis::new("shear strain γ"),
