@@ -117,6 +117,10 @@ pub fn cli_err(py: Python<'_>, e: CliError) -> PyErr {
             SolverError::new_err(msg)
         }
         CliError::Io { .. } | CliError::Plot { .. } => OutputError::new_err(msg),
+        // A run's verdict is returned in its summary (`verdict`, `verdict_reasons`), not
+        // raised; only the command line turns it into an exit status.
+        CliError::Verdict { .. } => GrainlawError::new_err(msg),
+        CliError::CampaignStopped { .. } => PyKeyboardInterrupt::new_err(msg),
     }
 }
 
