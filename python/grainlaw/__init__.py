@@ -9,6 +9,9 @@ compressive-positive magnitudes (as ``grainlaw fit`` does).
 - ``World`` / ``Snapshot``: the contact-dynamics engine (Moreau–Jean, Coulomb friction).
 - ``grain_stresses``, ``mean_stress``, ``solid_fraction``, ``coordination``, ``fabric``:
   homogenisation of a snapshot.
+- ``read_snapshots(format, files, ...)``: snapshots of LAMMPS/LIGGGHTS, LMGC90 or plain
+  grainlaw-snapshot-v1 files, as ``grainlaw homogenise --from`` reads them, for the functions
+  above.
 - ``fit_janssen``, ``fit_janssen_kmu``, ``fit_wall_law``, ``fit_mu_i``, ``fit_mu_i_linear``,
   ``fit_phi_i``, ``fit_phi_i_linear``, ``fit_mohr_coulomb`` (and the generic ``fit``): laws
   with confidence intervals, as ``Law`` objects; ``load_law`` reads a calibrated-law JSON.
@@ -40,6 +43,7 @@ from ._grainlaw import (
     law_from_json,
     load_law,
     mean_stress,
+    read_snapshots,
     run,
     scenarios,
     solid_fraction,
@@ -58,6 +62,7 @@ __all__ = [
     "coordination",
     "fabric",
     "fit",
+    "read_snapshots",
     "fit_janssen",
     "fit_janssen_kmu",
     "fit_mohr_coulomb",

@@ -21,6 +21,7 @@ mod arrays;
 mod errors;
 mod fit;
 mod homog;
+mod readers;
 mod run;
 mod world;
 
@@ -43,6 +44,7 @@ fn _grainlaw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(homog::solid_fraction, m)?)?;
     m.add_function(wrap_pyfunction!(homog::coordination, m)?)?;
     m.add_function(wrap_pyfunction!(homog::fabric, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::read_snapshots, m)?)?;
     m.add_class::<fit::Law>()?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(fit::load_law, m)?)?;
