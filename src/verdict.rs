@@ -614,6 +614,7 @@ pub fn export_law(
     let mut law = law.clone();
     law.verdict = Some(v.as_str().to_string());
     law.verdict_reasons = checks.reasons.iter().map(Reason::to_json).collect();
+    // the one writer of a law JSON (atomic, with a final newline)
     let text = law.to_json_string()?;
     out.write(&file, (text + "\n").as_bytes())?;
     let stale = out.file(&stale);

@@ -261,13 +261,6 @@ pub fn mean_diameter(world: &World) -> f64 {
     }
 }
 
-/// Writes a calibrated law as pretty JSON, atomically.
-pub fn write_law(out: &mut OutputDir, name: &str, law: &identify::CalibratedLaw) -> Result<()> {
-    let text = law.to_json_string()?;
-    out.write(name, (text + "\n").as_bytes())?;
-    Ok(())
-}
-
 /// Pointwise confidence band of a fitted curve by the delta method: for each `x`, the value
 /// `f(p, x)`, and `f ∓ t √(gᵀ C g)` with `g = ∂f/∂p` by central differences (relative step 1e-6)
 /// and `C` the parameters' covariance. Returns `(x, f, lo, hi)`.
