@@ -34,6 +34,49 @@ pub(crate) struct RheologyFit<'a> {
     pub(crate) phi_checks: Checks,
 }
 
+/// How an accepted fit is shown: its summary-key prefix, the form recorded under
+/// `{key}_form` (with `{key}_r_squared`), the formula (legend), the printed title and colour.
+struct Shown {
+    key: &'static str,
+    form: Option<&'static str>,
+    formula: &'static str,
+    title: &'static str,
+    colour: plotters::style::RGBColor,
+}
+
+impl Shown {
+    /// The fitted curve with its 95 % band on `plot`, the summary keys, and the printed
+    /// parameters with their intervals.
+    fn record(
+        &self,
+        plot: &mut XyPlot,
+        xs: &[f64],
+        report: &identify::FitReport,
+        s: &mut Summary,
+        headline: &mut Vec<String>,
+        model: impl Fn(&[f64], f64) -> f64,
+    ) {
+        let band = delta_band(
+            &report.values(),
+            &report.covariance,
+            report.t_critical,
+            xs,
+            model,
+        );
+        add_fitted_curve(plot, self.formula, self.colour, PALETTE[1], &band);
+        fit_keys(s, self.key, &report.parameters);
+        if let Some(form) = self.form {
+            s.text(&format!("{}_form", self.key), form)
+                .num(&format!("{}_r_squared", self.key), report.r_squared);
+        }
+        headline.extend(parameter_lines(
+            self.title,
+            report.r_squared,
+            &report.parameters,
+        ));
+    }
+}
+
 /// Fits μ(I) and φ(I) to `series`, writes the laws that pass (or their `.rejected.json`),
 /// records refusals in `verdict`, the keys in `s`, the printed lines in `headline`; returns
 /// the μ(I) and φ(I) figures.
@@ -71,36 +114,21 @@ pub(crate) fn fit_mu_phi(
     ));
     match fit_mu_i(series, &opts) {
         Ok(f) => {
-            let p = f.report.values();
-            let band = delta_band(
-                &p,
-                &f.report.covariance,
-                f.report.t_critical,
-                &xs,
-                |p, i| {
-                    identify::laws::mu_i::MuILaw {
-                        mu_s: p[0],
-                        mu_2: p[1],
-                        i0: p[2],
-                    }
-                    .mu(i)
-                },
-            );
-            add_fitted_curve(
-                &mut pmu,
-                "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                PALETTE[0],
-                PALETTE[1],
-                &band,
-            );
-            fit_keys(s, "mu_i", &f.report.parameters);
-            s.text("mu_i_form", "mu-i")
-                .num("mu_i_r_squared", f.report.r_squared);
-            headline.extend(parameter_lines(
-                "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                f.report.r_squared,
-                &f.report.parameters,
-            ));
+            let shown = Shown {
+                key: "mu_i",
+                form: Some("mu-i"),
+                formula: "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                title: "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                colour: PALETTE[0],
+            };
+            shown.record(&mut pmu, &xs, &f.report, s, headline, |p, i| {
+                identify::laws::mu_i::MuILaw {
+                    mu_s: p[0],
+                    mu_2: p[1],
+                    i0: p[2],
+                }
+                .mu(i)
+            });
             export_law(
                 out,
                 verdict,
@@ -116,23 +144,16 @@ pub(crate) fn fit_mu_phi(
             s.text("mu_i_fit_error", &e.to_string());
             match fit_mu_i_linear(series, &opts) {
                 Ok(f) => {
-                    let p = f.report.values();
-                    let band = delta_band(
-                        &p,
-                        &f.report.covariance,
-                        f.report.t_critical,
-                        &xs,
-                        |p, i| p[0] + p[1] * i,
-                    );
-                    add_fitted_curve(&mut pmu, "μ_s + b I", PALETTE[0], PALETTE[1], &band);
-                    fit_keys(s, "mu_i", &f.report.parameters);
-                    s.text("mu_i_form", "mu-i-linear")
-                        .num("mu_i_r_squared", f.report.r_squared);
-                    headline.extend(parameter_lines(
-                        "μ(I) = μ_s + b I (linear form)",
-                        f.report.r_squared,
-                        &f.report.parameters,
-                    ));
+                    let shown = Shown {
+                        key: "mu_i",
+                        form: Some("mu-i-linear"),
+                        formula: "μ_s + b I",
+                        title: "μ(I) = μ_s + b I (linear form)",
+                        colour: PALETTE[0],
+                    };
+                    shown.record(&mut pmu, &xs, &f.report, s, headline, |p, i| {
+                        p[0] + p[1] * i
+                    });
                     export_law(
                         out,
                         verdict,
@@ -170,27 +191,16 @@ pub(crate) fn fit_mu_phi(
     ));
     match fit_phi_i(series, &opts) {
         Ok(f) => {
-            let p = f.report.values();
-            let band = delta_band(
-                &p,
-                &f.report.covariance,
-                f.report.t_critical,
-                &xs,
-                |p, i| p[0] - (p[0] - p[1]) * i,
-            );
-            add_fitted_curve(
-                &mut pphi,
-                "φ_max − (φ_max − φ_min) I",
-                PALETTE[2],
-                PALETTE[1],
-                &band,
-            );
-            fit_keys(s, "phi_i", &f.report.parameters);
-            headline.extend(parameter_lines(
-                "φ(I) = φ_max − (φ_max − φ_min) I",
-                f.report.r_squared,
-                &f.report.parameters,
-            ));
+            let shown = Shown {
+                key: "phi_i",
+                form: None,
+                formula: "φ_max − (φ_max − φ_min) I",
+                title: "φ(I) = φ_max − (φ_max − φ_min) I",
+                colour: PALETTE[2],
+            };
+            shown.record(&mut pphi, &xs, &f.report, s, headline, |p, i| {
+                p[0] - (p[0] - p[1]) * i
+            });
             export_law(
                 out,
                 verdict,
