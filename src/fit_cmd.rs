@@ -10,8 +10,9 @@
 
 use std::path::Path;
 
+use identify::data::Table;
 use identify::law::{CalibratedLaw, DerivedQuantity, LawParameter};
-use identify::user_fit::{fit_csv_file, CsvFitOptions};
+use identify::user_fit::{fit_csv_file, passed_points, CsvFitOptions, POINT_VERDICT};
 use identify::IdentifyError;
 
 use crate::error::{CliError, Result};
@@ -25,7 +26,17 @@ pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
     let cal =
         fit_csv_file(law, data, &CsvFitOptions::default()).map_err(|e| naming_file(data, e))?;
     let json = cal.to_json_string()? + "\n";
-    let lines = report_lines(&cal, data);
+    let mut lines = report_lines(&cal, data);
+    let left_out = left_out_points(data);
+    if left_out > 0 {
+        lines.insert(
+            1,
+            format!(
+                "{left_out} rows left out: their {POINT_VERDICT} is not 0 (the run judged them \
+                 suspect or refused)"
+            ),
+        );
+    }
     match out {
         Some(path) => {
             write_atomic(path, json.as_bytes())?;
@@ -42,6 +53,18 @@ pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Rows of `data` that the fit left out for their `point_verdict` (0 when the file has no such
+/// column; the fit has already read the file, so a read error here cannot happen and counts 0).
+fn left_out_points(data: &Path) -> usize {
+    let Ok(text) = std::fs::read_to_string(data) else {
+        return 0;
+    };
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    Table::parse_csv(text, &data.display().to_string())
+        .and_then(|t| passed_points(&t))
+        .map_or(0, |(_, n)| n)
 }
 
 /// The printed report: a title line, one line per parameter (in the registry's order), one per

@@ -184,6 +184,25 @@ fn cases() -> Vec<Case> {
             truth: &[("mu_s", 0.38, 1e-6), ("I_0", 0.279, 1e-5)],
         },
         Case {
+            what: "a point_verdict column: only its rows with 0 are fitted, the others counted",
+            law: "mu-i",
+            text: format!(
+                "{GRAIN}I,mu,point_verdict\n{}0.01,5.0,1\n0.1,-2.0,2\n0.5,9.0,1\n",
+                mu_rows().replace('\n', ",0\n")
+            ),
+            code: 0,
+            fragments: &["3 rows left out: their point_verdict is not 0"],
+            truth: &[("mu_s", 0.38, 1e-6), ("I_0", 0.279, 1e-5)],
+        },
+        Case {
+            what: "a point_verdict column where every row failed: nothing is fitted",
+            law: "mu-i",
+            text: format!("{GRAIN}I,mu,point_verdict\n{}", mu_rows().replace('\n', ",2\n")),
+            code: 3,
+            fragments: &["all 20 rows of ", " have point_verdict ≠ 0 (each failed its run's checks)"],
+            truth: &[],
+        },
+        Case {
             what: "an unknown metadata key, refused with the keys the law reads",
             law: "mu-i",
             text: format!("{GRAIN}# colour = 3\nI,mu\n{}", mu_rows()),

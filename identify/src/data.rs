@@ -154,6 +154,21 @@ impl Table {
         self.cells.len()
     }
 
+    /// The table with only the rows `r` for which `keep[r]` is true (metadata and headers
+    /// unchanged, file lines kept for error messages).
+    ///
+    /// # Panics
+    /// If `keep.len() != self.rows()` (programming error).
+    pub fn with_rows(&self, keep: &[bool]) -> Table {
+        assert_eq!(keep.len(), self.rows(), "one flag per row");
+        let mut t = self.clone();
+        let mut k = keep.iter();
+        t.cells.retain(|_| *k.next().unwrap_or(&false));
+        let mut k = keep.iter();
+        t.lines.retain(|_| *k.next().unwrap_or(&false));
+        t
+    }
+
     fn index_of(&self, header: &str) -> Option<usize> {
         self.headers
             .iter()

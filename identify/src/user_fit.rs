@@ -130,6 +130,38 @@ pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<C
     Ok(law)
 }
 
+/// Name of the column in which grainlaw's scenarios judge each point of a table (0 passed its
+/// checks, 1 suspect, 2 refused; `docs/outputs.md` §2.1).
+pub const POINT_VERDICT: &str = "point_verdict";
+
+/// The rows of `table` that may be fitted, and how many were left out: a table with a
+/// [`POINT_VERDICT`] column keeps only its rows whose verdict is 0, so that a point measured on
+/// unconverged steps or outside its steady state never enters a law; any other table is kept
+/// whole. Errors: a verdict cell that is not a number ([`IdentifyError::NonNumericCell`]), and
+/// the refusal [`IdentifyError::NotIdentifiable`] when no row passed.
+pub fn passed_points(table: &Table) -> Result<(Table, usize)> {
+    if !table.has_column(POINT_VERDICT) {
+        return Ok((table.clone(), 0));
+    }
+    let keep: Vec<bool> = table
+        .column(POINT_VERDICT)?
+        .iter()
+        .map(|v| *v == 0.0)
+        .collect();
+    let left_out = keep.iter().filter(|k| !**k).count();
+    if left_out == keep.len() {
+        return Err(IdentifyError::NotIdentifiable {
+            reason: format!(
+                "all {} rows of {} have {POINT_VERDICT} ≠ 0 (each failed its run's checks): \
+                 nothing may be fitted",
+                keep.len(),
+                table.source
+            ),
+        });
+    }
+    Ok((table.with_rows(&keep), left_out))
+}
+
 /// 1-based line of the header: the first line that is neither blank nor a `#` comment.
 fn header_line(text: &str) -> u64 {
     text.lines()
@@ -236,6 +268,22 @@ fn grain_scale(table: &Table) -> Result<GrainScale> {
 pub fn fit_table(law: &str, table: &Table, options: &CsvFitOptions) -> Result<CalibratedLaw> {
     check_law_name(law)?;
     check_metadata(law, table, options)?;
+    let (passed, left_out) = passed_points(table)?;
+    fit_rows(law, &passed, options).map_err(|e| match e {
+        IdentifyError::TooFewPoints { law, needed, got } if left_out > 0 => {
+            IdentifyError::NotIdentifiable {
+                reason: format!(
+                    "{law}: {got} points passed their run's checks ({left_out} left out for \
+                     {POINT_VERDICT} ≠ 0), at least {needed} needed"
+                ),
+            }
+        }
+        e => e,
+    })
+}
+
+/// [`fit_table`] on rows that may all be fitted.
+fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<CalibratedLaw> {
     let mut table = table.clone();
     for (k, v) in &options.metadata {
         table.metadata.insert(k.clone(), *v);
