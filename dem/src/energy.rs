@@ -12,6 +12,7 @@
 use nalgebra::Vector2;
 
 use crate::body::{Body, BodyKind, Dof};
+use crate::cell::Imposed;
 use crate::world::World;
 
 /// Gravity `g` (if it acts on the body) plus the applied force and torque, `(f_x, f_y, torque)`.
@@ -108,10 +109,13 @@ impl EnergyProbe {
     }
 }
 
-/// Energy scale of the energy-balance check, `E_load = Σ_grains m |g| d + Σ_bodies |f_a| d̄`
-/// (J): the work of every external load over one diameter (`d = 2R` of the grain, `d̄` the mean
-/// grain diameter for a load `f_a` applied on another body, e.g. a pressure-controlled platen).
-/// Without loads it falls back to `Σ m d̄²/s²` (1 J for a world without grains).
+/// Energy scale of the energy-balance check,
+/// `E_load = Σ_grains m |g| d + Σ_bodies |f_a| d̄ + Σ_ij |σ*_ij| √V d̄` (J per metre): the work
+/// of every external load over one diameter (`d = 2R` of the grain, `d̄` the mean grain
+/// diameter for a load `f_a` applied on another body, e.g. a pressure-controlled platen; for
+/// each stress `σ*_ij` imposed on a periodic cell of area `V`, its work over a boundary
+/// displacement of `d̄`). Without loads it falls back to `Σ m d̄²/s²` (1 J for a world without
+/// grains).
 pub fn load_energy_scale(world: &World) -> f64 {
     let g = world.params.gravity.norm();
     let (mut n, mut dsum, mut mass, mut s) = (0usize, 0.0, 0.0, 0.0);
@@ -129,11 +133,69 @@ pub fn load_energy_scale(world: &World) -> f64 {
             s += (b.applied_force.norm() + b.applied_torque.abs() / dmean.max(1e-300)) * dmean;
         }
     }
+    // A stress-controlled periodic cell: the work of each imposed stress over a boundary
+    // displacement of one mean diameter, |σ*_ij| V (d̄ / √V).
+    if let (Some(cell), Some(ctl)) = (world.cell(), world.cell_control.as_ref()) {
+        let side = cell.volume().abs().sqrt();
+        for imposed in [ctl.xx, ctl.yy, ctl.xy] {
+            if let Imposed::Stress(sigma) = imposed {
+                s += sigma.abs() * side * dmean;
+            }
+        }
+    }
     if s > 0.0 && s.is_finite() {
         s
     } else if mass > 0.0 && dmean > 0.0 {
         mass * dmean * dmean
     } else {
         1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::{Cell, CellControl};
+    use crate::{ContactLaws, WorldParams};
+
+    /// Without gravity, the scale of a cell under imposed σ_xx = σ_yy = −100 Pa (rate-controlled
+    /// shear) is the work of both stresses over one mean diameter, 2 · 100 Pa · √V · d̄, exactly;
+    /// without the control it falls back to Σ m d̄².
+    #[test]
+    fn scale_of_a_stress_controlled_cell_is_the_work_of_its_stresses() {
+        let params = WorldParams {
+            gravity: Vector2::zeros(),
+            ..Default::default()
+        };
+        let mut w = World::new(params, ContactLaws::new(&["g"], 0.3));
+        for k in 0..4 {
+            w.add_grain(
+                Vector2::new(2.5e-3 * (k as f64 + 0.5), 5e-3),
+                1e-3,
+                2500.0,
+                0,
+            );
+        }
+        w.set_cell(Some(Cell::rectangle(1e-2, 1e-2).unwrap()))
+            .unwrap();
+        let mass: f64 = w.bodies.iter().map(|b| b.mass).sum();
+        let fallback = load_energy_scale(&w);
+        assert!((fallback - mass * 4e-6).abs() <= 1e-12 * fallback);
+        w.cell_control = Some(CellControl {
+            xx: Imposed::Stress(-100.0),
+            yy: Imposed::Stress(-100.0),
+            xy: Imposed::Rate(0.0),
+            gain: 1e-3,
+            max_rate: 1.0,
+            relaxation: 0.0,
+            tolerance: 0.0,
+            max_corrections: 0,
+        });
+        let expected = 2.0 * 100.0 * 1e-2 * 2e-3;
+        let s = load_energy_scale(&w);
+        assert!(
+            (s - expected).abs() <= 1e-12 * expected,
+            "{s} vs {expected}"
+        );
     }
 }
