@@ -117,7 +117,7 @@ pub fn phase_warnings(
     }
     if stats.energy_growth_steps > 0 {
         lines.push(format!(
-            "{name}: the mechanical energy grew in {} of {} steps, first at step {}; worst growth {:.2e} of Σ m g d (tolerance {ENERGY_GROWTH_TOLERANCE:.0e})",
+            "{name}: the mechanical energy grew in {} of {} steps, first at step {}; worst growth {:.2e} of the load energy E_load (tolerance {ENERGY_GROWTH_TOLERANCE:.0e})",
             stats.energy_growth_steps,
             stats.steps,
             first(stats.first_energy_growth_step),
@@ -137,7 +137,7 @@ pub fn phase_warnings(
     }
     if looks_for_rest && !stats.at_rest {
         lines.push(format!(
-            "{name}: not at rest after {:.3} s (kinetic energy / Σ m g d = {:.2e})",
+            "{name}: not at rest after {:.3} s (kinetic energy / E_load = {:.2e})",
             stats.simulated_time, stats.final_energy_ratio
         ));
     }
