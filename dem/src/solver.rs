@@ -424,13 +424,17 @@ pub(crate) trait AutoStages {
     fn sweeps(&mut self, sweeps: usize) -> Result<(usize, f64, bool), Self::Error>;
     /// The Newton stage, with at most `sweeps` smoothing sweeps: `(smoothing sweeps, converged)`.
     fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), Self::Error>;
+    /// The active-set finish ([`crate::fc::newton::active_set_finish`]) from the current
+    /// iterate, kept when it lowers the error: whether the solve has now converged.
+    fn finish(&mut self) -> Result<bool, Self::Error>;
 }
 
 /// The `auto` schedule, for both the engine and `solve-fc`: Gauss–Seidel in chunks of `chunk`
 /// sweeps as long as [`gauss_seidel_will_finish`] (from the error `start_error` of the starting
 /// iterate); then, unless `backoff` says to skip it, Newton; then Gauss–Seidel for the sweeps
-/// left of `max_sweeps`. `chunk = 0` goes straight to Newton (the `newton` method). The back-off
-/// records the Newton stage's outcome. The stages keep their own report.
+/// left of `max_sweeps`; then, still unconverged, one active-set finish. `chunk = 0` goes
+/// straight to Newton (the `newton` method). The back-off records the Newton stage's outcome.
+/// The stages keep their own report.
 pub(crate) fn run_auto<S: AutoStages>(
     stages: &mut S,
     start_error: f64,
@@ -470,9 +474,10 @@ pub(crate) fn run_auto<S: AutoStages>(
             }
         }
     }
-    if done < max_sweeps {
-        stages.sweeps(max_sweeps - done)?;
+    if done < max_sweeps && stages.sweeps(max_sweeps - done)?.2 {
+        return Ok(());
     }
+    stages.finish()?;
     Ok(())
 }
 
@@ -506,6 +511,44 @@ impl AutoStages for EngineStages<'_, '_> {
             ..r
         };
         Ok((r.iterations, r.converged))
+    }
+
+    fn finish(&mut self) -> Result<bool, Self::Error> {
+        let step = &mut *self.step;
+        let error_now = step.error();
+        if error_now.is_nan() || error_now > newton::FINISH_MAX_ERROR {
+            return Ok(false);
+        }
+        let problem = contact_problem(step.rows, step.v_free, step.inv);
+        let r: Vec<f64> = step.rows.iter().flat_map(|c| c.r).collect();
+        let Ok(Some((better, _))) =
+            newton::active_set_finish(&problem, &r, error_now, self.newton_work)
+        else {
+            return Ok(false);
+        };
+        for (c, x) in step.rows.iter_mut().zip(better.chunks_exact(2)) {
+            c.r = [x[0], x[1]];
+        }
+        step.rebuild();
+        let error = step.error();
+        if error >= error_now {
+            // Rounding between the two measures: keep what the sweeps left.
+            for (c, x) in step.rows.iter_mut().zip(r.chunks_exact(2)) {
+                c.r = [x[0], x[1]];
+            }
+            step.rebuild();
+            return Ok(false);
+        }
+        let approach = step.approach_speed();
+        let converged = error <= self.params.tolerance && approach <= step.approach_limit;
+        self.report = SolveReport {
+            error,
+            converged,
+            approach_speed: approach,
+            newton_iterations: self.report.newton_iterations + 1,
+            ..self.report
+        };
+        Ok(converged)
     }
 }
 

@@ -213,3 +213,69 @@ fn newton_backoff_doubles_to_its_cap_and_resets() {
     b.record(false);
     assert_eq!(b.skip, 1);
 }
+
+/// The active-set finish on a two-contact problem built from a known solution: contact 0
+/// sticks (`r = (1, 0.1)`, `u = 0`, μ = 0.5), contact 1 slides (`r = (2, −1)` on the cone's
+/// edge, `u = (0, 0.7)`), `q = u − W r` with a coupled positive definite `W`. From the solution
+/// perturbed by 10⁻⁷ (statuses unchanged) one solve returns it to 10⁻¹² (relative).
+#[test]
+fn active_set_finish_recovers_a_known_solution() {
+    let w = vec![
+        vec![2.0, 0.3, 0.5, 0.1],
+        vec![0.3, 3.0, 0.2, -0.4],
+        vec![0.5, 0.2, 2.5, 0.3],
+        vec![0.1, -0.4, 0.3, 3.5],
+    ];
+    let r_star = [1.0, 0.1, 2.0, -1.0];
+    let u_star = [0.0, 0.0, 0.0, 0.7];
+    let q: Vec<f64> = (0..4)
+        .map(|i| u_star[i] - (0..4).map(|j| w[i][j] * r_star[j]).sum::<f64>())
+        .collect();
+    let p = dem::fc::problem::FcProblem::new(
+        vec![0.5, 0.5],
+        q,
+        dem::fc::BlockCsr2::from_dense(&w).unwrap(),
+    )
+    .unwrap();
+    assert!(dem::fc::fc_error(&p, &r_star) <= 1e-15);
+    let eps = 1e-7;
+    let start = [1.0 + eps, 0.1 - eps, 2.0 * (1.0 + eps), -(1.0 + eps)];
+    let e0 = dem::fc::fc_error(&p, &start);
+    assert!(
+        e0 > 1e-9 && e0 <= dem::fc::newton::FINISH_MAX_ERROR,
+        "{e0:e}"
+    );
+    let mut work = dem::fc::newton::NewtonWork::default();
+    let (r, e) = dem::fc::newton::active_set_finish(&p, &start, e0, &mut work)
+        .unwrap()
+        .expect("the finish improves a start with the solution's statuses");
+    for (a, b) in r.iter().zip(&r_star) {
+        assert!((a - b).abs() <= 1e-12 * 2.0, "{r:?} vs {r_star:?}");
+    }
+    assert!(e <= 1e-14 && (dem::fc::fc_error(&p, &r) - e).abs() <= 1e-15);
+}
+
+/// The slow-shear hard problem (`shear-cell_I0.005_0000201`), which Gauss–Seidel, the Newton
+/// stage and Siconos' NSGS leave near 10⁻⁵: `auto` with 10⁵ sweeps reaches statuses good enough
+/// for the active-set finish, and the error recomputed from the returned impulses is ≤ 10⁻⁸.
+#[test]
+fn auto_solves_the_slow_shear_hard_problem() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../datasets/fc-problems/hard");
+    let p = read_problem(root.join("shear-cell_I0.005_0000201.json.gz")).unwrap();
+    let opts = FcOptions {
+        tolerance: 1e-8,
+        max_iterations: 100_000,
+        ..FcOptions::default()
+    };
+    let (s, _) = solve_by(&p, &opts, SolverMethod::Auto, &NewtonParams::default()).unwrap();
+    let e = dem::fc::fc_error(&p, &s.r);
+    assert!(
+        s.converged && e <= 1e-8,
+        "error {e:e} (reported {:e})",
+        s.error
+    );
+    for a in 0..p.contacts() {
+        let (rn, rt) = (s.r[2 * a], s.r[2 * a + 1]);
+        assert!(rn >= 0.0 && rt.abs() <= p.mu()[a] * rn * (1.0 + 1e-12));
+    }
+}

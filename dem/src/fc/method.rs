@@ -146,4 +146,30 @@ impl AutoStages for FcStages<'_> {
         self.keep(s);
         Ok(out)
     }
+
+    fn finish(&mut self) -> Result<bool, FcError> {
+        let Some(last) = self.last.as_ref() else {
+            return Ok(false);
+        };
+        let t0 = std::time::Instant::now();
+        let mut work = newton::NewtonWork::default();
+        let Some((r, error)) =
+            newton::active_set_finish(self.problem, &last.r, last.error, &mut work)?
+        else {
+            self.seconds += t0.elapsed().as_secs_f64();
+            return Ok(false);
+        };
+        let u = self.problem.velocity(&r);
+        let converged = error <= self.options.tolerance;
+        self.stats.iterations += 1;
+        self.keep(FcSolution {
+            r,
+            u,
+            iterations: 0,
+            error,
+            seconds: t0.elapsed().as_secs_f64(),
+            converged,
+        });
+        Ok(converged)
+    }
 }
