@@ -377,6 +377,54 @@ fn homogenise_command_writes_the_outputs() {
 }
 
 #[test]
+fn homogenise_lists_csv_figures_and_vtk_of_every_snapshot() {
+    // the library call behind the command line and Python's `grainlaw.homogenise`: the three
+    // snapshots of the LAMMPS run give one per-grain table and one VTK frame (grains, contacts,
+    // walls) each, the figures are PNG, every file written is listed once, summary.json last
+    let dir = tempfile::tempdir().unwrap();
+    let plan = grainlaw::homogenise_cmd::HomogenisePlan {
+        format: Format::Lammps,
+        files: lammps_files(),
+        out: dir.path().join("out"),
+        options: ReadOptions {
+            mu: Some(0.5),
+            ..Default::default()
+        },
+        quiet: true,
+    };
+    let o = grainlaw::homogenise_cmd::homogenise(&plan).unwrap();
+    assert_eq!(o.files.last().map(String::as_str), Some("summary.json"));
+    let mut unique = o.files.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), o.files.len(), "{:?}", o.files);
+    for f in &o.files {
+        let len = std::fs::metadata(plan.out.join(f)).unwrap().len();
+        assert!(len > 0, "{f} empty");
+    }
+    let count = |pre: &str, ext: &str| {
+        o.files
+            .iter()
+            .filter(|f| f.starts_with(pre) && f.ends_with(ext))
+            .count()
+    };
+    assert_eq!(count("grains_", ".csv"), 3);
+    for kind in ["grains", "contacts", "walls"] {
+        assert_eq!(count(&format!("vtk/{kind}_"), ".vtp"), 3, "{kind}");
+        let pvd = std::fs::read_to_string(plan.out.join(format!("{kind}.pvd"))).unwrap();
+        assert_eq!(pvd.matches("<DataSet ").count(), 3, "{kind}.pvd");
+    }
+    for png in ["grains.png", "stress_profile.png"] {
+        let bytes = std::fs::read(plan.out.join(png)).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{png}");
+    }
+    // the grains VTK frame holds every grain of its snapshot (the run has 152 disks)
+    let vtp = std::fs::read_to_string(plan.out.join("vtk/grains_0002.vtp")).unwrap();
+    assert!(vtp.contains("NumberOfPoints=\"152\""), "{}", &vtp[..300]);
+    assert_eq!(o.lines[0], format!("report: {}/", plan.out.display()));
+}
+
+#[test]
 fn synthetic_benchmark_dump_reads_back() {
     // the generator of `grainlaw bench --homogenise-grains`: a 20 × 20 square lattice has
     // 2 · 20 · 19 = 760 neighbour contacts, and a lattice of spacing 0.999 d a solid fraction
