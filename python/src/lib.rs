@@ -48,6 +48,7 @@ fn _grainlaw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(homog::fabric, m)?)?;
     m.add_function(wrap_pyfunction!(readers::read_snapshots, m)?)?;
     m.add_function(wrap_pyfunction!(readers::homogenise, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::synthetic_lammps_dump, m)?)?;
     m.add_class::<fit::Law>()?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(fit::load_law, m)?)?;

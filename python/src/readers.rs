@@ -154,3 +154,17 @@ pub fn homogenise<'py>(
     result.set_item("out", out.display().to_string())?;
     Ok(result)
 }
+
+/// _synthetic_lammps_dump(n)
+/// --
+///
+/// The synthetic LAMMPS dump of `grainlaw bench --homogenise-grains N`
+/// (`grainlaw::homogenise_cmd::synthetic_lammps_dump`): ``(atoms, pairs)``, the texts of the
+/// per-atom and local dumps of ``n`` disks of radius 0.5 mm on a square lattice of spacing
+/// 0.999 mm, each touching its right and upper neighbours (about ``2 n`` contacts). For the
+/// benchmarks (python/bench/overhead.py), not part of the public API.
+#[pyfunction]
+#[pyo3(name = "_synthetic_lammps_dump")]
+pub fn synthetic_lammps_dump(n: usize) -> (String, String) {
+    grainlaw::homogenise_cmd::synthetic_lammps_dump(n)
+}
