@@ -119,3 +119,25 @@ def test_homogenise_refuses_bad_input(tmp_path):
         grainlaw.homogenise("lammps", lammps_files(), out=bad)
     # nothing was written by the refused calls
     assert not (tmp_path / "o").exists()
+
+
+def test_homogenise_a_real_lmgc90_run(tmp_path):
+    """The files LMGC90 wrote (datasets/external/lmgc90/real, 36 disks settled in a box of three
+    JONCx walls): the wall forces of summary.json are LMGC90's own reactions `Reac_` to the 7
+    digits of its files, and the walls carry the disks' weight (m = ρ π R², ρ = 2500 kg/m³)."""
+    real = LAMMPS.parent / "lmgc90" / "real"
+    files = [str(real / f) for f in ("BODIES.DAT", "DOF.OUT.1", "DOF.OUT.2", "Vloc_Rloc.OUT.1", "Vloc_Rloc.OUT.2")]
+    r = grainlaw.homogenise("lmgc90", files, out=tmp_path / "o", density=2500.0, mu=0.3)
+    s = r["summary"]
+    assert s["snapshots"] == 2 and s["step"] == 400 and s["grains"] == 36
+    ref = np.loadtxt(real / "lmgc90_reference_2.csv", delimiter=",", skiprows=2)
+    scale = np.hypot(ref[:, 4], ref[:, 5]).max()
+    for body in (1, 2, 3):
+        row = ref[ref[:, 0] == body][0]
+        assert abs(s[f"wall_body{body}_force_x_N"] - row[4]) < 1e-6 * scale
+        assert abs(s[f"wall_body{body}_force_y_N"] - row[5]) < 1e-6 * scale
+    snap = grainlaw.read_snapshots("lmgc90", files, density=2500.0)[-1]["snapshot"]
+    radii = snap.radii[snap.is_grain]
+    weight = 9.81 * (2500.0 * np.pi * radii**2).sum()
+    carried = -sum(s[f"wall_{w}_force_y_N"] for w in s["walls"])
+    assert abs(carried - weight) < 1e-5 * weight, (carried, weight)
