@@ -311,9 +311,9 @@ fn homogenise_cmd(a: HomogeniseArgs) -> Result<()> {
         },
         quiet: a.quiet,
     };
-    let lines = crate::homogenise_cmd::homogenise(&plan)?;
+    let outcome = crate::homogenise_cmd::homogenise(&plan)?;
     if !plan.quiet {
-        for l in lines {
+        for l in outcome.lines {
             println!("{l}");
         }
     }

@@ -70,8 +70,20 @@ fn mean_diameter(s: &Snapshot) -> f64 {
     }
 }
 
-/// Reads the files, homogenises every snapshot, writes the outputs; returns the report lines.
-pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
+/// What [`homogenise`] did: the report lines and the files it wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HomogeniseOutcome {
+    /// The report printed by the command line (last snapshot's state, wall forces).
+    pub lines: Vec<String>,
+    /// The files written, relative to the output directory, in the order written
+    /// (`summary.json` last).
+    pub files: Vec<String>,
+}
+
+/// Reads the files, homogenises every snapshot, writes the outputs (CSV tables, figures, VTK
+/// series, `summary.json`; `docs/outputs.md` § "homogenise"); returns the report and the files.
+/// The one implementation behind `grainlaw homogenise` and the Python `grainlaw.homogenise`.
+pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
     if plan.files.is_empty() {
         return Err(CliError::Usage("homogenise: no input file".into()));
     }
@@ -271,7 +283,10 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<Vec<String>> {
             w.name, w.force.x, w.force.y
         ));
     }
-    Ok(lines)
+    Ok(HomogeniseOutcome {
+        lines,
+        files: out.written().to_vec(),
+    })
 }
 
 /// The row of `snapshots.csv` of one snapshot (whole-sample means: solid fraction,

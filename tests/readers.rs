@@ -4,6 +4,7 @@
 //! by hand in LMGC90's layout (`datasets/external/lmgc90`); the plain format against analytic
 //! answers; errors naming file and line.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use dem::snapshot::BodyKind;
@@ -255,6 +256,162 @@ fn lmgc90_hand_written_sample() {
     assert!((wc.mobilisation().unwrap() - 0.1).abs() < 1e-12);
 }
 
+/// `lmgc90_reference_K.csv` of the real LMGC90 run: per LMGC90 body number, LMGC90's own
+/// `Coor_` (x, y, θ) and `Reac_` (force x, y and moment of its contacts), full precision.
+fn lmgc90_reference(k: usize) -> BTreeMap<u64, [f64; 6]> {
+    let text =
+        std::fs::read_to_string(data("lmgc90/real").join(format!("lmgc90_reference_{k}.csv")))
+            .unwrap();
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("body"))
+        .map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            let mut row = [0.0; 6];
+            for (r, x) in row.iter_mut().zip(&v[1..]) {
+                *r = x.parse().unwrap();
+            }
+            (v[0].parse().unwrap(), row)
+        })
+        .collect()
+}
+
+#[test]
+fn lmgc90_real_run_matches_lmgc90_positions_and_reactions() {
+    // 36 disks settled for 400 steps of 1 ms in a box of three JONCx walls by LMGC90 itself
+    // (datasets/external/lmgc90/real, its README): the files LMGC90 wrote, read by grainlaw,
+    // against what LMGC90's solver held at the same steps. LMGC90 prints its files with 7
+    // significant digits (D/E formats), hence the tolerances of a few 1e-7, relative.
+    let d = data("lmgc90/real");
+    for bodies in ["BODIES.DAT", "BODIES.OUT"] {
+        // the pre-processor's BODIES.DAT (`axe1=`) and LMGC90's own BODIES.OUT (`ax1 =`)
+        let files: Vec<PathBuf> = [
+            bodies,
+            "DOF.OUT.1",
+            "DOF.OUT.2",
+            "Vloc_Rloc.OUT.1",
+            "Vloc_Rloc.OUT.2",
+        ]
+        .iter()
+        .map(|f| d.join(f))
+        .collect();
+        let opts = ReadOptions {
+            density: Some(2500.0),
+            mu: Some(0.3),
+            ..Default::default()
+        };
+        let snaps = readers::read_lmgc90(&files, &opts).unwrap();
+        assert_eq!(snaps.len(), 2);
+        for (k, ext) in snaps.iter().enumerate() {
+            let s = &ext.snapshot;
+            assert_eq!(s.step, 200 * (k as u64 + 1));
+            let reference = lmgc90_reference(k + 1);
+            // LMGC90 body number of every snapshot body: grains by `grain_ids`, walls by name
+            let mut id = vec![0u64; s.bodies.len()];
+            let grains: Vec<usize> = (0..s.bodies.len())
+                .filter(|&b| s.bodies[b].kind == BodyKind::Grain)
+                .collect();
+            assert_eq!(grains.len(), 36);
+            for (&b, &g) in grains.iter().zip(&ext.grain_ids) {
+                id[b] = g;
+            }
+            assert_eq!(s.walls.len(), 3);
+            for w in &s.walls {
+                id[w.body as usize] = w.name.trim_start_matches("body").parse().unwrap();
+            }
+            // the resultant force and moment of each body's contacts, assembled by grainlaw
+            let mut force = vec![Vector2::zeros(); s.bodies.len()];
+            let mut moment = vec![0.0; s.bodies.len()];
+            let cross = |l: Vector2<f64>, f: Vector2<f64>| l.x * f.y - l.y * f.x;
+            let (mut dkdk, mut dkjc) = (0, 0);
+            for c in &s.contacts {
+                let f = c.force_on_b();
+                force[c.body_b as usize] += f;
+                moment[c.body_b as usize] += cross(c.lever_b, f);
+                force[c.body_a as usize] -= f;
+                moment[c.body_a as usize] -= cross(c.lever_a, f);
+                if s.bodies[c.body_a as usize].kind == BodyKind::Grain {
+                    dkdk += 1;
+                } else {
+                    dkjc += 1;
+                }
+            }
+            assert!(dkdk > 40 && dkjc > 8, "{dkdk} DKDKx, {dkjc} DKJCx");
+            let scale = reference
+                .values()
+                .map(|r| r[3].hypot(r[4]))
+                .fold(0.0, f64::max);
+            for (b, body) in s.bodies.iter().enumerate() {
+                let r = reference[&id[b]];
+                // positions: the BODIES reference coordinates plus DOF.OUT's displacement
+                assert!(
+                    (body.position - Vector2::new(r[0], r[1])).norm() < 2e-8,
+                    "body {}: {} vs {r:?}",
+                    id[b],
+                    body.position
+                );
+                // the contact reactions: LMGC90's `Reac_` summed by LMGC90 over the same
+                // contacts, against grainlaw's sum of Vloc_Rloc.OUT's rln/H n + rlt/H t
+                let err = (force[b] - Vector2::new(r[3], r[4])).norm();
+                assert!(
+                    err < 1e-6 * scale,
+                    "body {}: {} vs ({}, {}), scale {scale}",
+                    id[b],
+                    force[b],
+                    r[3],
+                    r[4]
+                );
+                // moments about the centre (levers of 5 mm: force × 1e-2 m), on the settled snapshot:
+                // at step 200 some grains still move, and the contact points LMGC90 writes
+                // (its mid-step detection configuration) are off the end-of-step centres of
+                // DOF.OUT by their motion over half a step (1.7 % of the moment of body 30)
+                if k == 1 {
+                    assert!(
+                        (moment[b] - r[5]).abs() < 1e-6 * scale * 1e-2,
+                        "body {}: moment {} vs {}",
+                        id[b],
+                        moment[b],
+                        r[5]
+                    );
+                }
+            }
+            for w in &s.walls {
+                let r = reference[&id[w.body as usize]];
+                assert!(
+                    (w.force - Vector2::new(r[3], r[4])).norm() < 1e-6 * scale,
+                    "{}",
+                    w.name
+                );
+            }
+            if k == 1 {
+                // settled at step 400: every grain's contacts carry its weight m g with m = ρ π R²
+                // (grainlaw's masses, LMGC90's reactions), and the walls carry the whole weight
+                let mut weight = 0.0;
+                for &b in &grains {
+                    let m = s.bodies[b].mass;
+                    assert!(
+                        (m - 2500.0 * std::f64::consts::PI * s.bodies[b].radius.powi(2)).abs()
+                            < 1e-12 * m
+                    );
+                    let r = reference[&id[b]];
+                    assert!(
+                        (r[4] - m * 9.81).abs() < 1e-5 * m * 9.81,
+                        "body {}: {} vs m g = {}",
+                        id[b],
+                        r[4],
+                        m * 9.81
+                    );
+                    weight += m * 9.81;
+                }
+                let carried: f64 = s.walls.iter().map(|w| -w.force.y).sum();
+                assert!(
+                    (carried - weight).abs() < 1e-5 * weight,
+                    "{carried} vs {weight}"
+                );
+            }
+        }
+    }
+}
+
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
@@ -374,6 +531,54 @@ fn homogenise_command_writes_the_outputs() {
     // settled packing: solid fraction of a 2D disk packing
     let phi = s["solid_fraction"].as_f64().unwrap();
     assert!(phi > 0.75 && phi < 0.91, "{phi}");
+}
+
+#[test]
+fn homogenise_lists_csv_figures_and_vtk_of_every_snapshot() {
+    // the library call behind the command line and Python's `grainlaw.homogenise`: the three
+    // snapshots of the LAMMPS run give one per-grain table and one VTK frame (grains, contacts,
+    // walls) each, the figures are PNG, every file written is listed once, summary.json last
+    let dir = tempfile::tempdir().unwrap();
+    let plan = grainlaw::homogenise_cmd::HomogenisePlan {
+        format: Format::Lammps,
+        files: lammps_files(),
+        out: dir.path().join("out"),
+        options: ReadOptions {
+            mu: Some(0.5),
+            ..Default::default()
+        },
+        quiet: true,
+    };
+    let o = grainlaw::homogenise_cmd::homogenise(&plan).unwrap();
+    assert_eq!(o.files.last().map(String::as_str), Some("summary.json"));
+    let mut unique = o.files.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), o.files.len(), "{:?}", o.files);
+    for f in &o.files {
+        let len = std::fs::metadata(plan.out.join(f)).unwrap().len();
+        assert!(len > 0, "{f} empty");
+    }
+    let count = |pre: &str, ext: &str| {
+        o.files
+            .iter()
+            .filter(|f| f.starts_with(pre) && f.ends_with(ext))
+            .count()
+    };
+    assert_eq!(count("grains_", ".csv"), 3);
+    for kind in ["grains", "contacts", "walls"] {
+        assert_eq!(count(&format!("vtk/{kind}_"), ".vtp"), 3, "{kind}");
+        let pvd = std::fs::read_to_string(plan.out.join(format!("{kind}.pvd"))).unwrap();
+        assert_eq!(pvd.matches("<DataSet ").count(), 3, "{kind}.pvd");
+    }
+    for png in ["grains.png", "stress_profile.png"] {
+        let bytes = std::fs::read(plan.out.join(png)).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{png}");
+    }
+    // the grains VTK frame holds every grain of its snapshot (the run has 152 disks)
+    let vtp = std::fs::read_to_string(plan.out.join("vtk/grains_0002.vtp")).unwrap();
+    assert!(vtp.contains("NumberOfPoints=\"152\""), "{}", &vtp[..300]);
+    assert_eq!(o.lines[0], format!("report: {}/", plan.out.display()));
 }
 
 #[test]

@@ -12,6 +12,8 @@ compressive-positive magnitudes (as ``grainlaw fit`` does).
 - ``read_snapshots(format, files, ...)``: snapshots of LAMMPS/LIGGGHTS, LMGC90 or plain
   grainlaw-snapshot-v1 files, as ``grainlaw homogenise --from`` reads them, for the functions
   above.
+- ``homogenise(format, files, out, ...)``: ``grainlaw homogenise --from FORMAT FILES --out
+  OUT`` itself (CSV tables, figures, VTK, summary.json); returns the summary and the paths.
 - ``fit_janssen``, ``fit_janssen_kmu``, ``fit_wall_law``, ``fit_mu_i``, ``fit_mu_i_linear``,
   ``fit_phi_i``, ``fit_phi_i_linear``, ``fit_mohr_coulomb`` (and the generic ``fit``): laws
   with confidence intervals, as ``Law`` objects; ``load_law`` reads a calibrated-law JSON.
@@ -40,6 +42,7 @@ from ._grainlaw import (
     fabric,
     fit,
     grain_stresses,
+    homogenise,
     law_from_json,
     load_law,
     mean_stress,
@@ -72,6 +75,7 @@ __all__ = [
     "fit_phi_i_linear",
     "fit_wall_law",
     "grain_stresses",
+    "homogenise",
     "law_from_json",
     "load_law",
     "mean_stress",

@@ -8,6 +8,8 @@
 //! - [`world`]: `World` and `Snapshot` over `dem::World` and `dem::Snapshot`;
 //! - [`homog`]: per-grain and region mean stress (contact + inertia parts), solid fraction,
 //!   coordination and fabric (`homogenise`);
+//! - [`readers`]: `read_snapshots` (other codes' files as `Snapshot`s) and `homogenise`
+//!   (`grainlaw homogenise --from`: every output written, the GIL released);
 //! - [`fit`]: the fits of `identify` from numpy columns and `Law`, the calibrated-law JSON
 //!   (schemas 1 and 2) with vectorised evaluation;
 //! - [`errors`]: the exception hierarchy (`GrainlawError` and its subclasses).
@@ -45,6 +47,8 @@ fn _grainlaw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(homog::coordination, m)?)?;
     m.add_function(wrap_pyfunction!(homog::fabric, m)?)?;
     m.add_function(wrap_pyfunction!(readers::read_snapshots, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::homogenise, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::synthetic_lammps_dump, m)?)?;
     m.add_class::<fit::Law>()?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(fit::load_law, m)?)?;

@@ -1,7 +1,9 @@
 """Snapshots of another code from Python: the committed 2D LAMMPS run (152 disks settling in a
 box, datasets/external/lammps) read as ``grainlaw homogenise --from lammps`` reads it."""
 
+import json
 import pathlib
+import subprocess
 
 import numpy as np
 import pytest
@@ -50,3 +52,92 @@ def test_unknown_format_and_unreadable_file_are_input_errors(tmp_path):
     bad.write_text("ITEM: TIMESTEP\nnot a number\n")
     with pytest.raises(grainlaw.InputError, match="atoms.1.dump"):
         grainlaw.read_snapshots("lammps", [str(bad)])
+
+
+def homogenise_args(out):
+    return ["homogenise", "--from", "lammps", "--mu", "0.5", "-q", "--out", str(out), *lammps_files()]
+
+
+def test_homogenise_writes_what_the_cli_writes(tmp_path):
+    """``grainlaw.homogenise`` is ``grainlaw homogenise --from``: the same files, the same
+    summary.json bit for bit (but wall_seconds), the same CSV bytes; and the walls of the settled
+    column carry its weight."""
+    out = tmp_path / "py"
+    r = grainlaw.homogenise("lammps", lammps_files(), out=out, mu=0.5)
+    assert r["out"] == str(out)
+    files = r["files"]
+    # every file written is listed once with its path, summary.json last; nothing else is left
+    assert list(files)[-1] == "summary.json"
+    on_disk = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
+    assert on_disk == sorted(files)
+    for name, path in files.items():
+        assert pathlib.Path(path) == out / name and pathlib.Path(path).stat().st_size > 0
+    # CSV per snapshot, figures, a VTK frame per snapshot
+    for step in (400000, 400001, 400002):
+        assert f"grains_{step}.csv" in files
+    for name in ("snapshots.csv", "walls.csv", "coarse.csv", "stress_profile.csv", "mobilisation.csv",
+                 "grains.png", "stress_profile.png", "grains.pvd", "contacts.pvd", "walls.pvd"):
+        assert name in files, name
+    for kind in ("grains", "contacts", "walls"):
+        assert [f"vtk/{kind}_{k:04d}.vtp" for k in range(3)] == [f for f in files if f.startswith(f"vtk/{kind}_")]
+    assert (out / "grains.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    s = r["summary"]
+    assert s["command"] == "homogenise" and s["snapshots"] == 3 and s["grains"] == 152
+    # the weight of the 152 disks (Σ m g, masses from the dump) is carried by the walls to 2 %
+    # (the column is still settling: kinetic energy 6e-8 J)
+    snap = grainlaw.read_snapshots("lammps", lammps_files())[-1]["snapshot"]
+    weight = 9.81 * snap.masses[snap.is_grain].sum()
+    carried = -sum(s[f"wall_{w}_force_y_N"] for w in s["walls"])
+    assert abs(carried - weight) < 0.02 * weight, (carried, weight)
+
+    from test_run import cli_binary
+
+    exe = cli_binary()
+    if exe is None:
+        pytest.skip("no grainlaw executable: set GRAINLAW_BIN or run `cargo build --release`")
+    cli_out = tmp_path / "cli"
+    subprocess.run([exe, *homogenise_args(cli_out)], check=True)
+    cli = json.loads((cli_out / "summary.json").read_text())
+    assert list(cli) == list(s)
+    for key in cli:
+        if key != "wall_seconds":
+            # the same numbers, not close ones: the same Rust function on the same files
+            assert cli[key] == s[key], key
+    for name in ("snapshots.csv", "grains_400002.csv", "walls.csv", "coarse.csv"):
+        assert (cli_out / name).read_bytes() == (out / name).read_bytes(), name
+    assert sorted(str(p.relative_to(cli_out)) for p in cli_out.rglob("*") if p.is_file()) == on_disk
+
+
+def test_homogenise_refuses_bad_input(tmp_path):
+    bad = tmp_path / "atoms.1.dump"
+    bad.write_text("ITEM: TIMESTEP\nnot a number\n")
+    with pytest.raises(grainlaw.InputError, match="atoms.1.dump"):
+        grainlaw.homogenise("lammps", [str(bad)], out=tmp_path / "o")
+    with pytest.raises(grainlaw.InputError, match="mu"):
+        grainlaw.homogenise("lammps", lammps_files(), out=tmp_path / "o", mu=-1.0)
+    with pytest.raises(grainlaw.InputError, match="not a directory"):
+        grainlaw.homogenise("lammps", lammps_files(), out=bad)
+    # nothing was written by the refused calls
+    assert not (tmp_path / "o").exists()
+
+
+def test_homogenise_a_real_lmgc90_run(tmp_path):
+    """The files LMGC90 wrote (datasets/external/lmgc90/real, 36 disks settled in a box of three
+    JONCx walls): the wall forces of summary.json are LMGC90's own reactions `Reac_` to the 7
+    digits of its files, and the walls carry the disks' weight (m = ρ π R², ρ = 2500 kg/m³)."""
+    real = LAMMPS.parent / "lmgc90" / "real"
+    files = [str(real / f) for f in ("BODIES.DAT", "DOF.OUT.1", "DOF.OUT.2", "Vloc_Rloc.OUT.1", "Vloc_Rloc.OUT.2")]
+    r = grainlaw.homogenise("lmgc90", files, out=tmp_path / "o", density=2500.0, mu=0.3)
+    s = r["summary"]
+    assert s["snapshots"] == 2 and s["step"] == 400 and s["grains"] == 36
+    ref = np.loadtxt(real / "lmgc90_reference_2.csv", delimiter=",", skiprows=2)
+    scale = np.hypot(ref[:, 4], ref[:, 5]).max()
+    for body in (1, 2, 3):
+        row = ref[ref[:, 0] == body][0]
+        assert abs(s[f"wall_body{body}_force_x_N"] - row[4]) < 1e-6 * scale
+        assert abs(s[f"wall_body{body}_force_y_N"] - row[5]) < 1e-6 * scale
+    snap = grainlaw.read_snapshots("lmgc90", files, density=2500.0)[-1]["snapshot"]
+    radii = snap.radii[snap.is_grain]
+    weight = 9.81 * (2500.0 * np.pi * radii**2).sum()
+    carried = -sum(s[f"wall_{w}_force_y_N"] for w in s["walls"])
+    assert abs(carried - weight) < 1e-5 * weight, (carried, weight)

@@ -13,8 +13,14 @@
 //! / `Vloc_Rloc.OUT` files (`DOF.OUT.1`, ...) are matched by their `$steps` number.
 //!
 //! The layout follows LMGC90's writers (`write_out_dof`, `write_bodies`,
-//! `write_out_Vloc_Rloc` of the `RBDY2`, `DKDKx` and `DKJCx` modules); no LMGC90 run could be
-//! made here, and the tests read a sample written by hand in that layout.
+//! `write_out_Vloc_Rloc` of the `RBDY2`, `DKDKx` and `DKJCx` modules). The tests read a sample
+//! written by hand in that layout and the files of a real LMGC90 run
+//! (`datasets/external/lmgc90/real`), checked against LMGC90's own positions and reactions.
+//!
+//! The contact point is the one LMGC90 writes, that of its detection configuration (the
+//! θ-scheme's mid-step positions), while `DOF.OUT` holds the end-of-step centres: on grains
+//! still moving the levers `x − c` then differ from LMGC90's own (`∓R n`) by the motion over
+//! half a step; on a settled sample they agree (the test's moments to 1e-6).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -35,6 +41,17 @@ fn labeled_number(path: &Path, ln: usize, line: &str, label: &str) -> Result<f64
     let v = labeled(line, label)
         .ok_or_else(|| ReadError::parse(path, ln, format!("no `{}` on the line", label.trim())))?;
     number(path, ln, label.trim_end_matches(['=', ' ']), v)
+}
+
+/// Half-axis `k` of a `JONCx`: `axeK=` as LMGC90's pre-processor (pylmgc90.pre) writes
+/// `DATBOX/BODIES.DAT`, `axK =` as LMGC90's own writer writes `OUTBOX/BODIES.OUT`.
+fn jonc_axis(path: &Path, ln: usize, line: &str, k: u8) -> Result<f64, ReadError> {
+    let pre = format!("axe{k}=");
+    if labeled(line, &pre).is_some() {
+        labeled_number(path, ln, line, &pre)
+    } else {
+        labeled_number(path, ln, line, &format!("ax{k} ="))
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -126,8 +143,8 @@ fn parse_bodies(path: &Path, text: &str) -> Result<BTreeMap<u64, Body>, ReadErro
                 let tactor = match kind {
                     "DISKx" => Tactor::Disk { radius: labeled_number(path, ln, line, "byrd=")? },
                     "JONCx" => {
-                        labeled_number(path, ln, line, "ax2 =")?;
-                        Tactor::Jonc { ax1: labeled_number(path, ln, line, "ax1 =")? }
+                        jonc_axis(path, ln, line, 2)?;
+                        Tactor::Jonc { ax1: jonc_axis(path, ln, line, 1)? }
                     }
                     other => {
                         return Err(ReadError::parse(path, ln, format!("body {id}: contactor `{other}` is not read (DISKx grains and JONCx walls only)")))
