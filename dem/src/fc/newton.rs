@@ -228,6 +228,35 @@ impl NewtonWork {
     }
 }
 
+/// The diagonal `D = (W_nn, W_tt)` of each contact (negative rounding clipped to 0) and the
+/// Alart–Curnier weights `ρ = 1/D` (1 where a diagonal entry vanishes).
+fn scales(problem: &FcProblem) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
+    let diag: Vec<[f64; 2]> = (0..problem.contacts())
+        .map(|a| {
+            let d = problem.delassus(a);
+            [d.nn.max(0.0), d.tt.max(0.0)]
+        })
+        .collect();
+    let rho = diag
+        .iter()
+        .map(|d| {
+            let inv = |x: f64| if x > 0.0 { 1.0 / x } else { 1.0 };
+            [inv(d[0]), inv(d[1])]
+        })
+        .collect();
+    (diag, rho)
+}
+
+impl NewtonWork {
+    /// Zeroes the per-iteration vectors for `n` contacts.
+    fn reset(&mut self, n: usize) {
+        for v in [&mut self.u, &mut self.phi, &mut self.d, &mut self.trial] {
+            v.clear();
+            v.resize(2 * n, 0.0);
+        }
+    }
+}
+
 /// The sparse LU of the Newton matrices of one solve: the symbolic analysis once (the pattern
 /// is that of `W`), a numeric factorisation per direction.
 #[derive(Default)]
@@ -386,23 +415,8 @@ pub fn solve_with(
         None => vec![0.0; 2 * n],
     };
     let mut stats = NewtonStats::default();
-    let diag: Vec<[f64; 2]> = (0..n)
-        .map(|a| {
-            let d = problem.delassus(a);
-            [d.nn.max(0.0), d.tt.max(0.0)]
-        })
-        .collect();
-    let rho: Vec<[f64; 2]> = diag
-        .iter()
-        .map(|d| {
-            let inv = |x: f64| if x > 0.0 { 1.0 / x } else { 1.0 };
-            [inv(d[0]), inv(d[1])]
-        })
-        .collect();
-    for v in [&mut work.u, &mut work.phi, &mut work.d, &mut work.trial] {
-        v.clear();
-        v.resize(2 * n, 0.0);
-    }
+    let (diag, rho) = scales(problem);
+    work.reset(n);
     work.best.clear();
     work.best.extend_from_slice(&r);
     let mut u_step = vec![0.0; 2 * n];
@@ -558,23 +572,8 @@ pub fn active_set_finish(
     if n == 0 || r.len() != 2 * n || error_now.is_nan() || error_now > FINISH_MAX_ERROR {
         return Ok(None);
     }
-    let diag: Vec<[f64; 2]> = (0..n)
-        .map(|a| {
-            let d = problem.delassus(a);
-            [d.nn.max(0.0), d.tt.max(0.0)]
-        })
-        .collect();
-    let rho: Vec<[f64; 2]> = diag
-        .iter()
-        .map(|d| {
-            let inv = |x: f64| if x > 0.0 { 1.0 / x } else { 1.0 };
-            [inv(d[0]), inv(d[1])]
-        })
-        .collect();
-    for v in [&mut work.u, &mut work.phi, &mut work.d, &mut work.trial] {
-        v.clear();
-        v.resize(2 * n, 0.0);
-    }
+    let (diag, rho) = scales(problem);
+    work.reset(n);
     problem.w().mul_add(r, problem.q(), &mut work.u);
     // Statuses: 0 open, 1 sticking, ±2 sliding with sign s.
     let status: Vec<i8> = (0..n)
