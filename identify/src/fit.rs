@@ -12,6 +12,10 @@
 //! - optionally a seeded case-resampling bootstrap (resampling observations within each group,
 //!   refitting from `θ̂`), with percentile intervals.
 //!
+//! Observations with known standard errors `σ_k` ([`Observations::std_errors`]) are weighted by
+//! `w_k ∝ 1/σ_k` (weighted least squares; the covariance keeps the residual-variance scale `s²`,
+//! so only the relative sizes of the `σ_k` matter).
+//!
 //! With several groups, group weights are estimated (two-stage feasible weighted least
 //! squares): a first unweighted fit gives each group's residual variance `s_g² = RSS_g/n_g`,
 //! the final fit uses `w_g = 1/s_g`. This makes a joint fit of quantities with different noise
@@ -108,6 +112,10 @@ pub struct Observations {
     pub group_of: Vec<usize>,
     /// Group names (quantity names, e.g. `sigma_v`).
     pub group_names: Vec<String>,
+    /// Standard error `σ_k` of each observation, when known (e.g. block-averaged over a steady
+    /// state): the fit then weighs observation `k` by `1/σ_k` (relative weights; the covariance
+    /// keeps its residual-variance scale).
+    pub std_errors: Option<Vec<f64>>,
 }
 
 impl Observations {
@@ -118,7 +126,14 @@ impl Observations {
             y,
             group_of: vec![0; n],
             group_names: vec![name.to_string()],
+            std_errors: None,
         }
+    }
+
+    /// The same observations with the standard error of each (`None`: unweighted).
+    pub fn with_std_errors(mut self, std_errors: Option<Vec<f64>>) -> Self {
+        self.std_errors = std_errors;
+        self
     }
 
     /// Several groups, stacked in the given order.
@@ -135,6 +150,7 @@ impl Observations {
             y,
             group_of,
             group_names,
+            std_errors: None,
         }
     }
 
@@ -156,6 +172,34 @@ pub struct BootstrapOptions {
     pub resamples: usize,
     /// Seed of the `ChaCha8Rng`.
     pub seed: u64,
+}
+
+/// The weight `w_k = σ̄/σ_k` of each observation from its standard error (`σ̄` their mean, so
+/// that the weights are of order one), or 1 for all without standard errors. Errors: a length
+/// that differs from the observations' ([`IdentifyError::LengthMismatch`]), a standard error
+/// that is not a finite positive number ([`IdentifyError::OutOfDomain`]).
+fn observation_weights(obs: &Observations) -> Result<Vec<f64>> {
+    let Some(se) = &obs.std_errors else {
+        return Ok(vec![1.0; obs.len()]);
+    };
+    if se.len() != obs.len() {
+        return Err(IdentifyError::LengthMismatch {
+            first: "observations".into(),
+            first_len: obs.len(),
+            second: "standard errors".into(),
+            second_len: se.len(),
+        });
+    }
+    if let Some(k) = se.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(IdentifyError::OutOfDomain {
+            column: "std_error".into(),
+            index: k,
+            value: se[k],
+            expected: "a finite standard error > 0".into(),
+        });
+    }
+    let mean = se.iter().sum::<f64>() / se.len() as f64;
+    Ok(se.iter().map(|s| mean / s).collect())
 }
 
 /// Settings of [`fit_least_squares`].
@@ -301,8 +345,10 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
         .collect();
     let all: Vec<usize> = (0..n).collect();
 
-    // Stage 1: unweighted; stage 2: one weight per group.
-    let mut weight = vec![1.0; n];
+    // Stage 1: the observations' own weights (1/σ_k, or 1); stage 2: one weight per group on
+    // top of them.
+    let base = observation_weights(obs)?;
+    let mut weight = base.clone();
     let mut outcome = run(
         model,
         &obs.y,
@@ -319,7 +365,7 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
                 let (rss, ng) = (0..n)
                     .filter(|&k| obs.group_of[k] == g)
                     .fold((0.0, 0usize), |(a, c), k| {
-                        (a + (obs.y[k] - f[k]).powi(2), c + 1)
+                        (a + (base[k] * (obs.y[k] - f[k])).powi(2), c + 1)
                     });
                 (rss / ng.max(1) as f64).sqrt()
             })
@@ -328,7 +374,7 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
         if s_max > 0.0 {
             let floor = 1e-9 * s_max;
             for k in 0..n {
-                weight[k] = s_max / s[obs.group_of[k]].max(floor);
+                weight[k] = base[k] * s_max / s[obs.group_of[k]].max(floor);
             }
             let start = outcome.x.as_slice().to_vec();
             outcome = run(

@@ -46,6 +46,13 @@ pub struct RheologySeries {
     pub phi: Option<Vec<f64>>,
     /// Pressure `P` (Pa, compressive positive), optional: checked and reported as validity.
     pub pressure_pa: Option<Vec<f64>>,
+    /// Standard error of each `μ` (e.g. block-averaged over the steady state), optional: the
+    /// μ(I) fits then weigh each point by `1/σ` ([`crate::fit::Observations::std_errors`]).
+    #[serde(default)]
+    pub mu_std_error: Option<Vec<f64>>,
+    /// Standard error of each `φ`, optional: the φ(I) fits weigh by it.
+    #[serde(default)]
+    pub phi_std_error: Option<Vec<f64>>,
 }
 
 /// Result of [`fit_mu_i`].
@@ -237,7 +244,7 @@ pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit>
     let scale = ScaleCheck::new("I_0", "I", i);
     let result = fit_least_squares(
         &model,
-        &Observations::single("mu", mu.to_vec()),
+        &Observations::single("mu", mu.to_vec()).with_std_errors(series.mu_std_error.clone()),
         &theta0,
         options,
         validity(series),
@@ -342,12 +349,13 @@ fn ols_start(x: &[f64], y: &[f64]) -> (f64, f64) {
 }
 
 /// The unchecked least-squares fit of the line `y = a ± b I` (no bounds; `decreasing` for
-/// `a − b I`), parameters `names`, to the column `y` of `series`.
+/// `a − b I`), parameters `names`, to the column `y` of `series` (`(name, values, standard
+/// errors)`).
 fn linear_report(
     series: &RheologySeries,
     options: &FitOptions,
     law: &'static str,
-    column: (&str, &[f64]),
+    column: (&str, &[f64], &Option<Vec<f64>>),
     names: [&'static str; 2],
     decreasing: bool,
 ) -> Result<FitReport> {
@@ -362,7 +370,7 @@ fn linear_report(
     let (a, b) = ols_start(i, column.1);
     fit_least_squares(
         &model,
-        &Observations::single(column.0, column.1.to_vec()),
+        &Observations::single(column.0, column.1.to_vec()).with_std_errors(column.2.clone()),
         &[a, if decreasing { -b } else { b }],
         options,
         validity(series),
@@ -378,7 +386,7 @@ fn linear_mu_report(series: &RheologySeries, options: &FitOptions) -> Result<Fit
         series,
         options,
         "mu-i-linear",
-        ("mu", mu),
+        ("mu", mu, &series.mu_std_error),
         ["mu_s", "b"],
         false,
     )
@@ -443,7 +451,7 @@ fn linear_phi_report(series: &RheologySeries, options: &FitOptions) -> Result<Fi
         series,
         options,
         "phi-i-linear",
-        ("phi", phi),
+        ("phi", phi, &series.phi_std_error),
         ["phi_max", "a"],
         true,
     )
@@ -496,7 +504,7 @@ pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFi
     let (a, b) = ols_start(i, phi);
     let report = fit_least_squares(
         &model,
-        &Observations::single("phi", phi.to_vec()),
+        &Observations::single("phi", phi.to_vec()).with_std_errors(series.phi_std_error.clone()),
         &[a.clamp(0.01, 0.99), (-b).clamp(1e-3, 0.99)],
         options,
         validity(series),

@@ -10,8 +10,8 @@
 //! | `janssen` | `z_m`, `sigma_v_Pa`, `sigma_h_Pa` | `tau_w_Pa` | `width_m`, `bulk_density_kg_m3`, `wall_friction`; optional `gravity_m_s2` (9.81), `depth_min_m`, `depth_max_m`, `full_mobilisation` (1 = fix μ_w = μ_wall) |
 //! | `janssen-kmu` | `z_m`, `sigma_v_Pa` | | `width_m`, `bulk_density_kg_m3`; optional `gravity_m_s2`, `depth_min_m`, `depth_max_m`; `wall_friction`, `full_mobilisation` accepted (a `janssen` file) and not used |
 //! | `wall-law` | `slip_velocity_m_s` and either `mu_eff` or both `tau_w_Pa`, `sigma_w_Pa` | | `grain_diameter_m`; optional `gravity_m_s2` |
-//! | `mu-i`, `mu-i-linear` | `I`, `mu` | `P_Pa` | `grain_diameter_m`, `grain_density_kg_m3` (the law's `d`, `rho_s`) |
-//! | `phi-i`, `phi-i-linear` | `I`, `phi` | `P_Pa` | `grain_diameter_m`, `grain_density_kg_m3` |
+//! | `mu-i`, `mu-i-linear` | `I`, `mu` | `P_Pa`, `mu_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` (the law's `d`, `rho_s`) |
+//! | `phi-i`, `phi-i-linear` | `I`, `phi` | `P_Pa`, `phi_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` |
 //! | `mohr-coulomb` | one of: `p_Pa`, `q_Pa` (Mohr circles) · `sigma_xx_Pa`, `sigma_yy_Pa`, `sigma_xy_Pa` (2D tensors, **tension positive**) · `sigma_n_Pa`, `tau_Pa` (failure plane) | | optional `cohesion` (only `0`: fixes `c = 0`, and 3 states suffice) |
 //!
 //! `z` is the depth below the free surface, `I` the inertial number, `mu = τ/P`, `phi` the solid
@@ -397,8 +397,10 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
             let o = &options.fit;
             if law.starts_with("mu") {
                 series.mu = Some(table.column("mu")?);
+                series.mu_std_error = table.optional_column("mu_std_error")?;
             } else {
                 series.phi = Some(table.column("phi")?);
+                series.phi_std_error = table.optional_column("phi_std_error")?;
             }
             Ok(match law {
                 "mu-i" => {

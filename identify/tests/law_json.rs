@@ -57,6 +57,7 @@ fn rheology(seed: u64) -> RheologySeries {
         ),
         pressure_pa: None,
         inertial_number: i,
+        ..Default::default()
     }
 }
 
@@ -78,6 +79,7 @@ fn linear_rheology(seed: u64) -> RheologySeries {
         ),
         pressure_pa: None,
         inertial_number: i,
+        ..Default::default()
     }
 }
 

@@ -31,6 +31,7 @@ fn series(seed: u64, noise: f64) -> RheologySeries {
         ),
         pressure_pa: Some(vec![1000.0; i.len()]),
         inertial_number: i,
+        ..Default::default()
     }
 }
 
@@ -224,4 +225,55 @@ fn degenerate_series_give_typed_errors() {
         fit_phi_i(&s, &o).unwrap_err(),
         IdentifyError::ParameterAtBound { .. }
     ));
+}
+
+/// Standard errors weigh the points: on the exact line μ = 0.3 + 0.9 I at eight points, one
+/// point moved up by 0.2 with a standard error 10⁶ times the others' leaves the weighted fit
+/// on the line (parameters to 10⁻⁹), while the unweighted fit is pulled off it by more than
+/// 10⁻²; a standard error that is zero is refused with the point it names.
+#[test]
+fn standard_errors_weigh_the_points() {
+    let i: Vec<f64> = (0..8).map(|k| 0.01 + 0.04 * k as f64).collect();
+    let mut mu: Vec<f64> = i.iter().map(|i| 0.3 + 0.9 * i).collect();
+    // A little exact-zero-mean scatter, so that the residual variance is not zero.
+    for (k, m) in mu.iter_mut().enumerate() {
+        *m += if k % 2 == 0 { 1e-12 } else { -1e-12 };
+    }
+    mu[5] += 0.2;
+    let mut se = vec![1e-3; i.len()];
+    se[5] = 1e3;
+    let base = RheologySeries {
+        inertial_number: i,
+        mu: Some(mu),
+        ..Default::default()
+    };
+    let weighted = RheologySeries {
+        mu_std_error: Some(se.clone()),
+        ..base.clone()
+    };
+    let opts = FitOptions::default();
+    let w = fit_mu_i_linear(&weighted, &opts).unwrap();
+    let (mu_s, b) = (w.law.mu_s, w.law.slope);
+    assert!(
+        (mu_s - 0.3).abs() < 1e-9 && (b - 0.9).abs() < 1e-9,
+        "{mu_s} {b}"
+    );
+    match fit_mu_i_linear(&base, &opts) {
+        Ok(u) => assert!(
+            (u.law.mu_s - 0.3).abs() > 1e-2 || (u.law.slope - 0.9).abs() > 1e-2,
+            "the unweighted fit should feel the moved point: {} {}",
+            u.law.mu_s,
+            u.law.slope
+        ),
+        Err(e) => assert!(e.is_refusal(), "{e}"),
+    }
+    se[2] = 0.0;
+    let bad = RheologySeries {
+        mu_std_error: Some(se),
+        ..base
+    };
+    match fit_mu_i_linear(&bad, &opts) {
+        Err(IdentifyError::OutOfDomain { index, .. }) => assert_eq!(index, 2),
+        other => panic!("expected the zero standard error refused, got {other:?}"),
+    }
 }

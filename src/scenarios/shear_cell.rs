@@ -446,6 +446,9 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         mu: Some(rows.iter().map(|r| r[2]).collect()),
         phi: Some(rows.iter().map(|r| r[3]).collect()),
         pressure_pa: Some(rows.iter().map(|r| r[4]).collect()),
+        // the wall-bounded cell measures no standard error per point: unweighted fits
+        mu_std_error: None,
+        phi_std_error: None,
     };
     let opts = FitOptions::default();
     let provenance = crate::provenance::of_run(ctx, ctl, "shear-cell", c.seed);

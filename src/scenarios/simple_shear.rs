@@ -414,6 +414,10 @@ pub fn run(
         mu: Some(rows.iter().map(|r| r[3]).collect()),
         phi: Some(rows.iter().map(|r| r[5]).collect()),
         pressure_pa: Some(rows.iter().map(|r| r[7]).collect()),
+        // each point weighted by its block-averaged standard error (unweighted when one is
+        // not a positive number, e.g. a window too short for its blocks)
+        mu_std_error: weights_if_usable(rows.iter().map(|r| r[4]).collect()),
+        phi_std_error: weights_if_usable(rows.iter().map(|r| r[6]).collect()),
     };
     let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
     let prov = || provenance.clone();
@@ -482,4 +486,9 @@ pub fn run(
         headline,
         verdict,
     })
+}
+
+/// Standard errors usable as fit weights: all finite and positive, or `None` (unweighted).
+fn weights_if_usable(se: Vec<f64>) -> Option<Vec<f64>> {
+    se.iter().all(|s| s.is_finite() && *s > 0.0).then_some(se)
 }
