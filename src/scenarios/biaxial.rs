@@ -1152,3 +1152,96 @@ fn analyse(
         verdict,
     })
 }
+
+/// The figures of one biaxial benchmark row ([`bench_rve`]).
+#[derive(Debug, Clone, Copy)]
+pub struct BiaxialBench {
+    /// Grains.
+    pub grains: usize,
+    /// Steps of the isotropic compression and its wall seconds.
+    pub compress_steps: usize,
+    /// Wall seconds of the compression.
+    pub compress_seconds: f64,
+    /// Timed steps of the axial compression.
+    pub axial_steps: usize,
+    /// Axial strain of one step `ε̇_a Δt` (1).
+    pub strain_per_step: f64,
+    /// Wall seconds per axial step.
+    pub seconds_per_step: f64,
+    /// Wall seconds per percent of axial strain, `0.01 / (ε̇_a Δt)` steps.
+    pub seconds_per_percent: f64,
+    /// Mean contacts, sweeps and re-solves (cell control) per axial step.
+    pub contacts: f64,
+    /// Mean sweeps per solve.
+    pub sweeps: f64,
+    /// Mean re-solves of a step by the cell control.
+    pub corrections: f64,
+    /// Axial steps stopped at the sweep cap.
+    pub unconverged: usize,
+}
+
+/// The biaxial benchmark row: the built-in `biaxial` scenario with `grains` grains at
+/// p₀ = 1 kPa, `compress_steps` steps of isotropic compression (not timed per step), then
+/// `axial_steps` timed steps of the axial compression (the scenario's own control and solver
+/// settings; rayon's global pool).
+pub fn bench_rve(grains: usize, compress_steps: usize, axial_steps: usize) -> Result<BiaxialBench> {
+    let loaded = datasets::scenario::load(
+        "biaxial",
+        &[
+            format!("grains={grains}"),
+            "confining_pressures=[1000.0]".to_string(),
+        ],
+    )?;
+    let datasets::Scenario::Biaxial(c) = loaded.scenario else {
+        return Err(crate::error::CliError::Usage(
+            "the built-in biaxial scenario is not a biaxial scenario".into(),
+        ));
+    };
+    let bx = Biaxial {
+        c: &c,
+        pressures: vec![1000.0],
+    };
+    let p0 = 1000.0;
+    let mut w = datasets::build_cell::biaxial(&c)?;
+    if c.preparation == Preparation::Dense {
+        w.laws.set_friction(0, 0, 0.0);
+    }
+    let d = mean_diameter(&w);
+    let dt = c.dt_max;
+    w.params.dt = dt;
+    w.cell_control = Some(bx.control(p0, -p0, dt, d, None));
+    let t0 = std::time::Instant::now();
+    for _ in 0..compress_steps {
+        w.step()?;
+    }
+    let compress_seconds = t0.elapsed().as_secs_f64();
+    w.laws.set_friction(0, 0, c.friction.grain_grain);
+    let rate = c.axial_rate(p0);
+    let l = w.cell().map_or_else(Mat::zeros, |cell| cell.l);
+    w.set_velocity_gradient(Mat::new(l[(0, 0)], 0.0, 0.0, -rate));
+    w.cell_control = Some(bx.control(p0, -p0, dt, d, Some(rate)));
+    let (mut contacts, mut sweeps, mut corrections, mut unconverged) = (0usize, 0usize, 0u64, 0);
+    let t1 = std::time::Instant::now();
+    for _ in 0..axial_steps {
+        let r = w.step()?;
+        contacts += r.contacts;
+        sweeps += r.solver.iterations;
+        corrections += u64::from(r.cell_corrections);
+        unconverged += usize::from(!r.solver.converged);
+    }
+    let secs = t1.elapsed().as_secs_f64() / axial_steps.max(1) as f64;
+    let k = axial_steps.max(1) as f64;
+    Ok(BiaxialBench {
+        grains,
+        compress_steps,
+        compress_seconds,
+        axial_steps,
+        strain_per_step: rate * dt,
+        seconds_per_step: secs,
+        seconds_per_percent: secs * 0.01 / (rate * dt),
+        contacts: contacts as f64 / k,
+        sweeps: sweeps as f64 / k,
+        corrections: corrections as f64 / k,
+        unconverged,
+    })
+}
