@@ -545,7 +545,8 @@ impl PhasedRun for Biaxial<'_> {
                         reason: "the biaxial world has no biperiodic cell".into(),
                     })?;
                     world.params.dt = dt;
-                    world.set_velocity_gradient(Mat::new(cell.l[(0, 0)], 0.0, 0.0, -rate));
+                    // the lateral rate starts at rest (not at the compression's last value)
+                    world.set_velocity_gradient(Mat::new(0.0, 0.0, 0.0, -rate));
                     st.run = RunPlan {
                         rate,
                         dt,
@@ -1217,8 +1218,7 @@ pub fn bench_rve(grains: usize, compress_steps: usize, axial_steps: usize) -> Re
     let compress_seconds = t0.elapsed().as_secs_f64();
     w.laws.set_friction(0, 0, c.friction.grain_grain);
     let rate = c.axial_rate(p0);
-    let l = w.cell().map_or_else(Mat::zeros, |cell| cell.l);
-    w.set_velocity_gradient(Mat::new(l[(0, 0)], 0.0, 0.0, -rate));
+    w.set_velocity_gradient(Mat::new(0.0, 0.0, 0.0, -rate));
     w.cell_control = Some(bx.control(p0, -p0, dt, d, Some(rate)));
     let (mut contacts, mut sweeps, mut corrections, mut unconverged) = (0usize, 0usize, 0u64, 0);
     let t1 = std::time::Instant::now();
