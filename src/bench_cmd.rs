@@ -9,7 +9,9 @@
 //! 4. Janssen columns settled to kinetic / potential energy < 10⁻⁸
 //!    ([`datasets::benchmarks::settle_column`]) against the reference times of a soft-contact
 //!    code (LAMMPS, Hookean with history, one core).
-//! 5. Memory per grain and per contact ([`dem::bench::MemoryFootprint`]).
+//! 5. Biaxial RVEs (the `biaxial` scenario's cell, [`crate::scenarios::biaxial::bench_rve`]):
+//!    time per step and per percent of axial strain, with the solver counts.
+//! 6. Memory per grain and per contact ([`dem::bench::MemoryFootprint`]).
 
 use std::path::Path;
 
@@ -37,6 +39,12 @@ pub struct BenchPlan {
     pub relax_steps: usize,
     /// Grain counts of the read-and-homogenise rows (synthetic LAMMPS dumps); none by default.
     pub homogenise_grains: Vec<usize>,
+    /// Grain counts of the biaxial RVE rows.
+    pub biaxial_grains: Vec<usize>,
+    /// Isotropic-compression steps before the timed axial steps of a biaxial row.
+    pub biaxial_compress_steps: usize,
+    /// Timed axial steps of a biaxial row.
+    pub biaxial_steps: usize,
 }
 
 /// Reference wall seconds (range) of a soft-contact DEM code for a settled column of `n` grains
@@ -198,6 +206,7 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
     engine_rows(plan)?;
     columns(plan)?;
     homogenise_rows(plan)?;
+    biaxial_rows(plan)?;
     let mem = dem::bench::MemoryFootprint::current(4);
     println!(
         "\nmemory: {} B per grain, {} B per contact; at 2 contacts per grain, 24 GiB hold about {:.1e} grains",
@@ -216,6 +225,50 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
         extra.per_contact,
         both.largest_sample(24 << 30, 2.0) as f64
     );
+    Ok(())
+}
+
+/// Biaxial RVEs: compression, then timed steps of the axial compression.
+fn biaxial_rows(plan: &BenchPlan) -> Result<()> {
+    if plan.biaxial_grains.is_empty() {
+        return Ok(());
+    }
+    println!(
+        "\nbiaxial RVE (built-in `biaxial`, p0 = 1 kPa, dense: {} frictionless compression steps, then {} timed axial steps at I = 1e-3, μ = 0.5, tolerance 1e-4):",
+        plan.biaxial_compress_steps, plan.biaxial_steps
+    );
+    println!(
+        "{:>7} {:>10} {:>9} {:>8} {:>8} {:>8} {:>8} {:>11} {:>10}",
+        "grains",
+        "compress s",
+        "contacts",
+        "sweeps",
+        "re-solve",
+        "capped",
+        "s/step",
+        "strain/step",
+        "s/percent"
+    );
+    for &n in &plan.biaxial_grains {
+        let r = crate::scenarios::biaxial::bench_rve(
+            n,
+            plan.biaxial_compress_steps,
+            plan.biaxial_steps,
+        )?;
+        println!(
+            "{:>7} {:>10.1} {:>9.0} {:>8.1} {:>8.2} {:>8} {:>8.3} {:>11.2e} {:>10.0}",
+            r.grains,
+            r.compress_seconds,
+            r.contacts,
+            r.sweeps,
+            r.corrections,
+            r.unconverged,
+            r.seconds_per_step,
+            r.strain_per_step,
+            r.seconds_per_percent
+        );
+    }
+    println!("(sweeps: of the last solve of a step; re-solve: solves of a step repeated by the cell control; capped: steps stopped at the sweep cap)");
     Ok(())
 }
 

@@ -134,6 +134,15 @@ pub enum Command {
         /// Grain counts of synthetic LAMMPS dumps read and homogenised (none by default).
         #[arg(long, value_name = "N", num_args = 0..)]
         homogenise_grains: Vec<usize>,
+        /// Grain counts of the biaxial RVE rows (none by default: a 10⁴-grain row takes minutes).
+        #[arg(long, value_name = "N", num_args = 0..)]
+        biaxial_grains: Vec<usize>,
+        /// Isotropic-compression steps of a biaxial row before its timed steps.
+        #[arg(long, value_name = "STEPS", default_value_t = 300)]
+        biaxial_compress_steps: usize,
+        /// Timed axial steps of a biaxial row.
+        #[arg(long, value_name = "STEPS", default_value_t = 20)]
+        biaxial_steps: usize,
     },
 }
 
@@ -356,6 +365,9 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             pour,
             relax_steps,
             homogenise_grains,
+            biaxial_grains,
+            biaxial_compress_steps,
+            biaxial_steps,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
             engine_grains,
@@ -364,6 +376,9 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             pour,
             relax_steps,
             homogenise_grains,
+            biaxial_grains,
+            biaxial_compress_steps,
+            biaxial_steps,
         }),
     }
 }

@@ -1,5 +1,5 @@
-//! The world of the `simple-shear` scenario: a loose packing in a biperiodic deformable cell
-//! (`dem::cell`), no walls, no gravity.
+//! The worlds of the `simple-shear` and `biaxial` scenarios: a loose packing in a biperiodic
+//! deformable cell (`dem::cell`), no walls, no gravity.
 
 use dem::cell::Cell;
 use dem::World;
@@ -7,29 +7,74 @@ use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::config::SimpleShearConfig;
+use crate::config::{BiaxialConfig, GrainSpec, SimpleShearConfig, SolverSpec};
 use crate::error::Result;
 use crate::generators::uniform_radii;
 
-/// The initial loose packing: `grains` disks (radii from `[grain]`, seeded) on a jittered
-/// square lattice in a square cell at the solid fraction `initial_solid_fraction` (lower if the
-/// lattice needs it: spacing at least 2 % above the largest diameter), at rest.
+/// The initial loose packing of the `simple-shear` scenario ([`loose_cell`]).
 pub fn simple_shear(c: &SimpleShearConfig) -> Result<World> {
+    loose_cell(&LooseCell {
+        seed: c.seed,
+        grains: c.grains,
+        grain: &c.grain,
+        friction: c.friction.grain_grain,
+        solid_fraction: c.initial_solid_fraction,
+        dt: c.dt_max,
+        solver: &c.solver,
+    })
+}
+
+/// The initial loose packing of the `biaxial` scenario ([`loose_cell`]), the same for every
+/// confining pressure.
+pub fn biaxial(c: &BiaxialConfig) -> Result<World> {
+    loose_cell(&LooseCell {
+        seed: c.seed,
+        grains: c.grains,
+        grain: &c.grain,
+        friction: c.friction.grain_grain,
+        solid_fraction: c.initial_solid_fraction,
+        dt: c.dt_max,
+        solver: &c.solver,
+    })
+}
+
+/// What [`loose_cell`] builds.
+pub struct LooseCell<'a> {
+    /// Seed of the radii and the placement.
+    pub seed: u64,
+    /// Number of grains.
+    pub grains: usize,
+    /// Radii and density.
+    pub grain: &'a GrainSpec,
+    /// Grain–grain friction coefficient.
+    pub friction: f64,
+    /// Solid fraction aimed at (1).
+    pub solid_fraction: f64,
+    /// Time step (s).
+    pub dt: f64,
+    /// Contact solver.
+    pub solver: &'a SolverSpec,
+}
+
+/// The initial loose packing: `grains` disks (radii from `grain`, seeded) on a jittered
+/// square lattice in a square cell at the solid fraction `solid_fraction` (lower if the
+/// lattice needs it: spacing at least 2 % above the largest diameter), at rest.
+pub fn loose_cell(c: &LooseCell) -> Result<World> {
     let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
-    let radii = uniform_radii(&mut rng, c.grains, &c.grain);
+    let radii = uniform_radii(&mut rng, c.grains, c.grain);
     let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
     let n_side = (c.grains as f64).sqrt().ceil() as usize;
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
-    let spacing = ((area / c.initial_solid_fraction).sqrt() / n_side as f64).max(2.04 * r_max);
+    let spacing = ((area / c.solid_fraction).sqrt() / n_side as f64).max(2.04 * r_max);
     let side = spacing * n_side as f64;
     let params = dem::WorldParams {
-        dt: c.dt_max,
+        dt: c.dt,
         gravity: Vector2::zeros(),
         detection_gap: 0.1 * c.grain.radius_min(),
         solver: c.solver.params(),
         ..Default::default()
     };
-    let laws = dem::ContactLaws::new(&["grain"], c.friction.grain_grain);
+    let laws = dem::ContactLaws::new(&["grain"], c.friction);
     let mut w = World::new(params, laws);
     let slack = 0.5 * (spacing - 2.0 * r_max) * 0.9;
     for (k, &r) in radii.iter().enumerate() {

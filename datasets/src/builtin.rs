@@ -12,7 +12,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scenario, the default (`janssen`) first.
-pub const BUILTINS: [Builtin; 7] = [
+pub const BUILTINS: [Builtin; 8] = [
     Builtin {
         name: "janssen",
         description: "350 grains deposited in a column, relaxed, released: wall stress vs depth, Janssen fit (Fig. 7)",
@@ -47,6 +47,11 @@ pub const BUILTINS: [Builtin; 7] = [
         name: "simple-shear",
         description: "Lees-Edwards shear of a biperiodic cell at imposed normal stress over several inertial numbers: mu(I), phi(I)",
         toml: include_str!("../scenarios/simple-shear.toml"),
+    },
+    Builtin {
+        name: "biaxial",
+        description: "biaxial compression of a biperiodic cell at constant lateral stress over several confining pressures: peak and critical friction, dilatancy, Mohr-Coulomb",
+        toml: include_str!("../scenarios/biaxial.toml"),
     },
 ];
 

@@ -8,8 +8,8 @@ use toml::{Table, Value};
 
 use crate::builtin::{builtin, builtin_names};
 use crate::config::{
-    ArrangementsConfig, InclinedFlowConfig, JanssenConfig, RollingConfig, ShearCellConfig,
-    SimpleShearConfig, StickSlipConfig,
+    ArrangementsConfig, BiaxialConfig, InclinedFlowConfig, JanssenConfig, RollingConfig,
+    ShearCellConfig, SimpleShearConfig, StickSlipConfig,
 };
 use crate::error::{DatasetError, Result};
 use crate::overrides::{apply_override, parse_override};
@@ -31,6 +31,8 @@ pub enum Scenario {
     ShearCell(ShearCellConfig),
     /// Lees–Edwards shear of a biperiodic cell at imposed normal stress.
     SimpleShear(SimpleShearConfig),
+    /// Biaxial compression of a biperiodic cell at constant lateral stress.
+    Biaxial(BiaxialConfig),
 }
 
 impl Scenario {
@@ -44,6 +46,7 @@ impl Scenario {
             Scenario::InclinedFlow(_) => "inclined-flow",
             Scenario::ShearCell(_) => "shear-cell",
             Scenario::SimpleShear(_) => "simple-shear",
+            Scenario::Biaxial(_) => "biaxial",
         }
     }
 
@@ -57,6 +60,7 @@ impl Scenario {
             Scenario::InclinedFlow(c) => c.seed,
             Scenario::ShearCell(c) => c.seed,
             Scenario::SimpleShear(c) => c.seed,
+            Scenario::Biaxial(c) => c.seed,
         }
     }
 }
@@ -262,6 +266,11 @@ pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Resul
             let c: SimpleShearConfig = typed(table, source)?;
             c.validate().map_err(|e| e.in_source(source))?;
             Scenario::SimpleShear(c)
+        }
+        "biaxial" => {
+            let c: BiaxialConfig = typed(table, source)?;
+            c.validate().map_err(|e| e.in_source(source))?;
+            Scenario::Biaxial(c)
         }
         other => {
             return Err(DatasetError::invalid(

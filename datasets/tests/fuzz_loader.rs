@@ -225,6 +225,7 @@ fn build(s: &Scenario) -> Result<(), DatasetError> {
         Scenario::InclinedFlow(c) => inclined_flow(c).map(drop),
         Scenario::ShearCell(c) => shear_cell(c).map(drop),
         Scenario::SimpleShear(c) => datasets::build_cell::simple_shear(c).map(drop),
+        Scenario::Biaxial(c) => datasets::build_cell::biaxial(c).map(drop),
     }
 }
 
@@ -237,6 +238,7 @@ fn grains(s: &Scenario) -> usize {
         Scenario::InclinedFlow(c) => c.grains,
         Scenario::ShearCell(c) => c.grains,
         Scenario::SimpleShear(c) => c.grains,
+        Scenario::Biaxial(c) => c.grains,
     }
 }
 

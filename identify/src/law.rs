@@ -62,12 +62,13 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use crate::critical_state::{CriticalStateFit, StressDilatancyFit};
 use crate::error::{IdentifyError, Result};
 use crate::expr::Expr;
 use crate::janssen::{JanssenFit, JanssenKMuFit};
 use crate::laws::{
-    JanssenLaw, JanssenVerticalLaw, LinearMuILaw, LinearPhiILaw, MohrCoulombLaw, MuILaw, PhiILaw,
-    VelocityBoundaryLayer, WallFrictionLaw,
+    CriticalStateLaw, JanssenLaw, JanssenVerticalLaw, LinearMuILaw, LinearPhiILaw, MohrCoulombLaw,
+    MuILaw, PhiILaw, StressDilatancyLaw, VelocityBoundaryLayer, WallFrictionLaw,
 };
 use crate::mohr_coulomb::MohrCoulombFit;
 use crate::mu_i::{LinearMuIFit, LinearPhiIFit, MuIFit, PhiIFit};
@@ -320,6 +321,34 @@ pub const REGISTRY: &[LawSpec] = &[
             ("dp_k", "Pa", "cohesion*cos(friction_angle)"),
         ],
         geometry: "plane strain (2D), compressive positive: shear strength tau on a plane of normal stress sigma_n; at yield the in-plane Mohr circle (centre p, radius q) touches the envelope, q = p*sin(friction_angle) + cohesion*cos(friction_angle), i.e. 2D Drucker-Prager q = dp_alpha*p + dp_k",
+    },
+    LawSpec {
+        name: "critical-state",
+        input: ("p", "Pa"),
+        output: ("q", "Pa"),
+        formula: "p*sin(friction_angle_c)",
+        also: &[OutputSpec {
+            name: "phi",
+            unit: "1",
+            formula: "solid_fraction_c",
+        }],
+        definitions: &[],
+        parameters: &[("friction_angle_c", "rad"), ("solid_fraction_c", "1")],
+        constants: &[],
+        derived: &[("M_c", "1", "sin(friction_angle_c)")],
+        geometry: "plane strain (2D), compressive positive: steady quasi-static shear at constant volume (critical state) of rigid cohesionless grains at any mean stress p = (sigma_1 + sigma_3)/2; deviator q = (sigma_1 - sigma_3)/2 = p*sin(friction_angle_c), solid fraction phi = solid_fraction_c",
+    },
+    LawSpec {
+        name: "stress-dilatancy",
+        input: ("sin_psi", "1"),
+        output: ("sin_phi", "1"),
+        formula: "sin_phi_c + beta*sin_psi",
+        also: &[],
+        definitions: &[],
+        parameters: &[("sin_phi_c", "1"), ("beta", "1")],
+        constants: &[],
+        derived: &[],
+        geometry: "plane strain (2D), compressive positive, quasi-static hardening: mobilised friction sin_phi = q/p against the dilatancy sin_psi = -rate_v/rate_gamma (rate_v = rate_1 + rate_3, rate_gamma = rate_1 - rate_3); beta = 1 is Taylor's energy form, Rowe's relation has slope 1 - sin_phi_c^2 at sin_psi = 0",
     },
 ];
 
@@ -757,6 +786,10 @@ pub enum Law {
     PhiILinear(LinearPhiILaw),
     /// Mohr–Coulomb, shear strength `τ(σ_n)`.
     MohrCoulomb(MohrCoulombLaw),
+    /// Critical state, `q(p)` (and `φ_c`).
+    CriticalState(CriticalStateLaw),
+    /// Stress–dilatancy, `sin φ_mob(sin ψ)`.
+    StressDilatancy(StressDilatancyLaw),
 }
 
 impl Law {
@@ -772,6 +805,8 @@ impl Law {
             Law::PhiI(l) => l.phi(x),
             Law::PhiILinear(l) => l.phi(x),
             Law::MohrCoulomb(l) => l.shear_strength(x),
+            Law::CriticalState(l) => l.q(x),
+            Law::StressDilatancy(l) => l.sin_phi(x),
         }
     }
 }
@@ -972,6 +1007,35 @@ impl CalibratedLaw {
         )
     }
 
+    /// From a critical state (parameters `friction_angle_c` (rad, with degrees),
+    /// `solid_fraction_c`; derived `M_c = sin φ_c`).
+    pub fn from_critical_state(fit: &CriticalStateFit, provenance: Provenance) -> Self {
+        let m = fit
+            .report
+            .derived("M_c", "1", |p| (p[0].sin(), vec![p[0].cos(), 0.0]));
+        Self::build(
+            "critical-state",
+            &[&fit.friction_angle, &fit.solid_fraction],
+            &[&m],
+            &[],
+            &fit.report,
+            provenance,
+        )
+    }
+
+    /// From a stress–dilatancy fit (parameters `sin_phi_c`, `beta`).
+    pub fn from_stress_dilatancy(fit: &StressDilatancyFit, provenance: Provenance) -> Self {
+        let params: Vec<&Estimate> = fit.report.parameters.iter().collect();
+        Self::build(
+            "stress-dilatancy",
+            &params,
+            &[],
+            &[],
+            &fit.report,
+            provenance,
+        )
+    }
+
     /// Parameter value by name.
     pub fn parameter(&self, name: &str) -> Result<f64> {
         self.parameters
@@ -1052,6 +1116,14 @@ impl CalibratedLaw {
             "mohr-coulomb" => Law::MohrCoulomb(MohrCoulombLaw {
                 friction_angle_rad: p("friction_angle")?,
                 cohesion_pa: p("cohesion")?,
+            }),
+            "critical-state" => Law::CriticalState(CriticalStateLaw {
+                friction_angle_rad: p("friction_angle_c")?,
+                solid_fraction: p("solid_fraction_c")?,
+            }),
+            "stress-dilatancy" => Law::StressDilatancy(StressDilatancyLaw {
+                sin_phi_c: p("sin_phi_c")?,
+                beta: p("beta")?,
             }),
             other => return Err(law_spec(other).err().unwrap_or(unknown_law(other))),
         })

@@ -16,6 +16,7 @@
 //! | [`wall_law`] | wall friction vs slip velocity (model choice by AIC), boundary-layer thickness |
 //! | [`mu_i`] | μ(I), φ(I) and their linear forms |
 //! | [`mohr_coulomb`] | Mohr–Coulomb envelope from stress states at yield (conic program, Clarabel) |
+//! | [`critical_state`] | critical state (plateau means over pressures) and stress–dilatancy of a biaxial test |
 //! | [`law`] | calibrated-law JSON (schema 2, the law registry, loader of schemas 1 and 2, evaluation) |
 //! | [`expr`] | the expression convention of the law formulas (parser, evaluator) |
 //! | [`continuum`] | closing the loop: Janssen ODE (RK4), Bagnold profile on a slope |
@@ -53,6 +54,7 @@
 
 pub mod accept;
 pub mod continuum;
+pub mod critical_state;
 pub mod data;
 pub mod error;
 pub mod expr;

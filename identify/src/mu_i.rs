@@ -305,13 +305,14 @@ pub fn fit_mu_i_or_linear(series: &RheologySeries, options: &FitOptions) -> Resu
     }
 }
 
-struct LinearModel<'a> {
-    x: &'a [f64],
-    name: &'static str,
-    names: [&'static str; 2],
-    bounds: [(f64, f64); 2],
+/// The line `y = a ± b x` as a least-squares model (shared with [`crate::critical_state`]).
+pub(crate) struct LinearModel<'a> {
+    pub(crate) x: &'a [f64],
+    pub(crate) name: &'static str,
+    pub(crate) names: [&'static str; 2],
+    pub(crate) bounds: [(f64, f64); 2],
     /// `y = a + b x` (false) or `y = a − b x` (true).
-    decreasing: bool,
+    pub(crate) decreasing: bool,
 }
 
 impl LeastSquaresModel for LinearModel<'_> {
@@ -338,7 +339,8 @@ impl LeastSquaresModel for LinearModel<'_> {
     }
 }
 
-fn ols_start(x: &[f64], y: &[f64]) -> (f64, f64) {
+/// Ordinary least-squares start `(a, b)` of the line `y = a + b x`.
+pub(crate) fn ols_start(x: &[f64], y: &[f64]) -> (f64, f64) {
     let n = x.len() as f64;
     let mx = x.iter().sum::<f64>() / n;
     let my = y.iter().sum::<f64>() / n;

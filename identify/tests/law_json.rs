@@ -245,6 +245,43 @@ fn every_law() -> Vec<Case> {
         Box::new(move |s| l.shear_strength(s)),
         sn,
     ));
+    let plateaus: Vec<identify::critical_state::PlateauMeasure> = [0.27, 0.28, 0.26]
+        .iter()
+        .map(|&s| identify::critical_state::PlateauMeasure {
+            pressure_pa: 1000.0,
+            sin_phi: s,
+            sin_phi_std_error: 0.005,
+            solid_fraction: 0.81,
+            solid_fraction_std_error: 0.002,
+            blocks: 8,
+        })
+        .collect();
+    let cs = identify::critical_state::fit_critical_state(&plateaus, 0.95).unwrap();
+    let l = cs.law;
+    out.push((
+        CalibratedLaw::from_critical_state(&cs, prov()),
+        Box::new(move |p| l.q(p)),
+        vec![100.0, 1000.0, 1e4],
+    ));
+    let psi: Vec<f64> = (0..10).map(|k| 0.02 * k as f64).collect();
+    let sd = identify::critical_state::fit_stress_dilatancy(
+        &identify::critical_state::StressDilatancyData {
+            sin_phi: psi
+                .iter()
+                .zip(gaussian(5, 10, 0.005))
+                .map(|(x, e)| 0.27 + 0.9 * x + e)
+                .collect(),
+            sin_psi: psi.clone(),
+        },
+        &o,
+    )
+    .unwrap();
+    let l = sd.law;
+    out.push((
+        CalibratedLaw::from_stress_dilatancy(&sd, prov()),
+        Box::new(move |x| l.sin_phi(x)),
+        psi,
+    ));
     out
 }
 

@@ -3,6 +3,7 @@
 //! its simulation can be checkpointed, stopped and resumed ([`run_controlled`]).
 
 pub mod arrangements;
+pub mod biaxial;
 pub mod common;
 pub mod dump;
 pub mod inclined_flow;
@@ -103,6 +104,7 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
         Scenario::InclinedFlow(c) => inclined_flow::run(c, ctx, ctl)?,
         Scenario::ShearCell(c) => shear_cell::run(c, ctx, ctl)?,
         Scenario::SimpleShear(c) => simple_shear::run(c, ctx, ctl)?,
+        Scenario::Biaxial(c) => biaxial::run(c, ctx, ctl)?,
     };
     let mut head = Summary::new();
     head.text("scenario", scenario.kind())

@@ -2,6 +2,7 @@
 //! `validate` that names the key of any out-of-range value.
 
 pub mod arrangements;
+pub mod biaxial;
 pub mod common;
 pub mod deposit;
 pub mod inclined_flow;
@@ -12,6 +13,7 @@ pub mod simple_shear;
 pub mod stick_slip;
 
 pub use arrangements::ArrangementsConfig;
+pub use biaxial::{BiaxialConfig, Preparation};
 pub use common::{FrictionSpec, GrainSpec, SolverSpec};
 pub use deposit::{DepositSpec, RelaxSpec};
 pub use inclined_flow::InclinedFlowConfig;

@@ -1,0 +1,322 @@
+//! The critical state and the stress–dilatancy relation of a biaxial test (laws in
+//! [`crate::laws::critical_state`]), from homogenised histories.
+//!
+//! **Critical state** ([`fit_critical_state`]): each confining pressure `k` gives a plateau
+//! (the large-strain end of its test) with the means of `sin φ = q/p` and of the solid
+//! fraction `φ` and their block-averaged standard errors `s_k` (Flyvbjerg & Petersen 1989).
+//! For rigid grains the critical state does not depend on the pressure, so the estimate is the
+//! mean over the pressures, `x̄ = (1/n) Σ x_k`, with the larger of two standard errors: the
+//! propagated one `√(Σ s_k²)/n` and, with two pressures or more, the scatter between them
+//! `sd(x_k)/√n` (a pressure dependence, or plateaus not reached, then shows as a wide
+//! interval). The interval is `x̄ ∓ t s` with Student's `t` at `Σ (b_k − 1)` degrees of
+//! freedom (`b_k` blocks per plateau) for the propagated error, `n − 1` for the scatter. The
+//! angle is `φ_c = asin(sin φ_c)` with `s_φ = s / cos φ_c` (delta method). A constant explains
+//! none of the variance of its data: the report's `R²` is 0 by definition and no `R²`
+//! threshold applies; refusals: a standard error above its value, an interval of `φ_c` outside
+//! `[0, π/2]` or of the solid fraction outside `[0, 1]`.
+//!
+//! **Stress–dilatancy** ([`fit_stress_dilatancy`]): `sin φ_mob = sin φ_cv + β sin ψ` by least
+//! squares ([`crate::fit`]) over binned points of the hardening phase, with the checks of
+//! [`crate::accept`]: `sin φ_cv` inside `[0, 1]`, `β ≥ 0`, standard errors below the values,
+//! `R²` above the threshold.
+
+use serde::{Deserialize, Serialize};
+
+use crate::accept::{Acceptance, PhysicalRange};
+use crate::error::{check_finite, check_spread, IdentifyError, Result};
+use crate::fit::{fit_least_squares, FitOptions, Observations};
+use crate::laws::{CriticalStateLaw, StressDilatancyLaw};
+use crate::mu_i::{ols_start, LinearModel};
+use crate::report::{
+    correlation_of, matrix_rows, Estimate, FitReport, GroupSummary, ValidityRange,
+};
+use crate::stats;
+
+/// The critical-state plateau of one test.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PlateauMeasure {
+    /// Mean pressure `p` on the plateau (Pa, compressive positive).
+    pub pressure_pa: f64,
+    /// Mean `sin φ = q/p` (1).
+    pub sin_phi: f64,
+    /// Its block-averaged standard error (1).
+    pub sin_phi_std_error: f64,
+    /// Mean solid fraction (1).
+    pub solid_fraction: f64,
+    /// Its block-averaged standard error (1).
+    pub solid_fraction_std_error: f64,
+    /// Blocks of the block average (≥ 2).
+    pub blocks: usize,
+}
+
+/// Result of [`fit_critical_state`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CriticalStateFit {
+    /// The law.
+    pub law: CriticalStateLaw,
+    /// `φ_c` (rad), parameter `friction_angle_c`.
+    pub friction_angle: Estimate,
+    /// The same in degrees (`friction_angle_c_deg`).
+    pub friction_angle_deg: Estimate,
+    /// `sin φ_c` (`sin_phi_c`).
+    pub sin_phi: Estimate,
+    /// Critical solid fraction (`solid_fraction_c`).
+    pub solid_fraction: Estimate,
+    /// Parameters `friction_angle_c`, `solid_fraction_c` (observations: the `sin φ` of each
+    /// plateau).
+    pub report: FitReport,
+}
+
+/// Mean, standard error and degrees of freedom of the module documentation.
+fn pooled(x: &[f64], se: &[f64], blocks: &[usize]) -> (f64, f64, usize) {
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    let prop = se.iter().map(|s| s * s).sum::<f64>().sqrt() / n;
+    let dof_prop: usize = blocks.iter().map(|b| b.saturating_sub(1).max(1)).sum();
+    if x.len() >= 2 {
+        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        let scatter = (var / n).sqrt();
+        if scatter > prop {
+            return (mean, scatter, x.len() - 1);
+        }
+    }
+    (mean, prop, dof_prop)
+}
+
+/// The critical state from the plateaus of one or more tests (module documentation).
+///
+/// Errors: [`IdentifyError::TooFewPoints`] (none), [`IdentifyError::NonFinite`], and the
+/// refusals of the module documentation.
+pub fn fit_critical_state(
+    plateaus: &[PlateauMeasure],
+    confidence: f64,
+) -> Result<CriticalStateFit> {
+    if plateaus.is_empty() {
+        return Err(IdentifyError::TooFewPoints {
+            law: "critical-state".into(),
+            needed: 1,
+            got: 0,
+        });
+    }
+    let col = |f: fn(&PlateauMeasure) -> f64| -> Vec<f64> { plateaus.iter().map(f).collect() };
+    let (s, s_se, f, f_se, p) = (
+        col(|m| m.sin_phi),
+        col(|m| m.sin_phi_std_error),
+        col(|m| m.solid_fraction),
+        col(|m| m.solid_fraction_std_error),
+        col(|m| m.pressure_pa),
+    );
+    for (name, v) in [
+        ("sin_phi", &s),
+        ("sin_phi_std_error", &s_se),
+        ("solid_fraction", &f),
+        ("solid_fraction_std_error", &f_se),
+        ("p", &p),
+    ] {
+        check_finite(name, v)?;
+    }
+    let blocks: Vec<usize> = plateaus.iter().map(|m| m.blocks).collect();
+    let (sm, sse, sdof) = pooled(&s, &s_se, &blocks);
+    let (fm, fse, fdof) = pooled(&f, &f_se, &blocks);
+    let ts = stats::t_critical(confidence, sdof);
+    let tf = stats::t_critical(confidence, fdof);
+    let sin_phi = Estimate::new("sin_phi_c", "1", sm, sse, ts);
+    let angle = sm.clamp(-1.0, 1.0).asin();
+    let angle_se = sse / angle.cos().max(1e-12);
+    let friction_angle = Estimate::new("friction_angle_c", "rad", angle, angle_se, ts);
+    let k = 180.0 / std::f64::consts::PI;
+    let friction_angle_deg =
+        Estimate::new("friction_angle_c_deg", "deg", angle * k, angle_se * k, ts);
+    let solid_fraction = Estimate::new("solid_fraction_c", "1", fm, fse, tf);
+    let cov = nalgebra::DMatrix::from_row_slice(2, 2, &[angle_se * angle_se, 0.0, 0.0, fse * fse]);
+    let n = s.len();
+    let residuals: Vec<f64> = s.iter().map(|v| v - sm).collect();
+    let rss: f64 = residuals.iter().map(|r| r * r).sum();
+    let dof = sdof.min(fdof);
+    let report = FitReport {
+        model: "critical-state".into(),
+        confidence,
+        t_critical: ts,
+        parameters: vec![friction_angle.clone(), solid_fraction.clone()],
+        covariance: matrix_rows(&cov),
+        correlation: matrix_rows(&correlation_of(&cov)),
+        observed: s.clone(),
+        fitted: vec![sm; n],
+        residuals,
+        group_of: vec![0; n],
+        groups: vec![GroupSummary {
+            name: "sin_phi".into(),
+            n,
+            rss,
+            tss: rss,
+            weight: 1.0,
+        }],
+        n,
+        dof,
+        residual_variance: if n > 1 {
+            rss / (n - 1) as f64
+        } else {
+            sse * sse
+        },
+        // a constant explains none of the variance about the mean (module documentation)
+        r_squared: 0.0,
+        aic: stats::aic(&[(n, rss.max(f64::MIN_POSITIVE))], 1),
+        bic: stats::bic(&[(n, rss.max(f64::MIN_POSITIVE))], 1),
+        iterations: 0,
+        validity: vec![ValidityRange::of("p", "Pa", &p)],
+        bootstrap: None,
+    };
+    Acceptance::new("critical-state", f64::NEG_INFINITY)
+        .range(PhysicalRange::new(
+            "friction_angle_c",
+            0.0,
+            std::f64::consts::FRAC_PI_2,
+        ))
+        .range(PhysicalRange::new("solid_fraction_c", 0.0, 1.0))
+        .check(&report)?;
+    Ok(CriticalStateFit {
+        law: CriticalStateLaw {
+            friction_angle_rad: angle,
+            solid_fraction: fm,
+        },
+        friction_angle,
+        friction_angle_deg,
+        sin_phi,
+        solid_fraction,
+        report,
+    })
+}
+
+/// Points of a stress–dilatancy relation: `sin ψ` and `sin φ_mob` (1), same length.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StressDilatancyData {
+    /// `sin ψ = −ε̇_v/ε̇_γ` (1).
+    pub sin_psi: Vec<f64>,
+    /// `sin φ_mob = q/p` (1).
+    pub sin_phi: Vec<f64>,
+}
+
+/// Result of [`fit_stress_dilatancy`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StressDilatancyFit {
+    /// The law.
+    pub law: StressDilatancyLaw,
+    /// Parameters `sin_phi_c`, `beta`.
+    pub report: FitReport,
+}
+
+/// Fits `sin φ_mob = sin φ_cv + β sin ψ` (module documentation).
+///
+/// Errors: [`IdentifyError::TooFewPoints`] (< 4), [`IdentifyError::NonFinite`],
+/// [`IdentifyError::ZeroVariance`] (no spread of `sin ψ`), and the refusals of
+/// [`crate::accept`].
+pub fn fit_stress_dilatancy(
+    data: &StressDilatancyData,
+    options: &FitOptions,
+) -> Result<StressDilatancyFit> {
+    let (x, y) = (&data.sin_psi, &data.sin_phi);
+    check_finite("sin_psi", x)?;
+    check_finite("sin_phi", y)?;
+    crate::error::check_same_len("sin_psi", x, "sin_phi", y)?;
+    if x.len() < 4 {
+        return Err(IdentifyError::TooFewPoints {
+            law: "stress-dilatancy".into(),
+            needed: 4,
+            got: x.len(),
+        });
+    }
+    check_spread("sin_psi", x)?;
+    let model = LinearModel {
+        x,
+        name: "stress-dilatancy",
+        names: ["sin_phi_c", "beta"],
+        bounds: [(f64::NEG_INFINITY, f64::INFINITY); 2],
+        decreasing: false,
+    };
+    let (a, b) = ols_start(x, y);
+    let report = fit_least_squares(
+        &model,
+        &Observations::single("sin_phi", y.clone()),
+        &[a, b],
+        options,
+        vec![
+            ValidityRange::of("sin_psi", "1", x),
+            ValidityRange::of("sin_phi", "1", y),
+        ],
+    )?;
+    Acceptance::new("stress-dilatancy", options.min_r_squared)
+        .range(PhysicalRange::new("sin_phi_c", 0.0, 1.0))
+        .non_negative(&["beta"])
+        .check(&report)?;
+    Ok(StressDilatancyFit {
+        law: StressDilatancyLaw {
+            sin_phi_c: report.parameters[0].value,
+            beta: report.parameters[1].value,
+        },
+        report,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plateau(s: f64, se: f64, f: f64) -> PlateauMeasure {
+        PlateauMeasure {
+            pressure_pa: 1000.0,
+            sin_phi: s,
+            sin_phi_std_error: se,
+            solid_fraction: f,
+            solid_fraction_std_error: 0.001,
+            blocks: 4,
+        }
+    }
+
+    #[test]
+    fn critical_state_is_the_mean_with_the_larger_error() {
+        // three plateaus 0.30, 0.32, 0.34 with tiny block errors: the scatter dominates,
+        // s = sd/√3 = 0.02/√3, t at 2 degrees of freedom (4.303)
+        let f = fit_critical_state(
+            &[
+                plateau(0.30, 1e-4, 0.82),
+                plateau(0.32, 1e-4, 0.82),
+                plateau(0.34, 1e-4, 0.82),
+            ],
+            0.95,
+        )
+        .unwrap();
+        assert!((f.sin_phi.value - 0.32).abs() < 1e-12);
+        let se = 0.02 / 3f64.sqrt();
+        assert!((f.sin_phi.std_error - se).abs() < 1e-12);
+        assert!((f.sin_phi.ci_high - 0.32 - 4.303 * se).abs() < 1e-3 * se * 4.3);
+        assert!((f.friction_angle.value - 0.32f64.asin()).abs() < 1e-12);
+        // one plateau: its own block error, 3 degrees of freedom
+        let g = fit_critical_state(&[plateau(0.30, 0.01, 0.82)], 0.95).unwrap();
+        assert!((g.sin_phi.std_error - 0.01).abs() < 1e-15);
+        assert!((g.report.t_critical - 3.182).abs() < 1e-3);
+        // an error above its value is refused
+        assert!(fit_critical_state(&[plateau(0.01, 0.05, 0.82)], 0.95).is_err());
+    }
+
+    #[test]
+    fn taylor_line_is_recovered() {
+        // sin φ = 0.25 + 1.0 sin ψ with a ±0.002 alternating scatter
+        let x: Vec<f64> = (0..12).map(|k| 0.01 * k as f64).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(k, v)| 0.25 + v + if k % 2 == 0 { 0.002 } else { -0.002 })
+            .collect();
+        let f = fit_stress_dilatancy(
+            &StressDilatancyData {
+                sin_psi: x,
+                sin_phi: y,
+            },
+            &FitOptions::default(),
+        )
+        .unwrap();
+        assert!((f.law.sin_phi_c - 0.25).abs() < 0.003, "{:?}", f.law);
+        assert!((f.law.beta - 1.0).abs() < 0.05, "{:?}", f.law);
+        assert!(f.report.parameters[1].covers(1.0));
+    }
+}

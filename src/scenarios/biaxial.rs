@@ -1,0 +1,1247 @@
+//! The `biaxial` scenario: a representative volume without walls or gravity, a biperiodic
+//! deformable cell (`dem::cell`). For each confining pressure p₀ (lowest first) the same loose
+//! packing (same seed) is compressed isotropically under stress control, σ_xx = σ_yy = −p₀ with
+//! L_xy = 0 (tension positive), with the grain–grain friction switched to 0 for a `dense`
+//! preparation or kept for a `loose` one; then it is compressed along y at the constant axial
+//! strain rate `ε̇_a = I √(p₀/ρ)/d` (L_yy = −ε̇_a imposed) with σ_xx = −p₀ held and L_xy = 0,
+//! to `max_axial_strain` (`docs/physics.md` §8).
+//!
+//! Per pressure, the whole-cell state (`homogenise::cell`) of every step of the axial
+//! compression is written to `history_p{k}.csv`. With compression positive, as in soil
+//! mechanics: axial strain `ε_a = −ln(H/H₀)`, volumetric strain `ε_v = −ln(V/V₀)` (positive
+//! in contraction), `p = (σ₁ + σ₃)/2 = −tr Σ/2`, `q = (σ₁ − σ₃)/2`, `sin φ_mob = q/p`. Over bins
+//! of `bin_strain` of axial strain: the peak `sin φ_peak` (largest bin mean of q/p), the
+//! dilatancy `d = −Δε_v/Δε_a` and the 2D dilatancy angle `sin ψ = −ε̇_v/ε̇_γ = d/(2 + d)`
+//! (`ε̇_γ = ε̇₁ − ε̇₃ = 2ε̇_a − ε̇_v`). Over the last `critical_strain`: the critical state, means
+//! and block-averaged standard errors of q/p, φ, p, Z.
+//!
+//! Identification: Mohr–Coulomb (2D Drucker–Prager) over the peak Mohr circles
+//! (`identify::mohr_coulomb`, Clarabel), the critical state (`identify::critical_state`) and a
+//! stress–dilatancy relation `sin φ_mob = sin φ_cv + β sin ψ` fitted over the hardening phase
+//! (bins before the peak) of every pressure.
+
+use datasets::config::{BiaxialConfig, Preparation};
+use datasets::phases::PhaseStats;
+use dem::cell::{CellControl, Imposed, Mat};
+use homogenise::averaging::block_average;
+use homogenise::cell::cell_state;
+use identify::critical_state::{
+    fit_critical_state, fit_stress_dilatancy, PlateauMeasure, StressDilatancyData,
+};
+use identify::mohr_coulomb::{fit_mohr_coulomb_with, MohrCoulombOptions, YieldData};
+use identify::CalibratedLaw;
+use serde::{Deserialize, Serialize};
+
+use super::common::{fit_keys, mean_diameter, parameter_lines, solver_keys, Stop, VtkFrames};
+use super::phased::{drive, PhasedRun, RunControl};
+use super::{PhaseEnv, RunContext, RunOutcome};
+use crate::checkpoint::PhasePlan;
+use crate::error::Result;
+use crate::output::{CsvTable, OutputDir, Summary};
+use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
+use crate::plot::PALETTE;
+use crate::progress::warn;
+use crate::verdict::{
+    export_law, max_solid_fraction, remove_stale_law, Checks, RunVerdict, Verdict, WindowStats,
+};
+
+/// Columns of `history_p{k}.csv`.
+const HISTORY: [&str; 20] = [
+    "t_s",
+    "axial_strain",
+    "volumetric_strain",
+    "sigma_xx_Pa",
+    "sigma_yy_Pa",
+    "sigma_xy_Pa",
+    "D_xx_1_s",
+    "D_yy_1_s",
+    "D_xy_1_s",
+    "p_Pa",
+    "q_Pa",
+    "sin_phi_mob",
+    "phi",
+    "Z",
+    "fabric_anisotropy",
+    "I",
+    "cell_corrections",
+    "fabric_angle_deg",
+    "q_axial_Pa",
+    "target_sigma_xx_Pa",
+];
+/// Columns of `compression_p{k}.csv`.
+const COMPRESSION: [&str; 7] = [
+    "t_s",
+    "sigma_xx_Pa",
+    "sigma_yy_Pa",
+    "phi",
+    "Z",
+    "cell_corrections",
+    "target_sigma_Pa",
+];
+/// Column indices of [`HISTORY`].
+const EA: usize = 1;
+const EV: usize = 2;
+const SXX: usize = 3;
+const SYY: usize = 4;
+const P: usize = 9;
+const PHI: usize = 12;
+const Z: usize = 13;
+const ANISO: usize = 14;
+const INERTIAL: usize = 15;
+const CORRECTIONS: usize = 16;
+
+/// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
+const GAIN_FRACTION: f64 = 0.3;
+/// Gain of the lateral control in the axial compression, as a fraction of `Δt/(ρ d²)`: lower
+/// than in the isotropic compression, so that the step-to-step noise of Σ_xx (tens of % of p₀
+/// for rigid grains) does not drive the lateral rate.
+const AXIAL_GAIN_FRACTION: f64 = 0.05;
+/// Cap of the lateral rate in the axial compression, in units of ε̇_a.
+const AXIAL_RATE_CAP: f64 = 3.0;
+/// Filter time of the lateral control in the axial compression, in time steps.
+const AXIAL_FILTER_STEPS: f64 = 10.0;
+/// Tolerance of the implicit correction of the cell control, as a fraction of p₀.
+const CONTROL_TOLERANCE: f64 = 0.5;
+/// Re-solves of a step at most by the implicit correction.
+const MAX_CORRECTIONS: usize = 8;
+/// Blocks of the block-averaged standard errors (at least).
+const MIN_BLOCKS: usize = 4;
+/// Fraction of the isotropic compression (its last steps) over which the reached stress is
+/// averaged and compared with −p₀.
+const COMPRESSION_TAIL: f64 = 0.2;
+/// Axial strain of a segment of the axial compression: after each, the lateral target moves
+/// by the mean error of Σ_xx over it, `σ* ← σ* − (⟨Σ_xx⟩ + p₀)` (an outer integral
+/// correction, which removes the bias of the proportional control of a packing that carries
+/// compression only).
+const SEGMENT_STRAIN: f64 = 0.005;
+/// Relative error `max(|⟨Σ_xx⟩ + p₀|, |⟨Σ_yy⟩ + p₀|)/p₀` of the stress reached by the isotropic
+/// compression (means over its last [`COMPRESSION_TAIL`]) above which the sample is suspect.
+/// The explicit control of a massless cell on rigid grains holds the stress of a jammed
+/// packing only through the impulses of its deformation (`dem::cell`): the stress of a step
+/// scatters by tens of % of p₀ and its mean sits 10–15 % on the tensile side of the target
+/// (measured: 14 % for 100 disks at p₀ = 1 kPa); the axial compression then brings the lateral
+/// stress to −p₀ (its own check).
+pub const COMPRESSION_ERROR_SUSPECT: f64 = 0.1;
+/// The same, above which it is refused.
+pub const COMPRESSION_ERROR_REFUSED: f64 = 0.25;
+/// Relative error `|⟨Σ_xx⟩ + p₀|/p₀` of the lateral stress over the axial compression (mean of
+/// every step, after the outer correction of each segment) above which the results are
+/// suspect.
+pub const LATERAL_ERROR_SUSPECT: f64 = 0.05;
+/// The same, above which they are refused.
+pub const LATERAL_ERROR_REFUSED: f64 = 0.15;
+/// Bound of a quasi-static test: the inertial number of the axial compression
+/// `I = ε̇_a d/√(⟨p⟩/ρ)` (with the mean pressure of the axial compression) must stay at or below
+/// it; suspect above (1).
+pub const QUASI_STATIC_I: f64 = 1e-3;
+/// Above this the axial compression is refused as not quasi-static (1).
+pub const QUASI_STATIC_I_REFUSED: f64 = 1e-2;
+/// Difference of the plateau halves of q/p that matters (absolute; `verdict::halves_drift`).
+pub const STEADY_SIN_PHI_TOLERANCE: f64 = 0.02;
+/// Difference of the plateau halves of φ that matters (absolute).
+pub const STEADY_PHI_TOLERANCE: f64 = 0.005;
+
+/// Columns of a per-pressure result row ([`State::rows`], `biaxial.csv`).
+const ROW: [&str; 25] = [
+    "p0_Pa",
+    "sin_phi_peak",
+    "axial_strain_peak",
+    "p_peak_Pa",
+    "q_peak_Pa",
+    "sin_phi_critical",
+    "sin_phi_critical_std_error",
+    "phi_critical",
+    "phi_critical_std_error",
+    "p_critical_Pa",
+    "Z_critical",
+    "sin_psi_max",
+    "axial_strain_psi_max",
+    "sin_psi_critical",
+    "lateral_stress_error",
+    "I_mean",
+    "compression_stress_error",
+    "phi_compressed",
+    "Z_compressed",
+    "axial_rate_1_s",
+    "dt_s",
+    "critical_samples",
+    "cell_corrections_per_step",
+    "fabric_anisotropy_critical",
+    "phi_initial_axial",
+];
+
+/// The plan of the current phase.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+struct RunPlan {
+    #[serde(with = "dem::serde_float")]
+    rate: f64,
+    #[serde(with = "dem::serde_float")]
+    dt: f64,
+    steps: u64,
+    n: u64,
+    /// Height and volume of the cell when the axial compression starts (m, m²).
+    #[serde(with = "dem::serde_float")]
+    h0: f64,
+    #[serde(with = "dem::serde_float")]
+    v0: f64,
+}
+
+/// What the checks of one pressure need.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+struct PressureCheck {
+    #[serde(with = "dem::serde_float")]
+    p0: f64,
+    /// Numerics of the axial compression.
+    window: WindowStats,
+    /// q/p and φ over the critical-state plateau.
+    #[serde(with = "crate::floats::vec")]
+    sin_phi: Vec<f64>,
+    #[serde(with = "crate::floats::vec")]
+    phi: Vec<f64>,
+}
+
+/// What the phases collect.
+#[derive(Serialize, Deserialize)]
+struct State {
+    all: PhaseStats,
+    /// One row per pressure ([`ROW`]).
+    #[serde(with = "crate::floats::table")]
+    rows: Vec<Vec<f64>>,
+    /// The current axial compression's history ([`HISTORY`]).
+    #[serde(with = "crate::floats::table")]
+    history: Vec<Vec<f64>>,
+    /// t, Σ_xx, Σ_yy, φ, Z, cell corrections of the steps of the current isotropic compression
+    /// ([`COMPRESSION`]).
+    #[serde(with = "crate::floats::table")]
+    compression: Vec<Vec<f64>>,
+    /// Binned curves of the finished pressures: rows (pressure index, ε_a, sin φ, ε_v, sin ψ,
+    /// hardening flag).
+    #[serde(with = "crate::floats::table")]
+    bins: Vec<Vec<f64>>,
+    run: RunPlan,
+    frames: VtkFrames,
+    window: WindowStats,
+    checks: Vec<PressureCheck>,
+    /// The imposed stress target of the current phase (Pa), after the outer correction.
+    #[serde(with = "dem::serde_float")]
+    target: f64,
+    /// Sums of Σ_xx, Σ_yy (Σ_xx twice in the axial compression) and steps of the current
+    /// phase, for the outer correction.
+    seg: (f64, f64, u64),
+}
+
+/// Bins of a history: per bin of `width` in ε_a (the first starting at ε_a = 0, bins with at
+/// least one sample), the means of ε_a, ε_v, I, Σ_xx, Σ_yy, p, and from the mean tensor the
+/// mobilised friction `sin φ = q_a/p`, `q_a = (⟨Σ_xx⟩ − ⟨Σ_yy⟩)/2` (σ₁ axial, σ₃ lateral, the
+/// shear stress averaging 0 under L_xy = 0): `[ε_a, sin φ, ε_v, I, p, q_a]`. The mean of the
+/// tensor, not of the step's q/p, which the noise of the step biases upward.
+fn bin_history(history: &[Vec<f64>], width: f64) -> Vec<[f64; 6]> {
+    let mut out: Vec<[f64; 6]> = Vec::new();
+    let mut acc = [0.0; 6];
+    let mut n = 0usize;
+    let mut current = 0i64;
+    let flush = |acc: &mut [f64; 6], n: &mut usize, out: &mut Vec<[f64; 6]>| {
+        if *n > 0 {
+            let m = acc.map(|v| v / *n as f64);
+            // m: ε_a, ε_v, I, Σ_xx, Σ_yy, p
+            let qa = 0.5 * (m[3] - m[4]);
+            out.push([m[0], qa / m[5], m[1], m[2], m[5], qa]);
+        }
+        *acc = [0.0; 6];
+        *n = 0;
+    };
+    for r in history {
+        let b = (r[EA] / width).floor() as i64;
+        if b != current {
+            flush(&mut acc, &mut n, &mut out);
+            current = b;
+        }
+        if r[INERTIAL].is_finite() {
+            for (a, j) in acc.iter_mut().zip([EA, EV, INERTIAL, SXX, SYY, P]) {
+                *a += r[j];
+            }
+            n += 1;
+        }
+    }
+    flush(&mut acc, &mut n, &mut out);
+    out
+}
+
+/// Mean of `num/den` as the ratio of the means `⟨num⟩/⟨den⟩`, with its block-averaged standard
+/// error by the delta method: the error of the mean of `(num_t − r den_t)/⟨den⟩`.
+fn ratio_of_means(num: &[f64], den: &[f64]) -> (f64, f64) {
+    let n = num.len().max(1) as f64;
+    let (mn, md) = (num.iter().sum::<f64>() / n, den.iter().sum::<f64>() / n);
+    let r = mn / md;
+    let y: Vec<f64> = num.iter().zip(den).map(|(a, b)| (a - r * b) / md).collect();
+    let se = block_average(&y, MIN_BLOCKS).map_or(f64::NAN, |a| a.std_error);
+    (r, se)
+}
+
+/// The 2D dilatancy angle of the dilatancy `d = −dε_v/dε_a` (compression positive):
+/// `sin ψ = −ε̇_v/ε̇_γ` with `ε̇_γ = 2 ε̇_a − ε̇_v`, i.e. `d/(2 + d)`.
+pub fn sin_psi_of_dilatancy(d: f64) -> f64 {
+    d / (2.0 + d)
+}
+
+struct Biaxial<'a> {
+    c: &'a BiaxialConfig,
+    pressures: Vec<f64>,
+}
+
+impl Biaxial<'_> {
+    /// The control of the cell at confining pressure `p0`, time step `dt`, mean diameter `d`:
+    /// the isotropic compression (`axial_rate` None) or the axial compression at that rate.
+    fn control(
+        &self,
+        p0: f64,
+        target: f64,
+        dt: f64,
+        d: f64,
+        axial_rate: Option<f64>,
+    ) -> CellControl {
+        let rho = self.c.grain.density;
+        let cap = self.c.control_inertial_number * (p0 / rho).sqrt() / d;
+        let (yy, max_rate, gf, tau) = match axial_rate {
+            None => (Imposed::Stress(target), cap, GAIN_FRACTION, 0.0),
+            // the lateral expansion of a dilating sample runs at ε̇_a (1 + d), d ≲ 1
+            Some(r) => (
+                Imposed::Rate(-r),
+                AXIAL_RATE_CAP * r,
+                AXIAL_GAIN_FRACTION,
+                AXIAL_FILTER_STEPS,
+            ),
+        };
+        CellControl {
+            xx: Imposed::Stress(target),
+            yy,
+            xy: Imposed::Rate(0.0),
+            gain: gf * dt / (rho * d * d),
+            max_rate,
+            relaxation: tau * dt,
+            tolerance: CONTROL_TOLERANCE * p0,
+            max_corrections: MAX_CORRECTIONS,
+        }
+    }
+
+    /// Closes an axial compression: the result row, the binned curves, the check data.
+    fn close_axial(&self, i: usize, st: &mut State, world: &dem::World) -> Result<()> {
+        let c = self.c;
+        let p0 = self.pressures[i];
+        let h = &st.history;
+        let bins = bin_history(h, c.bin_strain);
+        // the peak: the largest bin mean of q/p
+        let (kpeak, peak) =
+            bins.iter()
+                .enumerate()
+                .fold((0, f64::NEG_INFINITY), |(k, m), (j, b)| {
+                    if b[1] > m {
+                        (j, b[1])
+                    } else {
+                        (k, m)
+                    }
+                });
+        let (eps_peak, p_peak, q_peak) = bins
+            .get(kpeak)
+            .map_or((f64::NAN, f64::NAN, f64::NAN), |b| (b[0], b[4], b[5]));
+        // dilatancy between consecutive bins
+        let mut psi_max = (f64::NEG_INFINITY, f64::NAN);
+        let mut sin_psi = vec![f64::NAN; bins.len()];
+        for j in 1..bins.len() {
+            let de = bins[j][0] - bins[j - 1][0];
+            if de > 0.0 {
+                let d = -(bins[j][2] - bins[j - 1][2]) / de;
+                let s = sin_psi_of_dilatancy(d);
+                let x = 0.5 * (bins[j][0] + bins[j - 1][0]);
+                sin_psi[j] = s;
+                if s > psi_max.0 {
+                    psi_max = (s, x);
+                }
+            }
+        }
+        for (j, b) in bins.iter().enumerate() {
+            // mid-bin dilatancy between bins j−1 and j is attributed to bin j; the hardening
+            // phase: bins up to the peak
+            st.bins.push(vec![
+                i as f64,
+                b[0],
+                b[1],
+                b[2],
+                sin_psi[j],
+                if j <= kpeak { 1.0 } else { 0.0 },
+            ]);
+        }
+        let p_mean = h.iter().map(|r| r[P]).sum::<f64>() / h.len().max(1) as f64;
+        let i_mean = st.run.rate * mean_diameter(world) / (p_mean / c.grain.density).sqrt();
+        // the critical-state plateau
+        let start = c.max_axial_strain - c.critical_strain;
+        let tail: Vec<&Vec<f64>> = h.iter().filter(|r| r[EA] >= start).collect();
+        let col = |j: usize| -> Vec<f64> { tail.iter().map(|r| r[j]).collect() };
+        let avg = |j: usize| -> (f64, f64) {
+            block_average(&col(j), MIN_BLOCKS)
+                .map_or((f64::NAN, f64::NAN), |a| (a.mean, a.std_error))
+        };
+        let qa: Vec<f64> = tail.iter().map(|r| 0.5 * (r[SXX] - r[SYY])).collect();
+        let (sphi, sphi_se) = ratio_of_means(&qa, &col(P));
+        let (phi, phi_se) = avg(PHI);
+        let (pc, _) = avg(P);
+        let (zc, _) = avg(Z);
+        let (ac, _) = avg(ANISO);
+        // mean dilatancy over the plateau: slope of ε_v against ε_a
+        let (xe, ye) = (col(EA), col(EV));
+        let slope = {
+            let n = xe.len().max(1) as f64;
+            let mx = xe.iter().sum::<f64>() / n;
+            let my = ye.iter().sum::<f64>() / n;
+            let sxx: f64 = xe.iter().map(|x| (x - mx).powi(2)).sum();
+            let sxy: f64 = xe.iter().zip(&ye).map(|(x, y)| (x - mx) * (y - my)).sum();
+            if sxx > 0.0 {
+                sxy / sxx
+            } else {
+                f64::NAN
+            }
+        };
+        let sin_psi_c = sin_psi_of_dilatancy(-slope);
+        let sxx_mean = h.iter().map(|r| r[SXX]).sum::<f64>() / h.len().max(1) as f64;
+        let lateral = (sxx_mean + p0).abs() / p0;
+        let corr = h.iter().map(|r| r[CORRECTIONS]).sum::<f64>() / h.len().max(1) as f64;
+        let comp = st.rows.pop().unwrap_or_else(|| vec![f64::NAN; 3]);
+        st.rows.push(vec![
+            p0,
+            peak,
+            eps_peak,
+            p_peak,
+            q_peak,
+            sphi,
+            sphi_se,
+            phi,
+            phi_se,
+            pc,
+            zc,
+            psi_max.0,
+            psi_max.1,
+            sin_psi_c,
+            lateral,
+            i_mean,
+            comp[0],
+            comp[1],
+            comp[2],
+            st.run.rate,
+            st.run.dt,
+            tail.len() as f64,
+            corr,
+            ac,
+            h.first().map_or(f64::NAN, |r| r[PHI]),
+        ]);
+        st.checks.push(PressureCheck {
+            p0,
+            window: st.window,
+            sin_phi: qa.iter().zip(col(P)).map(|(q, p)| q / p).collect(),
+            phi: col(PHI),
+        });
+        Ok(())
+    }
+}
+
+/// What phase `k` of a run is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Part {
+    /// The isotropic compression of pressure `i`.
+    Compress,
+    /// Segment `j` of the axial compression.
+    Axial(usize),
+}
+
+impl Biaxial<'_> {
+    /// Segments of the axial compression.
+    fn segments(&self) -> usize {
+        (self.c.max_axial_strain / SEGMENT_STRAIN).ceil().max(1.0) as usize
+    }
+
+    /// Phases per pressure.
+    fn per_pressure(&self) -> usize {
+        1 + self.segments()
+    }
+
+    /// Pressure index and part of phase `k`.
+    fn part(&self, k: usize) -> (usize, Part) {
+        let (i, j) = (k / self.per_pressure(), k % self.per_pressure());
+        let part = if j == 0 {
+            Part::Compress
+        } else {
+            Part::Axial(j - 1)
+        };
+        (i, part)
+    }
+
+    /// The outer integral correction at the end of a phase: the target moves by the mean
+    /// error of the controlled stress over the phase, `σ* ← σ* − (⟨σ⟩ − (−p₀))`, within
+    /// `[−3 p₀, −p₀/3]`.
+    fn corrected_target(st: &State, p0: f64) -> f64 {
+        if st.seg.2 == 0 {
+            return st.target;
+        }
+        let mean = 0.5 * (st.seg.0 + st.seg.1) / st.seg.2 as f64;
+        (st.target - (mean + p0)).clamp(-3.0 * p0, -p0 / 3.0)
+    }
+}
+
+impl PhasedRun for Biaxial<'_> {
+    type State = State;
+
+    fn phase_count(&self) -> usize {
+        self.per_pressure() * self.pressures.len()
+    }
+
+    fn enter(
+        &self,
+        k: usize,
+        _env: &PhaseEnv,
+        world: &mut dem::World,
+        st: &mut State,
+        _out: &mut OutputDir,
+    ) -> Result<Option<PhasePlan>> {
+        let c = self.c;
+        let (i, part) = self.part(k);
+        let p0 = self.pressures[i];
+        let d = mean_diameter(world);
+        let dt = c.dt_max;
+        let target = match part {
+            Part::Compress | Part::Axial(0) => -p0,
+            Part::Axial(_) => Self::corrected_target(st, p0),
+        };
+        st.target = target;
+        st.seg = (0.0, 0.0, 0);
+        match part {
+            Part::Compress => {
+                // the same initial packing for every pressure
+                *world = datasets::build_cell::biaxial(c)?;
+                if c.preparation == Preparation::Dense {
+                    world.laws.set_friction(0, 0, 0.0);
+                }
+                st.compression.clear();
+                let d = mean_diameter(world);
+                world.params.dt = dt;
+                world.cell_control = Some(self.control(p0, target, dt, d, None));
+                world.validate(1e-9)?;
+                st.run = RunPlan {
+                    dt,
+                    steps: (c.compression_time / dt).ceil() as u64,
+                    ..Default::default()
+                };
+                Ok(Some(PhasePlan {
+                    name: format!("compress p0={p0}"),
+                    stop: Stop::Steps(st.run.steps),
+                }))
+            }
+            Part::Axial(j) => {
+                let rate = c.axial_rate(p0);
+                let total = (c.max_axial_strain / (rate * dt)).ceil() as u64;
+                let per = total.div_ceil(self.segments() as u64);
+                if j == 0 {
+                    world.laws.set_friction(0, 0, c.friction.grain_grain);
+                    let cell = *world.cell().ok_or_else(|| dem::DemError::Parameter {
+                        name: "cell".into(),
+                        reason: "the biaxial world has no biperiodic cell".into(),
+                    })?;
+                    world.params.dt = dt;
+                    // the lateral rate starts at rest (not at the compression's last value)
+                    world.set_velocity_gradient(Mat::new(0.0, 0.0, 0.0, -rate));
+                    st.run = RunPlan {
+                        rate,
+                        dt,
+                        steps: total,
+                        n: 0,
+                        h0: cell.h[(1, 1)],
+                        v0: cell.volume(),
+                    };
+                    st.history.clear();
+                    st.window.reset();
+                }
+                world.cell_control = Some(self.control(p0, target, dt, d, Some(rate)));
+                let steps = per.min(total.saturating_sub(st.run.n));
+                if steps == 0 {
+                    return Ok(None);
+                }
+                Ok(Some(PhasePlan {
+                    name: format!("axial p0={p0} ({}/{})", j + 1, self.segments()),
+                    stop: Stop::Steps(steps),
+                }))
+            }
+        }
+    }
+
+    fn step(
+        &self,
+        k: usize,
+        st: &mut State,
+        out: &mut OutputDir,
+        w: &dem::World,
+        r: &dem::StepReport,
+        p: &datasets::phases::PhaseProgress,
+    ) -> Result<()> {
+        let (i, part) = self.part(k);
+        if i + 1 == self.pressures.len() && matches!(part, Part::Axial(_)) {
+            st.frames.maybe(out, w)?;
+        }
+        let snap = w.snapshot();
+        let cs = cell_state(&snap)?;
+        let s = cs.stress;
+        if !matches!(part, Part::Axial(_)) {
+            st.seg = (st.seg.0 + s[(0, 0)], st.seg.1 + s[(1, 1)], st.seg.2 + 1);
+            st.compression.push(vec![
+                w.time,
+                s[(0, 0)],
+                s[(1, 1)],
+                cs.solid_fraction,
+                cs.coordination,
+                r.cell_corrections as f64,
+                st.target,
+            ]);
+            return Ok(());
+        }
+        st.seg = (st.seg.0 + s[(0, 0)], st.seg.1 + s[(0, 0)], st.seg.2 + 1);
+        st.run.n += 1;
+        st.window.step(true, w, r, &p.stats);
+        let Some(cell) = w.cell().copied() else {
+            return Ok(());
+        };
+        let d = mean_diameter(w);
+        let pm = cs.pressure;
+        let inertial = if pm > 0.0 {
+            st.run.rate * d / (pm / self.c.grain.density).sqrt()
+        } else {
+            f64::NAN
+        };
+        let f = cs.fabric;
+        let aniso = 2.0 * ((f[(0, 0)] - f[(1, 1)]).powi(2) + 4.0 * f[(0, 1)].powi(2)).sqrt();
+        let angle = 0.5 * (2.0 * f[(0, 1)]).atan2(f[(0, 0)] - f[(1, 1)]);
+        st.history.push(vec![
+            w.time,
+            -(cell.h[(1, 1)] / st.run.h0).ln(),
+            -(cell.volume() / st.run.v0).ln(),
+            s[(0, 0)],
+            s[(1, 1)],
+            s[(0, 1)],
+            cs.strain_rate[(0, 0)],
+            cs.strain_rate[(1, 1)],
+            cs.strain_rate[(0, 1)],
+            pm,
+            cs.deviator,
+            if pm > 0.0 { cs.deviator / pm } else { f64::NAN },
+            cs.solid_fraction,
+            cs.coordination,
+            aniso,
+            inertial,
+            r.cell_corrections as f64,
+            angle.to_degrees(),
+            0.5 * (s[(0, 0)] - s[(1, 1)]),
+            st.target,
+        ]);
+        Ok(())
+    }
+
+    fn leave(
+        &self,
+        k: usize,
+        st: &mut State,
+        out: &mut OutputDir,
+        world: &mut dem::World,
+        stats: &PhaseStats,
+    ) -> Result<()> {
+        st.all.merge(stats);
+        let (i, part) = self.part(k);
+        let p0 = self.pressures[i];
+        match part {
+            Part::Compress => {
+                // the stress reached: means over the last COMPRESSION_TAIL of the steps
+                let n = st.compression.len();
+                let m = ((n as f64 * COMPRESSION_TAIL).ceil() as usize).clamp(1, n.max(1));
+                let tail = &st.compression[n.saturating_sub(m)..];
+                let mean =
+                    |j: usize| tail.iter().map(|r| r[j]).sum::<f64>() / tail.len().max(1) as f64;
+                let err = (mean(1) + p0).abs().max((mean(2) + p0).abs()) / p0;
+                // kept until the axial compression closes the row
+                st.rows.push(vec![err, mean(3), mean(4)]);
+                let mut table = CsvTable::new(&COMPRESSION);
+                for row in &st.compression {
+                    table.push(row.clone());
+                }
+                table.comments.push(format!(
+                    "isotropic compression to p0 = {p0} Pa ({} preparation: grain friction {} during it): whole-cell mean stress (tension positive), solid fraction, coordination over force-carrying contacts, re-solves of the step by the cell control, the imposed target",
+                    self.c.preparation.as_str(),
+                    match self.c.preparation {
+                        Preparation::Dense => 0.0,
+                        Preparation::Loose => self.c.friction.grain_grain,
+                    }
+                ));
+                table.write(out, &format!("compression_p{}.csv", i + 1))?;
+                Ok(())
+            }
+            Part::Axial(_) => {
+                if st.run.n < st.run.steps {
+                    return Ok(());
+                }
+                let mut table = CsvTable::new(&HISTORY);
+                for row in &st.history {
+                    table.push(row.clone());
+                }
+                table.comments.push(format!(
+                    "biaxial compression at confining pressure p0 = {p0} Pa ({} preparation), axial rate {:.6e} 1/s along y with sigma_xx = -p0 held: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s); compression positive for the strains: axial_strain = -ln(H/H0), volumetric_strain = -ln(V/V0) (positive in contraction); p = -tr(sigma)/2, q = sqrt(((sigma_xx - sigma_yy)/2)^2 + sigma_xy^2), sin_phi_mob = q/p of the step (noisy: the analysis uses means of the tensor), q_axial = (sigma_xx - sigma_yy)/2; phi solid fraction, Z coordination and fabric over force-carrying contacts, fabric_anisotropy a = 2 (F1 - F2) of the fabric tensor F (Rothenburg & Bathurst 1989), fabric_angle_deg its major direction from x; I = rate d / sqrt(p/rho); cell_corrections counts the re-solves of the step by the cell control; target_sigma_xx the imposed lateral stress after the outer correction",
+                    self.c.preparation.as_str(),
+                    st.run.rate
+                ));
+                table.write(out, &format!("history_p{}.csv", i + 1))?;
+                self.close_axial(i, st, world)
+            }
+        }
+    }
+}
+
+/// Runs the scenario.
+pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    let mut pressures = c.confining_pressures.clone();
+    pressures.sort_by(f64::total_cmp);
+    let bx = Biaxial { c, pressures };
+    let fresh = || -> Result<(dem::World, State)> {
+        let world = datasets::build_cell::biaxial(c)?;
+        let p_last = *bx.pressures.last().unwrap_or(&1.0);
+        let t_last = c.compression_time + c.max_axial_strain / c.axial_rate(p_last);
+        Ok((
+            world,
+            State {
+                all: PhaseStats::default(),
+                rows: Vec::new(),
+                history: Vec::new(),
+                compression: Vec::new(),
+                bins: Vec::new(),
+                run: RunPlan::default(),
+                // frames of the last (highest) pressure's sample
+                frames: VtkFrames::new(t_last / 40.0, 41),
+                window: WindowStats::default(),
+                checks: Vec::new(),
+                target: 0.0,
+                seg: (0.0, 0.0, 0),
+            },
+        ))
+    };
+    let (world, state) = drive(ctx, ctl, &bx, fresh)?;
+    let State {
+        all,
+        rows,
+        bins,
+        frames,
+        checks,
+        ..
+    } = state;
+    frames.finish(&mut ctx.out, &world)?;
+    analyse(
+        c,
+        &bx.pressures,
+        ctx,
+        ctl,
+        &world,
+        &all,
+        &rows,
+        &bins,
+        &checks,
+    )
+}
+
+/// The checks, fits, laws, table, figures and summary of a finished run.
+#[allow(clippy::too_many_arguments)]
+fn analyse(
+    c: &BiaxialConfig,
+    pressures: &[f64],
+    ctx: &mut RunContext,
+    ctl: &RunControl,
+    world: &dem::World,
+    all: &PhaseStats,
+    rows: &[Vec<f64>],
+    bins: &[Vec<f64>],
+    checks: &[PressureCheck],
+) -> Result<RunOutcome> {
+    // --- checks (crate::verdict) ---
+    let mut common = Checks::new();
+    let mut critical = Checks::new();
+    let mut windows = WindowStats::default();
+    let phi_bound = max_solid_fraction(c.grain.radius_spread);
+    for (r, pc) in rows.iter().zip(checks) {
+        let label = format!("p0 = {} Pa", pc.p0);
+        common.window(&format!("{label}, axial compression"), &pc.window);
+        windows.merge(&pc.window);
+        common.at_most(
+            "biaxial.compression_stress_error",
+            r[16],
+            COMPRESSION_ERROR_SUSPECT,
+            Some(COMPRESSION_ERROR_REFUSED),
+            |t| {
+                format!(
+                    "{label}: the isotropic compression ended {:.2} % away from -p0 (means over its last {:.0} %; limit {:.0} %)",
+                    100.0 * r[16],
+                    100.0 * COMPRESSION_TAIL,
+                    100.0 * t
+                )
+            },
+        );
+        common.at_most(
+            "biaxial.lateral_stress_error",
+            r[14],
+            LATERAL_ERROR_SUSPECT,
+            Some(LATERAL_ERROR_REFUSED),
+            |t| {
+                format!(
+                    "{label}: the mean lateral stress of the axial compression is {:.2} % away from -p0 (limit {:.0} %)",
+                    100.0 * r[14],
+                    100.0 * t
+                )
+            },
+        );
+        common.at_most(
+            "biaxial.quasi_static",
+            r[15],
+            QUASI_STATIC_I,
+            Some(QUASI_STATIC_I_REFUSED),
+            |t| {
+                format!(
+                    "{label}: the inertial number of the axial compression is {:.2e} (with its mean pressure; limit {t:.0e})",
+                    r[15]
+                )
+            },
+        );
+        critical.steady(
+            "biaxial.steady_sin_phi",
+            &format!("{label}: q/p on the plateau"),
+            &pc.sin_phi,
+            STEADY_SIN_PHI_TOLERANCE,
+        );
+        critical.steady(
+            "biaxial.steady_phi",
+            &format!("{label}: φ on the plateau"),
+            &pc.phi,
+            STEADY_PHI_TOLERANCE,
+        );
+        critical.solid_fraction("biaxial.solid_fraction", &label, r[7], phi_bound);
+    }
+    let critical = {
+        let mut k = critical;
+        k.extend(&common);
+        k
+    };
+    let mut verdict = RunVerdict {
+        run: critical.clone(),
+        allow_suspect: ctl.allow_suspect,
+        ..Default::default()
+    };
+
+    // --- table ---
+    let mut table = CsvTable::new(&ROW);
+    for r in rows {
+        table.push(r.clone());
+    }
+    table.comments.push(format!(
+        "biaxial compression ({} preparation) at each confining pressure p0: peak = largest mean of sin_phi_mob = q/p over axial-strain bins of {}, p and q at the peak (means over its bin); critical = means over the last {} of axial strain with block-averaged standard errors; sin_psi = d/(2+d), d = -d(eps_v)/d(eps_a) between bins (2D dilatancy angle sin psi = -rate_v/rate_gamma), sin_psi_critical from the slope of eps_v over the plateau; lateral_stress_error = |<sigma_xx> + p0|/p0 over the axial compression, compression_stress_error the largest of |<sigma_xx> + p0|/p0 and |<sigma_yy> + p0|/p0 over the last 20 % of the isotropic compression; I_mean = rate d / sqrt(<p>/rho) over the axial compression",
+        c.preparation.as_str(),
+        c.bin_strain,
+        c.critical_strain
+    ));
+    let d = mean_diameter(world);
+    table.metadata = vec![
+        ("grain_diameter_m".into(), d),
+        ("grain_density_kg_m3".into(), c.grain.density),
+        ("grain_friction".into(), c.friction.grain_grain),
+    ];
+    table.write(&mut ctx.out, "biaxial.csv")?;
+
+    // --- summary: per pressure ---
+    let mut s = Summary::new();
+    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
+    s.int("grains", c.grains as u64)
+        .text("preparation", c.preparation.as_str())
+        .num("grain_friction", c.friction.grain_grain)
+        .num("mean_diameter_m", d)
+        .int("pressures", rows.len() as u64)
+        .num("inertial_number_target", c.inertial_number)
+        .num("quasi_static_bound_I", QUASI_STATIC_I);
+    let deg = |x: f64| x.asin().to_degrees();
+    for (k, r) in rows.iter().enumerate() {
+        let pre = format!("p{}", k + 1);
+        s.num(&format!("{pre}_confining_pressure_Pa"), r[0])
+            .num(&format!("{pre}_compression_stress_error"), r[16])
+            .num(&format!("{pre}_phi_compressed"), r[17])
+            .num(&format!("{pre}_Z_compressed"), r[18])
+            .num(&format!("{pre}_friction_peak_sin_phi"), r[1])
+            .num(&format!("{pre}_friction_peak_angle_deg"), deg(r[1]))
+            .num(&format!("{pre}_axial_strain_peak"), r[2])
+            .num(&format!("{pre}_friction_critical_sin_phi"), r[5])
+            .num(&format!("{pre}_friction_critical_sin_phi_std_error"), r[6])
+            .num(&format!("{pre}_friction_critical_angle_deg"), deg(r[5]))
+            .num(&format!("{pre}_solid_fraction_critical"), r[7])
+            .num(&format!("{pre}_solid_fraction_critical_std_error"), r[8])
+            .num(&format!("{pre}_Z_critical"), r[10])
+            .num(&format!("{pre}_fabric_anisotropy_critical"), r[23])
+            .num(&format!("{pre}_dilatancy_max_sin_psi"), r[11])
+            .num(&format!("{pre}_dilatancy_max_angle_deg"), deg(r[11]))
+            .num(&format!("{pre}_axial_strain_dilatancy_max"), r[12])
+            .num(&format!("{pre}_dilatancy_critical_sin_psi"), r[13])
+            .num(&format!("{pre}_lateral_stress_error"), r[14])
+            .num(&format!("{pre}_I"), r[15])
+            .num(&format!("{pre}_axial_rate_1_s"), r[19]);
+        headline.push(format!(
+            "p0 = {} Pa: peak sin φ = {:.4} at ε_a = {:.3}; critical sin φ = {:.4} ± {:.4} (s.e.), φ = {:.4} ± {:.4}; max sin ψ = {:.4}",
+            r[0], r[1], r[2], r[5], r[6], r[7], r[8], r[11]
+        ));
+    }
+    let provenance = crate::provenance::of_run(ctx, ctl, "biaxial", c.seed);
+    let out = &mut ctx.out;
+
+    // --- Mohr–Coulomb over the peaks ---
+    let n = rows.len();
+    let peaks = YieldData::Circles {
+        p_pa: rows.iter().map(|r| r[3]).collect(),
+        q_pa: rows.iter().map(|r| r[4]).collect(),
+    };
+    let mc_options = if n >= 4 {
+        MohrCoulombOptions::default()
+    } else {
+        MohrCoulombOptions::cohesionless()
+    };
+    let mut mc_line = None;
+    match fit_mohr_coulomb_with(&peaks, &mc_options) {
+        Ok(f) => {
+            fit_keys(&mut s, "friction_peak", &f.report.parameters);
+            fit_keys(
+                &mut s,
+                "friction_peak",
+                std::slice::from_ref(&f.friction_angle_deg),
+            );
+            s.num("friction_peak_r_squared", f.report.r_squared).flag(
+                "friction_peak_cohesion_fixed_zero",
+                mc_options.cohesion_fixed_zero,
+            );
+            headline.extend(parameter_lines(
+                "Mohr–Coulomb over the peaks, q = p sin φ + c cos φ",
+                f.report.r_squared,
+                &[f.friction_angle_deg.clone(), f.cohesion.clone()],
+            ));
+            mc_line = Some((
+                f.law.friction_angle_rad.sin(),
+                f.law.cohesion_pa * f.law.friction_angle_rad.cos(),
+            ));
+            export_law(
+                out,
+                &mut verdict,
+                "mohr_coulomb",
+                &CalibratedLaw::from_mohr_coulomb(&f, provenance.clone()),
+                common.clone(),
+            )?;
+        }
+        Err(e) => {
+            warn(&format!("Mohr–Coulomb fit over the peaks refused: {e}"));
+            s.text("friction_peak_fit_error", &e.to_string());
+            remove_stale_law(out, "mohr_coulomb")?;
+            verdict.run.fail(
+                "biaxial.mohr_coulomb_fit",
+                Verdict::Refused,
+                n as f64,
+                f64::NAN,
+                format!("no Mohr–Coulomb envelope over the peaks: {e}"),
+            );
+        }
+    }
+
+    // --- the critical state ---
+    let plateaus: Vec<PlateauMeasure> = rows
+        .iter()
+        .map(|r| PlateauMeasure {
+            pressure_pa: r[9],
+            sin_phi: r[5],
+            sin_phi_std_error: r[6],
+            solid_fraction: r[7],
+            solid_fraction_std_error: r[8],
+            blocks: MIN_BLOCKS,
+        })
+        .collect();
+    match fit_critical_state(&plateaus, 0.95) {
+        Ok(f) => {
+            fit_keys(
+                &mut s,
+                "friction_critical",
+                &[
+                    f.friction_angle.clone(),
+                    f.friction_angle_deg.clone(),
+                    f.sin_phi.clone(),
+                ],
+            );
+            fit_keys(
+                &mut s,
+                "solid_fraction_critical",
+                std::slice::from_ref(&f.solid_fraction),
+            );
+            s.num("friction_critical_sin_phi_value", f.sin_phi.value)
+                .num("solid_fraction_critical", f.solid_fraction.value);
+            headline.extend(parameter_lines(
+                "critical state (plateau means over the pressures)",
+                f.report.r_squared,
+                &[
+                    f.friction_angle_deg.clone(),
+                    f.sin_phi.clone(),
+                    f.solid_fraction.clone(),
+                ],
+            ));
+            export_law(
+                out,
+                &mut verdict,
+                "critical_state",
+                &CalibratedLaw::from_critical_state(&f, provenance.clone()),
+                critical.clone(),
+            )?;
+        }
+        Err(e) => {
+            warn(&format!("critical state refused: {e}"));
+            s.text("friction_critical_fit_error", &e.to_string());
+            remove_stale_law(out, "critical_state")?;
+            verdict.run.fail(
+                "biaxial.critical_state_fit",
+                Verdict::Refused,
+                n as f64,
+                f64::NAN,
+                format!("no critical state: {e}"),
+            );
+        }
+    }
+
+    // --- stress–dilatancy over the hardening phases ---
+    let hard: Vec<&Vec<f64>> = bins
+        .iter()
+        .filter(|b| b[5] > 0.5 && b[4].is_finite())
+        .collect();
+    let sd_data = StressDilatancyData {
+        sin_psi: hard.iter().map(|b| b[4]).collect(),
+        sin_phi: hard.iter().map(|b| b[2]).collect(),
+    };
+    let mut sd_line = None;
+    match fit_stress_dilatancy(&sd_data, &identify::FitOptions::default()) {
+        Ok(f) => {
+            fit_keys(&mut s, "stress_dilatancy", &f.report.parameters);
+            s.num("stress_dilatancy_r_squared", f.report.r_squared)
+                .int("stress_dilatancy_points", f.report.n as u64);
+            headline.extend(parameter_lines(
+                "stress–dilatancy over the hardening phases, sin φ = sin φ_cv + β sin ψ",
+                f.report.r_squared,
+                &f.report.parameters,
+            ));
+            sd_line = Some((f.law.sin_phi_c, f.law.beta));
+            export_law(
+                out,
+                &mut verdict,
+                "stress_dilatancy",
+                &CalibratedLaw::from_stress_dilatancy(&f, provenance.clone()),
+                common.clone(),
+            )?;
+        }
+        Err(e) => {
+            warn(&format!("stress–dilatancy fit refused: {e}"));
+            s.text("stress_dilatancy_fit_error", &e.to_string());
+            remove_stale_law(out, "stress_dilatancy")?;
+            verdict.run.fail(
+                "biaxial.stress_dilatancy_fit",
+                Verdict::Refused,
+                sd_data.sin_psi.len() as f64,
+                f64::NAN,
+                format!("no stress–dilatancy relation: {e}"),
+            );
+        }
+    }
+
+    // --- figures ---
+    let mut pq = XyPlot::new(
+        "Mobilised friction",
+        Axis::new("axial strain ε_a"),
+        Axis::new("sin φ_mob = q/p"),
+    );
+    let mut pv = XyPlot::new(
+        "Volumetric strain (positive in contraction)",
+        Axis::new("axial strain ε_a"),
+        Axis::new("ε_v = −ln(V/V₀)"),
+    );
+    for (k, p0) in pressures.iter().enumerate().take(rows.len()) {
+        let pts = |j: usize| -> Vec<(f64, f64)> {
+            bins.iter()
+                .filter(|b| b[0] as usize == k && b[j].is_finite())
+                .map(|b| (b[1], b[j]))
+                .collect()
+        };
+        let colour = PALETTE[k % PALETTE.len()];
+        pq.series.push(Series::new(
+            &format!("p₀ = {p0} Pa"),
+            Style::Line,
+            colour,
+            pts(2),
+        ));
+        pv.series.push(Series::new(
+            &format!("p₀ = {p0} Pa"),
+            Style::Line,
+            colour,
+            pts(3),
+        ));
+    }
+    pq.legend = LegendAt::LowerRight;
+    pv.legend = LegendAt::UpperLeft;
+    let mut pmc = XyPlot::new(
+        "Peak Mohr circles (compression positive)",
+        Axis::new("p = (σ₁ + σ₃)/2 (Pa)"),
+        Axis::new("q = (σ₁ − σ₃)/2 (Pa)"),
+    );
+    pmc.series.push(Series::new(
+        "peaks",
+        Style::Points,
+        PALETTE[0],
+        rows.iter().map(|r| (r[3], r[4])).collect(),
+    ));
+    if let Some((a, b)) = mc_line {
+        let pmax = rows.iter().map(|r| r[3]).fold(0.0, f64::max) * 1.1;
+        pmc.series.push(Series::new(
+            "q = p sin φ + c cos φ",
+            Style::Line,
+            PALETTE[1],
+            (0..=20)
+                .map(|j| {
+                    let x = pmax * j as f64 / 20.0;
+                    (x, a * x + b)
+                })
+                .collect(),
+        ));
+    }
+    pmc.legend = LegendAt::UpperLeft;
+    let mut psd = XyPlot::new(
+        "Stress–dilatancy (hardening phases)",
+        Axis::new("sin ψ = −ε̇_v / ε̇_γ"),
+        Axis::new("sin φ_mob"),
+    );
+    psd.series.push(Series::new(
+        "bins before the peak",
+        Style::Points,
+        PALETTE[2],
+        sd_data
+            .sin_psi
+            .iter()
+            .copied()
+            .zip(sd_data.sin_phi.iter().copied())
+            .collect(),
+    ));
+    if let Some((a, b)) = sd_line {
+        let (lo, hi) = sd_data
+            .sin_psi
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(*x), h.max(*x)));
+        psd.series.push(Series::new(
+            "sin φ_cv + β sin ψ",
+            Style::Line,
+            PALETTE[1],
+            vec![(lo, a + b * lo), (hi, a + b * hi)],
+        ));
+    }
+    psd.legend = LegendAt::UpperLeft;
+    draw_row(out, "biaxial.png", &[pq, pv], (1300, 650))?;
+    draw_row(out, "biaxial_fits.png", &[pmc, psd], (1300, 650))?;
+    solver_keys(&mut s, all);
+    windows.keys(&mut s, "window");
+    Ok(RunOutcome {
+        summary: s,
+        headline,
+        verdict,
+    })
+}
+
+/// The figures of one biaxial benchmark row ([`bench_rve`]).
+#[derive(Debug, Clone, Copy)]
+pub struct BiaxialBench {
+    /// Grains.
+    pub grains: usize,
+    /// Steps of the isotropic compression and its wall seconds.
+    pub compress_steps: usize,
+    /// Wall seconds of the compression.
+    pub compress_seconds: f64,
+    /// Timed steps of the axial compression.
+    pub axial_steps: usize,
+    /// Axial strain of one step `ε̇_a Δt` (1).
+    pub strain_per_step: f64,
+    /// Wall seconds per axial step.
+    pub seconds_per_step: f64,
+    /// Wall seconds per percent of axial strain, `0.01 / (ε̇_a Δt)` steps.
+    pub seconds_per_percent: f64,
+    /// Mean contacts, sweeps and re-solves (cell control) per axial step.
+    pub contacts: f64,
+    /// Mean sweeps per solve.
+    pub sweeps: f64,
+    /// Mean re-solves of a step by the cell control.
+    pub corrections: f64,
+    /// Axial steps stopped at the sweep cap.
+    pub unconverged: usize,
+}
+
+/// The biaxial benchmark row: the built-in `biaxial` scenario with `grains` grains at
+/// p₀ = 1 kPa, `compress_steps` steps of isotropic compression (not timed per step), then
+/// `axial_steps` timed steps of the axial compression (the scenario's own control and solver
+/// settings; rayon's global pool).
+pub fn bench_rve(grains: usize, compress_steps: usize, axial_steps: usize) -> Result<BiaxialBench> {
+    let loaded = datasets::scenario::load(
+        "biaxial",
+        &[
+            format!("grains={grains}"),
+            "confining_pressures=[1000.0]".to_string(),
+        ],
+    )?;
+    let datasets::Scenario::Biaxial(c) = loaded.scenario else {
+        return Err(crate::error::CliError::Usage(
+            "the built-in biaxial scenario is not a biaxial scenario".into(),
+        ));
+    };
+    let bx = Biaxial {
+        c: &c,
+        pressures: vec![1000.0],
+    };
+    let p0 = 1000.0;
+    let mut w = datasets::build_cell::biaxial(&c)?;
+    if c.preparation == Preparation::Dense {
+        w.laws.set_friction(0, 0, 0.0);
+    }
+    let d = mean_diameter(&w);
+    let dt = c.dt_max;
+    w.params.dt = dt;
+    w.cell_control = Some(bx.control(p0, -p0, dt, d, None));
+    let t0 = std::time::Instant::now();
+    for _ in 0..compress_steps {
+        w.step()?;
+    }
+    let compress_seconds = t0.elapsed().as_secs_f64();
+    w.laws.set_friction(0, 0, c.friction.grain_grain);
+    let rate = c.axial_rate(p0);
+    w.set_velocity_gradient(Mat::new(0.0, 0.0, 0.0, -rate));
+    w.cell_control = Some(bx.control(p0, -p0, dt, d, Some(rate)));
+    let (mut contacts, mut sweeps, mut corrections, mut unconverged) = (0usize, 0usize, 0u64, 0);
+    let t1 = std::time::Instant::now();
+    for _ in 0..axial_steps {
+        let r = w.step()?;
+        contacts += r.contacts;
+        sweeps += r.solver.iterations;
+        corrections += u64::from(r.cell_corrections);
+        unconverged += usize::from(!r.solver.converged);
+    }
+    let secs = t1.elapsed().as_secs_f64() / axial_steps.max(1) as f64;
+    let k = axial_steps.max(1) as f64;
+    Ok(BiaxialBench {
+        grains,
+        compress_steps,
+        compress_seconds,
+        axial_steps,
+        strain_per_step: rate * dt,
+        seconds_per_step: secs,
+        seconds_per_percent: secs * 0.01 / (rate * dt),
+        contacts: contacts as f64 / k,
+        sweeps: sweeps as f64 / k,
+        corrections: corrections as f64 / k,
+        unconverged,
+    })
+}
