@@ -192,45 +192,20 @@ impl Detector {
                 Shape::Disk { .. } => {
                     let d = disk_pos;
                     disk_pos += 1;
-                    self.neighbours.clear();
-                    // Fast disks meet every disk; every disk meets the fast ones.
-                    if self.fast.binary_search(&(d as u32)).is_ok() {
-                        for e in d + 1..nd {
-                            self.neighbours.push((self.disk_collider[e], e as u32));
-                        }
-                    } else {
-                        for &e in &self.fast {
-                            if e as usize > d {
-                                self.neighbours.push((self.disk_collider[e as usize], e));
-                            }
-                        }
-                    }
                     let cid = self.cell_of[d] as usize;
                     let (ix, iy) = ((cid % ncx) as isize, (cid / ncx) as isize);
-                    for dy in -1isize..=1 {
-                        let jy = iy + dy;
-                        if jy < 0 || jy >= ncy as isize {
-                            continue;
+                    let mut around = [None; 9];
+                    for (k, slot) in around.iter_mut().enumerate() {
+                        let jy = iy + k as isize / 3 - 1;
+                        let mut jx = ix + k as isize % 3 - 1;
+                        if periodic.is_some() {
+                            jx = jx.rem_euclid(ncx as isize);
                         }
-                        for dx in -1isize..=1 {
-                            let mut jx = ix + dx;
-                            if periodic.is_some() {
-                                jx = jx.rem_euclid(ncx as isize);
-                            } else if jx < 0 || jx >= ncx as isize {
-                                continue;
-                            }
-                            let c2 = jy as usize * ncx + jx as usize;
-                            for &e in &self.cell_items
-                                [self.cell_start[c2] as usize..self.cell_start[c2 + 1] as usize]
-                            {
-                                if (e as usize) > d {
-                                    self.neighbours.push((self.disk_collider[e as usize], e));
-                                }
-                            }
+                        if (0..ncy as isize).contains(&jy) && (0..ncx as isize).contains(&jx) {
+                            *slot = Some(jy as usize * ncx + jx as usize);
                         }
                     }
-                    self.neighbours.sort_unstable();
-                    self.neighbours.dedup();
+                    self.gather_neighbours(d, nd, &around);
                     for k in 0..self.neighbours.len() {
                         let (cj, e) = self.neighbours[k];
                         self.disk_disk(
@@ -742,36 +717,15 @@ impl Detector {
         }
         for d in 0..nd {
             let ci = self.disk_collider[d];
-            self.neighbours.clear();
-            if self.fast.binary_search(&(d as u32)).is_ok() {
-                for e in d + 1..nd {
-                    self.neighbours.push((self.disk_collider[e], e as u32));
-                }
-            } else {
-                for &e in &self.fast {
-                    if e as usize > d {
-                        self.neighbours.push((self.disk_collider[e as usize], e));
-                    }
-                }
-            }
             let cid = self.cell_of[d] as usize;
             let (i1, i2) = ((cid % n1) as isize, (cid / n1) as isize);
-            for d2 in -1isize..=1 {
-                let j2 = (i2 + d2).rem_euclid(n2 as isize) as usize;
-                for d1 in -1isize..=1 {
-                    let j1 = (i1 + d1).rem_euclid(n1 as isize) as usize;
-                    let c2 = j2 * n1 + j1;
-                    for &e in &self.cell_items
-                        [self.cell_start[c2] as usize..self.cell_start[c2 + 1] as usize]
-                    {
-                        if (e as usize) > d {
-                            self.neighbours.push((self.disk_collider[e as usize], e));
-                        }
-                    }
-                }
+            let mut around = [None; 9];
+            for (k, slot) in around.iter_mut().enumerate() {
+                let j2 = (i2 + k as isize / 3 - 1).rem_euclid(n2 as isize) as usize;
+                let j1 = (i1 + k as isize % 3 - 1).rem_euclid(n1 as isize) as usize;
+                *slot = Some(j2 * n1 + j1);
             }
-            self.neighbours.sort_unstable();
-            self.neighbours.dedup();
+            self.gather_neighbours(d, nd, &around);
             for k in 0..self.neighbours.len() {
                 let (cj, e) = self.neighbours[k];
                 self.disk_disk_cell(
@@ -790,6 +744,35 @@ impl Detector {
             }
         }
         Ok(())
+    }
+
+    /// The candidate partners of disk `d` (of `nd`) into `self.neighbours`, sorted and without
+    /// repeats: the higher disks of the grid cells `around` (`None`: outside the grid) and the
+    /// fast disks (a fast disk meets every disk; every disk meets the fast ones).
+    fn gather_neighbours(&mut self, d: usize, nd: usize, around: &[Option<usize>; 9]) {
+        self.neighbours.clear();
+        if self.fast.binary_search(&(d as u32)).is_ok() {
+            for e in d + 1..nd {
+                self.neighbours.push((self.disk_collider[e], e as u32));
+            }
+        } else {
+            for &e in &self.fast {
+                if e as usize > d {
+                    self.neighbours.push((self.disk_collider[e as usize], e));
+                }
+            }
+        }
+        for &c2 in around.iter().flatten() {
+            for &e in
+                &self.cell_items[self.cell_start[c2] as usize..self.cell_start[c2 + 1] as usize]
+            {
+                if (e as usize) > d {
+                    self.neighbours.push((self.disk_collider[e as usize], e));
+                }
+            }
+        }
+        self.neighbours.sort_unstable();
+        self.neighbours.dedup();
     }
 
     #[allow(clippy::too_many_arguments)]
