@@ -152,6 +152,34 @@ pub(crate) fn point_verdict_code(v: Option<&Verdict>) -> f64 {
     }
 }
 
+/// Writes `rheology.csv`: `rows` under `headers` (whose last one is `point_verdict`, filled
+/// here from `point_verdicts`), the table's `description`, how to fit it again, the meaning of
+/// `point_verdict` and the grain's diameter and density as metadata (the fits' `d`, `ρ_s`).
+pub(crate) fn write_rheology_table(
+    out: &mut OutputDir,
+    headers: &[&str],
+    rows: &[Vec<f64>],
+    point_verdicts: &[Verdict],
+    description: &str,
+    grain: GrainScale,
+) -> Result<()> {
+    let mut table = CsvTable::new(headers);
+    for (k, r) in rows.iter().enumerate() {
+        let mut r = r.clone();
+        r.push(point_verdict_code(point_verdicts.get(k)));
+        table.push(r);
+    }
+    table.comments.push(format!(
+        "{description}; fit again with grainlaw fit mu-i rheology.csv"
+    ));
+    table.comments.push("point_verdict: the point's own checks (averaging-window numerics, I against its target, steady state, solid fraction): 0 ok, 1 suspect, 2 refused".into());
+    table.metadata = vec![
+        ("grain_diameter_m".into(), grain.diameter_m),
+        ("grain_density_kg_m3".into(), grain.density_kg_m3),
+    ];
+    table.write(out, "rheology.csv")
+}
+
 /// Measured inertial number over its target (or the inverse) above which a run is suspect: the
 /// point then belongs to another part of μ(I) than planned (1).
 pub const I_FACTOR_SUSPECT: f64 = 2.0;
@@ -426,19 +454,18 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         "samples",
         "point_verdict",
     ];
-    let mut table = CsvTable::new(&headers);
-    for (k, r) in rows.iter().enumerate() {
-        let mut r = r.clone();
-        r.push(point_verdict_code(point_verdicts.get(k)));
-        table.push(r);
-    }
-    table.comments.push("steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip; fit again with grainlaw fit mu-i rheology.csv".into());
-    table.comments.push("point_verdict: the point's own checks (averaging-window numerics, I against its target, steady state, solid fraction): 0 ok, 1 suspect, 2 refused".into());
-    table.metadata = vec![
-        ("grain_diameter_m".into(), d),
-        ("grain_density_kg_m3".into(), c.grain.density),
-    ];
-    table.write(&mut ctx.out, "rheology.csv")?;
+    let grain = GrainScale {
+        diameter_m: d,
+        density_kg_m3: c.grain.density,
+    };
+    write_rheology_table(
+        &mut ctx.out,
+        &headers,
+        &rows,
+        &point_verdicts,
+        "steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip",
+        grain,
+    )?;
 
     // Fits.
     let series = RheologySeries {
@@ -453,10 +480,6 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     let opts = FitOptions::default();
     let provenance = crate::provenance::of_run(ctx, ctl, "shear-cell", c.seed);
     let prov = || provenance.clone();
-    let grain = GrainScale {
-        diameter_m: d,
-        density_kg_m3: c.grain.density,
-    };
     let mut s = Summary::new();
     s.int("grains", c.grains as u64)
         .num("pressure_Pa", c.pressure)

@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
-use super::shear_cell::{judge_points, point_verdict_code, PointJudgement, RunCheckData};
+use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -395,19 +395,18 @@ pub fn run(
         "cell_corrections_per_step",
         "point_verdict",
     ];
-    let mut table = CsvTable::new(&headers);
-    for (k, r) in rows.iter().enumerate() {
-        let mut r = r.clone();
-        r.push(point_verdict_code(point_verdicts.get(k)));
-        table.push(r);
-    }
-    table.comments.push("point_verdict: the point's own checks (averaging-window numerics, I against its target, steady state, solid fraction): 0 ok, 1 suspect, 2 refused".into());
-    table.comments.push("Lees-Edwards simple shear at imposed normal stress: means over the last average_strain with block-averaged standard errors; P is -sigma_yy, I is gamma_dot d / sqrt(P/rho), mu is |sigma_xy|/P; fit again with grainlaw fit mu-i rheology.csv".into());
-    table.metadata = vec![
-        ("grain_diameter_m".into(), d),
-        ("grain_density_kg_m3".into(), c.grain.density),
-    ];
-    table.write(&mut ctx.out, "rheology.csv")?;
+    let grain = GrainScale {
+        diameter_m: d,
+        density_kg_m3: c.grain.density,
+    };
+    super::shear_cell::write_rheology_table(
+        &mut ctx.out,
+        &headers,
+        &rows,
+        &point_verdicts,
+        "Lees-Edwards simple shear at imposed normal stress: means over the last average_strain with block-averaged standard errors; P is -sigma_yy, I is gamma_dot d / sqrt(P/rho), mu is |sigma_xy|/P",
+        grain,
+    )?;
 
     let series = RheologySeries {
         inertial_number: rows.iter().map(|r| r[1]).collect(),
@@ -421,10 +420,6 @@ pub fn run(
     };
     let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
     let prov = || provenance.clone();
-    let grain = GrainScale {
-        diameter_m: d,
-        density_kg_m3: c.grain.density,
-    };
     let mut s = Summary::new();
     let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
     let imin = is.iter().cloned().fold(f64::MAX, f64::min);
