@@ -40,6 +40,23 @@ pub struct HomogenisePlan {
     pub quiet: bool,
 }
 
+/// The stress columns of the whole-sample and per-grain tables (Pa, tension positive): the
+/// total mean stress, its contact (Love–Weber) part and its inertia part.
+const STRESS_COLUMNS: [&str; 12] = [
+    "sigma_xx_Pa",
+    "sigma_xy_Pa",
+    "sigma_yx_Pa",
+    "sigma_yy_Pa",
+    "contact_sigma_xx_Pa",
+    "contact_sigma_xy_Pa",
+    "contact_sigma_yx_Pa",
+    "contact_sigma_yy_Pa",
+    "inertia_sigma_xx_Pa",
+    "inertia_sigma_xy_Pa",
+    "inertia_sigma_yx_Pa",
+    "inertia_sigma_yy_Pa",
+];
+
 /// Parses `KEY=HEADER` column overrides.
 pub fn parse_columns(items: &[String]) -> Result<Vec<(String, String)>> {
     items
@@ -109,35 +126,31 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
     }
     let mut out = OutputDir::create(&plan.out)?;
     let started = std::time::Instant::now();
-    let mut table = CsvTable::new(&[
-        "step",
-        "time_s",
-        "grains",
-        "contacts",
-        "solid_fraction",
-        "z",
-        "z_without_rattlers",
-        "rattler_fraction",
-        "fabric_anisotropy",
-        "fabric_major_angle_rad",
-        "sigma_xx_Pa",
-        "sigma_xy_Pa",
-        "sigma_yx_Pa",
-        "sigma_yy_Pa",
-        "contact_sigma_xx_Pa",
-        "contact_sigma_xy_Pa",
-        "contact_sigma_yx_Pa",
-        "contact_sigma_yy_Pa",
-        "inertia_sigma_xx_Pa",
-        "inertia_sigma_xy_Pa",
-        "inertia_sigma_yx_Pa",
-        "inertia_sigma_yy_Pa",
-        "pressure_Pa",
-        "shear_stress_Pa",
-        "stress_ratio",
-        "mean_mobilisation",
-        "fraction_at_limit",
-    ]);
+    let mut table = CsvTable::new(
+        &[
+            &[
+                "step",
+                "time_s",
+                "grains",
+                "contacts",
+                "solid_fraction",
+                "z",
+                "z_without_rattlers",
+                "rattler_fraction",
+                "fabric_anisotropy",
+                "fabric_major_angle_rad",
+            ][..],
+            &STRESS_COLUMNS,
+            &[
+                "pressure_Pa",
+                "shear_stress_Pa",
+                "stress_ratio",
+                "mean_mobilisation",
+                "fraction_at_limit",
+            ],
+        ]
+        .concat(),
+    );
     table
         .comments
         .push("whole-sample means per snapshot (grainlaw homogenise)".into());
@@ -190,24 +203,8 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
         let whole_total = Tensor2::new(row[10], row[11], row[12], row[13]);
         let inv = stress_invariants(&whole_total);
         table.push(row);
-        let mut g = CsvTable::new(&[
-            "id",
-            "x_m",
-            "y_m",
-            "radius_m",
-            "sigma_xx_Pa",
-            "sigma_xy_Pa",
-            "sigma_yx_Pa",
-            "sigma_yy_Pa",
-            "contact_sigma_xx_Pa",
-            "contact_sigma_xy_Pa",
-            "contact_sigma_yx_Pa",
-            "contact_sigma_yy_Pa",
-            "inertia_sigma_xx_Pa",
-            "inertia_sigma_xy_Pa",
-            "inertia_sigma_yx_Pa",
-            "inertia_sigma_yy_Pa",
-        ]);
+        let mut g =
+            CsvTable::new(&[&["id", "x_m", "y_m", "radius_m"][..], &STRESS_COLUMNS].concat());
         g.comments.push(format!(
             "per-grain mean stress at step {} (t = {} s), accelerations: {}",
             s.step,
