@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{GrainSpec, SolverSpec};
+use super::common::{check_cell_compression, GrainSpec, SolverSpec};
 use super::simple_shear::CellFriction;
 use crate::error::{in_range, num, positive, DatasetError, Result};
 use crate::limits;
@@ -122,26 +122,12 @@ impl BiaxialConfig {
                 ),
             ));
         }
-        positive("dt_max", self.dt_max)?;
-        in_range(
-            "control_inertial_number",
-            self.control_inertial_number,
-            1e-6,
-            0.1,
-        )?;
-        positive("compression_time", self.compression_time)?;
-        in_range(
-            "initial_solid_fraction",
-            self.initial_solid_fraction,
-            0.2,
-            0.6,
-        )?;
-        self.solver.validate("solver")?;
-        limits::steps(
-            "compression_time",
-            "compression_time / dt_max",
-            self.compression_time,
+        check_cell_compression(
             self.dt_max,
+            self.control_inertial_number,
+            self.compression_time,
+            self.initial_solid_fraction,
+            &self.solver,
         )?;
         let d = 2.0 * self.grain.radius_mean;
         let p_min = self

@@ -220,3 +220,34 @@ pub fn check_dt(key: &str, dt: f64, max: f64) -> Result<f64> {
     }
     Ok(dt)
 }
+
+/// The keys of a biperiodic cell's isotropic compression, shared by `simple-shear` and
+/// `biaxial`: `dt_max` > 0, `control_inertial_number` in [10⁻⁶, 0.1] (the cap of the cell's
+/// strain rate under stress control), `compression_time` > 0 and at most
+/// [`limits`]-many steps of `dt_max`, `initial_solid_fraction` in [0.2, 0.6], and the solver
+/// table `solver`.
+pub fn check_cell_compression(
+    dt_max: f64,
+    control_inertial_number: f64,
+    compression_time: f64,
+    initial_solid_fraction: f64,
+    solver: &SolverSpec,
+) -> Result<()> {
+    positive("dt_max", dt_max)?;
+    in_range(
+        "control_inertial_number",
+        control_inertial_number,
+        1e-6,
+        0.1,
+    )?;
+    positive("compression_time", compression_time)?;
+    in_range("initial_solid_fraction", initial_solid_fraction, 0.2, 0.6)?;
+    solver.validate("solver")?;
+    limits::steps(
+        "compression_time",
+        "compression_time / dt_max",
+        compression_time,
+        dt_max,
+    )?;
+    Ok(())
+}

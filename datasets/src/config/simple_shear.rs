@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{GrainSpec, SolverSpec};
+use super::common::{check_cell_compression, GrainSpec, SolverSpec};
 use crate::error::{in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
 
@@ -98,27 +98,13 @@ impl SimpleShearConfig {
                 ),
             ));
         }
-        positive("dt_max", self.dt_max)?;
         in_range("travel_per_step", self.travel_per_step, 1e-4, 0.5)?;
-        in_range(
-            "control_inertial_number",
-            self.control_inertial_number,
-            1e-6,
-            0.1,
-        )?;
-        positive("compression_time", self.compression_time)?;
-        in_range(
-            "initial_solid_fraction",
-            self.initial_solid_fraction,
-            0.2,
-            0.6,
-        )?;
-        self.solver.validate("solver")?;
-        limits::steps(
-            "compression_time",
-            "compression_time / dt_max",
-            self.compression_time,
+        check_cell_compression(
             self.dt_max,
+            self.control_inertial_number,
+            self.compression_time,
+            self.initial_solid_fraction,
+            &self.solver,
         )?;
         let d = 2.0 * self.grain.radius_mean;
         let i_min = self
