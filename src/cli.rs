@@ -6,7 +6,7 @@
 //! grainlaw run --resume DIR [--checkpoint-every STEPS] [--checkpoint-seconds S] [--quiet]
 //! grainlaw scenarios [--show NAME]
 //! grainlaw fit LAW DATA.csv [--out law.json]
-//! grainlaw solve-fc PROBLEM.json [--tol T] [--method nlgs|newton|auto] [--out SOLUTION.json]
+//! grainlaw solve-fc PROBLEM.json [--tol T] [--method nlgs|newton|auto|lemke] [--out SOLUTION.json]
 //! grainlaw bench [--dir DIR] [--engine-grains N ...]
 //! ```
 //!
@@ -78,8 +78,9 @@ pub enum Command {
         /// Largest number of Gauss–Seidel sweeps.
         #[arg(long, default_value_t = 100_000)]
         max_iterations: usize,
-        /// The solver: nlgs (Gauss–Seidel), newton (proximal semismooth Newton) or auto
-        /// (Gauss–Seidel, then Newton if it stalls).
+        /// The solver: nlgs (Gauss–Seidel), newton (proximal semismooth Newton), auto
+        /// (Gauss–Seidel, then Newton if it stalls, then Lemke's method if still unconverged)
+        /// or lemke (Lemke's complementary pivoting method alone: exact).
         #[arg(long, default_value = "auto")]
         method: String,
         /// Write `{"r", "u", "iterations", "error", "seconds", "converged"}` here.

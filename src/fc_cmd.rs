@@ -24,8 +24,9 @@ pub fn parse_method(name: &str) -> Result<dem::fc::SolverMethod> {
         "nlgs" => Ok(dem::fc::SolverMethod::Nlgs),
         "newton" => Ok(dem::fc::SolverMethod::Newton),
         "auto" => Ok(dem::fc::SolverMethod::Auto),
+        "lemke" => Ok(dem::fc::SolverMethod::Lemke),
         other => Err(CliError::Usage(format!(
-            "--method must be nlgs, newton or auto, got `{other}`"
+            "--method must be nlgs, newton, auto or lemke, got `{other}`"
         ))),
     }
 }
@@ -64,8 +65,8 @@ pub fn solve_fc(
         return Err(CliError::NotConverged {
             path: problem.display().to_string(),
             reason: format!(
-                "did not reach the tolerance {tol:.0e} (error {:.3e} after {} sweeps and {} Newton iterations)",
-                report.solution.error, report.solution.iterations, report.method.newton.iterations
+                "did not reach the tolerance {tol:.0e} (error {:.3e} after {} sweeps, {} Newton iterations and {} Lemke pivots)",
+                report.solution.error, report.solution.iterations, report.method.newton.iterations, report.method.pivots
             ),
         });
     }

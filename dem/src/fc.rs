@@ -65,6 +65,7 @@ pub mod bench;
 pub mod block_csr;
 pub mod command;
 pub mod error;
+pub mod lemke;
 pub mod measure;
 pub mod method;
 pub mod newton;

@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 use crate::assemble::contact_problem;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
+use crate::fc::method::{exact_finish, Finish};
 use crate::fc::newton::{self, NewtonParams, NewtonWork};
 use crate::fc::FcOptions;
 use crate::local::{natural_map_residual, ContactStatus};
@@ -55,10 +56,17 @@ pub enum SolverMethod {
     /// The regularised semismooth Newton method of [`crate::fc::newton`] on the assembled
     /// problem, from the warm start.
     Newton,
-    /// Gauss–Seidel for at most [`SolverParams::auto_sweeps`] sweeps, then, if it has not
-    /// converged, Newton from its best iterate (the default).
+    /// Gauss–Seidel in chunks of [`SolverParams::auto_sweeps`] sweeps while it converges fast
+    /// enough, then, if it has not converged, Newton from its best iterate, then the exact
+    /// finish ([`crate::fc::method::exact_finish`]: the active-set solve, then Lemke's method),
+    /// then Gauss–Seidel for the sweeps left if all of these failed (the default).
     #[default]
     Auto,
+    /// Lemke's complementary pivoting method ([`crate::fc::lemke`]) on the assembled problem,
+    /// warm-started from the statuses of the stored impulses: an exact solution at the cost of
+    /// a few sparse pivots per contact, whatever the packing; Gauss–Seidel takes over if the
+    /// path fails.
+    Lemke,
 }
 
 impl SolverMethod {
@@ -68,6 +76,7 @@ impl SolverMethod {
             SolverMethod::Nlgs => "nlgs",
             SolverMethod::Newton => "newton",
             SolverMethod::Auto => "auto",
+            SolverMethod::Lemke => "lemke",
         }
     }
 }
@@ -102,10 +111,19 @@ pub struct SolverParams {
     /// Parameters of the Newton solver (`newton` and `auto`).
     #[serde(default)]
     pub newton: NewtonParams,
+    /// Largest number of contacts for which `auto` ends an unconverged solve with Lemke's
+    /// method (its cost grows as the square of the contacts: about 2.5 s for 700 contacts).
+    #[serde(default = "lemke_max_contacts")]
+    pub lemke_max_contacts: usize,
 }
 
 fn auto_sweeps() -> usize {
     100
+}
+
+/// Default of [`SolverParams::lemke_max_contacts`].
+pub fn lemke_max_contacts() -> usize {
+    3000
 }
 
 /// The stall test of `auto`: Gauss–Seidel, whose error went from `before` to `after` over the
@@ -152,6 +170,7 @@ impl Default for SolverParams {
             method: SolverMethod::Auto,
             auto_sweeps: auto_sweeps(),
             newton: NewtonParams::default(),
+            lemke_max_contacts: lemke_max_contacts(),
         }
     }
 }
@@ -172,6 +191,9 @@ pub struct SolveReport {
     /// Newton iterations (factorisations) done after the sweeps (0 with `nlgs`).
     #[serde(default)]
     pub newton_iterations: usize,
+    /// Pivots of Lemke's method (0 unless it ran).
+    #[serde(default)]
+    pub pivots: usize,
 }
 
 pub use crate::nlgs::{STAGNATION_WINDOW, STALL_SWEEPS};
@@ -385,6 +407,27 @@ pub fn solve(
     if params.method == SolverMethod::Nlgs {
         return nlgs(&mut step, params, params.max_iterations, drive_work);
     }
+    if params.method == SolverMethod::Lemke {
+        let mut stages = EngineStages {
+            step: &mut step,
+            params,
+            drive_work,
+            newton_work,
+            report: SolveReport::default(),
+        };
+        let Ok(true) = stages.finish(true) else {
+            // The path failed (or the warm start was already the answer's best): sweeps.
+            let pivots = stages.report.pivots;
+            let r = nlgs(
+                stages.step,
+                params,
+                params.max_iterations,
+                stages.drive_work,
+            );
+            return SolveReport { pivots, ..r };
+        };
+        return stages.report;
+    }
     if backoff.params != Some(*params) {
         // New solver settings (a new phase): Newton gets a fresh chance.
         *backoff = NewtonBackoff {
@@ -424,15 +467,17 @@ pub(crate) trait AutoStages {
     fn sweeps(&mut self, sweeps: usize) -> Result<(usize, f64, bool), Self::Error>;
     /// The Newton stage, with at most `sweeps` smoothing sweeps: `(smoothing sweeps, converged)`.
     fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), Self::Error>;
-    /// The active-set finish ([`crate::fc::newton::active_set_finish`]) from the current
-    /// iterate, kept when it lowers the error: whether the solve has now converged.
-    fn finish(&mut self) -> Result<bool, Self::Error>;
+    /// The exact finish ([`crate::fc::method::exact_finish`]: the active-set solve, then, if
+    /// `lemke`, Lemke's method) from the current iterate, kept when it lowers the error:
+    /// whether the solve has now converged.
+    fn finish(&mut self, lemke: bool) -> Result<bool, Self::Error>;
 }
 
 /// The `auto` schedule, for both the engine and `solve-fc`: Gauss–Seidel in chunks of `chunk`
 /// sweeps as long as [`gauss_seidel_will_finish`] (from the error `start_error` of the starting
-/// iterate); then, unless `backoff` says to skip it, Newton; then Gauss–Seidel for the sweeps
-/// left of `max_sweeps`; then, still unconverged, one active-set finish. `chunk = 0` goes
+/// iterate); then, unless `backoff` says to skip it, Newton; then the exact finish (the
+/// active-set solve, then Lemke's method); then, if that failed, Gauss–Seidel for the sweeps
+/// left of `max_sweeps` and one more active-set solve from where they end. `chunk = 0` goes
 /// straight to Newton (the `newton` method). The back-off records the Newton stage's outcome.
 /// The stages keep their own report.
 pub(crate) fn run_auto<S: AutoStages>(
@@ -474,10 +519,12 @@ pub(crate) fn run_auto<S: AutoStages>(
             }
         }
     }
-    if done < max_sweeps && stages.sweeps(max_sweeps - done)?.2 {
+    if stages.finish(true)? {
         return Ok(());
     }
-    stages.finish()?;
+    if done < max_sweeps && !stages.sweeps(max_sweeps - done)?.2 {
+        stages.finish(false)?;
+    }
     Ok(())
 }
 
@@ -513,16 +560,30 @@ impl AutoStages for EngineStages<'_, '_> {
         Ok((r.iterations, r.converged))
     }
 
-    fn finish(&mut self) -> Result<bool, Self::Error> {
+    fn finish(&mut self, lemke: bool) -> Result<bool, Self::Error> {
         let step = &mut *self.step;
         let error_now = step.error();
-        if error_now.is_nan() || error_now > newton::FINISH_MAX_ERROR {
+        if error_now.is_nan() {
             return Ok(false);
         }
         let problem = contact_problem(step.rows, step.v_free, step.inv);
         let r: Vec<f64> = step.rows.iter().flat_map(|c| c.r).collect();
-        let Ok(Some((better, _))) =
-            newton::active_set_finish(&problem, &r, error_now, self.newton_work)
+        let max_contacts = match (lemke, self.params.method) {
+            (false, _) => 0,
+            (true, SolverMethod::Lemke) => usize::MAX,
+            (true, _) => self.params.lemke_max_contacts,
+        };
+        let finish = exact_finish(
+            &problem,
+            &r,
+            error_now,
+            self.params.tolerance,
+            max_contacts,
+            self.newton_work,
+        );
+        let Ok(Some(Finish {
+            r: better, pivots, ..
+        })) = finish
         else {
             return Ok(false);
         };
@@ -545,7 +606,8 @@ impl AutoStages for EngineStages<'_, '_> {
             error,
             converged,
             approach_speed: approach,
-            newton_iterations: self.report.newton_iterations + 1,
+            newton_iterations: self.report.newton_iterations + usize::from(pivots == 0),
+            pivots: self.report.pivots + pivots,
             ..self.report
         };
         Ok(converged)
@@ -681,6 +743,7 @@ fn global(
         converged: error <= params.tolerance && approach <= approach_limit,
         approach_speed: approach,
         newton_iterations,
+        pivots: 0,
     }
 }
 
@@ -730,6 +793,7 @@ fn nlgs(
         converged: report.converged,
         approach_speed: step.approach_speed(),
         newton_iterations: 0,
+        pivots: 0,
     }
 }
 

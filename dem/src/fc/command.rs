@@ -34,17 +34,18 @@ pub struct SolveReport {
 }
 
 impl fmt::Display for SolveReport {
-    /// One line: `problem=… contacts=… method=… iterations=… newton_iterations=… error=…
+    /// One line: `problem=… contacts=… method=… iterations=… newton_iterations=… pivots=… error=…
     /// verified_error=… seconds=… converged=…`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "problem={} contacts={} method={} iterations={} newton_iterations={} error={:.3e} verified_error={:.3e} tolerance={:.1e} seconds={:.4} converged={}",
+            "problem={} contacts={} method={} iterations={} newton_iterations={} pivots={} error={:.3e} verified_error={:.3e} tolerance={:.1e} seconds={:.4} converged={}",
             self.problem,
             self.contacts,
             self.method.method.name(),
             self.solution.iterations,
             self.method.newton.iterations,
+            self.method.pivots,
             self.solution.error,
             self.verified_error,
             self.tolerance,

@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use super::error::FcError;
+use super::lemke::{self, LemkeParams};
 use super::newton::{self, NewtonParams, NewtonStats};
 use super::nsgs::{self, FcOptions, FcSolution};
 use super::problem::FcProblem;
@@ -23,6 +24,70 @@ pub struct MethodReport {
     /// Newton iterations, line-search failures and smoothing sweeps (all zero if Newton did not
     /// run).
     pub newton: NewtonStats,
+    /// Pivots of Lemke's method (0 if it did not run).
+    pub pivots: usize,
+}
+
+/// What [`exact_finish`] returns: better impulses, their error and the pivots spent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finish {
+    /// The impulses (in their cones).
+    pub r: Vec<f64>,
+    /// Their error measure.
+    pub error: f64,
+    /// Pivots of Lemke's method (0 when the active-set solve was enough).
+    pub pivots: usize,
+}
+
+/// The exact finish of an unconverged solve (the last stage of `auto`, in the engine and in
+/// `solve-fc`), from impulses `r` whose error is `error_now`:
+///
+/// 1. when `error_now ≤` [`newton::FINISH_MAX_ERROR`], one active-set solve with the statuses
+///    read from `r` ([`newton::active_set_finish`], one sparse LU); done if it reaches
+///    `tolerance`;
+/// 2. otherwise, for at most `max_contacts` contacts, Lemke's method ([`lemke::solve`]), warm
+///    from the statuses of `r`, then cold: an exact solution of the 2D problem (every problem of
+///    `datasets/fc-problems/hard/` to ≤ 10⁻¹²).
+///
+/// Returns the best impulses found when they lower the error, else `None`.
+pub fn exact_finish(
+    problem: &FcProblem,
+    r: &[f64],
+    error_now: f64,
+    tolerance: f64,
+    max_contacts: usize,
+    work: &mut newton::NewtonWork,
+) -> Result<Option<Finish>, FcError> {
+    let mut best: Option<Finish> = None;
+    if let Some((r1, e1)) = newton::active_set_finish(problem, r, error_now, work)? {
+        best = Some(Finish {
+            r: r1,
+            error: e1,
+            pivots: 0,
+        });
+        if e1 <= tolerance {
+            return Ok(best);
+        }
+    }
+    if problem.contacts() <= max_contacts {
+        let (r2, report) = lemke::solve(problem, Some(r), &LemkeParams::default())?;
+        let floor = best.as_ref().map_or(error_now, |b| b.error);
+        match r2 {
+            Some(r2) if report.error < floor => {
+                return Ok(Some(Finish {
+                    r: r2,
+                    error: report.error,
+                    pivots: report.pivots,
+                }))
+            }
+            _ => {
+                if let Some(b) = best.as_mut() {
+                    b.pivots = report.pivots;
+                }
+            }
+        }
+    }
+    Ok(best)
 }
 
 /// Solves `problem` with `method`:
@@ -43,7 +108,11 @@ pub fn solve_by(
     params: &NewtonParams,
 ) -> Result<(FcSolution, MethodReport), FcError> {
     params.validate()?;
-    let report = |newton| MethodReport { method, newton };
+    let report = |newton| MethodReport {
+        method,
+        newton,
+        pivots: 0,
+    };
     match method {
         SolverMethod::Nlgs => Ok((
             nsgs::solve(problem, options)?,
@@ -57,6 +126,33 @@ pub fn solve_by(
                     ..s
                 },
                 report(stats),
+            ))
+        }
+        SolverMethod::Lemke => {
+            let t0 = std::time::Instant::now();
+            let (r, lr) = lemke::solve(
+                problem,
+                options.initial_guess.as_deref(),
+                &LemkeParams::default(),
+            )?;
+            let converged = r.is_some() && lr.error <= options.tolerance;
+            let r = r.unwrap_or_else(|| vec![0.0; 2 * problem.contacts()]);
+            let error = super::measure::fc_error(problem, &r);
+            let u = problem.velocity(&r);
+            Ok((
+                FcSolution {
+                    r,
+                    u,
+                    iterations: 0,
+                    error,
+                    seconds: t0.elapsed().as_secs_f64(),
+                    converged,
+                },
+                MethodReport {
+                    method,
+                    newton: NewtonStats::default(),
+                    pivots: lr.pivots,
+                },
             ))
         }
         SolverMethod::Auto => {
@@ -73,6 +169,7 @@ pub fn solve_by(
                 last: None,
                 stats: NewtonStats::default(),
                 sweeps: 0,
+                pivots: 0,
                 seconds: 0.0,
             };
             run_auto(
@@ -90,7 +187,10 @@ pub fn solve_by(
                     seconds: stages.seconds,
                     ..solution
                 },
-                report(stages.stats),
+                MethodReport {
+                    pivots: stages.pivots,
+                    ..report(stages.stats)
+                },
             ))
         }
     }
@@ -108,6 +208,8 @@ struct FcStages<'a> {
     stats: NewtonStats,
     /// Gauss–Seidel sweeps in all (smoothing included).
     sweeps: usize,
+    /// Pivots of Lemke's method.
+    pivots: usize,
     seconds: f64,
 }
 
@@ -147,21 +249,34 @@ impl AutoStages for FcStages<'_> {
         Ok(out)
     }
 
-    fn finish(&mut self) -> Result<bool, FcError> {
+    fn finish(&mut self, lemke: bool) -> Result<bool, FcError> {
         let Some(last) = self.last.as_ref() else {
             return Ok(false);
         };
         let t0 = std::time::Instant::now();
         let mut work = newton::NewtonWork::default();
-        let Some((r, error)) =
-            newton::active_set_finish(self.problem, &last.r, last.error, &mut work)?
-        else {
+        let finish = exact_finish(
+            self.problem,
+            &last.r,
+            last.error,
+            self.options.tolerance,
+            if lemke {
+                crate::solver::lemke_max_contacts()
+            } else {
+                0
+            },
+            &mut work,
+        )?;
+        let Some(Finish { r, error, pivots }) = finish else {
             self.seconds += t0.elapsed().as_secs_f64();
             return Ok(false);
         };
         let u = self.problem.velocity(&r);
         let converged = error <= self.options.tolerance;
-        self.stats.iterations += 1;
+        self.pivots += pivots;
+        if pivots == 0 {
+            self.stats.iterations += 1;
+        }
         self.keep(FcSolution {
             r,
             u,
