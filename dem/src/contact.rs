@@ -39,6 +39,12 @@ pub struct ContactRow {
     pub mu: f64,
     /// Impulse `(r_n, r_t)` (N·s).
     pub r: [f64; 2],
+    /// The contact's part of the final basis of the last Lemke solve that ended a step's solve
+    /// ([`crate::fc::lemke::Warm::basis`]: bit `j` set where `z_j` of `(r_n, β⁺, β⁻, λ)` is
+    /// basic), carried from step to step with the impulse as the next Lemke path's warm start;
+    /// 0 for a new contact.
+    #[serde(default)]
+    pub basis: u8,
 }
 
 impl ContactRow {
@@ -189,8 +195,10 @@ impl ContactSet {
             if j < pk.len() && pk[j].key == g.key {
                 let r = previous.rows[j].r;
                 self.rows[i].r = [r[0] * scale, r[1] * scale];
+                self.rows[i].basis = previous.rows[j].basis;
             } else {
                 self.rows[i].r = [0.0, 0.0];
+                self.rows[i].basis = 0;
             }
         }
     }

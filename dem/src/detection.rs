@@ -562,6 +562,7 @@ fn push_contact(
         },
         mu: laws.friction(ca.material, cb.material),
         r: [0.0, 0.0],
+        basis: 0,
     });
     out.geometry.push(ContactGeometry {
         key: ((ci as u64) << 32) | cj as u64,

@@ -112,7 +112,8 @@ pub struct SolverParams {
     #[serde(default)]
     pub newton: NewtonParams,
     /// Largest number of contacts for which `auto` ends an unconverged solve with Lemke's
-    /// method (its cost grows as the square of the contacts: about 2.5 s for 700 contacts).
+    /// method (default 400: its cost grows as the square of the contacts, 2–7 s a step at 700
+    /// contacts; raise it to trade time for converged steps in larger packings).
     #[serde(default = "lemke_max_contacts")]
     pub lemke_max_contacts: usize,
 }
@@ -121,9 +122,10 @@ fn auto_sweeps() -> usize {
     100
 }
 
-/// Default of [`SolverParams::lemke_max_contacts`].
+/// Default of [`SolverParams::lemke_max_contacts`]: 400 contacts, where one cold Lemke path
+/// takes about 0.5 s (its cost grows as the square of the contacts: 2–7 s at 700).
 pub fn lemke_max_contacts() -> usize {
-    3000
+    400
 }
 
 /// The stall test of `auto`: Gauss–Seidel, whose error went from `before` to `after` over the
@@ -415,7 +417,7 @@ pub fn solve(
             newton_work,
             report: SolveReport::default(),
         };
-        let Ok(true) = stages.finish(true) else {
+        let Ok((true, _)) = stages.finish(true) else {
             // The path failed (or the warm start was already the answer's best): sweeps.
             let pivots = stages.report.pivots;
             let r = nlgs(
@@ -469,8 +471,8 @@ pub(crate) trait AutoStages {
     fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), Self::Error>;
     /// The exact finish ([`crate::fc::method::exact_finish`]: the active-set solve, then, if
     /// `lemke`, Lemke's method) from the current iterate, kept when it lowers the error:
-    /// whether the solve has now converged.
-    fn finish(&mut self, lemke: bool) -> Result<bool, Self::Error>;
+    /// whether the solve has now converged, and whether Lemke's method ran.
+    fn finish(&mut self, lemke: bool) -> Result<(bool, bool), Self::Error>;
 }
 
 /// The `auto` schedule, for both the engine and `solve-fc`: Gauss–Seidel in chunks of `chunk`
@@ -503,14 +505,15 @@ pub(crate) fn run_auto<S: AutoStages>(
             return Ok(());
         }
     }
-    match backoff {
+    let mut backoff = backoff;
+    match backoff.as_deref_mut() {
         Some(b) if b.skip > 0 => {
             // Newton failed on a recent step: Gauss–Seidel alone for the sweeps left.
             b.skip -= 1;
         }
-        backoff => {
+        b => {
             let (used, converged) = stages.newton(max_sweeps - done)?;
-            if let Some(b) = backoff {
+            if let Some(b) = b {
                 b.record(converged);
             }
             done += used;
@@ -519,7 +522,19 @@ pub(crate) fn run_auto<S: AutoStages>(
             }
         }
     }
-    if stages.finish(true)? {
+    let lemke = match backoff.as_deref_mut() {
+        Some(b) if b.lemke_skip > 0 => {
+            // Lemke's path failed on a recent step.
+            b.lemke_skip -= 1;
+            false
+        }
+        _ => true,
+    };
+    let (converged, lemke_ran) = stages.finish(lemke)?;
+    if let (Some(b), true) = (backoff.as_deref_mut(), lemke_ran) {
+        b.record_lemke(converged);
+    }
+    if converged {
         return Ok(());
     }
     if done < max_sweeps && !stages.sweeps(max_sweeps - done)?.2 {
@@ -560,35 +575,46 @@ impl AutoStages for EngineStages<'_, '_> {
         Ok((r.iterations, r.converged))
     }
 
-    fn finish(&mut self, lemke: bool) -> Result<bool, Self::Error> {
+    fn finish(&mut self, lemke: bool) -> Result<(bool, bool), Self::Error> {
         let step = &mut *self.step;
         let error_now = step.error();
         if error_now.is_nan() {
-            return Ok(false);
+            return Ok((false, false));
         }
         let problem = contact_problem(step.rows, step.v_free, step.inv);
         let r: Vec<f64> = step.rows.iter().flat_map(|c| c.r).collect();
+        let warm_basis: Vec<u8> = step.rows.iter().map(|c| c.basis).collect();
         let max_contacts = match (lemke, self.params.method) {
             (false, _) => 0,
             (true, SolverMethod::Lemke) => usize::MAX,
             (true, _) => self.params.lemke_max_contacts,
         };
+        let lemke_ran = step.rows.len() <= max_contacts;
         let finish = exact_finish(
             &problem,
             &r,
             error_now,
             self.params.tolerance,
             max_contacts,
+            Some(&warm_basis),
             self.newton_work,
         );
         let Ok(Some(Finish {
-            r: better, pivots, ..
+            r: better,
+            pivots,
+            basis,
+            ..
         })) = finish
         else {
-            return Ok(false);
+            return Ok((false, lemke_ran));
         };
         for (c, x) in step.rows.iter_mut().zip(better.chunks_exact(2)) {
             c.r = [x[0], x[1]];
+        }
+        if let Some(basis) = &basis {
+            for (c, &b) in step.rows.iter_mut().zip(basis) {
+                c.basis = b;
+            }
         }
         step.rebuild();
         let error = step.error();
@@ -598,7 +624,7 @@ impl AutoStages for EngineStages<'_, '_> {
                 c.r = [x[0], x[1]];
             }
             step.rebuild();
-            return Ok(false);
+            return Ok((false, lemke_ran));
         }
         let approach = step.approach_speed();
         let converged = error <= self.params.tolerance && approach <= step.approach_limit;
@@ -610,7 +636,7 @@ impl AutoStages for EngineStages<'_, '_> {
             pivots: self.report.pivots + pivots,
             ..self.report
         };
-        Ok(converged)
+        Ok((converged, lemke_ran))
     }
 }
 
@@ -824,6 +850,14 @@ pub struct NewtonBackoff {
     /// tighter tolerance) start afresh.
     #[serde(default)]
     pub params: Option<SolverParams>,
+    /// Stalled steps left before Lemke's method is tried again (the same doubling rule: a
+    /// path that ends on a ray, as in a jammed packing whose deformation is imposed, where the
+    /// contact problem has no solution, is not retried on every step).
+    #[serde(default)]
+    pub lemke_skip: u32,
+    /// The `lemke_skip` that the next failure of Lemke's method sets.
+    #[serde(default)]
+    pub lemke_next: u32,
 }
 
 impl NewtonBackoff {
@@ -838,6 +872,17 @@ impl NewtonBackoff {
         } else {
             self.skip = self.next.max(1);
             self.next = (self.skip * 2).min(Self::MAX_SKIP);
+        }
+    }
+
+    /// Records the outcome of Lemke's method (converged or not), as [`NewtonBackoff::record`].
+    pub fn record_lemke(&mut self, converged: bool) {
+        if converged {
+            self.lemke_skip = 0;
+            self.lemke_next = 0;
+        } else {
+            self.lemke_skip = self.lemke_next.max(1);
+            self.lemke_next = (self.lemke_skip * 2).min(Self::MAX_SKIP);
         }
     }
 }

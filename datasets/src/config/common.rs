@@ -128,9 +128,14 @@ pub struct SolverSpec {
     /// thread count. Default false.
     #[serde(default)]
     pub parallel: bool,
-    /// The algorithm: `"nlgs"`, `"newton"` or `"auto"` (default; [`dem::solver::SolverMethod`]).
+    /// The algorithm: `"nlgs"`, `"newton"`, `"auto"` (default) or `"lemke"`
+    /// ([`dem::solver::SolverMethod`]).
     #[serde(default)]
     pub method: dem::solver::SolverMethod,
+    /// Largest step (contacts) that `auto` ends with Lemke's method when the other stages did
+    /// not converge ([`dem::SolverParams::lemke_max_contacts`], default 400).
+    #[serde(default = "dem::solver::lemke_max_contacts")]
+    pub lemke_max_contacts: usize,
 }
 
 impl SolverSpec {
@@ -153,6 +158,7 @@ impl SolverSpec {
             max_iterations: self.max_iterations,
             parallel: self.parallel,
             method: self.method,
+            lemke_max_contacts: self.lemke_max_contacts,
             ..Default::default()
         }
     }

@@ -94,6 +94,10 @@ pub struct LemkeReport {
     pub factorisations: usize,
     /// Whether the warm start's path gave the answer.
     pub warm_solved: bool,
+    /// How the warm start's path ended (`None` without a warm start).
+    pub warm_outcome: Option<LemkeOutcome>,
+    /// Pivots of the warm start's path.
+    pub warm_pivots: usize,
     /// How the last path ended.
     pub outcome: LemkeOutcome,
     /// Error measure of the returned impulses (`NaN` if none).
@@ -110,6 +114,10 @@ const HARRIS_DELTA: f64 = 1e-11;
 /// final basis is then evaluated with the true `q̄`.
 const PERTURBATION: f64 = 1e-10;
 
+/// `z₀` counts as vanished when `z₀ ‖B⁻¹ d‖∞ ≤` this `× ‖q̄‖∞`: its part in every basic value
+/// is below rounding, and the almost-complementary point is a solution.
+const Z0_ZERO: f64 = 1e-12;
+
 /// Variable codes: `k < m` is `w_k`, `m ≤ k < 2m` is `z_{k−m}`, `2m` is `z₀`.
 struct Lcp {
     m: usize,
@@ -123,6 +131,8 @@ struct Lcp {
     q_path: Vec<f64>,
     /// Impulse scale: `r = z / scale` for the impulse variables.
     scale: f64,
+    /// Friction coefficients.
+    mu: Vec<f64>,
 }
 
 impl Lcp {
@@ -212,6 +222,7 @@ impl Lcp {
             val,
             q,
             scale,
+            mu: p.mu().to_vec(),
         }
     }
 
@@ -340,18 +351,33 @@ impl Basis {
     }
 }
 
-/// One Lemke path from the basis `vars` with covering vector `d` (`B⁻¹ d = e` is assumed, which
-/// holds for `d = B e`). Returns the outcome and the final basis values.
+/// The covering vector of a path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Cover {
+    /// `d = e` from the basis `B = I` (Lemke's original start, which his theory covers).
+    Unit,
+    /// From a complementary basis with values `x* = B⁻¹ q̄`: `d = B v` with `v_i = δ − x*_i` on
+    /// the infeasible basics (`x*_i < 0`) and 0 elsewhere, so that the path starts from
+    /// `x*` moved onto the feasible side along the infeasible basics only (`δ = 10⁻⁶ ‖q̄‖∞`).
+    Infeasible,
+}
+
+/// One Lemke path from the complementary basis `vars` with the covering vector of `cover`;
+/// `d` receives that vector. Returns the outcome and the final basis values.
 fn path(
     lcp: &Lcp,
     vars: &mut [usize],
-    d: &[f64],
+    cover: Cover,
+    d: &mut Vec<f64>,
     basis: &mut Basis,
     params: &LemkeParams,
     pivots: &mut usize,
 ) -> (LemkeOutcome, Vec<f64>) {
     let m = lcp.m;
     let z0 = 2 * m;
+    d.clear();
+    d.resize(m, 0.0);
+    // z₀ is not basic yet: the covering vector plays no part in this factorisation.
     if !basis.factorise(lcp, vars, d) {
         return (LemkeOutcome::Singular, Vec::new());
     }
@@ -366,23 +392,55 @@ fn path(
     }
     x.clone_from(&lcp.q_path);
     basis.solve(&mut x);
-    let (imin, &xmin) = x
+    // v = B⁻¹ d.
+    let v: Vec<f64> = match cover {
+        Cover::Unit => vec![1.0; m],
+        Cover::Infeasible => x
+            .iter()
+            .map(|&xi| if xi < 0.0 { 1e-6 * qn - xi } else { 0.0 })
+            .collect(),
+    };
+    let mut col = Vec::new();
+    for (&var, &vi) in vars.iter().zip(&v) {
+        if vi != 0.0 {
+            col.clear();
+            lcp.column(var, &[], &mut col);
+            for &(i, c) in &col {
+                d[i] += vi * c;
+            }
+        }
+    }
+    // z₀ enters at the row that needs the largest t for x + t v ≥ 0, t = max(−x_i / v_i).
+    let (imin, t) = x
         .iter()
+        .zip(&v)
         .enumerate()
-        .min_by(|a, b| a.1.total_cmp(b.1))
-        .expect("m > 0");
-    // z₀ enters at the row of the most negative value: x ← x + |x_min| e, x[imin] = |x_min|.
-    let t = -xmin;
-    x.iter_mut().for_each(|v| *v += t);
+        .filter(|(_, (_, &vi))| vi > 0.0)
+        .map(|(i, (&xi, &vi))| (i, -xi / vi))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("some x_i < 0");
+    for (xi, vi) in x.iter_mut().zip(&v) {
+        *xi += t * vi;
+    }
     x[imin] = t;
     basis.etas.push(Eta {
         row: imin,
-        pivot: -1.0,
-        rest: (0..m).filter(|&i| i != imin).map(|i| (i, -1.0)).collect(),
+        pivot: -v[imin],
+        rest: v
+            .iter()
+            .enumerate()
+            .filter(|&(i, vi)| i != imin && *vi != 0.0)
+            .map(|(i, vi)| (i, -vi))
+            .collect(),
     });
     let mut leaving = std::mem::replace(&mut vars[imin], z0);
-    let cap = params.max_pivots_per_variable.max(1) * m;
-    let mut col = Vec::new();
+    let mut z0_row = imin;
+    let vmax = v.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+    let cap = match cover {
+        // A warm path longer than this is not worth its start: the cold one takes 2–4 m.
+        Cover::Infeasible => m / 4,
+        Cover::Unit => params.max_pivots_per_variable.max(1) * m,
+    };
     let mut y = vec![0.0; m];
     let mut since = 1;
     for _ in 0..cap {
@@ -410,6 +468,12 @@ fn path(
             }
         }
         if !bound.is_finite() {
+            if std::env::var_os("LEMKE_DEBUG").is_some() {
+                let npos = y.iter().filter(|v| **v > 0.0).count();
+                let ypos = y.iter().fold(0.0f64, |s, v| s.max(*v));
+                let dneg = d.iter().filter(|v| **v < 0.0).count();
+                eprintln!("ray: cover {cover:?} pivot {} entering {entering} (m {m}) ymax {ymax:.3e} ypos {ypos:.3e} npos {npos} d<0: {dneg} z0 = {:?}", *pivots, vars.iter().position(|v| *v == z0).map(|i| x[i]));
+            }
             return (LemkeOutcome::Ray, x);
         }
         let mut row = usize::MAX;
@@ -443,13 +507,27 @@ fn path(
                 .collect(),
         });
         since += 1;
-        if leaving == z0 {
+        if row == z0_row {
+            z0_row = usize::MAX;
+        }
+        let z0_vanished = z0_row != usize::MAX && x[z0_row] * vmax <= Z0_ZERO * qn;
+        if z0_vanished {
+            // z₀ ≈ 0 while still basic: the point is already a solution (the missing pair has
+            // both members at zero); complete the basis with the next entering variable.
+            vars[z0_row] = lcp.complement(leaving);
+            x[z0_row] = 0.0;
+        }
+        if leaving == z0 || z0_vanished {
             // A complementary basis: its exact values, from a fresh factorisation.
+            let kept = x.clone();
             if !basis.factorise(lcp, vars, d) {
-                return (LemkeOutcome::Singular, x);
+                return (LemkeOutcome::Solved, kept);
             }
             x.clone_from(&lcp.q);
             basis.solve(&mut x);
+            if !x.iter().all(|v| v.is_finite()) {
+                return (LemkeOutcome::Solved, kept);
+            }
             return (LemkeOutcome::Solved, x);
         }
         if since >= params.refactor_every {
@@ -468,18 +546,27 @@ fn path(
     (LemkeOutcome::PivotCap, x)
 }
 
-/// Impulses `r` of the basic values `x` of basis `vars`.
-fn impulses(lcp: &Lcp, vars: &[usize], x: &[f64]) -> Vec<f64> {
+/// The impulses `r` and the basis bits of the basic values `x` of the basis `vars`.
+fn solution(lcp: &Lcp, vars: &[usize], x: &[f64]) -> LemkeSolution {
     let m = lcp.m;
     let mut z = vec![0.0; m];
+    let mut basis = vec![0u8; m / 4];
     for (&v, &xv) in vars.iter().zip(x) {
         if (m..2 * m).contains(&v) {
             z[v - m] = xv.max(0.0);
+            basis[(v - m) / 4] |= 1 << ((v - m) % 4);
         }
     }
-    z.chunks_exact(4)
-        .flat_map(|c| [c[0] / lcp.scale, (c[1] - c[2]) / lcp.scale])
-        .collect()
+    let r = z
+        .chunks_exact(4)
+        .zip(&lcp.mu)
+        .flat_map(|(c, &mu)| {
+            // w_λ ≥ 0 holds to rounding: clip r_t into the cone.
+            let (rn, rt) = (c[0] / lcp.scale, (c[1] - c[2]) / lcp.scale);
+            [rn, rt.clamp(-mu * rn, mu * rn)]
+        })
+        .collect();
+    LemkeSolution { r, basis }
 }
 
 /// The complementary basis defined by the statuses of `r` (with `u = W r + q`).
@@ -517,14 +604,39 @@ fn warm_basis(p: &FcProblem, r: &[f64]) -> Vec<usize> {
     vars
 }
 
-/// Solves `problem` by Lemke's method, from the statuses of `warm` if given (then from the cold
-/// basis if that path fails). Returns the impulses of the last complementary basis reached (if
-/// any) with the report; the impulses are in their cones, their error is in the report.
+/// A warm start of [`solve`]: the final basis of a previous solve and/or approximate impulses.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Warm<'a> {
+    /// Per contact, the bits `j = 0..4` set where `z_{4α+j}` (`r_n, β⁺, β⁻, λ`) is basic and
+    /// clear where its complement `w` is: [`LemkeSolution::basis`] of the previous step mapped
+    /// onto this step's contacts (0, all `w` basic, for a new contact). The best start in a
+    /// time-stepping sequence: a basis Lemke's path reached is well conditioned.
+    pub basis: Option<&'a [u8]>,
+    /// Approximate impulses: the basis their statuses define (open, sliding, sticking); often
+    /// ill conditioned in a hyperstatic packing, since the statuses of an interior point are
+    /// not those of a vertex.
+    pub impulses: Option<&'a [f64]>,
+}
+
+/// An exact solution found by [`solve`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LemkeSolution {
+    /// The impulses (in their cones).
+    pub r: Vec<f64>,
+    /// The final complementary basis, per contact (see [`Warm::basis`]).
+    pub basis: Vec<u8>,
+}
+
+/// Solves `problem` by Lemke's method: from the warm bases of `warm` in turn (previous basis,
+/// then the statuses of the impulses), each kept when its path ends with an error within
+/// `tolerance`, then from the cold basis (`B = I`, `d = e`). Returns the solution of the last
+/// path that ended on a complementary basis (if any) with the report.
 pub fn solve(
     problem: &FcProblem,
-    warm: Option<&[f64]>,
+    warm: Warm<'_>,
+    tolerance: f64,
     params: &LemkeParams,
-) -> Result<(Option<Vec<f64>>, LemkeReport), FcError> {
+) -> Result<(Option<LemkeSolution>, LemkeReport), FcError> {
     let nc = problem.contacts();
     if params.refactor_every == 0 {
         return Err(FcError::Option {
@@ -536,55 +648,106 @@ pub fn solve(
         pivots: 0,
         factorisations: 0,
         warm_solved: false,
+        warm_outcome: None,
+        warm_pivots: 0,
         outcome: LemkeOutcome::Solved,
         error: f64::NAN,
     };
     if nc == 0 {
         report.error = 0.0;
-        return Ok((Some(Vec::new()), report));
+        let empty = LemkeSolution {
+            r: Vec::new(),
+            basis: Vec::new(),
+        };
+        return Ok((Some(empty), report));
     }
     let lcp = Lcp::new(problem);
     let m = lcp.m;
     let mut basis = Basis::new();
     let mut pivots = 0;
-    if let Some(r0) = warm.filter(|r| r.len() == 2 * nc && r.iter().all(|x| x.is_finite())) {
-        let mut vars = warm_basis(problem, r0);
-        // d = B e, so that B⁻¹ d = e.
-        let mut d = vec![0.0; m];
-        let mut col = Vec::new();
-        for &v in &vars {
-            col.clear();
-            lcp.column(v, &[], &mut col);
-            for (i, x) in &col {
-                d[*i] += x;
-            }
-        }
-        let (outcome, x) = path(&lcp, &mut vars, &d, &mut basis, params, &mut pivots);
+    let mut d = Vec::new();
+    let mut starts: Vec<Vec<usize>> = Vec::new();
+    if let Some(b) = warm.basis.filter(|b| b.len() == nc) {
+        starts.push(
+            b.iter()
+                .enumerate()
+                .flat_map(|(a, bits)| {
+                    (0..4).map(move |j| {
+                        let k = 4 * a + j;
+                        if bits & (1 << j) != 0 {
+                            k + m
+                        } else {
+                            k
+                        }
+                    })
+                })
+                .collect(),
+        );
+    }
+    let no_basis = starts.is_empty() || warm.basis.is_some_and(|b| b.iter().all(|&x| x == 0));
+    if let Some(r0) = warm
+        .impulses
+        .filter(|r| no_basis && r.len() == 2 * nc && r.iter().all(|x| x.is_finite()))
+    {
+        starts.push(warm_basis(problem, r0));
+    }
+    let mut found = None;
+    for mut vars in starts {
+        let (outcome, x) = path(
+            &lcp,
+            &mut vars,
+            Cover::Infeasible,
+            &mut d,
+            &mut basis,
+            params,
+            &mut pivots,
+        );
+        report.warm_outcome = Some(outcome);
+        report.warm_pivots = pivots;
         if outcome == LemkeOutcome::Solved {
-            let r = impulses(&lcp, &vars, &x);
-            let error = fc_error(problem, &r);
-            if error.is_finite() {
+            let sol = solution(&lcp, &vars, &x);
+            let error = fc_error(problem, &sol.r);
+            if error <= tolerance {
                 report = LemkeReport {
                     pivots,
                     factorisations: basis.factorisations,
                     warm_solved: true,
                     outcome,
                     error,
+                    ..report
                 };
-                return Ok((Some(r), report));
+                return Ok((Some(sol), report));
+            }
+            if error.is_finite() {
+                found = Some((sol, error));
             }
         }
     }
     let mut vars: Vec<usize> = (0..m).collect();
-    let d = vec![1.0; m];
-    let (outcome, x) = path(&lcp, &mut vars, &d, &mut basis, params, &mut pivots);
+    let (outcome, x) = path(
+        &lcp,
+        &mut vars,
+        Cover::Unit,
+        &mut d,
+        &mut basis,
+        params,
+        &mut pivots,
+    );
     report.pivots = pivots;
     report.factorisations = basis.factorisations;
     report.outcome = outcome;
-    if outcome != LemkeOutcome::Solved {
-        return Ok((None, report));
+    if outcome == LemkeOutcome::Solved {
+        let sol = solution(&lcp, &vars, &x);
+        let error = fc_error(problem, &sol.r);
+        if found.as_ref().is_none_or(|(_, e)| error <= *e) {
+            found = Some((sol, error));
+        }
     }
-    let r = impulses(&lcp, &vars, &x);
-    report.error = fc_error(problem, &r);
-    Ok((Some(r), report))
+    Ok(match found {
+        Some((sol, error)) => {
+            report.error = error;
+            (Some(sol), report)
+        }
+        None => (None, report),
+    })
 }

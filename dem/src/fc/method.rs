@@ -15,6 +15,11 @@ use crate::solver::{run_auto, AutoStages};
 /// [`crate::SolverParams::auto_sweeps`]).
 pub const AUTO_SWEEPS: usize = 100;
 
+/// Largest problem (contacts) that `auto` on a standalone problem ([`solve_by`]) ends with
+/// Lemke's method when the other stages did not converge: about a minute for one cold path.
+/// (The engine's per-step limit is [`crate::SolverParams::lemke_max_contacts`].)
+pub const STANDALONE_LEMKE_MAX_CONTACTS: usize = 5000;
+
 /// What a solve by [`solve_by`] did: Gauss–Seidel sweeps in all (`solution.iterations`), and
 /// the Newton statistics when Newton ran.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -37,6 +42,8 @@ pub struct Finish {
     pub error: f64,
     /// Pivots of Lemke's method (0 when the active-set solve was enough).
     pub pivots: usize,
+    /// The final basis of Lemke's method when it gave `r` (the warm start of the next step).
+    pub basis: Option<Vec<u8>>,
 }
 
 /// The exact finish of an unconverged solve (the last stage of `auto`, in the engine and in
@@ -46,7 +53,8 @@ pub struct Finish {
 ///    read from `r` ([`newton::active_set_finish`], one sparse LU); done if it reaches
 ///    `tolerance`;
 /// 2. otherwise, for at most `max_contacts` contacts, Lemke's method ([`lemke::solve`]), warm
-///    from the statuses of `r`, then cold: an exact solution of the 2D problem (every problem of
+///    from `basis` (the final basis of the previous step's Lemke solve, if any), then from the
+///    statuses of `r`, then cold: an exact solution of the 2D problem (every problem of
 ///    `datasets/fc-problems/hard/` to ≤ 10⁻¹²).
 ///
 /// Returns the best impulses found when they lower the error, else `None`.
@@ -56,6 +64,7 @@ pub fn exact_finish(
     error_now: f64,
     tolerance: f64,
     max_contacts: usize,
+    basis: Option<&[u8]>,
     work: &mut newton::NewtonWork,
 ) -> Result<Option<Finish>, FcError> {
     let mut best: Option<Finish> = None;
@@ -64,20 +73,39 @@ pub fn exact_finish(
             r: r1,
             error: e1,
             pivots: 0,
+            basis: None,
         });
         if e1 <= tolerance {
             return Ok(best);
         }
     }
     if problem.contacts() <= max_contacts {
-        let (r2, report) = lemke::solve(problem, Some(r), &LemkeParams::default())?;
+        let warm = lemke::Warm {
+            basis,
+            impulses: Some(r),
+        };
+        let t0 = std::time::Instant::now();
+        let (sol, report) = lemke::solve(problem, warm, tolerance, &LemkeParams::default())?;
+        if std::env::var_os("LEMKE_DEBUG").is_some() {
+            eprintln!(
+                "lemke: nc {} err_now {:.2e} -> {:.2e} pivots {} warm {:?}/{} {:.3}s",
+                problem.contacts(),
+                error_now,
+                report.error,
+                report.pivots,
+                report.warm_outcome,
+                report.warm_pivots,
+                t0.elapsed().as_secs_f64()
+            );
+        }
         let floor = best.as_ref().map_or(error_now, |b| b.error);
-        match r2 {
-            Some(r2) if report.error < floor => {
+        match sol {
+            Some(sol) if report.error < floor => {
                 return Ok(Some(Finish {
-                    r: r2,
+                    r: sol.r,
                     error: report.error,
                     pivots: report.pivots,
+                    basis: Some(sol.basis),
                 }))
             }
             _ => {
@@ -130,13 +158,14 @@ pub fn solve_by(
         }
         SolverMethod::Lemke => {
             let t0 = std::time::Instant::now();
-            let (r, lr) = lemke::solve(
-                problem,
-                options.initial_guess.as_deref(),
-                &LemkeParams::default(),
-            )?;
-            let converged = r.is_some() && lr.error <= options.tolerance;
-            let r = r.unwrap_or_else(|| vec![0.0; 2 * problem.contacts()]);
+            let warm = lemke::Warm {
+                basis: None,
+                impulses: options.initial_guess.as_deref(),
+            };
+            let (sol, lr) =
+                lemke::solve(problem, warm, options.tolerance, &LemkeParams::default())?;
+            let converged = sol.is_some() && lr.error <= options.tolerance;
+            let r = sol.map_or_else(|| vec![0.0; 2 * problem.contacts()], |s| s.r);
             let error = super::measure::fc_error(problem, &r);
             let u = problem.velocity(&r);
             Ok((
@@ -249,10 +278,11 @@ impl AutoStages for FcStages<'_> {
         Ok(out)
     }
 
-    fn finish(&mut self, lemke: bool) -> Result<bool, FcError> {
+    fn finish(&mut self, lemke: bool) -> Result<(bool, bool), FcError> {
         let Some(last) = self.last.as_ref() else {
-            return Ok(false);
+            return Ok((false, false));
         };
+        let lemke_ran = lemke && self.problem.contacts() <= STANDALONE_LEMKE_MAX_CONTACTS;
         let t0 = std::time::Instant::now();
         let mut work = newton::NewtonWork::default();
         let finish = exact_finish(
@@ -261,15 +291,19 @@ impl AutoStages for FcStages<'_> {
             last.error,
             self.options.tolerance,
             if lemke {
-                crate::solver::lemke_max_contacts()
+                STANDALONE_LEMKE_MAX_CONTACTS
             } else {
                 0
             },
+            None,
             &mut work,
         )?;
-        let Some(Finish { r, error, pivots }) = finish else {
+        let Some(Finish {
+            r, error, pivots, ..
+        }) = finish
+        else {
             self.seconds += t0.elapsed().as_secs_f64();
-            return Ok(false);
+            return Ok((false, lemke_ran));
         };
         let u = self.problem.velocity(&r);
         let converged = error <= self.options.tolerance;
@@ -285,6 +319,6 @@ impl AutoStages for FcStages<'_> {
             seconds: t0.elapsed().as_secs_f64(),
             converged,
         });
-        Ok(converged)
+        Ok((converged, lemke_ran))
     }
 }
