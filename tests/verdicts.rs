@@ -29,8 +29,16 @@ const JANSSEN: &[&str] = &["run", "janssen", "-q", "--set", "grains=100"];
 
 /// The same with a loose solver: the relaxation to 10⁻⁵ and the release to 10⁻², and the
 /// measured step stopped after one sweep (its error is then about 10² times its tolerance, and
-/// the column is not in equilibrium to 1 %): suspect.
+/// the column is not in equilibrium to 1 %): suspect. (Without Lemke's finish, as when these
+/// expectations were measured: with it the deposit ends in another, exactly solved state, from
+/// which the loose release gives a column whose Janssen fit is refused outright.)
 const LOOSE: &[&str] = &[
+    "--set",
+    "deposit.solver.lemke_max_contacts=0",
+    "--set",
+    "relax.solver.lemke_max_contacts=0",
+    "--set",
+    "release.solver.lemke_max_contacts=0",
     "--set",
     "relax.solver.tolerance=1e-5",
     "--set",

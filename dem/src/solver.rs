@@ -531,7 +531,7 @@ pub(crate) fn run_auto<S: AutoStages>(
         _ => true,
     };
     let (converged, lemke_ran) = stages.finish(lemke)?;
-    if let (Some(b), true) = (backoff.as_deref_mut(), lemke_ran) {
+    if let (Some(b), true) = (backoff, lemke_ran) {
         b.record_lemke(converged);
     }
     if converged {

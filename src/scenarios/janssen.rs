@@ -322,6 +322,7 @@ impl PhasedRun for Column<'_> {
                     tolerance: c.relax.solver.tolerance,
                     max_iterations: c.analysis.final_max_iterations,
                     method: c.relax.solver.method,
+                    lemke_max_contacts: c.relax.solver.lemke_max_contacts,
                     ..Default::default()
                 };
                 info(

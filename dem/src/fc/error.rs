@@ -59,6 +59,10 @@ pub enum FcError {
         /// Key path with index, e.g. `q[12]`.
         key: String,
     },
+    /// The solve overflowed: some `W r + q` or `r` is not finite (entries of `W` or `q` too
+    /// large for double precision).
+    #[error("the solve overflowed: W r + q is not finite (entries of W or q too large for double precision)")]
+    Overflow,
     /// A friction coefficient is negative.
     #[error("key `mu[{contact}]`: friction coefficient {value} < 0")]
     NegativeFriction {

@@ -468,12 +468,6 @@ fn path(
             }
         }
         if !bound.is_finite() {
-            if std::env::var_os("LEMKE_DEBUG").is_some() {
-                let npos = y.iter().filter(|v| **v > 0.0).count();
-                let ypos = y.iter().fold(0.0f64, |s, v| s.max(*v));
-                let dneg = d.iter().filter(|v| **v < 0.0).count();
-                eprintln!("ray: cover {cover:?} pivot {} entering {entering} (m {m}) ymax {ymax:.3e} ypos {ypos:.3e} npos {npos} d<0: {dneg} z0 = {:?}", *pivots, vars.iter().position(|v| *v == z0).map(|i| x[i]));
-            }
             return (LemkeOutcome::Ray, x);
         }
         let mut row = usize::MAX;

@@ -84,20 +84,7 @@ pub fn exact_finish(
             basis,
             impulses: Some(r),
         };
-        let t0 = std::time::Instant::now();
         let (sol, report) = lemke::solve(problem, warm, tolerance, &LemkeParams::default())?;
-        if std::env::var_os("LEMKE_DEBUG").is_some() {
-            eprintln!(
-                "lemke: nc {} err_now {:.2e} -> {:.2e} pivots {} warm {:?}/{} {:.3}s",
-                problem.contacts(),
-                error_now,
-                report.error,
-                report.pivots,
-                report.warm_outcome,
-                report.warm_pivots,
-                t0.elapsed().as_secs_f64()
-            );
-        }
         let floor = best.as_ref().map_or(error_now, |b| b.error);
         match sol {
             Some(sol) if report.error < floor => {

@@ -387,6 +387,9 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
         r[2 * old..2 * old + 2].copy_from_slice(&ws.r[new]);
         u[2 * old..2 * old + 2].copy_from_slice(&ws.u[new]);
     }
+    if !r.iter().chain(&u).all(|x| x.is_finite()) {
+        return Err(FcError::Overflow);
+    }
     Ok(FcSolution {
         r,
         u,
