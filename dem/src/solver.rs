@@ -866,23 +866,23 @@ impl NewtonBackoff {
 
     /// Records the outcome of a Newton stage.
     pub fn record(&mut self, converged: bool) {
-        if converged {
-            self.skip = 0;
-            self.next = 0;
-        } else {
-            self.skip = self.next.max(1);
-            self.next = (self.skip * 2).min(Self::MAX_SKIP);
-        }
+        Self::update(&mut self.skip, &mut self.next, converged);
     }
 
     /// Records the outcome of Lemke's method (converged or not), as [`NewtonBackoff::record`].
     pub fn record_lemke(&mut self, converged: bool) {
+        Self::update(&mut self.lemke_skip, &mut self.lemke_next, converged);
+    }
+
+    /// The doubling rule: reset on success, else skip `max(next, 1)` steps and double `next`
+    /// up to [`NewtonBackoff::MAX_SKIP`].
+    fn update(skip: &mut u32, next: &mut u32, converged: bool) {
         if converged {
-            self.lemke_skip = 0;
-            self.lemke_next = 0;
+            *skip = 0;
+            *next = 0;
         } else {
-            self.lemke_skip = self.lemke_next.max(1);
-            self.lemke_next = (self.lemke_skip * 2).min(Self::MAX_SKIP);
+            *skip = (*next).max(1);
+            *next = (*skip * 2).min(Self::MAX_SKIP);
         }
     }
 }

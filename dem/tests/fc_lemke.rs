@@ -9,24 +9,14 @@
 //! - the engine with `method = lemke` on a hyperstatic stack between frictional walls: at rest,
 //!   the supports carry exactly the weight.
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::Path;
+
+use common::{problems, stack};
 use dem::fc::block_csr::BlockCsr2;
 use dem::fc::lemke::{self, LemkeParams, Warm};
 use dem::fc::{fc_error, read_problem, solve_by, FcOptions, FcProblem, NewtonParams, SolverMethod};
-use dem::{ContactLaws, World, WorldParams};
-use nalgebra::Vector2;
-
-fn problems(dir: &str) -> Vec<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../datasets/fc-problems");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
-        .unwrap_or_else(|e| panic!("{dir}: {e}"))
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with(".json.gz"))
-        .collect();
-    v.sort();
-    v
-}
 
 /// Every impulse in its cone: `r_n ≥ 0`, `|r_t| ≤ μ r_n` (to rounding).
 fn in_cones(p: &FcProblem, r: &[f64]) -> bool {
@@ -165,26 +155,7 @@ fn warm_start_from_the_previous_basis_is_short() {
 #[test]
 fn lemke_holds_a_hyperstatic_stack_at_rest() {
     let (cols, rows, r) = (6, 8, 1e-3);
-    let mut params = WorldParams::default();
-    params.solver.method = SolverMethod::Lemke;
-    params.solver.tolerance = 1e-12;
-    let mut w = World::new(params, ContactLaws::new(&["grain"], 0.4));
-    let width = 2.0 * r * cols as f64;
-    w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        0,
-    );
-    for j in 0..rows {
-        for i in 0..cols {
-            let at = Vector2::new(r + 2.0 * r * i as f64, r + 2.0 * r * j as f64);
-            w.add_grain(at, r, 2500.0, 0);
-        }
-    }
-    let weight: f64 = w.bodies.iter().map(|b| b.mass).sum::<f64>() * 9.81;
+    let (mut w, weight) = stack(cols, rows, SolverMethod::Lemke, 1e-12);
     let rep = w.step().unwrap();
     assert!(
         rep.solver.converged && rep.solver.error <= 1e-12,

@@ -7,54 +7,12 @@
 //!   (`datasets/fc-problems/hard`): Newton (`auto`) and Gauss–Seidel agree on the velocities.
 //! - The engine's assembled `W` has the diagonal blocks the Gauss–Seidel rows carry.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::{problems, stack};
 use dem::fc::{read_problem, solve_by, FcOptions, NewtonParams, SolverMethod};
-use dem::{ContactLaws, World, WorldParams};
-use nalgebra::Vector2;
-
-fn problems(dir: &str) -> Vec<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../datasets/fc-problems");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
-        .unwrap_or_else(|e| panic!("{dir}: {e}"))
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with(".json.gz"))
-        .collect();
-    v.sort();
-    v
-}
-
-/// `cols × rows` equal disks on a square lattice, touching each other, the floor and two
-/// vertical walls, μ = 0.4 everywhere, at rest; one step with `method`.
-fn stack(cols: usize, rows: usize, method: SolverMethod, tol: f64) -> (World, f64) {
-    let r = 1e-3;
-    let mut params = WorldParams::default();
-    params.solver.method = method;
-    params.solver.tolerance = tol;
-    params.solver.max_iterations = 100_000;
-    let mut w = World::new(params, ContactLaws::new(&["grain"], 0.4));
-    let width = 2.0 * r * cols as f64;
-    w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        0,
-    );
-    for j in 0..rows {
-        for i in 0..cols {
-            w.add_grain(
-                Vector2::new(r + 2.0 * r * i as f64, r + 2.0 * r * j as f64),
-                r,
-                2500.0,
-                0,
-            );
-        }
-    }
-    let weight: f64 = w.bodies.iter().map(|b| b.mass).sum::<f64>() * 9.81;
-    (w, weight)
-}
 
 #[test]
 fn hyperstatic_stack_between_frictional_walls_carries_its_weight_exactly() {

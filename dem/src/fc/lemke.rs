@@ -56,7 +56,7 @@ use super::problem::FcProblem;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LemkeParams {
     /// Largest number of pivots of one path, per LCP variable (`4 × contacts`); a problem of
-    /// the hard set takes 1–3.
+    /// the hard set takes 0.5–7 (2–26 per contact).
     pub max_pivots_per_variable: usize,
     /// Pivots applied in product form between two sparse LU factorisations of the basis.
     pub refactor_every: usize,
