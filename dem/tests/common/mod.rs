@@ -1,10 +1,86 @@
-//! Helpers shared by the solver tests (`fc_newton`, `fc_lemke`).
+//! Worlds and problem lists used by several engine and solver tests.
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 
 use dem::fc::SolverMethod;
-use dem::{ContactLaws, World, WorldParams};
+use dem::{ContactLaws, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A box `[0, width] × [0, ∞)` with floor and two side walls (line walls), filled with `n`
+/// random disks of radius in `[r_min, r_max]` placed without overlap on a loose grid with small
+/// random velocities. Density 2500 kg/m³, friction `mu` everywhere.
+pub fn random_box(
+    n: usize,
+    width: f64,
+    r_min: f64,
+    r_max: f64,
+    mu: f64,
+    theta: f64,
+    seed: u64,
+) -> World {
+    let params = WorldParams {
+        dt: 1e-3,
+        theta,
+        gravity: Vector2::new(0.0, -9.81),
+        periodic_x: None,
+        detection_gap: 0.2 * r_min,
+        overlap_rate: 1e-4,
+        position_correction: true,
+        solver: SolverParams {
+            tolerance: 1e-10,
+            max_iterations: 20_000,
+            ..Default::default()
+        },
+    };
+    let mut w = World::new(params, ContactLaws::new(&["grain"], mu));
+    w.add_line_wall("bottom", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
+    w.add_line_wall("left", Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0), 0);
+    w.add_line_wall(
+        "right",
+        Vector2::new(width, 0.0),
+        Vector2::new(-1.0, 0.0),
+        0,
+    );
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let pitch = 2.0 * r_max * 1.05;
+    let per_row = ((width / pitch).floor() as usize).max(1);
+    for i in 0..n {
+        let (ix, iy) = (i % per_row, i / per_row);
+        let r = rng.random_range(r_min..=r_max);
+        let x = pitch * (ix as f64 + 0.5) + rng.random_range(-0.02..0.02) * r_max;
+        let y = pitch * (iy as f64 + 0.5);
+        let b = w.add_grain(Vector2::new(x, y), r, 2500.0, 0);
+        let body = &mut w.bodies[b as usize];
+        body.velocity = Vector2::new(rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05));
+        body.omega = rng.random_range(-1.0..1.0);
+    }
+    w
+}
+
+/// Every number of the state, bit for bit: positions, angles, velocities of every body, and the
+/// impulses of every contact (for tests of bit-identical runs).
+pub fn fingerprint(w: &World) -> Vec<u64> {
+    let mut f = Vec::new();
+    for b in &w.bodies {
+        for x in [
+            b.position.x,
+            b.position.y,
+            b.angle,
+            b.velocity.x,
+            b.velocity.y,
+            b.omega,
+        ] {
+            f.push(x.to_bits());
+        }
+    }
+    for c in &w.contacts().rows {
+        f.extend([c.r[0].to_bits(), c.r[1].to_bits()]);
+    }
+    f
+}
 
 /// The `.json.gz` problems of `datasets/fc-problems/DIR`, sorted.
 pub fn problems(dir: &str) -> Vec<PathBuf> {
