@@ -112,8 +112,9 @@ pub struct SolverParams {
     #[serde(default)]
     pub newton: NewtonParams,
     /// Largest number of contacts for which `auto` ends an unconverged solve with Lemke's
-    /// method (default 400: its cost grows as the square of the contacts, 2–7 s a step at 700
-    /// contacts; raise it to trade time for converged steps in larger packings).
+    /// method. Default 0 (off): a cold path costs 2–26 pivots per contact, 1–7 s a step at 700
+    /// contacts, and the default stick-slip run took 17 min instead of 2 with it on its
+    /// 380-contact steps; raise it per phase to trade time for converged steps.
     #[serde(default = "lemke_max_contacts")]
     pub lemke_max_contacts: usize,
 }
@@ -122,10 +123,10 @@ fn auto_sweeps() -> usize {
     100
 }
 
-/// Default of [`SolverParams::lemke_max_contacts`]: 400 contacts, where one cold Lemke path
-/// takes about 0.5 s (its cost grows as the square of the contacts: 2–7 s at 700).
+/// Default of [`SolverParams::lemke_max_contacts`]: 0, Lemke's method off in the engine's
+/// `auto` (see the field).
 pub fn lemke_max_contacts() -> usize {
-    400
+    0
 }
 
 /// The stall test of `auto`: Gauss–Seidel, whose error went from `before` to `after` over the

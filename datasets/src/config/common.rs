@@ -133,7 +133,7 @@ pub struct SolverSpec {
     #[serde(default)]
     pub method: dem::solver::SolverMethod,
     /// Largest step (contacts) that `auto` ends with Lemke's method when the other stages did
-    /// not converge ([`dem::SolverParams::lemke_max_contacts`], default 400).
+    /// not converge ([`dem::SolverParams::lemke_max_contacts`], default 0: off).
     #[serde(default = "dem::solver::lemke_max_contacts")]
     pub lemke_max_contacts: usize,
 }
