@@ -83,6 +83,8 @@ impl ProblemDump {
             "max_iterations": solver.max_iterations,
             "engine_sweeps": r.solver.iterations,
             "engine_newton_iterations": r.solver.newton_iterations,
+            "engine_lemke_pivots": r.solver.pivots,
+            "lemke_max_contacts": solver.lemke_max_contacts,
             "engine_error": r.solver.error,
             "engine_converged": r.solver.converged,
         });
