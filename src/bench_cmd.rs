@@ -203,6 +203,7 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
         return Err(CliError::Usage("--threads must list counts ≥ 1".into()));
     }
     run_fc(&plan.fc_dir)?;
+    hard_rows(&plan.fc_dir.join("hard"))?;
     engine_rows(plan)?;
     columns(plan)?;
     homogenise_rows(plan)?;
@@ -225,6 +226,53 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
         extra.per_contact,
         both.largest_sample(24 << 30, 2.0) as f64
     );
+    Ok(())
+}
+
+/// The hard problems (`DIR/hard`, where Gauss–Seidel and Newton stall): Lemke's method from a
+/// cold start to 10⁻⁸, pivots, error recomputed from `r`, seconds (one thread). Siconos' times
+/// on the same files (NSGS stalls; its dense Lemke takes 0.9–57 s or does not finish in 120 s)
+/// are in `datasets/fc-problems/hard/README.md`: Siconos is not needed to run this.
+fn hard_rows(dir: &Path) -> Result<()> {
+    if !dir.is_dir() {
+        return Ok(());
+    }
+    let files = dem::fc::bench::problem_files(dir)?;
+    println!(
+        "
+hard problems ({}), Lemke's method from a cold start to 1e-8, one thread:",
+        dir.display()
+    );
+    println!(
+        "{:<40} {:>8} {:>8} {:>10} {:>9}",
+        "problem", "contacts", "pivots", "error", "seconds"
+    );
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| CliError::Usage(format!("cannot start a thread pool: {e}")))?;
+    for f in files {
+        let problem = dem::fc::read_problem(&f)?;
+        let t0 = std::time::Instant::now();
+        let (sol, report) = pool.install(|| {
+            dem::fc::lemke::solve(
+                &problem,
+                dem::fc::lemke::Warm::default(),
+                1e-8,
+                &dem::fc::lemke::LemkeParams::default(),
+            )
+        })?;
+        let seconds = t0.elapsed().as_secs_f64();
+        let error = sol.map_or(f64::NAN, |s| dem::fc::fc_error(&problem, &s.r));
+        println!(
+            "{:<40} {:>8} {:>8} {:>10.3e} {:>9.3}",
+            dem::fc::bench::problem_name(dir, &f),
+            problem.contacts(),
+            report.pivots,
+            error,
+            seconds
+        );
+    }
     Ok(())
 }
 
