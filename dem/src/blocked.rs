@@ -100,10 +100,12 @@ impl BlockLayout {
             .extend(self.body_old.iter().map(|&i| pos[i as usize]));
     }
 
-    /// Copies the impulses and velocities back to the world's numbering.
+    /// Copies the impulses (with the Lemke basis bits that go with them) and velocities back
+    /// to the world's numbering.
     pub fn scatter(&self, rows: &mut [ContactRow], vel: &mut [[f64; 3]]) {
         for (c, &k) in self.rows.iter().zip(&self.row_old) {
             rows[k as usize].r = c.r;
+            rows[k as usize].basis = c.basis;
         }
         for (v, &i) in self.vel.iter().zip(&self.body_old) {
             vel[i as usize] = *v;

@@ -590,8 +590,7 @@ impl AutoStages for EngineStages<'_, '_> {
             (true, SolverMethod::Lemke) => usize::MAX,
             (true, _) => self.params.lemke_max_contacts,
         };
-        let lemke_ran = step.rows.len() <= max_contacts;
-        let finish = exact_finish(
+        let Ok(out) = exact_finish(
             &problem,
             &r,
             error_now,
@@ -599,23 +598,19 @@ impl AutoStages for EngineStages<'_, '_> {
             max_contacts,
             Some(&warm_basis),
             self.newton_work,
-        );
-        let Ok(Some(Finish {
-            r: better,
-            pivots,
-            basis,
-            ..
-        })) = finish
+        ) else {
+            return Ok((false, false));
+        };
+        self.report.pivots += out.pivots;
+        self.report.newton_iterations += usize::from(out.active_set);
+        let Some(Finish {
+            r: better, basis, ..
+        }) = out.better
         else {
-            return Ok((false, lemke_ran));
+            return Ok((false, out.lemke_ran));
         };
         for (c, x) in step.rows.iter_mut().zip(better.chunks_exact(2)) {
             c.r = [x[0], x[1]];
-        }
-        if let Some(basis) = &basis {
-            for (c, &b) in step.rows.iter_mut().zip(basis) {
-                c.basis = b;
-            }
         }
         step.rebuild();
         let error = step.error();
@@ -625,7 +620,13 @@ impl AutoStages for EngineStages<'_, '_> {
                 c.r = [x[0], x[1]];
             }
             step.rebuild();
-            return Ok((false, lemke_ran));
+            return Ok((false, out.lemke_ran));
+        }
+        // The basis of an accepted Lemke solution is the next step's warm start.
+        if let Some(basis) = &basis {
+            for (c, &b) in step.rows.iter_mut().zip(basis) {
+                c.basis = b;
+            }
         }
         let approach = step.approach_speed();
         let converged = error <= self.params.tolerance && approach <= step.approach_limit;
@@ -633,11 +634,9 @@ impl AutoStages for EngineStages<'_, '_> {
             error,
             converged,
             approach_speed: approach,
-            newton_iterations: self.report.newton_iterations + usize::from(pivots == 0),
-            pivots: self.report.pivots + pivots,
             ..self.report
         };
-        Ok((converged, lemke_ran))
+        Ok((converged, out.lemke_ran))
     }
 }
 

@@ -61,6 +61,28 @@ fn one_contact_sticks_slides_and_opens_as_coulomb_says() {
     }
 }
 
+/// A complementary basis that is feasible only once `q̄` is perturbed (a residual of 10⁻¹²,
+/// below the perturbation), given as the warm start: solved, no panic (found by review).
+#[test]
+fn a_warm_basis_feasible_to_rounding_is_the_answer() {
+    let p = one_contact([-1e-12, 1.0], [1.0, 1.0], 0.5);
+    for warm in [
+        Warm {
+            basis: Some(&[12]),
+            impulses: None,
+        },
+        Warm {
+            basis: None,
+            impulses: Some(&[0.0, 0.0]),
+        },
+    ] {
+        let (sol, rep) = lemke::solve(&p, warm, 1e-9, &LemkeParams::default()).unwrap();
+        let r = sol.expect("solved").r;
+        assert!(rep.error <= 1e-9, "{rep:?}");
+        assert!(r.iter().all(|x| x.is_finite()) && in_cones(&p, &r), "{r:?}");
+    }
+}
+
 /// Every hard problem, cold: error ≤ 10⁻¹⁰ recomputed from `r` (most end at 10⁻¹⁴–10⁻¹³).
 #[test]
 fn lemke_solves_every_hard_problem_exactly() {

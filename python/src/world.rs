@@ -130,9 +130,10 @@ impl World {
             "nlgs" => SolverMethod::Nlgs,
             "newton" => SolverMethod::Newton,
             "auto" => SolverMethod::Auto,
+            "lemke" => SolverMethod::Lemke,
             other => {
                 return Err(input(format!(
-                    "method `{other}`: one of nlgs, newton, auto"
+                    "method `{other}`: one of nlgs, newton, auto, lemke"
                 )))
             }
         };

@@ -34,11 +34,13 @@
 //! Impulses are scaled by the mean diagonal of `W` so that every entry of `M` is of order one.
 //!
 //! Ties in the ratio test (a degenerate, hyperstatic problem has many) go to `z₀`, then to the
-//! largest pivot. A warm start ([`solve`] with `warm`) reads the statuses of an approximate
-//! solution (open, sliding, sticking), takes the complementary basis they define and the
-//! covering vector `d = B e`, so that the path starts at `x_B = B⁻¹ q̄ + z₀ e`; when the statuses
-//! are right it ends after few pivots, and when that basis is singular or the path ends on a
-//! ray the method restarts from the cold basis (`B = I`, `d = e`).
+//! largest pivot. A warm start ([`solve`] with a [`Warm`]) takes a complementary basis: the final
+//! basis of the previous step's solve, or else the one the statuses of approximate impulses
+//! define (open, sliding, sticking), with the covering vector `d = B v`, `v_i = δ − x*_i` on the
+//! basic variables that are infeasible at `x* = B⁻¹ q̄` and 0 elsewhere; when the basis is nearly
+//! right the path ends after few pivots. When that basis is singular, or the warm path ends on a
+//! ray, at its cap of `m/4` pivots or with an error above the tolerance asked for, the method
+//! restarts from the cold basis (`B = I`, `d = e`).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::lu::{
@@ -55,8 +57,8 @@ use super::problem::FcProblem;
 /// Parameters of [`solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LemkeParams {
-    /// Largest number of pivots of one path, per LCP variable (`4 × contacts`); a problem of
-    /// the hard set takes 0.5–7 (2–26 per contact).
+    /// Largest number of pivots of the cold path, per LCP variable (`4 × contacts`); a problem
+    /// of the hard set takes 0.5–7 (2–26 per contact). A warm path stops at `m/4` pivots.
     pub max_pivots_per_variable: usize,
     /// Pivots applied in product form between two sparse LU factorisations of the basis.
     pub refactor_every: usize,
@@ -96,7 +98,7 @@ pub struct LemkeReport {
     pub warm_solved: bool,
     /// How the warm start's path ended (`None` without a warm start).
     pub warm_outcome: Option<LemkeOutcome>,
-    /// Pivots of the warm start's path.
+    /// Pivots of the warm paths (from the previous basis, then from the statuses), together.
     pub warm_pivots: usize,
     /// How the last path ended.
     pub outcome: LemkeOutcome,
@@ -114,8 +116,9 @@ const HARRIS_DELTA: f64 = 1e-11;
 /// final basis is then evaluated with the true `q̄`.
 const PERTURBATION: f64 = 1e-10;
 
-/// `z₀` counts as vanished when `z₀ ‖B⁻¹ d‖∞ ≤` this `× ‖q̄‖∞`: its part in every basic value
-/// is below rounding, and the almost-complementary point is a solution.
+/// `z₀` counts as vanished when `z₀ ‖v‖∞ ≤` this `× ‖q̄‖∞`, with `v = B₀⁻¹ d` the direction of
+/// the path's start (`e` cold): its part in the basic values is then below rounding and the
+/// almost-complementary point is taken as a solution (its error is measured by the caller).
 const Z0_ZERO: f64 = 1e-12;
 
 /// Variable codes: `k < m` is `w_k`, `m ≤ k < 2m` is `z_{k−m}`, `2m` is `z₀`.
@@ -392,6 +395,13 @@ fn path(
     }
     x.clone_from(&lcp.q_path);
     basis.solve(&mut x);
+    if x.iter().all(|&xi| xi >= 0.0) {
+        // Feasible once perturbed (so within 2·10⁻¹⁰ ‖q̄‖∞ of feasible): this complementary
+        // basis is the answer, evaluated with the true q̄.
+        x.clone_from(&lcp.q);
+        basis.solve(&mut x);
+        return (LemkeOutcome::Solved, x);
+    }
     // v = B⁻¹ d.
     let v: Vec<f64> = match cover {
         Cover::Unit => vec![1.0; m],
@@ -411,14 +421,18 @@ fn path(
         }
     }
     // z₀ enters at the row that needs the largest t for x + t v ≥ 0, t = max(−x_i / v_i).
-    let (imin, t) = x
+    // Some x_i < 0 (else returned above), and v_i > 0 there: t > 0.
+    let Some((imin, t)) = x
         .iter()
         .zip(&v)
         .enumerate()
         .filter(|(_, (_, &vi))| vi > 0.0)
         .map(|(i, (&xi, &vi))| (i, -xi / vi))
         .max_by(|a, b| a.1.total_cmp(&b.1))
-        .expect("some x_i < 0");
+        .filter(|&(_, t)| t > 0.0 && t.is_finite())
+    else {
+        return (LemkeOutcome::Singular, x);
+    };
     for (xi, vi) in x.iter_mut().zip(&v) {
         *xi += t * vi;
     }
@@ -453,10 +467,10 @@ fn path(
             y[i] += v;
         }
         basis.solve(&mut y);
-        let ymax = y.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        if !ymax.is_finite() {
+        if !y.iter().all(|v| v.is_finite()) {
             return (LemkeOutcome::Singular, x);
         }
+        let ymax = y.iter().fold(0.0f64, |s, v| s.max(v.abs()));
         let tol = 1e-11 * ymax;
         // Harris' two-pass ratio test: the largest step that no basic variable overshoots by
         // more than δ, then, among the rows blocking within it, z₀ or the largest pivot.
@@ -621,10 +635,11 @@ pub struct LemkeSolution {
     pub basis: Vec<u8>,
 }
 
-/// Solves `problem` by Lemke's method: from the warm bases of `warm` in turn (previous basis,
-/// then the statuses of the impulses), each kept when its path ends with an error within
-/// `tolerance`, then from the cold basis (`B = I`, `d = e`). Returns the solution of the last
-/// path that ended on a complementary basis (if any) with the report.
+/// Solves `problem` by Lemke's method: from the warm basis of `warm` (the previous basis if one
+/// is given and not all zero, else the statuses of the impulses), kept when its path ends with
+/// an error within `tolerance`, then from the cold basis (`B = I`, `d = e`). Returns the
+/// solution with the smallest finite error among the paths that ended on a complementary
+/// basis (if any), with the report.
 pub fn solve(
     problem: &FcProblem,
     warm: Warm<'_>,
@@ -733,7 +748,7 @@ pub fn solve(
     if outcome == LemkeOutcome::Solved {
         let sol = solution(&lcp, &vars, &x);
         let error = fc_error(problem, &sol.r);
-        if found.as_ref().is_none_or(|(_, e)| error <= *e) {
+        if error.is_finite() && found.as_ref().is_none_or(|(_, e)| error <= *e) {
             found = Some((sol, error));
         }
     }

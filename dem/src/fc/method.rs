@@ -33,17 +33,29 @@ pub struct MethodReport {
     pub pivots: usize,
 }
 
-/// What [`exact_finish`] returns: better impulses, their error and the pivots spent.
+/// Better impulses found by [`exact_finish`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Finish {
     /// The impulses (in their cones).
     pub r: Vec<f64>,
     /// Their error measure.
     pub error: f64,
-    /// Pivots of Lemke's method (0 when the active-set solve was enough).
-    pub pivots: usize,
-    /// The final basis of Lemke's method when it gave `r` (the warm start of the next step).
+    /// The final basis of Lemke's method when it gave `r` (the warm start of the next step);
+    /// `None` when the active-set solve gave `r`.
     pub basis: Option<Vec<u8>>,
+}
+
+/// What [`exact_finish`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FinishOutcome {
+    /// The best impulses found, when they lower the error.
+    pub better: Option<Finish>,
+    /// Whether the active-set solve was done (one sparse LU).
+    pub active_set: bool,
+    /// Whether Lemke's method ran.
+    pub lemke_ran: bool,
+    /// Pivots of Lemke's method (counted whether or not its result was kept).
+    pub pivots: usize,
 }
 
 /// The exact finish of an unconverged solve (the last stage of `auto`, in the engine and in
@@ -53,11 +65,11 @@ pub struct Finish {
 ///    read from `r` ([`newton::active_set_finish`], one sparse LU); done if it reaches
 ///    `tolerance`;
 /// 2. otherwise, for at most `max_contacts` contacts, Lemke's method ([`lemke::solve`]), warm
-///    from `basis` (the final basis of the previous step's Lemke solve, if any), then from the
+///    from `basis` (the final basis of the previous step's Lemke solve, if any), else from the
 ///    statuses of `r`, then cold: an exact solution of the 2D problem (every problem of
-///    `datasets/fc-problems/hard/` to ≤ 10⁻¹²).
+///    `datasets/fc-problems/hard/` to ≤ 10⁻¹³).
 ///
-/// Returns the best impulses found when they lower the error, else `None`.
+/// `better` holds the best impulses found when they lower the error.
 pub fn exact_finish(
     problem: &FcProblem,
     r: &[f64],
@@ -66,17 +78,21 @@ pub fn exact_finish(
     max_contacts: usize,
     basis: Option<&[u8]>,
     work: &mut newton::NewtonWork,
-) -> Result<Option<Finish>, FcError> {
-    let mut best: Option<Finish> = None;
+) -> Result<FinishOutcome, FcError> {
+    let mut out = FinishOutcome {
+        better: None,
+        active_set: !error_now.is_nan() && error_now <= newton::FINISH_MAX_ERROR,
+        lemke_ran: false,
+        pivots: 0,
+    };
     if let Some((r1, e1)) = newton::active_set_finish(problem, r, error_now, work)? {
-        best = Some(Finish {
+        out.better = Some(Finish {
             r: r1,
             error: e1,
-            pivots: 0,
             basis: None,
         });
         if e1 <= tolerance {
-            return Ok(best);
+            return Ok(out);
         }
     }
     if problem.contacts() <= max_contacts {
@@ -85,24 +101,18 @@ pub fn exact_finish(
             impulses: Some(r),
         };
         let (sol, report) = lemke::solve(problem, warm, tolerance, &LemkeParams::default())?;
-        let floor = best.as_ref().map_or(error_now, |b| b.error);
-        match sol {
-            Some(sol) if report.error < floor => {
-                return Ok(Some(Finish {
-                    r: sol.r,
-                    error: report.error,
-                    pivots: report.pivots,
-                    basis: Some(sol.basis),
-                }))
-            }
-            _ => {
-                if let Some(b) = best.as_mut() {
-                    b.pivots = report.pivots;
-                }
-            }
+        out.lemke_ran = true;
+        out.pivots = report.pivots;
+        let floor = out.better.as_ref().map_or(error_now, |b| b.error);
+        if let Some(sol) = sol.filter(|_| report.error < floor) {
+            out.better = Some(Finish {
+                r: sol.r,
+                error: report.error,
+                basis: Some(sol.basis),
+            });
         }
     }
-    Ok(best)
+    Ok(out)
 }
 
 /// Solves `problem` with `method`:
@@ -269,35 +279,32 @@ impl AutoStages for FcStages<'_> {
         let Some(last) = self.last.as_ref() else {
             return Ok((false, false));
         };
-        let lemke_ran = lemke && self.problem.contacts() <= STANDALONE_LEMKE_MAX_CONTACTS;
         let t0 = std::time::Instant::now();
         let mut work = newton::NewtonWork::default();
-        let finish = exact_finish(
+        let max_contacts = if lemke {
+            STANDALONE_LEMKE_MAX_CONTACTS
+        } else {
+            0
+        };
+        let out = exact_finish(
             self.problem,
             &last.r,
             last.error,
             self.options.tolerance,
-            if lemke {
-                STANDALONE_LEMKE_MAX_CONTACTS
-            } else {
-                0
-            },
+            max_contacts,
             None,
             &mut work,
         )?;
-        let Some(Finish {
-            r, error, pivots, ..
-        }) = finish
-        else {
+        self.pivots += out.pivots;
+        if out.active_set {
+            self.stats.iterations += 1;
+        }
+        let Some(Finish { r, error, .. }) = out.better else {
             self.seconds += t0.elapsed().as_secs_f64();
-            return Ok((false, lemke_ran));
+            return Ok((false, out.lemke_ran));
         };
         let u = self.problem.velocity(&r);
         let converged = error <= self.options.tolerance;
-        self.pivots += pivots;
-        if pivots == 0 {
-            self.stats.iterations += 1;
-        }
         self.keep(FcSolution {
             r,
             u,
@@ -306,6 +313,6 @@ impl AutoStages for FcStages<'_> {
             seconds: t0.elapsed().as_secs_f64(),
             converged,
         });
-        Ok((converged, lemke_ran))
+        Ok((converged, out.lemke_ran))
     }
 }
