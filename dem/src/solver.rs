@@ -410,27 +410,6 @@ pub fn solve(
     if params.method == SolverMethod::Nlgs {
         return nlgs(&mut step, params, params.max_iterations, drive_work);
     }
-    if params.method == SolverMethod::Lemke {
-        let mut stages = EngineStages {
-            step: &mut step,
-            params,
-            drive_work,
-            newton_work,
-            report: SolveReport::default(),
-        };
-        let Ok((true, _)) = stages.finish(true) else {
-            // The path failed (or the warm start was already the answer's best): sweeps.
-            let pivots = stages.report.pivots;
-            let r = nlgs(
-                stages.step,
-                params,
-                params.max_iterations,
-                stages.drive_work,
-            );
-            return SolveReport { pivots, ..r };
-        };
-        return stages.report;
-    }
     if backoff.params != Some(*params) {
         // New solver settings (a new phase): Newton gets a fresh chance.
         *backoff = NewtonBackoff {
@@ -450,6 +429,28 @@ pub fn solve(
         newton_work,
         report: SolveReport::default(),
     };
+    if params.method == SolverMethod::Lemke {
+        if let Ok((true, _)) = stages.finish(true) {
+            return stages.report;
+        }
+        // The path failed (or the stored impulses were already the best): sweeps.
+        let SolveReport {
+            pivots,
+            newton_iterations,
+            ..
+        } = stages.report;
+        let r = nlgs(
+            stages.step,
+            params,
+            params.max_iterations,
+            stages.drive_work,
+        );
+        return SolveReport {
+            pivots,
+            newton_iterations,
+            ..r
+        };
+    }
     let Ok(()) = run_auto(
         &mut stages,
         start_error,
