@@ -583,14 +583,19 @@ impl AutoStages for EngineStages<'_, '_> {
         if error_now.is_nan() {
             return Ok((false, false));
         }
-        let problem = contact_problem(step.rows, step.v_free, step.inv);
-        let r: Vec<f64> = step.rows.iter().flat_map(|c| c.r).collect();
-        let warm_basis: Vec<u8> = step.rows.iter().map(|c| c.basis).collect();
         let max_contacts = match (lemke, self.params.method) {
             (false, _) => 0,
             (true, SolverMethod::Lemke) => usize::MAX,
             (true, _) => self.params.lemke_max_contacts,
         };
+        if step.rows.len() > max_contacts && error_now > newton::FINISH_MAX_ERROR {
+            // Neither stage would run: do not assemble the problem (every stalled step of a
+            // run with Lemke off comes here).
+            return Ok((false, false));
+        }
+        let problem = contact_problem(step.rows, step.v_free, step.inv);
+        let r: Vec<f64> = step.rows.iter().flat_map(|c| c.r).collect();
+        let warm_basis: Vec<u8> = step.rows.iter().map(|c| c.basis).collect();
         let Ok(out) = exact_finish(
             &problem,
             &r,
