@@ -15,6 +15,7 @@
 //! Degrees of freedom with imposed velocity have a zero inverse mass and contribute nothing, so
 //! walls and driven bodies do not couple the contacts they carry.
 
+use crate::cell_coupling::CellCoupling;
 use crate::contact::ContactRow;
 use crate::fc::block_csr::BlockCsr2;
 use crate::fc::problem::FcProblem;
@@ -34,6 +35,16 @@ fn body_rows(c: &ContactRow, side: usize) -> [[f64; 3]; 2] {
 /// `W = H M⁻¹ Hᵀ` of the contacts `rows` with inverse masses `inv` (per body `[1/m, 1/m, 1/I]`,
 /// zero for imposed degrees of freedom).
 pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
+    delassus_with(rows, inv, None)
+}
+
+/// [`delassus_matrix`] plus the term `m Σ_κ B_κ B_κᵀ` of a cell whose stress-controlled
+/// components are unknowns of the step ([`crate::cell_coupling`]).
+pub fn delassus_with(
+    rows: &[ContactRow],
+    inv: &[[f64; 3]],
+    cell: Option<&CellCoupling>,
+) -> BlockCsr2 {
     // Body → (contact, side) adjacency in compressed form.
     let nb = inv.len();
     let mut count = vec![0usize; nb + 1];
@@ -76,6 +87,9 @@ pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
             }
         }
     }
+    if let Some(cell) = cell {
+        cell.add_to_delassus(&mut ri, &mut ci, &mut v);
+    }
     // Indices are in range and the values finite by construction.
     BlockCsr2::from_triplets(rows.len(), &ri, &ci, &v)
         .unwrap_or_else(|e| panic!("engine Delassus assembly: {e}"))
@@ -84,10 +98,27 @@ pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
 /// The step's problem: `W` from [`delassus_matrix`], `q_α = H_α v_free + shift_α` from the free
 /// velocities, μ from the rows.
 pub fn contact_problem(rows: &[ContactRow], v_free: &[[f64; 3]], inv: &[[f64; 3]]) -> FcProblem {
-    let w = delassus_matrix(rows, inv);
+    contact_problem_with(rows, v_free, inv, None)
+}
+
+/// [`contact_problem`] of a step whose cell's stress-controlled components are unknowns
+/// ([`crate::cell_coupling`]): `W + m Σ_κ B_κ B_κᵀ`, and `q` with the impulse-free part
+/// `Σ_κ B_κ δ⁰_κ` of the cell's change on the coupled contacts.
+pub fn contact_problem_with(
+    rows: &[ContactRow],
+    v_free: &[[f64; 3]],
+    inv: &[[f64; 3]],
+    cell: Option<&CellCoupling>,
+) -> FcProblem {
+    let w = delassus_with(rows, inv, cell);
     let mut q = Vec::with_capacity(2 * rows.len());
-    for c in rows {
-        let u = c.velocity(&v_free[c.a as usize], &v_free[c.b as usize]);
+    for (i, c) in rows.iter().enumerate() {
+        let mut u = c.velocity(&v_free[c.a as usize], &v_free[c.b as usize]);
+        if let Some(cell) = cell {
+            let d = cell.free_correction(i);
+            u[0] += d[0];
+            u[1] += d[1];
+        }
         q.extend_from_slice(&u);
     }
     FcProblem::from_engine(rows.iter().map(|c| c.mu).collect(), q, w)

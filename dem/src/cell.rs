@@ -291,6 +291,13 @@ pub struct CellControl {
     /// Largest number of re-solves of one step by the implicit correction.
     #[serde(default)]
     pub max_corrections: usize,
+    /// The stress-controlled components as unknowns of each step's contact problem
+    /// ([`crate::cell_coupling`]): `L⁺ = clamp(L⁻, ±ε̇_max) + g (σ* − σ⁺)` with the stress `σ⁺`
+    /// of the step's own impulses, instead of the explicit law above (then `tolerance` and
+    /// `max_corrections` are not used, no step is solved twice, and `g` has no stability
+    /// limit). The rates of the other components are imposed at the end of each step.
+    #[serde(default)]
+    pub implicit: bool,
 }
 
 impl CellControl {
@@ -329,6 +336,29 @@ impl CellControl {
             }
         }
         Ok(())
+    }
+
+    /// What is imposed on xx, yy and xy, in that order ([`crate::cell_coupling::COMPONENTS`]).
+    pub fn components(&self) -> [Imposed; 3] {
+        [self.xx, self.yy, self.xy]
+    }
+
+    /// The velocity gradient for the next step of the implicit law ([`CellControl::implicit`]):
+    /// `l` with the imposed rates set and `L_yx = 0`; the stress-controlled components are
+    /// those the step's solve found.
+    pub fn implicit_next(&self, l: &Mat) -> Mat {
+        let mut out = *l;
+        out[(1, 0)] = 0.0;
+        for (c, ij) in self
+            .components()
+            .into_iter()
+            .zip(crate::cell_coupling::COMPONENTS)
+        {
+            if let Imposed::Rate(v) = c {
+                out[ij] = v;
+            }
+        }
+        out
     }
 
     /// The velocity gradient after a step of `dt` (s) that ended with the mean stress `sigma`

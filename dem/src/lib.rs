@@ -32,6 +32,7 @@ pub mod bench;
 pub mod blocked;
 pub mod body;
 pub mod cell;
+pub mod cell_coupling;
 pub mod checkpoint;
 pub mod collider;
 pub mod colouring;

@@ -33,7 +33,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::assemble::contact_problem;
+use crate::assemble::contact_problem_with;
+use crate::cell_coupling::CellCoupling;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
 use crate::fc::method::{exact_finish, Finish};
@@ -379,6 +380,11 @@ impl SweepOrder<'_> {
 /// warm start, then sweeps for what is left; `auto` follows `run_auto` (sweeps while they
 /// converge fast enough, Newton, sweeps), with the back-off of [`NewtonBackoff`]. In every mode
 /// `max_iterations` bounds the sweeps in all, smoothing sweeps included.
+///
+/// With `cell`, the stress-controlled components of a biperiodic cell are unknowns of the
+/// problem ([`crate::cell_coupling`]): the sweeps keep them current (one thread: `order` must be
+/// [`SweepOrder::Natural`]) and the global methods assemble the augmented operator; on return
+/// [`CellCoupling::delta`] is the change of `L` that goes with the returned impulses.
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     rows: &mut [ContactRow],
@@ -390,7 +396,11 @@ pub fn solve(
     approach_limit: f64,
     params: &SolverParams,
     work: &mut SolverWork,
+    mut cell: Option<&mut CellCoupling>,
 ) -> SolveReport {
+    if let Some(c) = cell.as_deref_mut() {
+        c.attach(rows);
+    }
     let mut step = Step {
         rows,
         order,
@@ -401,14 +411,24 @@ pub fn solve(
         approach_limit,
         omega: params.relaxation,
         seed: SHUFFLE_SEED,
+        cell,
     };
+    let report = solve_step(&mut step, params, work);
+    if let Some(c) = step.cell.as_deref_mut() {
+        c.detach(step.rows);
+    }
+    report
+}
+
+/// [`solve`] on the assembled step.
+fn solve_step(step: &mut Step, params: &SolverParams, work: &mut SolverWork) -> SolveReport {
     let SolverWork {
         newton: newton_work,
         nlgs: drive_work,
         backoff,
     } = work;
     if params.method == SolverMethod::Nlgs {
-        return nlgs(&mut step, params, params.max_iterations, drive_work);
+        return nlgs(step, params, params.max_iterations, drive_work);
     }
     if backoff.params != Some(*params) {
         // New solver settings (a new phase): Newton gets a fresh chance.
@@ -423,7 +443,7 @@ pub fn solve(
     };
     let start_error = step.error();
     let mut stages = EngineStages {
-        step: &mut step,
+        step,
         params,
         drive_work,
         newton_work,
@@ -593,7 +613,7 @@ impl AutoStages for EngineStages<'_, '_> {
             // run with Lemke off comes here).
             return Ok((false, false));
         }
-        let problem = contact_problem(step.rows, step.v_free, step.inv);
+        let problem = step.problem();
         let r: Vec<f64> = step.rows.iter().flat_map(|c| c.r).collect();
         let warm_basis: Vec<u8> = step.rows.iter().map(|c| c.basis).collect();
         let Ok(out) = exact_finish(
@@ -664,12 +684,22 @@ struct Step<'a> {
     omega: f64,
     /// State of the shuffling LCG.
     seed: u64,
+    /// The cell's stress-controlled components as unknowns, if any ([`crate::cell_coupling`]).
+    cell: Option<&'a mut CellCoupling>,
 }
 
 impl Step<'_> {
-    /// `v = v_free + M⁻¹ Hᵀ R` for the impulses in the rows.
+    /// `v = v_free + M⁻¹ Hᵀ R` for the impulses in the rows (and the cell's `δ` from them).
     fn rebuild(&mut self) {
         rebuild_velocities(self.rows, self.vel, self.v_free, self.inv, &self.order);
+        if let Some(c) = self.cell.as_deref_mut() {
+            c.refresh(self.rows);
+        }
+    }
+
+    /// The step's problem assembled ([`contact_problem_with`]), the cell's term included.
+    fn problem(&self) -> crate::fc::FcProblem {
+        contact_problem_with(self.rows, self.v_free, self.inv, self.cell.as_deref())
     }
 
     fn approach_speed(&self) -> f64 {
@@ -683,7 +713,12 @@ impl SweepProblem for Step<'_> {
     }
 
     fn sweep(&mut self) -> Option<f64> {
-        self.order.sweep(self.rows, self.vel, self.inv, self.omega);
+        match (self.cell.as_deref_mut(), &mut self.order) {
+            (Some(cell), SweepOrder::Natural(order)) => {
+                cell.sweep(self.rows, order, self.vel, self.inv, self.omega)
+            }
+            (_, order) => order.sweep(self.rows, self.vel, self.inv, self.omega),
+        }
         None
     }
 
@@ -740,7 +775,7 @@ fn global(
     max_sweeps: usize,
     newton_work: &mut NewtonWork,
 ) -> SolveReport {
-    let problem = contact_problem(step.rows, step.v_free, step.inv);
+    let problem = step.problem();
     let options = FcOptions {
         tolerance: params.tolerance,
         max_iterations: max_sweeps,

@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 use crate::blocked::BlockLayout;
 use crate::body::{Body, Dof};
 use crate::cell::{Cell, CellControl, Mat, Vect};
+use crate::cell_coupling::CellCoupling;
 use crate::checkpoint::WorldState;
 use crate::collider::{rotate, Collider, Shape};
 use crate::colouring::ContactColouring;
@@ -306,28 +307,44 @@ impl World {
             );
             m += f * l.transpose();
         }
+        let thickness = self.grain_thickness();
+        let j = Mat::new(0.0, -1.0, 1.0, 0.0);
+        for b in self.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
+            m += (j * (-b.angular_acceleration) + Mat::identity() * (b.omega * b.omega))
+                * (0.5 * b.inertia);
+        }
+        let s = m / (cell.volume() * thickness);
+        (s + s.transpose()) * 0.5 + self.kinetic_stress(cell)
+    }
+
+    /// The thickness of the grains (m; 1 without grains).
+    fn grain_thickness(&self) -> f64 {
+        self.bodies
+            .iter()
+            .rfind(|b| b.kind == BodyKind::Grain)
+            .map_or(1.0, |b| b.thickness)
+    }
+
+    /// Kinetic (Reynolds) stress of the grains' velocity fluctuations in `cell` (Pa, tension
+    /// positive): `−(1/V) Σ_p m_p ṽ_p ⊗ ṽ_p`, `ṽ_p = v_p − L (x_p − c)` minus its mass mean.
+    fn kinetic_stress(&self, cell: &Cell) -> Mat {
         let c = cell.centre();
         let (mut mass, mut mom) = (0.0, Vect::zeros());
-        let mut thickness: f64 = 1.0;
         for b in self.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
             mass += b.mass;
             mom += (b.velocity - cell.l * (b.position - c)) * b.mass;
-            thickness = b.thickness;
         }
         let mean = if mass > 0.0 {
             mom / mass
         } else {
             Vect::zeros()
         };
-        let j = Mat::new(0.0, -1.0, 1.0, 0.0);
+        let mut m = Mat::zeros();
         for b in self.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
             let v = b.velocity - cell.l * (b.position - c) - mean;
             m -= v * v.transpose() * b.mass;
-            m += (j * (-b.angular_acceleration) + Mat::identity() * (b.omega * b.omega))
-                * (0.5 * b.inertia);
         }
-        let s = m / (cell.volume() * thickness);
-        (s + s.transpose()) * 0.5
+        m / (cell.volume() * self.grain_thickness())
     }
 
     /// Wraps every grain into the cell (`x ← x + h k`) with `v ← v + L h k`; returns the kinetic
@@ -843,7 +860,7 @@ impl World {
         let (Some(ctl), Some(_)) = (self.cell_control, self.cell) else {
             return self.step_plain();
         };
-        if ctl.tolerance <= 0.0 || ctl.max_corrections == 0 {
+        if ctl.implicit || ctl.tolerance <= 0.0 || ctl.max_corrections == 0 {
             return self.step_plain();
         }
         let backup = self.clone();
@@ -974,15 +991,34 @@ impl World {
             }
         }
 
-        // 3. Contact solve.
+        // 3. Contact solve (with the cell's stress-controlled components as unknowns under an
+        //    implicit control, `crate::cell_coupling`).
+        let mut coupling = match (self.cell_control, self.cell) {
+            (Some(ctl), Some(cell)) if ctl.implicit => CellCoupling::new(
+                &ctl,
+                &cell,
+                &self.contacts.rows,
+                &self.contacts.geometry,
+                h,
+                self.grain_thickness(),
+                &self.kinetic_stress(&cell),
+            ),
+            _ => None,
+        };
         let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
         let approach_limit = self.approach_limit();
         self.v_free.clear();
         self.v_free.extend_from_slice(&self.vel);
         self.last_problem = self.record_problems.then(|| {
-            crate::assemble::contact_problem(&self.contacts.rows, &self.v_free, &self.inv)
+            crate::assemble::contact_problem_with(
+                &self.contacts.rows,
+                &self.v_free,
+                &self.inv,
+                coupling.as_ref(),
+            )
         });
-        let report = if self.params.solver.parallel {
+        // The cell is shared by every coupled contact: a coupled step is swept on one thread.
+        let report = if self.params.solver.parallel && coupling.is_none() {
             self.mobile.clear();
             self.mobile
                 .extend(self.inv.iter().map(|i| i.iter().any(|&x| x != 0.0)));
@@ -1022,6 +1058,7 @@ impl World {
                 approach_limit,
                 &self.params.solver,
                 &mut self.work,
+                None,
             );
             l.scatter(&mut self.contacts.rows, &mut self.vel);
             report
@@ -1046,9 +1083,14 @@ impl World {
                 approach_limit,
                 &self.params.solver,
                 &mut self.work,
+                coupling.as_mut(),
             )
         };
         solver::classify(&self.contacts.rows, &mut self.contacts.status);
+        if let (Some(c), Some(cell)) = (&coupling, self.cell.as_mut()) {
+            // The images moved with L⁺ h k during the solve: the cell takes L⁺.
+            cell.l += c.delta();
+        }
 
         // 4. Positions, accelerations.
         self.displacement.clear();
@@ -1148,7 +1190,11 @@ impl World {
             let sigma = self.measure_cell_stress(&cell);
             self.cell_sigma = Some(sigma);
             if let Some(ctl) = self.cell_control {
-                let l = ctl.update(&cell.l, &sigma, h);
+                let l = if ctl.implicit {
+                    ctl.implicit_next(&cell.l)
+                } else {
+                    ctl.update(&cell.l, &sigma, h)
+                };
                 if l != cell.l {
                     cell_work += self.set_velocity_gradient(l);
                 }

@@ -271,6 +271,7 @@ fn stress_control_reaches_its_target() {
         relaxation: 0.0,
         tolerance: 0.5 * p,
         max_corrections: 12,
+        implicit: false,
     });
     w.validate(1e-4 * d).unwrap();
     let steps = (1.0 / (gd * w.params.dt)) as usize;
@@ -288,4 +289,186 @@ fn stress_control_reaches_its_target() {
         worst < 1e-6,
         "energy residual / kinetic energy up to {worst:e}"
     );
+}
+
+/// The implicit control's stress-controlled components (`dem::cell_coupling`) with gain `gain`
+/// (1/(Pa·s)) and rate cap `max_rate` (1/s).
+fn implicit(xx: Imposed, yy: Imposed, xy: Imposed, gain: f64, max_rate: f64) -> CellControl {
+    CellControl {
+        xx,
+        yy,
+        xy,
+        gain,
+        max_rate,
+        relaxation: 0.0,
+        tolerance: 0.0,
+        max_corrections: 0,
+        implicit: true,
+    }
+}
+
+/// A square lattice of 5 × 4 equal frictionless touching disks (radius R) filling a periodic cell at rest,
+/// with σ_xx = −p_x and σ_yy = −p_y imposed by the implicit control (L_xy = 0): a rigid
+/// lattice cannot deform, so the cell stays at rest (|L| ≤ 10⁻⁹ of the rate cap) and the
+/// contacts carry the imposed stress exactly: the image contacts across x sum to
+/// `p_x L_y h`, those across y to `p_y L_x h` (statics of the cell, 10⁻¹⁰ relative), every
+/// chain carries one force along its length (equilibrium of each grain), and no grain moves
+/// (≤ 10⁻¹² m/s) — over 20 steps. With `L` fixed during the step (the explicit law) this
+/// problem has no bounded solution once the target moves the cell inward.
+#[test]
+fn implicit_control_holds_a_rigid_lattice_at_its_stress() {
+    let (r, nx, ny) = (1e-3, 5usize, 4usize);
+    let (lx, ly) = (2.0 * r * nx as f64, 2.0 * r * ny as f64);
+    let (px, py) = (100.0, 300.0);
+    // Frictionless: with friction, the tangential impulses of one direction's contacts could
+    // carry a self-stress between the chains of the other (hyperstatic), so the chain forces
+    // would not be unique.
+    let mut w = World::new(params(1e-4), ContactLaws::new(&["g"], 0.0));
+    for i in 0..nx {
+        for j in 0..ny {
+            w.add_grain(
+                Vect::new((2 * i + 1) as f64 * r, (2 * j + 1) as f64 * r),
+                r,
+                2500.0,
+                0,
+            );
+        }
+    }
+    w.set_cell(Some(Cell::rectangle(lx, ly).unwrap())).unwrap();
+    let max_rate = 1.0;
+    w.cell_control = Some(implicit(
+        Imposed::Stress(-px),
+        Imposed::Stress(-py),
+        Imposed::Rate(0.0),
+        10.0 * max_rate / py,
+        max_rate,
+    ));
+    w.validate(1e-12).unwrap();
+    let thickness = w.bodies[0].thickness;
+    let h = w.params.dt;
+    for _ in 0..20 {
+        let rep = w.step().unwrap();
+        assert!(rep.solver.converged, "{:?}", rep.solver);
+        let l = w.cell().unwrap().l;
+        assert!(l.abs().max() < 1e-9 * max_rate, "L = {l}");
+        let c = w.contacts();
+        let (mut sx, mut sy) = (0.0, 0.0);
+        for (row, geo) in c.rows.iter().zip(&c.geometry) {
+            let fx = row.r[0] * row.n[0] - row.r[1] * row.n[1];
+            let fy = row.r[0] * row.n[1] + row.r[1] * row.n[0];
+            sx += fx * geo.image[0];
+            sy += fy * geo.image[1];
+        }
+        let (ex, ey) = (px * ly * thickness * h * lx, py * lx * thickness * h * ly);
+        assert!((sx - ex).abs() < 1e-10 * ex, "x: {sx:e} vs {ex:e}");
+        assert!((sy - ey).abs() < 1e-10 * ey, "y: {sy:e} vs {ey:e}");
+        // One normal impulse along each chain.
+        for row in &c.rows {
+            let horizontal = row.n[0].abs() > 0.5;
+            let twin = c
+                .rows
+                .iter()
+                .find(|o| {
+                    (o.n[0].abs() > 0.5) == horizontal
+                        && (o.b == row.a || o.a == row.b || o.a == row.a || o.b == row.b)
+                        && !std::ptr::eq(*o, row)
+                })
+                .unwrap();
+            assert!(
+                (row.r[0] - twin.r[0]).abs() < 1e-10 * row.r[0].abs().max(twin.r[0].abs()),
+                "chain impulses {} vs {}",
+                row.r[0],
+                twin.r[0]
+            );
+        }
+        for b in &w.bodies {
+            assert!(b.velocity.norm() < 1e-12 && b.omega.abs() < 1e-9, "{b:?}");
+        }
+    }
+}
+
+/// The implicit law holds at every step of a frictional biaxial compression of 36 disks
+/// (σ_xx = −P, L_yy = −ε̇ imposed, μ = 0.5), recomputed from the public state alone: after each
+/// converged step, `L⁺_xx = clamp(L⁻_xx, ±ε̇_max) + g (σ* − σ⁺)` with
+/// `σ⁺ = σ^kin − (1/(hV)) Σ R_x (h k)_x` over the step's image contacts and `σ^kin` the kinetic
+/// stress at its start, to 10⁻⁸ of `ε̇_max`; every step converges, and the measured lateral
+/// stress (`World::cell_stress`) averages −P within 10 % over the compression.
+#[test]
+fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
+    let p = 100.0;
+    let mut w = packing(6, 5, 0.5);
+    let (rho, d): (f64, f64) = (2500.0, 2e-3);
+    let rate = 1e-3 * (p / rho).sqrt() / d;
+    let max_rate = 20.0 * rate;
+    let gain = 10.0 * max_rate / p;
+    // Isotropic compression to P, implicit on both normal components.
+    w.cell_control = Some(implicit(
+        Imposed::Stress(-p),
+        Imposed::Stress(-p),
+        Imposed::Rate(0.0),
+        gain,
+        max_rate,
+    ));
+    w.params.solver.tolerance = 1e-9;
+    // Exact steps (Lemke's method where the sweeps stall).
+    w.params.solver.lemke_max_contacts = 1000;
+    for _ in 0..1500 {
+        w.step().unwrap();
+    }
+    let s = w.cell_stress().unwrap();
+    assert!(
+        (s[(0, 0)] + p).abs() < 0.2 * p && (s[(1, 1)] + p).abs() < 0.2 * p,
+        "isotropic stress {s}"
+    );
+    let ctl = implicit(
+        Imposed::Stress(-p),
+        Imposed::Rate(-rate),
+        Imposed::Rate(0.0),
+        gain,
+        max_rate,
+    );
+    w.cell_control = Some(ctl);
+    let thickness = w.bodies[0].thickness;
+    let (mut mean, mut n) = (0.0, 0);
+    for _ in 0..400 {
+        let cell0 = *w.cell().unwrap();
+        // Kinetic stress at the start of the step (module documentation of dem::cell_coupling).
+        let grains: Vec<_> = w.bodies.iter().filter(|b| b.mass > 0.0).collect();
+        let c0 = cell0.centre();
+        let mass: f64 = grains.iter().map(|b| b.mass).sum();
+        let mom = grains.iter().fold(Vect::zeros(), |m, b| {
+            m + (b.velocity - cell0.l * (b.position - c0)) * b.mass
+        });
+        let mean_v = mom / mass;
+        let kin_xx: f64 = -grains
+            .iter()
+            .map(|b| {
+                let v = b.velocity - cell0.l * (b.position - c0) - mean_v;
+                b.mass * v.x * v.x
+            })
+            .sum::<f64>()
+            / (cell0.volume() * thickness);
+        let rep = w.step().unwrap();
+        assert!(rep.solver.converged, "{:?}", rep.solver);
+        let h = w.params.dt;
+        let c = w.contacts();
+        let boundary: f64 = c
+            .rows
+            .iter()
+            .zip(&c.geometry)
+            .map(|(row, geo)| (row.r[0] * row.n[0] - row.r[1] * row.n[1]) * geo.image[0])
+            .sum();
+        let sigma = kin_xx - boundary / (h * cell0.volume() * thickness);
+        let want = cell0.l[(0, 0)].clamp(-max_rate, max_rate) + gain * (-p - sigma);
+        let got = w.cell().unwrap().l[(0, 0)];
+        assert!(
+            (got - want).abs() < 1e-8 * max_rate,
+            "L_xx {got:e} vs the law's {want:e}"
+        );
+        assert_eq!(w.cell().unwrap().l[(1, 1)], -rate);
+        mean += w.cell_stress().unwrap()[(0, 0)];
+        n += 1;
+    }
+    let mean = mean / n as f64;
+    assert!((mean + p).abs() < 0.1 * p, "mean σ_xx = {mean} Pa");
 }

@@ -20,7 +20,7 @@
 //! stress–dilatancy relation `sin φ_mob = sin φ_cv + β sin ψ` fitted over the hardening phase
 //! (bins before the peak) of every pressure.
 
-use datasets::config::{BiaxialConfig, Preparation};
+use datasets::config::{BiaxialConfig, CellControlMode, Preparation};
 use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
@@ -100,7 +100,15 @@ const AXIAL_GAIN_FRACTION: f64 = 0.05;
 const AXIAL_RATE_CAP: f64 = 3.0;
 /// Filter time of the lateral control in the axial compression, in time steps.
 const AXIAL_FILTER_STEPS: f64 = 10.0;
-/// Tolerance of the implicit correction of the cell control, as a fraction of p₀.
+/// Gain of the implicit cell control (`dem::cell_coupling`) in units of `ε̇_max/p₀`: a cell
+/// without contacts closes at most at `(1 + K) ε̇_max`, and a jammed packing's stress misses its
+/// target by `p₀ ΔL/(K ε̇_max)`, `ΔL` the change of the rate it can follow over one step.
+/// Measured (100 disks, μ = 0.5, p₀ = 1 kPa, 5 % axial strain): K = 1, 10, 30 give a lateral
+/// stress of −p₀ ± 6 %, ± 1.8 %, ± 1.0 % (standard deviation over the steps) and 151, 119, 246
+/// of 475 steps at a sweep cap of 1000 (a lighter cell slows Gauss–Seidel); K = 100 closes the
+/// loose packing too fast in the isotropic compression.
+const IMPLICIT_GAIN: f64 = 10.0;
+/// Tolerance of the explicit law's correction of the cell control, as a fraction of p₀.
 const CONTROL_TOLERANCE: f64 = 0.5;
 /// Re-solves of a step at most by the implicit correction.
 const MAX_CORRECTIONS: usize = 8;
@@ -312,6 +320,19 @@ impl Biaxial<'_> {
                 AXIAL_FILTER_STEPS,
             ),
         };
+        if self.c.cell_control == CellControlMode::Implicit {
+            return CellControl {
+                xx: Imposed::Stress(target),
+                yy,
+                xy: Imposed::Rate(0.0),
+                gain: IMPLICIT_GAIN * max_rate / p0,
+                max_rate,
+                relaxation: 0.0,
+                tolerance: 0.0,
+                max_corrections: 0,
+                implicit: true,
+            };
+        }
         CellControl {
             xx: Imposed::Stress(target),
             yy,
@@ -321,6 +342,7 @@ impl Biaxial<'_> {
             relaxation: tau * dt,
             tolerance: CONTROL_TOLERANCE * p0,
             max_corrections: MAX_CORRECTIONS,
+            implicit: false,
         }
     }
 
@@ -858,6 +880,7 @@ fn analyse(
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
     s.int("grains", c.grains as u64)
         .text("preparation", c.preparation.as_str())
+        .text("cell_control", c.cell_control.as_str())
         .num("grain_friction", c.friction.grain_grain)
         .num("mean_diameter_m", d)
         .int("pressures", rows.len() as u64)

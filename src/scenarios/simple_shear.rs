@@ -121,6 +121,7 @@ impl Shear<'_> {
             relaxation: 0.0,
             tolerance: CONTROL_TOLERANCE * p,
             max_corrections: MAX_CORRECTIONS,
+            implicit: false,
         }
     }
 }

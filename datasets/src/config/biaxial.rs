@@ -30,6 +30,30 @@ impl Preparation {
     }
 }
 
+/// How the cell's stress-controlled components follow their targets (`dem::cell::CellControl`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CellControlMode {
+    /// Unknowns of each step's contact problem (`dem::cell_coupling`): a jammed frictional
+    /// packing finds the deformation it can follow within the step.
+    #[default]
+    Implicit,
+    /// The explicit proportional law between steps, with re-solves of a step whose stress
+    /// misses the target (the law before the implicit one; its frictional steps are mostly
+    /// infeasible, `docs/physics.md` §8).
+    Explicit,
+}
+
+impl CellControlMode {
+    /// `implicit` or `explicit`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CellControlMode::Implicit => "implicit",
+            CellControlMode::Explicit => "explicit",
+        }
+    }
+}
+
 /// Configuration of the `biaxial` scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -63,6 +87,9 @@ pub struct BiaxialConfig {
     /// Cap of the cell's strain rate under stress control, as an inertial number
     /// `I_cell = ε̇_max d / √(p₀/ρ)` (1), in (0, 0.1].
     pub control_inertial_number: f64,
+    /// `implicit` (default) or `explicit` control of the cell ([`CellControlMode`]).
+    #[serde(default)]
+    pub cell_control: CellControlMode,
     /// Duration of the isotropic compression (s).
     pub compression_time: f64,
     /// Solid fraction of the initial loose packing (1), in [0.2, 0.6].

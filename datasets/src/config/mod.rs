@@ -13,7 +13,7 @@ pub mod simple_shear;
 pub mod stick_slip;
 
 pub use arrangements::ArrangementsConfig;
-pub use biaxial::{BiaxialConfig, Preparation};
+pub use biaxial::{BiaxialConfig, CellControlMode, Preparation};
 pub use common::{FrictionSpec, GrainSpec, SolverSpec};
 pub use deposit::{DepositSpec, RelaxSpec};
 pub use inclined_flow::InclinedFlowConfig;

@@ -1,0 +1,309 @@
+//! The stress-controlled components of a biperiodic cell as unknowns of the step's contact
+//! problem: the *implicit* cell control ([`CellControl::implicit`]).
+//!
+//! With the velocity gradient `L` of the cell fixed during a step, a jammed packing of rigid
+//! grains asked to deform in a way its contact network cannot follow has no bounded contact
+//! impulses: the step's problem is infeasible (Lemke's method ends on a ray) and every solver
+//! stops at its cap. A periodic cell whose stress is imposed is properly a degree of freedom of
+//! the dynamics (Parrinello & Rahman 1981, J. Appl. Phys. 52, 7182; in contact dynamics,
+//! Radjai & Dubois 2011, "Discrete-element modeling of granular materials", ch. 7); here its
+//! stress-controlled components `L_κ`, `κ ∈ {xx, yy, xy}`, are solved for together with the
+//! impulses, by the implicit law
+//!
+//! ```text
+//! L⁺_κ = L^ref_κ + g (σ*_κ − σ⁺_κ),     L^ref_κ = clamp(L⁻_κ, −ε̇_max, ε̇_max),
+//! σ⁺_ij = σ^kin_ij − (1/(h V)) Σ_{image contacts c} R_c,i (h k_c)_j
+//! ```
+//!
+//! (`g` the gain, 1/(Pa·s); `ε̇_max` the rate cap; `R_c` the impulse of contact `c` on the image
+//! of `b` at `x_b + h k_c`, in N·s; `h` the time step; `V` the cell's volume, area × thickness;
+//! `σ^kin = −(1/V) Σ_p m_p ṽ_p ⊗ ṽ_p` the kinetic stress of the velocity fluctuations at the
+//! start of the step, tension positive). `σ⁺` is the mean stress carried across the cell's
+//! boundary (the virial of the periodic images, equal to the Love–Weber stress of
+//! [`crate::World::cell_stress`] at equilibrium): its contact part is linear in the impulses, so
+//! `δ = L⁺ − L⁻` is
+//!
+//! ```text
+//! δ_κ = δ⁰_κ + m Σ_c B_cκ · r_c,    δ⁰_κ = L^ref_κ − L⁻_κ + g (σ*_κ − σ^kin_κ),   m = g/(h V),
+//! B_cκ = (n_i (h k_c)_j, t_i (h k_c)_j)   for κ = (i, j)
+//! ```
+//!
+//! and the local velocity of an image contact gains `Σ_κ B_cκ δ_κ` (the image moves with
+//! `L⁺ h k`). Eliminating `δ`, the step's problem is the frictional-contact problem
+//!
+//! ```text
+//! u = (W + m Σ_κ B_κ B_κᵀ) r + q + Σ_κ B_κ δ⁰_κ
+//! ```
+//!
+//! whose operator is still symmetric positive semidefinite: the cell adds a rank-one term per
+//! controlled component, coupling the contacts across the boundary. A jammed packing now finds
+//! the cell rate it can follow, with the stress error `(L⁺ − L^ref)/g`: the change of that rate
+//! over one step divided by the gain. In the limit `g → ∞` the cell is massless and its stress
+//! is exactly `σ*`; the law is a Parrinello–Rahman cell of mass `h V/g` integrated by implicit
+//! Euler, whose reference rate saturates at `ε̇_max`, so that a packing without contacts closes at
+//! most at `ε̇_max + g |σ*|`. It has no stability limit on `g` (implicit).
+//!
+//! Gauss–Seidel keeps `δ` current: the update of a coupled contact uses the augmented diagonal
+//! block `W_cc + m Σ_κ B_cκ B_cκᵀ` and the velocity with the current `δ`, then adds
+//! `m B_cκ · Δr_c` to `δ_κ` (an exact Gauss–Seidel step on the eliminated problem). The global
+//! methods assemble the augmented operator ([`CellCoupling::add_to_delassus`]). A coupled step is
+//! swept on one thread (the cell is shared by every coupled contact).
+
+use crate::cell::{Cell, CellControl, Imposed, Mat};
+use crate::contact::{ContactGeometry, ContactRow};
+use crate::local::Delassus2;
+use crate::parallel::local_update;
+
+/// The components `(i, j)` of `L` a cell control can impose a stress on: xx, yy, xy.
+pub const COMPONENTS: [(usize, usize); 3] = [(0, 0), (1, 1), (0, 1)];
+
+/// No coupling slot.
+const NONE: u32 = u32::MAX;
+
+/// The cell's stress-controlled components as unknowns of one step's contact problem (module
+/// documentation): the contacts through the cell's boundary, their coupling coefficients, and
+/// the current change `δ` of `L`.
+#[derive(Debug, Clone, Default)]
+pub struct CellCoupling {
+    /// `m_κ = g/(h V)` per component, 0 where the rate is imposed (1/(kg·m²)).
+    compliance: [f64; 3],
+    /// `δ⁰_κ` (1/s).
+    delta0: [f64; 3],
+    /// Current `δ_κ` (1/s); every coupled row's `affine` is `base + Σ_κ B_κ δ_κ` outside a sweep.
+    delta: [f64; 3],
+    /// Coupled rows (indices into the step's rows).
+    rows: Vec<u32>,
+    /// Each coupled row's affine velocity with `L⁻` (m/s, contact frame).
+    base: Vec<[f64; 2]>,
+    /// `B_cκ` of each coupled row (m).
+    coef: Vec<[[f64; 2]; 3]>,
+    /// Each coupled row's own Delassus block, without the cell's term.
+    own: Vec<Delassus2>,
+    /// Row → slot in the lists above, or [`NONE`].
+    slot: Vec<u32>,
+    /// Whether the rows' blocks are augmented now.
+    attached: bool,
+}
+
+impl CellCoupling {
+    /// The coupling of a step of `cell` under `ctl` (implicit), with the contacts `rows` and
+    /// their `geometry` (image shift vectors), the impulse time `dt` (s), the grains'
+    /// `thickness` (m) and the kinetic stress `kinetic` at the start of the step (Pa, tension
+    /// positive). `None` when `ctl` is not implicit or imposes no stress.
+    pub fn new(
+        ctl: &CellControl,
+        cell: &Cell,
+        rows: &[ContactRow],
+        geometry: &[ContactGeometry],
+        dt: f64,
+        thickness: f64,
+        kinetic: &Mat,
+    ) -> Option<Self> {
+        if !ctl.implicit {
+            return None;
+        }
+        let volume = cell.volume() * thickness;
+        let m = ctl.gain / (dt * volume);
+        let mut compliance = [0.0; 3];
+        let mut delta0 = [0.0; 3];
+        let mut any = false;
+        for (k, (imposed, ij)) in ctl.components().into_iter().zip(COMPONENTS).enumerate() {
+            if let Imposed::Stress(target) = imposed {
+                let l = cell.l[ij];
+                let reference = l.clamp(-ctl.max_rate, ctl.max_rate);
+                compliance[k] = m;
+                delta0[k] = reference - l + ctl.gain * (target - kinetic[ij]);
+                any = true;
+            }
+        }
+        if !any || !(m.is_finite() && m > 0.0) {
+            return None;
+        }
+        let mut c = CellCoupling {
+            compliance,
+            delta0,
+            slot: vec![NONE; rows.len()],
+            ..CellCoupling::default()
+        };
+        for (i, (row, geo)) in rows.iter().zip(geometry).enumerate() {
+            if geo.image == [0.0, 0.0] {
+                continue;
+            }
+            let [nx, ny] = row.n;
+            let (n, t) = ([nx, ny], [-ny, nx]);
+            let mut coef = [[0.0; 2]; 3];
+            let mut coupled = false;
+            for (k, &(a, b)) in COMPONENTS.iter().enumerate() {
+                if compliance[k] > 0.0 {
+                    coef[k] = [n[a] * geo.image[b], t[a] * geo.image[b]];
+                    coupled |= coef[k] != [0.0, 0.0];
+                }
+            }
+            if coupled {
+                c.slot[i] = c.rows.len() as u32;
+                c.rows.push(i as u32);
+                c.base.push(row.affine);
+                c.coef.push(coef);
+                c.own.push(row.w);
+            }
+        }
+        Some(c)
+    }
+
+    /// Number of contacts coupled to the cell.
+    pub fn coupled_contacts(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The current change `δ = L⁺ − L⁻` of the velocity gradient (1/s): zero on the components
+    /// whose rate is imposed.
+    pub fn delta(&self) -> Mat {
+        let mut d = Mat::zeros();
+        for (k, &ij) in COMPONENTS.iter().enumerate() {
+            d[ij] = self.delta[k];
+        }
+        d
+    }
+
+    /// `Σ_κ B_cκ δ_κ` of slot `s` for the change `delta`.
+    #[inline]
+    fn affine_of(&self, s: usize, delta: &[f64; 3]) -> [f64; 2] {
+        let (b, c) = (&self.base[s], &self.coef[s]);
+        let mut a = *b;
+        for k in 0..3 {
+            a[0] += c[k][0] * delta[k];
+            a[1] += c[k][1] * delta[k];
+        }
+        a
+    }
+
+    /// Sets `δ` from the impulses in `rows` and every coupled row's affine velocity from it.
+    pub fn refresh(&mut self, rows: &mut [ContactRow]) {
+        let mut delta = self.delta0;
+        for (s, &i) in self.rows.iter().enumerate() {
+            let r = rows[i as usize].r;
+            for (k, d) in delta.iter_mut().enumerate() {
+                let b = self.coef[s][k];
+                *d += self.compliance[k] * (b[0] * r[0] + b[1] * r[1]);
+            }
+        }
+        self.delta = delta;
+        self.sync(rows);
+    }
+
+    /// Every coupled row's affine velocity from the current `δ`.
+    fn sync(&self, rows: &mut [ContactRow]) {
+        for (s, &i) in self.rows.iter().enumerate() {
+            rows[i as usize].affine = self.affine_of(s, &self.delta);
+        }
+    }
+
+    /// Augments the coupled rows' Delassus blocks by `m Σ_κ B_cκ B_cκᵀ` and sets `δ` from their
+    /// impulses (before a solve).
+    pub fn attach(&mut self, rows: &mut [ContactRow]) {
+        if !self.attached {
+            for (s, &i) in self.rows.iter().enumerate() {
+                let mut w = self.own[s];
+                for k in 0..3 {
+                    let (b, m) = (self.coef[s][k], self.compliance[k]);
+                    w.nn += m * b[0] * b[0];
+                    w.nt += m * b[0] * b[1];
+                    w.tt += m * b[1] * b[1];
+                }
+                rows[i as usize].w = w;
+            }
+            self.attached = true;
+        }
+        self.refresh(rows);
+    }
+
+    /// Restores the coupled rows' own Delassus blocks (after a solve); their affine velocities
+    /// keep the final `δ`.
+    pub fn detach(&mut self, rows: &mut [ContactRow]) {
+        if self.attached {
+            for (s, &i) in self.rows.iter().enumerate() {
+                rows[i as usize].w = self.own[s];
+            }
+            self.attached = false;
+        }
+        self.sync(rows);
+    }
+
+    /// One Gauss–Seidel sweep over `rows` in `order` with the cell's components kept current
+    /// (module documentation); the blocks must be [`CellCoupling::attach`]ed.
+    pub fn sweep(
+        &mut self,
+        rows: &mut [ContactRow],
+        order: &[u32],
+        vel: &mut [[f64; 3]],
+        inv: &[[f64; 3]],
+        omega: f64,
+    ) {
+        for &i in order {
+            let c = &mut rows[i as usize];
+            let s = self.slot[i as usize];
+            let (a, b) = (c.a as usize, c.b as usize);
+            let (mut va, mut vb) = (vel[a], vel[b]);
+            if s == NONE {
+                if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
+                    vel[a] = va;
+                    vel[b] = vb;
+                }
+                continue;
+            }
+            let s = s as usize;
+            c.affine = self.affine_of(s, &self.delta);
+            let before = c.r;
+            if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
+                vel[a] = va;
+                vel[b] = vb;
+                let d = [c.r[0] - before[0], c.r[1] - before[1]];
+                for k in 0..3 {
+                    let b = self.coef[s][k];
+                    self.delta[k] += self.compliance[k] * (b[0] * d[0] + b[1] * d[1]);
+                }
+            }
+        }
+        self.sync(rows);
+    }
+
+    /// The correction of the free local velocity `q` of row `i` from what its affine velocity
+    /// holds now (`Σ_κ B_cκ δ_κ`) to the impulse-free part `Σ_κ B_cκ δ⁰_κ`; zero for a row
+    /// not coupled.
+    pub fn free_correction(&self, i: usize) -> [f64; 2] {
+        match self.slot.get(i) {
+            Some(&s) if s != NONE => {
+                let s = s as usize;
+                let mut q = [0.0; 2];
+                for k in 0..3 {
+                    let (b, d) = (self.coef[s][k], self.delta0[k] - self.delta[k]);
+                    q[0] += b[0] * d;
+                    q[1] += b[1] * d;
+                }
+                q
+            }
+            _ => [0.0; 2],
+        }
+    }
+
+    /// Appends the cell's term `m Σ_κ B_cκ B_c'κᵀ` of every pair of coupled contacts to the
+    /// triplets `(row, col, value)` of an assembled Delassus operator (scalar indices `2c + i`).
+    pub fn add_to_delassus(&self, ri: &mut Vec<usize>, ci: &mut Vec<usize>, v: &mut Vec<f64>) {
+        for (s, &a) in self.rows.iter().enumerate() {
+            for (t, &b) in self.rows.iter().enumerate() {
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let x: f64 = (0..3)
+                            .map(|k| self.compliance[k] * self.coef[s][k][i] * self.coef[t][k][j])
+                            .sum();
+                        if x != 0.0 {
+                            ri.push(2 * a as usize + i);
+                            ci.push(2 * b as usize + j);
+                            v.push(x);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
