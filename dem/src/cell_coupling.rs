@@ -116,7 +116,7 @@ impl CellCoupling {
                 any = true;
             }
         }
-        if !any || !(m.is_finite() && m > 0.0) {
+        if !(any && m.is_finite() && m > 0.0) {
             return None;
         }
         let mut c = CellCoupling {
