@@ -11,7 +11,7 @@
 //! `I = γ̇ d / √(p_n/ρ)`. μ(I) and φ(I) are fitted by `identify::mu_i` (which refuses what the
 //! data cannot support).
 
-use datasets::config::SimpleShearConfig;
+use datasets::config::{CellControlMode, SimpleShearConfig};
 use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
@@ -56,6 +56,9 @@ const HISTORY: [&str; 18] = [
 
 /// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
 const GAIN_FRACTION: f64 = 0.3;
+/// Gain of the implicit cell control in units of `ε̇_max/P` (as in `biaxial`, whose constant
+/// documents the choice).
+const IMPLICIT_GAIN: f64 = 10.0;
 /// Tolerance of the implicit correction of the cell control, as a fraction of P.
 const CONTROL_TOLERANCE: f64 = 0.5;
 /// Re-solves of a step at most by the implicit correction.
@@ -112,6 +115,19 @@ impl Shear<'_> {
             // A sheared packing dilates at up to about γ̇: the cap must allow it.
             Some(g) => (Imposed::Rate(0.0), Imposed::Rate(g), rate_cap.max(g)),
         };
+        if c.cell_control == CellControlMode::Implicit {
+            return CellControl {
+                xx,
+                yy: Imposed::Stress(-p),
+                xy,
+                gain: IMPLICIT_GAIN * max_rate / p,
+                max_rate,
+                relaxation: 0.0,
+                tolerance: 0.0,
+                max_corrections: 0,
+                implicit: true,
+            };
+        }
         CellControl {
             xx,
             yy: Imposed::Stress(-p),
@@ -426,6 +442,7 @@ pub fn run(
     let imin = is.iter().cloned().fold(f64::MAX, f64::min);
     let imax = is.iter().cloned().fold(f64::MIN, f64::max);
     s.int("grains", c.grains as u64)
+        .text("cell_control", c.cell_control.as_str())
         .num("pressure_Pa", c.pressure)
         .num("mean_diameter_m", d)
         .int("runs", rows.len() as u64)

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_cell_compression, GrainSpec, SolverSpec};
+use super::common::{check_cell_compression, CellControlMode, GrainSpec, SolverSpec};
 use super::simple_shear::CellFriction;
 use crate::error::{in_range, num, positive, DatasetError, Result};
 use crate::limits;
@@ -26,30 +26,6 @@ impl Preparation {
         match self {
             Preparation::Dense => "dense",
             Preparation::Loose => "loose",
-        }
-    }
-}
-
-/// How the cell's stress-controlled components follow their targets (`dem::cell::CellControl`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum CellControlMode {
-    /// Unknowns of each step's contact problem (`dem::cell_coupling`): a jammed frictional
-    /// packing finds the deformation it can follow within the step.
-    #[default]
-    Implicit,
-    /// The explicit proportional law between steps, with re-solves of a step whose stress
-    /// misses the target (the law before the implicit one; its frictional steps are mostly
-    /// infeasible, `docs/physics.md` §8).
-    Explicit,
-}
-
-impl CellControlMode {
-    /// `implicit` or `explicit`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            CellControlMode::Implicit => "implicit",
-            CellControlMode::Explicit => "explicit",
         }
     }
 }

@@ -13,8 +13,8 @@ pub mod simple_shear;
 pub mod stick_slip;
 
 pub use arrangements::ArrangementsConfig;
-pub use biaxial::{BiaxialConfig, CellControlMode, Preparation};
-pub use common::{FrictionSpec, GrainSpec, SolverSpec};
+pub use biaxial::{BiaxialConfig, Preparation};
+pub use common::{CellControlMode, FrictionSpec, GrainSpec, SolverSpec};
 pub use deposit::{DepositSpec, RelaxSpec};
 pub use inclined_flow::InclinedFlowConfig;
 pub use janssen::{JanssenAnalysis, JanssenConfig, ReleaseSpec};

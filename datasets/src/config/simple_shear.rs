@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_cell_compression, GrainSpec, SolverSpec};
+use super::common::{check_cell_compression, CellControlMode, GrainSpec, SolverSpec};
 use crate::error::{in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
 
@@ -45,6 +45,9 @@ pub struct SimpleShearConfig {
     /// Cap of the cell's strain rate under stress control, as an inertial number
     /// `I_cell = ε̇_max d / √(P/ρ)` (1), in (0, 0.1].
     pub control_inertial_number: f64,
+    /// `implicit` (default) or `explicit` control of the cell ([`CellControlMode`]).
+    #[serde(default)]
+    pub cell_control: CellControlMode,
     /// Duration of the isotropic compression (s).
     pub compression_time: f64,
     /// Solid fraction of the initial loose packing (1), in [0.2, 0.6].
