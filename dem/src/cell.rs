@@ -343,6 +343,27 @@ impl CellControl {
         [self.xx, self.yy, self.xy]
     }
 
+    /// The change `δ⁰_κ = clamp(L_κ, ±ε̇_max) − L_κ + g (σ*_κ − σ^kin_κ)` of each
+    /// stress-controlled component `κ` (xx, yy, xy; 0 where the rate is imposed) over a step of
+    /// the implicit law ([`CellControl::implicit`], [`crate::cell_coupling`]) that carries no
+    /// contact impulse, from the gradient `l` and the kinetic stress `kinetic` (Pa) at the start
+    /// of the step (1/s).
+    pub fn free_change(&self, l: &Mat, kinetic: &Mat) -> [f64; 3] {
+        let mut d = [0.0; 3];
+        for (k, (c, ij)) in self
+            .components()
+            .into_iter()
+            .zip(crate::cell_coupling::COMPONENTS)
+            .enumerate()
+        {
+            if let Imposed::Stress(target) = c {
+                d[k] = l[ij].clamp(-self.max_rate, self.max_rate) - l[ij]
+                    + self.gain * (target - kinetic[ij]);
+            }
+        }
+        d
+    }
+
     /// The velocity gradient for the next step of the implicit law ([`CellControl::implicit`]):
     /// `l` with the imposed rates set and `L_yx = 0`; the stress-controlled components are
     /// those the step's solve found.

@@ -105,14 +105,11 @@ impl CellCoupling {
         let volume = cell.volume() * thickness;
         let m = ctl.gain / (dt * volume);
         let mut compliance = [0.0; 3];
-        let mut delta0 = [0.0; 3];
+        let delta0 = ctl.free_change(&cell.l, kinetic);
         let mut any = false;
-        for (k, (imposed, ij)) in ctl.components().into_iter().zip(COMPONENTS).enumerate() {
-            if let Imposed::Stress(target) = imposed {
-                let l = cell.l[ij];
-                let reference = l.clamp(-ctl.max_rate, ctl.max_rate);
+        for (k, imposed) in ctl.components().into_iter().enumerate() {
+            if let Imposed::Stress(_) = imposed {
                 compliance[k] = m;
-                delta0[k] = reference - l + ctl.gain * (target - kinetic[ij]);
                 any = true;
             }
         }

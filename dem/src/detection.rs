@@ -61,6 +61,9 @@ pub struct Detector {
     fill: Vec<u32>,
     fast: Vec<u32>,
     reduced: Vec<[f64; 2]>,
+    /// The change of a biperiodic cell's `L` within the step that the last detection's swept
+    /// margins cover (1/s; [`Detector::detect_cell`]'s `rate_bound`, capped).
+    image_rate: f64,
 }
 
 /// A line or segment in world coordinates.
@@ -311,6 +314,14 @@ impl Detector {
     /// `[Δx, Δy, Δθ]`): a disk kicked by a contact impulse can travel beyond the bound its
     /// velocity and loads gave at the start of the step, and then meet a disk no contact of the
     /// step knew about.
+    /// The change of a biperiodic cell's velocity gradient within a step (1/s, largest
+    /// component) that the swept margins of the last [`Detector::detect_cell`] cover: an
+    /// implicit cell that changed `L` by more may have moved an image into a disk no contact
+    /// knew.
+    pub fn image_rate(&self) -> f64 {
+        self.image_rate
+    }
+
     pub fn outran(&self, colliders: &[Collider], displacement: &[[f64; 3]]) -> bool {
         self.disk_collider
             .iter()
@@ -602,6 +613,7 @@ impl Detector {
         cell: &Cell,
         detection_gap: f64,
         dt: f64,
+        rate_bound: f64,
         out: &mut ContactSet,
     ) -> Result<(), DemError> {
         out.clear();
@@ -636,7 +648,19 @@ impl Detector {
                 });
             }
         }
-        let pair_affine = dt * l_norm * (r_max + 0.5 * detection_gap.max(0.0));
+        // An implicit cell changes L by up to `rate_bound` within the step while the grains keep
+        // their velocities: an image (shift h k, k ∈ {−1, 0, 1}²) then moves by up to
+        // dt rate_bound (|a₁| + |a₂|) relative to them, half on each disk's margin.
+        // Capped at a quarter of the largest radius per disk (a small cell stays detectable);
+        // a larger change is caught after the step ([`Detector::image_rate`]).
+        let lattice = 0.5 * dt * (cell.h.column(0).norm() + cell.h.column(1).norm());
+        let image_drift = (lattice * rate_bound).min(0.25 * r_max);
+        self.image_rate = if lattice > 0.0 {
+            image_drift / lattice
+        } else {
+            f64::INFINITY
+        };
+        let pair_affine = dt * l_norm * (r_max + 0.5 * detection_gap.max(0.0)) + image_drift;
         for (ci, col) in colliders.iter().enumerate() {
             if let Shape::Disk { radius, offset } = col.shape {
                 let b = &bodies[col.body as usize];

@@ -192,6 +192,9 @@ pub struct World {
     fluct_displacement: Vec<[f64; 3]>,
     /// Kinetic energy changed by wraps during the position correction (J).
     last_wrap_energy: f64,
+    /// Whether the last step's implicit cell changed `L` by more than the swept margins
+    /// covered ([`crate::detection::Detector::image_rate`]): detect again after it.
+    image_outran: bool,
 }
 
 impl World {
@@ -228,6 +231,7 @@ impl World {
             cell_sigma: None,
             fluct_displacement: Vec::new(),
             last_wrap_energy: 0.0,
+            image_outran: false,
         }
     }
 
@@ -774,6 +778,15 @@ impl World {
         set: &mut ContactSet,
     ) -> Result<(), DemError> {
         if let Some(cell) = self.cell {
+            // The largest change of L an implicit control can make in the step (without contact
+            // impulses, which only open the cell further; `crate::cell_coupling`).
+            let rate_bound = match self.cell_control {
+                Some(ctl) if ctl.implicit && h > 0.0 => ctl
+                    .free_change(&cell.l, &self.kinetic_stress(&cell))
+                    .iter()
+                    .fold(0.0f64, |m, d| m.max(d.abs())),
+                _ => 0.0,
+            };
             return self.detector.detect_cell(
                 &self.bodies,
                 &self.inv,
@@ -782,6 +795,7 @@ impl World {
                 &cell,
                 gap,
                 h,
+                rate_bound,
                 set,
             );
         }
@@ -1087,9 +1101,12 @@ impl World {
             )
         };
         solver::classify(&self.contacts.rows, &mut self.contacts.status);
-        if let (Some(c), Some(cell)) = (&coupling, self.cell.as_mut()) {
-            // The images moved with L⁺ h k during the solve: the cell takes L⁺.
-            cell.l += c.delta();
+        // The images moved with L⁺ h k during the solve: the cell takes L⁺ (the grains follow
+        // the change δ at the end of the step, 6.).
+        let delta = coupling.as_ref().map_or_else(Mat::zeros, |c| c.delta());
+        self.image_outran = delta.abs().max() > self.detector.image_rate();
+        if let Some(cell) = self.cell.as_mut() {
+            cell.l += delta;
         }
 
         // 4. Positions, accelerations.
@@ -1131,7 +1148,8 @@ impl World {
         let mut cell_work = 0.0;
         let mut cell_gap_shift = Vec::new();
         if let Some(mut cell) = self.cell {
-            let (h_old, l) = (cell.h, cell.l);
+            // The grains moved without the change δ of an implicit cell (the images with it).
+            let (h_old, l) = (cell.h, cell.l - delta);
             // Affine part of the step's displacements, for the outran check.
             let c = cell.centre();
             self.fluct_displacement.clear();
@@ -1152,6 +1170,9 @@ impl World {
                 }
             }
             cell.remap();
+            // Until the grains follow it (6.), the affine field of their velocities is L⁻: the
+            // wraps and the kinetic stress use it.
+            cell.l -= delta;
             self.cell = Some(cell);
             cell_work += self.wrap_grains();
             // Work of the impulses against the images' affine velocities.
@@ -1191,7 +1212,8 @@ impl World {
             self.cell_sigma = Some(sigma);
             if let Some(ctl) = self.cell_control {
                 let l = if ctl.implicit {
-                    ctl.implicit_next(&cell.l)
+                    // The grains take the step's change δ too (from L⁻ to the next L).
+                    ctl.implicit_next(&(cell.l + delta))
                 } else {
                     ctl.update(&cell.l, &sigma, h)
                 };
@@ -1240,7 +1262,7 @@ impl World {
         } else {
             &self.displacement
         };
-        if self.detector.outran(&self.colliders, moved) {
+        if self.image_outran || self.detector.outran(&self.colliders, moved) {
             let mut fresh = std::mem::take(&mut self.fresh);
             let reach = 0.25 * self.smallest_radius().unwrap_or(0.0);
             let detected = self.detect_into(reach, 0.0, 0.0, &mut fresh);
