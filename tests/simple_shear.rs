@@ -13,7 +13,7 @@ const TINY: &[&str] = &[
     "--set",
     "grains=50",
     "--set",
-    "compression_time=0.02",
+    "compression_time=0.06",
     "--set",
     "inertial_numbers=[0.2]",
     "--set",
@@ -82,7 +82,7 @@ fn bad_inputs_are_refused_with_one_line() {
     }
 }
 
-/// A run stopped after 45 steps (inside the shear run) and resumed writes the same files as
+/// A run stopped after 130 steps (inside the shear run, after the 120 compression steps) and resumed writes the same files as
 /// an uninterrupted run, `summary.json`'s `wall_seconds` aside: bit-identical results.
 #[test]
 fn resume_is_bit_identical() {
@@ -93,7 +93,7 @@ fn resume_is_bit_identical() {
     let o = grainlaw(TINY, Some(&a));
     let code = o.status.code();
     assert!(matches!(code, Some(0) | Some(3)), "{}", stderr(&o));
-    let o = grainlaw(&[TINY, &["--stop-after-steps", "45"]].concat(), Some(&b));
+    let o = grainlaw(&[TINY, &["--stop-after-steps", "130"]].concat(), Some(&b));
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
     let o = grainlaw(&["run", "--resume", b.to_str().unwrap(), "-q"], None);
     assert_eq!(o.status.code(), code, "{}", stderr(&o));

@@ -321,6 +321,12 @@ impl Biaxial<'_> {
             ),
         };
         if self.c.cell_control == CellControlMode::Implicit {
+            // The loose packing of the isotropic compression closes at (1 + K) ε̇_max until it
+            // jams: keep that within the cap.
+            let max_rate = match axial_rate {
+                None => max_rate / (1.0 + IMPLICIT_GAIN),
+                Some(_) => max_rate,
+            };
             return CellControl {
                 xx: Imposed::Stress(target),
                 yy,

@@ -116,6 +116,12 @@ impl Shear<'_> {
             Some(g) => (Imposed::Rate(0.0), Imposed::Rate(g), rate_cap.max(g)),
         };
         if c.cell_control == CellControlMode::Implicit {
+            // A packing without contacts closes at (1 + K) ε̇_max: in the isotropic compression
+            // keep that within the cap.
+            let max_rate = match gamma_dot {
+                None => max_rate / (1.0 + IMPLICIT_GAIN),
+                Some(_) => max_rate,
+            };
             return CellControl {
                 xx,
                 yy: Imposed::Stress(-p),
