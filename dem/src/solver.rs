@@ -717,7 +717,10 @@ impl SweepProblem for Step<'_> {
             (Some(cell), SweepOrder::Natural(order)) => {
                 cell.sweep(self.rows, order, self.vel, self.inv, self.omega)
             }
-            (_, order) => order.sweep(self.rows, self.vel, self.inv, self.omega),
+            (cell, order) => {
+                debug_assert!(cell.is_none(), "a coupled step is swept on one thread");
+                order.sweep(self.rows, self.vel, self.inv, self.omega)
+            }
         }
         None
     }

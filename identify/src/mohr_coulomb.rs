@@ -72,6 +72,19 @@ pub enum YieldData {
 }
 
 impl YieldData {
+    /// Number of stress states.
+    pub fn len(&self) -> usize {
+        match self {
+            YieldData::Circles { p_pa, .. } => p_pa.len(),
+            YieldData::FailurePlane { sigma_n_pa, .. } => sigma_n_pa.len(),
+        }
+    }
+
+    /// Whether there is no stress state.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// Mohr circles from 2D tension-positive stress tensors `(σ_xx, σ_yy, σ_xy)` (the project's
     /// convention, e.g. homogenised `Σ`): `p = −(σ_xx + σ_yy)/2`,
     /// `q = √(((σ_xx − σ_yy)/2)² + σ_xy²)`.
@@ -256,6 +269,36 @@ pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulomb
             ..Default::default()
         },
     )
+}
+
+/// Fits the envelope in the form the data support: with a free cohesion (at least 4 states)
+/// and, when that fit is refused (typically a cohesion whose interval crosses zero: rigid
+/// cohesionless grains have none), the cohesionless envelope `q = p sin φ` through the origin.
+/// Returns the fit, whether its cohesion is fixed at zero, and the refusal of the free form when
+/// it fell back to the cohesionless one; the errors are those of the last fit tried
+/// ([`fit_mohr_coulomb_with`]).
+pub fn fit_mohr_coulomb_supported(
+    data: &YieldData,
+    confidence: f64,
+) -> Result<(MohrCoulombFit, bool, Option<IdentifyError>)> {
+    let free = MohrCoulombOptions {
+        confidence,
+        ..Default::default()
+    };
+    let refusal = if data.len() >= 4 {
+        match fit_mohr_coulomb_with(data, &free) {
+            Ok(f) => return Ok((f, false, None)),
+            Err(e) => Some(e),
+        }
+    } else {
+        None
+    };
+    let fixed = MohrCoulombOptions {
+        confidence,
+        cohesion_fixed_zero: true,
+        ..Default::default()
+    };
+    fit_mohr_coulomb_with(data, &fixed).map(|f| (f, true, refusal))
 }
 
 /// Fits the Mohr–Coulomb envelope (see the module documentation).

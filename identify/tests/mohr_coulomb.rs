@@ -4,7 +4,7 @@ mod common;
 
 use common::gaussian;
 use identify::laws::MohrCoulombLaw;
-use identify::mohr_coulomb::{fit_mohr_coulomb, YieldData};
+use identify::mohr_coulomb::{fit_mohr_coulomb, fit_mohr_coulomb_supported, YieldData};
 use identify::IdentifyError;
 
 /// 40 Mohr circles at yield with p ∈ [1, 20] kPa, q = p sin φ + c cos φ + noise, each turned
@@ -179,4 +179,44 @@ fn degenerate_yield_data() {
         fit_mohr_coulomb(&nan, 0.95).unwrap_err(),
         IdentifyError::NonFinite { index: 2, .. }
     ));
+}
+
+/// Peak circles of a cohesionless material (sin φ = 0.45) with scatter of ±1–8 % at four
+/// pressures, as the biaxial scenario measures them: the free-cohesion fit is refused (its
+/// cohesion interval crosses zero), and [`fit_mohr_coulomb_supported`] fits the form the data
+/// support, `q = p sin φ`, whose angle is then the least-squares slope through the origin,
+/// `sin φ = Σ p q / Σ p²` (to 10⁻⁶), with the free form's refusal returned.
+#[test]
+fn unsupported_cohesion_falls_back_to_the_cohesionless_envelope() {
+    let p = vec![1000.0, 2000.0, 4000.0, 8000.0];
+    let q: Vec<f64> = p
+        .iter()
+        .zip([60.0, -80.0, 70.0, -40.0])
+        .map(|(p, e)| 0.45 * p + e)
+        .collect();
+    let data = YieldData::Circles {
+        p_pa: p.clone(),
+        q_pa: q.clone(),
+    };
+    assert!(
+        fit_mohr_coulomb(&data, 0.95).is_err(),
+        "the free fit must be refused"
+    );
+    let (fit, fixed, refusal) = fit_mohr_coulomb_supported(&data, 0.95).unwrap();
+    assert!(fixed && refusal.is_some());
+    assert_eq!(fit.cohesion.value, 0.0);
+    let slope: f64 =
+        p.iter().zip(&q).map(|(p, q)| p * q).sum::<f64>() / p.iter().map(|p| p * p).sum::<f64>();
+    assert!(
+        (fit.friction_angle.value.sin() - slope).abs() < 1e-6,
+        "sin φ = {} vs {slope}",
+        fit.friction_angle.value.sin()
+    );
+    // Exact cohesive data keep their free fit.
+    let cohesive = YieldData::Circles {
+        p_pa: p.clone(),
+        q_pa: p.iter().map(|p| 0.45 * p + 300.0).collect(),
+    };
+    let (fit, fixed, refusal) = fit_mohr_coulomb_supported(&cohesive, 0.95).unwrap();
+    assert!(!fixed && refusal.is_none() && fit.cohesion.value > 0.0);
 }

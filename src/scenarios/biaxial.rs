@@ -28,7 +28,7 @@ use homogenise::cell::cell_state;
 use identify::critical_state::{
     fit_critical_state, fit_stress_dilatancy, PlateauMeasure, StressDilatancyData,
 };
-use identify::mohr_coulomb::{fit_mohr_coulomb_with, MohrCoulombOptions, YieldData};
+use identify::mohr_coulomb::{fit_mohr_coulomb_supported, YieldData};
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
@@ -930,24 +930,28 @@ fn analyse(
         p_pa: rows.iter().map(|r| r[3]).collect(),
         q_pa: rows.iter().map(|r| r[4]).collect(),
     };
-    let mc_options = if n >= 4 {
-        MohrCoulombOptions::default()
-    } else {
-        MohrCoulombOptions::cohesionless()
-    };
+    // A free cohesion with 4 pressures or more, else (or when the data do not identify it:
+    // rigid cohesionless grains have none) the envelope through the origin.
+    let fitted = fit_mohr_coulomb_supported(&peaks, 0.95).map(|(f, fixed, refusal)| {
+        if let Some(e) = refusal {
+            warn(&format!(
+                "Mohr–Coulomb with a free cohesion refused ({e}); fitted the cohesionless form q = p sin φ"
+            ));
+            s.text("friction_peak_free_cohesion_error", &e.to_string());
+        }
+        (f, fixed)
+    });
     let mut mc_line = None;
-    match fit_mohr_coulomb_with(&peaks, &mc_options) {
-        Ok(f) => {
+    match fitted {
+        Ok((f, cohesion_fixed_zero)) => {
             fit_keys(&mut s, "friction_peak", &f.report.parameters);
             fit_keys(
                 &mut s,
                 "friction_peak",
                 std::slice::from_ref(&f.friction_angle_deg),
             );
-            s.num("friction_peak_r_squared", f.report.r_squared).flag(
-                "friction_peak_cohesion_fixed_zero",
-                mc_options.cohesion_fixed_zero,
-            );
+            s.num("friction_peak_r_squared", f.report.r_squared)
+                .flag("friction_peak_cohesion_fixed_zero", cohesion_fixed_zero);
             headline.extend(parameter_lines(
                 "Mohr–Coulomb over the peaks, q = p sin φ + c cos φ",
                 f.report.r_squared,
