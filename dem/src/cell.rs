@@ -293,8 +293,8 @@ pub struct CellControl {
     pub max_corrections: usize,
     /// The stress-controlled components as unknowns of each step's contact problem
     /// ([`crate::cell_coupling`]): `L⁺ = clamp(L⁻, ±ε̇_max) + g (σ* − σ⁺)` with the stress `σ⁺`
-    /// of the step's own impulses, instead of the explicit law above (then `tolerance` and
-    /// `max_corrections` are not used, no step is solved twice, and `g` has no stability
+    /// of the step's own impulses, instead of the explicit law above (then `relaxation`,
+    /// `tolerance` and `max_corrections` are not used, no step is solved twice, and `g` has no stability
     /// limit). The rates of the other components are imposed at the end of each step.
     #[serde(default)]
     pub implicit: bool,

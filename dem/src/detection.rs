@@ -309,19 +309,19 @@ impl Detector {
         }
     }
 
+    /// The change of a biperiodic cell's velocity gradient within a step (1/s, sum of the
+    /// magnitudes of its components, which bounds `|δ (h k)|/(|a₁| + |a₂|)` for `k ∈ {−1, 0, 1}²`)
+    /// that the swept margins of the last [`Detector::detect_cell`] cover: an implicit cell that
+    /// changed `L` by more may have moved an image into a disk no contact knew.
+    pub fn image_rate(&self) -> f64 {
+        self.image_rate
+    }
+
     /// Whether some disk moved, over a step whose contacts the last [`Detector::detect`] found,
     /// farther than the swept margin that detection allowed it (`displacement` per body,
     /// `[Δx, Δy, Δθ]`): a disk kicked by a contact impulse can travel beyond the bound its
     /// velocity and loads gave at the start of the step, and then meet a disk no contact of the
     /// step knew about.
-    /// The change of a biperiodic cell's velocity gradient within a step (1/s, largest
-    /// component) that the swept margins of the last [`Detector::detect_cell`] cover: an
-    /// implicit cell that changed `L` by more may have moved an image into a disk no contact
-    /// knew.
-    pub fn image_rate(&self) -> f64 {
-        self.image_rate
-    }
-
     pub fn outran(&self, colliders: &[Collider], displacement: &[[f64; 3]]) -> bool {
         self.disk_collider
             .iter()
@@ -648,9 +648,10 @@ impl Detector {
                 });
             }
         }
-        // An implicit cell changes L by up to `rate_bound` within the step while the grains keep
-        // their velocities: an image (shift h k, k ∈ {−1, 0, 1}²) then moves by up to
-        // dt rate_bound (|a₁| + |a₂|) relative to them, half on each disk's margin.
+        // An implicit cell changes L by δ within the step while the grains keep their
+        // velocities: an image (shift h k, k ∈ {−1, 0, 1}²) then moves by |δ h k| dt ≤
+        // dt Σ|δ_ij| (|a₁| + |a₂|) relative to them; `rate_bound` bounds Σ|δ_ij|; half of it on
+        // each disk's margin.
         // Capped at a quarter of the largest radius per disk (a small cell stays detectable);
         // a larger change is caught after the step ([`Detector::image_rate`]).
         let lattice = 0.5 * dt * (cell.h.column(0).norm() + cell.h.column(1).norm());

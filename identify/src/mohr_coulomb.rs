@@ -275,8 +275,8 @@ pub fn fit_mohr_coulomb(data: &YieldData, confidence: f64) -> Result<MohrCoulomb
 /// and, when that fit is refused (typically a cohesion whose interval crosses zero: rigid
 /// cohesionless grains have none), the cohesionless envelope `q = p sin φ` through the origin.
 /// Returns the fit, whether its cohesion is fixed at zero, and the refusal of the free form when
-/// it fell back to the cohesionless one; the errors are those of the last fit tried
-/// ([`fit_mohr_coulomb_with`]).
+/// it fell back to the cohesionless one. Errors: those of [`fit_mohr_coulomb_with`], the free
+/// form's when neither form is accepted.
 pub fn fit_mohr_coulomb_supported(
     data: &YieldData,
     confidence: f64,
@@ -298,7 +298,12 @@ pub fn fit_mohr_coulomb_supported(
         cohesion_fixed_zero: true,
         ..Default::default()
     };
-    fit_mohr_coulomb_with(data, &fixed).map(|f| (f, true, refusal))
+    match (fit_mohr_coulomb_with(data, &fixed), refusal) {
+        (Ok(f), refusal) => Ok((f, true, refusal)),
+        // Neither form: the free form's reason is the data's first refusal.
+        (Err(_), Some(free)) => Err(free),
+        (Err(e), None) => Err(e),
+    }
 }
 
 /// Fits the Mohr–Coulomb envelope (see the module documentation).
