@@ -148,10 +148,11 @@ fn stress_control_and_frictionless_critical_state() {
 /// with the explicit law 179 of 190 axial steps stopped at the sweep cap, worst error 10⁻²):
 /// 100 disks, μ = 0.5, p₀ = 1 kPa, dense, to ε_a = 0.03. The isotropic compression ends at
 /// −p₀ within 3 % (its stress fluctuates by a few % from step to step once jammed; measured
-/// 0.05–1.2 % over builds that differ in rounding; 14–29 % under the explicit law), the lateral stress of the axial compression averages −p₀
-/// within 1 % (measured 0.02 %), at most 3 % of its 285 steps end above the tolerance 10⁻⁴
-/// and none above 10× it (measured 2 steps, worst 1.2·10⁻⁴), and the mobilised friction has a
-/// peak above its value at the end, sin φ_peak in [0.35, 0.6] (measured 0.464, 27.7°; dense
+/// 0.05–1.2 % over builds that differ in rounding, 0.2 % with dt_max = 2.5·10⁻⁴ s; 14–29 %
+/// under the explicit law), the lateral stress of the axial compression averages −p₀
+/// within 1 % (measured 0.001 %), at most 3 % of its 570 steps end above the tolerance 10⁻⁴
+/// and none above 10× it (measured 2 steps, worst 2.0·10⁻⁴), and the mobilised friction has a
+/// peak above its value at the end, sin φ_peak in [0.35, 0.6] (measured 0.491, 29.4°; dense
 /// disks with μ = 0.5 peak at 25–35°, e.g. Azéma & Radjai, Phys. Rev. E 85, 2012). The explicit
 /// law on the same run: 125 unconverged steps, compression 29 % off, 20 times slower.
 #[test]
@@ -226,9 +227,9 @@ fn resume_is_bit_identical() {
     let o = grainlaw(tiny, Some(&a));
     let code = o.status.code();
     assert!(matches!(code, Some(0) | Some(3)), "{}", stderr(&o));
-    // 40 compression steps and 38 axial steps per pressure: stop inside the second pressure's
+    // 80 compression steps and 76 axial steps per pressure: stop inside the second pressure's
     // axial compression
-    let o = grainlaw(&[tiny, &["--stop-after-steps", "100"]].concat(), Some(&b));
+    let o = grainlaw(&[tiny, &["--stop-after-steps", "260"]].concat(), Some(&b));
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
     let o = grainlaw(&["run", "--resume", b.to_str().unwrap(), "-q"], None);
     assert_eq!(o.status.code(), code, "{}", stderr(&o));
