@@ -138,8 +138,9 @@ pub enum Command {
         /// Grain counts of the biaxial RVE rows (none by default: a 10⁴-grain row takes minutes).
         #[arg(long, value_name = "N", num_args = 0..)]
         biaxial_grains: Vec<usize>,
-        /// Isotropic-compression steps of a biaxial row before its timed steps.
-        #[arg(long, value_name = "STEPS", default_value_t = 300)]
+        /// Isotropic-compression steps of a biaxial row before its timed steps (default: the
+        /// built-in scenario's compression_time / dt_max, 0.15 s / 2.5e-4 s).
+        #[arg(long, value_name = "STEPS", default_value_t = 600)]
         biaxial_compress_steps: usize,
         /// Timed axial steps of a biaxial row.
         #[arg(long, value_name = "STEPS", default_value_t = 20)]
