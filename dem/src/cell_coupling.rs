@@ -52,7 +52,7 @@
 use crate::cell::{Cell, CellControl, Imposed, Mat};
 use crate::contact::{ContactGeometry, ContactRow};
 use crate::local::Delassus2;
-use crate::parallel::local_update;
+use crate::solver::update;
 
 /// The components `(i, j)` of `L` a cell control can impose a stress on: xx, yy, xy.
 pub const COMPONENTS: [(usize, usize); 3] = [(0, 0), (1, 1), (0, 1)];
@@ -239,21 +239,14 @@ impl CellCoupling {
         for &i in order {
             let c = &mut rows[i as usize];
             let s = self.slot[i as usize];
-            let (a, b) = (c.a as usize, c.b as usize);
-            let (mut va, mut vb) = (vel[a], vel[b]);
             if s == NONE {
-                if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
-                    vel[a] = va;
-                    vel[b] = vb;
-                }
+                update(c, vel, inv, omega);
                 continue;
             }
             let s = s as usize;
             c.affine = self.affine_of(s, &self.delta);
             let before = c.r;
-            if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
-                vel[a] = va;
-                vel[b] = vb;
+            if update(c, vel, inv, omega) {
                 let d = [c.r[0] - before[0], c.r[1] - before[1]];
                 for k in 0..3 {
                     let b = self.coef[s][k];

@@ -263,14 +263,22 @@ pub fn free_velocity_norm(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
 
 /// Update of one contact: exact local solve, optional relaxation projected back on the cone,
 /// velocities of its two bodies updated. O(1).
+/// Returns whether the impulse changed.
 #[inline(always)]
-fn update(c: &mut ContactRow, vel: &mut [[f64; 3]], inv: &[[f64; 3]], omega: f64) {
+pub(crate) fn update(
+    c: &mut ContactRow,
+    vel: &mut [[f64; 3]],
+    inv: &[[f64; 3]],
+    omega: f64,
+) -> bool {
     let (a, b) = (c.a as usize, c.b as usize);
     let (mut va, mut vb) = (vel[a], vel[b]);
-    if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
+    let changed = local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega);
+    if changed {
         vel[a] = va;
         vel[b] = vb;
     }
+    changed
 }
 
 /// One Gauss–Seidel sweep over `rows` in the order given by `order`, with relaxation `omega`.
