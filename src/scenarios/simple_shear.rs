@@ -96,6 +96,35 @@ struct State {
     /// The checks of the finished runs (crate::verdict).
     #[serde(default)]
     checks: Vec<RunCheckData>,
+    /// Peak of the stress ratio of each finished run ([`peak_mu`]).
+    #[serde(default, with = "crate::floats::vec")]
+    peaks: Vec<f64>,
+}
+
+/// Width of the shear-strain bins of the peak stress ratio of a run.
+const PEAK_BIN_STRAIN: f64 = 0.1;
+
+/// The peak stress ratio of a run's history (rows with the shear strain in column `strain` and
+/// μ in column `mu`): the largest mean of μ over bins of [`PEAK_BIN_STRAIN`] of shear strain
+/// (means of the noisy step values, as `biaxial`'s peak; NaN without data).
+fn peak_mu(history: &[Vec<f64>], strain: usize, mu: usize) -> f64 {
+    let mut bins: Vec<(f64, usize)> = Vec::new();
+    for row in history {
+        let (g, m) = (row[strain], row[mu]);
+        if !(g.is_finite() && m.is_finite()) || g < 0.0 {
+            continue;
+        }
+        let b = (g / PEAK_BIN_STRAIN) as usize;
+        if bins.len() <= b {
+            bins.resize(b + 1, (0.0, 0));
+        }
+        bins[b].0 += m;
+        bins[b].1 += 1;
+    }
+    bins.iter()
+        .filter(|b| b.1 > 0)
+        .map(|b| b.0 / b.1 as f64)
+        .fold(f64::NAN, f64::max)
 }
 
 struct Shear<'a> {
@@ -317,6 +346,7 @@ impl PhasedRun for Shear<'_> {
             tail.len() as f64,
             corrections / tail.len().max(1) as f64,
         ]);
+        st.peaks.push(peak_mu(&st.history, 1, 16));
         st.curves.push((
             i,
             st.history
@@ -360,6 +390,7 @@ pub fn run(
                 frames: VtkFrames::new(t_total / 40.0, 41),
                 window: WindowStats::default(),
                 checks: Vec::new(),
+                peaks: Vec::new(),
             },
         ))
     };
@@ -370,6 +401,7 @@ pub fn run(
         curves,
         frames,
         checks: run_checks,
+        peaks,
         ..
     } = state;
     // Checks (crate::verdict), as in the shear cell: per point, the numerics of its averaging
@@ -464,7 +496,18 @@ pub fn run(
             .num(&format!("run{}_mu_std_error", k + 1), r[4])
             .num(&format!("run{}_phi", k + 1), r[5])
             .num(&format!("run{}_phi_std_error", k + 1), r[6])
-            .num(&format!("run{}_P_Pa", k + 1), r[7]);
+            .num(&format!("run{}_P_Pa", k + 1), r[7])
+            // the steady state of the run: its critical state at that I
+            .num(&format!("run{}_friction_critical_mu", k + 1), r[3])
+            .num(&format!("run{}_solid_fraction_critical", k + 1), r[5]);
+        if let Some(&peak) = peaks.get(k) {
+            s.num(&format!("run{}_friction_peak_mu", k + 1), peak);
+        }
+    }
+    // The first run starts from the isotropically compressed sample: its transient peak is the
+    // sample's peak friction (the later runs start from the previous steady state).
+    if let Some(&peak) = peaks.first() {
+        s.num("friction_peak_mu", peak);
     }
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
     let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
@@ -510,4 +553,31 @@ pub fn run(
 /// Standard errors usable as fit weights: all finite and positive, or `None` (unweighted).
 fn weights_if_usable(se: Vec<f64>) -> Option<Vec<f64>> {
     se.iter().all(|s| s.is_finite() && *s > 0.0).then_some(se)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A history whose μ is 0.6 over the first bin of shear strain, 0.8 over the second and
+    /// 0.4 after (steps every 0.01 of strain), with a non-finite row: the peak is the second
+    /// bin's mean, 0.8 (to rounding), not the largest step value 1.0 of a spike in the third bin.
+    #[test]
+    fn peak_is_the_largest_bin_mean() {
+        let mut h = Vec::new();
+        for n in 0..40 {
+            let g = 0.005 + 0.01 * n as f64;
+            let mu = match n {
+                0..=9 => 0.6,
+                10..=19 => 0.8,
+                25 => 1.0,
+                _ => 0.4,
+            };
+            h.push(vec![g, mu]);
+        }
+        h.push(vec![0.5, f64::NAN]);
+        let p = peak_mu(&h, 0, 1);
+        assert!((p - 0.8).abs() < 1e-12, "{p}");
+        assert!(peak_mu(&[], 0, 1).is_nan());
+    }
 }
