@@ -34,8 +34,10 @@ use serde::{Deserialize, Serialize};
 use crate::error::{CliError, Result};
 use crate::scenarios::common::Stop;
 
-/// Format tag of run checkpoints.
-pub const FORMAT: &str = "grainlaw-run-checkpoint-v1";
+/// Format tag of run checkpoints. v2: a biperiodic cell may be under the implicit control
+/// (`dem::cell::CellControl::implicit`), the default of `simple-shear` and `biaxial`, whose
+/// stored scenario of a v1 run would not say so: a v1 checkpoint is refused (run again).
+pub const FORMAT: &str = "grainlaw-run-checkpoint-v2";
 
 /// Buffer between the gzip stream and the JSON deserialiser (bytes).
 const BUFFER: usize = 1 << 20;
