@@ -616,7 +616,7 @@ impl AutoStages for EngineStages<'_, '_> {
             (true, SolverMethod::Lemke) => usize::MAX,
             (true, _) => self.params.lemke_max_contacts,
         };
-        if step.rows.len() > max_contacts && error_now > newton::FINISH_MAX_ERROR {
+        if step.rows.len() > max_contacts && !newton::active_set_applies(error_now) {
             // Neither stage would run: do not assemble the problem (every stalled step of a
             // run with Lemke off comes here).
             return Ok((false, false));

@@ -81,7 +81,7 @@ pub fn exact_finish(
 ) -> Result<FinishOutcome, FcError> {
     let mut out = FinishOutcome {
         better: None,
-        active_set: !error_now.is_nan() && error_now <= newton::FINISH_MAX_ERROR,
+        active_set: newton::active_set_applies(error_now),
         lemke_ran: false,
         pivots: 0,
     };

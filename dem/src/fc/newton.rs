@@ -539,6 +539,13 @@ pub fn solve_with(
 /// cones), and an engine step would pay a factorisation for nothing.
 pub const FINISH_MAX_ERROR: f64 = 1e-5;
 
+/// Whether [`active_set_finish`] is tried from an iterate of error `error_now`: a finite error
+/// of at most [`FINISH_MAX_ERROR`] (the one gate, also for callers deciding whether the finish
+/// can do anything).
+pub fn active_set_applies(error_now: f64) -> bool {
+    !error_now.is_nan() && error_now <= FINISH_MAX_ERROR
+}
+
 /// Relative margin under which `|r_t| ≥ (1 − margin) μ r_n` reads as sliding in
 /// [`active_set_finish`].
 const SLIDING_MARGIN: f64 = 1e-9;
@@ -569,7 +576,7 @@ pub fn active_set_finish(
     work: &mut NewtonWork,
 ) -> Result<Option<(Vec<f64>, f64)>, FcError> {
     let n = problem.contacts();
-    if n == 0 || r.len() != 2 * n || error_now.is_nan() || error_now > FINISH_MAX_ERROR {
+    if n == 0 || r.len() != 2 * n || !active_set_applies(error_now) {
         return Ok(None);
     }
     let (diag, rho) = scales(problem);
