@@ -184,7 +184,14 @@ impl Cell {
 
     /// Advances the cell by `dt` (s) at constant `L`: `h ← exp(L dt) h`.
     pub fn advance(&mut self, dt: f64) {
-        let f = (self.l * dt).exp();
+        self.advance_with(&self.l.clone(), dt);
+    }
+
+    /// Advances the cell by `dt` (s) at the constant gradient `l` (1/s), `h ← exp(l dt) h`,
+    /// leaving its own `L` unchanged (an implicit control's step deforms the cell with the
+    /// `L⁺` its solve found before the grains take it, [`crate::cell_coupling`]).
+    pub fn advance_with(&mut self, l: &Mat, dt: f64) {
+        let f = (l * dt).exp();
         self.h = f * self.h;
     }
 

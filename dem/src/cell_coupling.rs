@@ -88,16 +88,18 @@ pub struct CellCoupling {
 impl CellCoupling {
     /// The coupling of a step of `cell` under `ctl` (implicit), with the contacts `rows` and
     /// their `geometry` (image shift vectors), the impulse time `dt` (s), the grains'
-    /// `thickness` (m) and the kinetic stress `kinetic` at the start of the step (Pa, tension
-    /// positive). `None` when `ctl` is not implicit or imposes no stress.
+    /// `thickness` (m) and the impulse-free change `delta0` ([`CellControl::free_change`] at the
+    /// start of the step). `δ` is set from the rows' (warm-start) impulses and the coupled rows'
+    /// affine velocities with it ([`CellCoupling::refresh`]). `None` when `ctl` is not implicit
+    /// or imposes no stress.
     pub fn new(
         ctl: &CellControl,
         cell: &Cell,
-        rows: &[ContactRow],
+        rows: &mut [ContactRow],
         geometry: &[ContactGeometry],
         dt: f64,
         thickness: f64,
-        kinetic: &Mat,
+        delta0: [f64; 3],
     ) -> Option<Self> {
         if !ctl.implicit {
             return None;
@@ -105,7 +107,6 @@ impl CellCoupling {
         let volume = cell.volume() * thickness;
         let m = ctl.gain / (dt * volume);
         let mut compliance = [0.0; 3];
-        let delta0 = ctl.free_change(&cell.l, kinetic);
         let mut any = false;
         for (k, imposed) in ctl.components().into_iter().enumerate() {
             if let Imposed::Stress(_) = imposed {
@@ -144,6 +145,7 @@ impl CellCoupling {
                 c.own.push(row.w);
             }
         }
+        c.refresh(rows);
         Some(c)
     }
 

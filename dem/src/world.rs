@@ -715,7 +715,7 @@ impl World {
         // Overlaps and grains behind walls, with the detector at zero gap.
         self.refresh_inverse_mass();
         let mut set = ContactSet::default();
-        self.detect_into(0.0, 0.0, 0.0, &mut set)?;
+        self.detect_into(0.0, 0.0, 0.0, 0.0, &mut set)?;
         for (row, g) in set.rows.iter().zip(&set.geometry) {
             if g.gap < -tolerance {
                 let (a, b) = (row.a as usize, row.b as usize);
@@ -747,7 +747,7 @@ impl World {
     /// in the middle of a run it discards the warm start of the previous step.
     pub fn prime_with_weight(&mut self) -> Result<(), DemError> {
         self.refresh_inverse_mass();
-        self.detect_step_contacts()?;
+        self.detect_step_contacts(self.implicit_free_change())?;
         let (h, g) = (self.params.dt, self.params.gravity);
         crate::hydrostatic::weight_impulses(&mut self.contacts.rows, &self.bodies, &self.inv, g, h);
         self.contacts.dt = h;
@@ -756,41 +756,49 @@ impl World {
 
     /// Detection into `self.contacts` with the step's gap, time step and gravity (the inverse
     /// masses must be current).
-    fn detect_step_contacts(&mut self) -> Result<(), DemError> {
+    ///
+    /// `free_change`: the impulse-free change `δ⁰` of an implicit cell control over the step
+    /// ([`World::implicit_free_change`]); the swept margins cover the images' drift under it,
+    /// as the sum of its components' magnitudes. Normal impulses across the boundary mostly
+    /// open the cell further, but frictional or shear ones can close it more: a change beyond
+    /// the margins detects again after the step (`image_outran`).
+    fn detect_step_contacts(&mut self, free_change: Option<[f64; 3]>) -> Result<(), DemError> {
         let mut set = std::mem::take(&mut self.contacts);
         let (gap, h, g) = (
             self.params.detection_gap,
             self.params.dt,
             self.params.gravity.norm(),
         );
-        let found = self.detect_into(gap, h, g, &mut set);
+        let rate_bound = free_change.map_or(0.0, |d| d.iter().map(|x| x.abs()).sum());
+        let found = self.detect_into(gap, h, g, rate_bound, &mut set);
         self.contacts = set;
         found
     }
 
+    /// The impulse-free change `δ⁰` of the stress-controlled components of an implicit cell
+    /// control over the next step ([`CellControl::free_change`], with the kinetic stress now);
+    /// `None` without one.
+    fn implicit_free_change(&self) -> Option<[f64; 3]> {
+        match (self.cell_control, self.cell) {
+            (Some(ctl), Some(cell)) if ctl.implicit => {
+                Some(ctl.free_change(&cell.l, &self.kinetic_stress(&cell)))
+            }
+            _ => None,
+        }
+    }
+
     /// Detection into `set`: pairs closer than `gap` (m) plus what they can travel in a step of
-    /// `h` (s) under gravity `g` (m/s²).
+    /// `h` (s) under gravity `g` (m/s²), and, in a biperiodic cell, the images' drift under a
+    /// change of `L` by up to `rate_bound` (1/s, sum of the components' magnitudes) within it.
     fn detect_into(
         &mut self,
         gap: f64,
         h: f64,
         g: f64,
+        rate_bound: f64,
         set: &mut ContactSet,
     ) -> Result<(), DemError> {
         if let Some(cell) = self.cell {
-            // The change of L an implicit control makes in the step without contact impulses
-            // (`crate::cell_coupling`), as the sum of its components' magnitudes. Normal impulses
-            // across the boundary mostly open the cell further, but frictional or shear ones can
-            // close it more: a change beyond the margins detects again after the step
-            // (`image_outran`).
-            let rate_bound = match self.cell_control {
-                Some(ctl) if ctl.implicit && h > 0.0 => ctl
-                    .free_change(&cell.l, &self.kinetic_stress(&cell))
-                    .iter()
-                    .map(|d| d.abs())
-                    .sum(),
-                _ => 0.0,
-            };
             return self.detector.detect_cell(
                 &self.bodies,
                 &self.inv,
@@ -964,7 +972,10 @@ impl World {
 
         // 1. Detection at q⁻, warm start from the previous step.
         std::mem::swap(&mut self.contacts, &mut self.previous);
-        self.detect_step_contacts()?;
+        // The impulse-free change of an implicit cell over the step (its images' drift widens
+        // the swept margins; the contact problem below starts from it).
+        let free_change = self.implicit_free_change();
+        self.detect_step_contacts(free_change)?;
         // Impulses scale with the time step (R = h r): rescale if it changed.
         let scale = if self.previous.dt > 0.0 {
             h / self.previous.dt
@@ -1011,24 +1022,20 @@ impl World {
 
         // 3. Contact solve (with the cell's stress-controlled components as unknowns under an
         //    implicit control, `crate::cell_coupling`).
-        let mut coupling = match (self.cell_control, self.cell) {
-            (Some(ctl), Some(cell)) if ctl.implicit => CellCoupling::new(
+        let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
+        let thickness = self.grain_thickness();
+        let mut coupling = match (self.cell_control, self.cell, free_change) {
+            (Some(ctl), Some(cell), Some(delta0)) => CellCoupling::new(
                 &ctl,
                 &cell,
-                &self.contacts.rows,
+                &mut self.contacts.rows,
                 &self.contacts.geometry,
                 h,
-                self.grain_thickness(),
-                &self.kinetic_stress(&cell),
+                thickness,
+                delta0,
             ),
             _ => None,
         };
-        // ‖q‖ of the grains' free velocities, without the cell's impulse-free change on the
-        // coupled contacts (`crate::cell_coupling`): that drive scales with the cell's size, not
-        // the grains', and would loosen the relative tolerance of every contact (measured: the
-        // stress of an isotropic compression 1.6 % off its target instead of 0.05 %). The error
-        // of a coupled step is therefore stricter than `solve-fc`'s on its dumped problem.
-        let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
         let approach_limit = self.approach_limit();
         self.v_free.clear();
         self.v_free.extend_from_slice(&self.vel);
@@ -1042,9 +1049,6 @@ impl World {
         });
         // The cell is shared by every coupled contact: a coupled step is swept on one thread.
         // Without a contact across the boundary the cell's change is δ⁰ whatever the impulses.
-        if let Some(c) = coupling.as_mut().filter(|c| c.coupled_contacts() == 0) {
-            c.refresh(&mut self.contacts.rows);
-        }
         let coupled = coupling.as_mut().filter(|c| c.coupled_contacts() > 0);
         let report = if self.params.solver.parallel && coupled.is_none() {
             self.mobile.clear();
@@ -1115,13 +1119,10 @@ impl World {
             )
         };
         solver::classify(&self.contacts.rows, &mut self.contacts.status);
-        // The images moved with L⁺ h k during the solve: the cell takes L⁺ (the grains follow
-        // the change δ at the end of the step, 6.).
+        // The images moved with L⁺ h k = (L⁻ + δ) h k during the solve: the cell deforms with
+        // L⁺ (4b), the grains follow δ at the end of the step (6.).
         let delta = coupling.as_ref().map_or_else(Mat::zeros, |c| c.delta());
         self.image_outran = delta.abs().sum() > self.detector.image_rate();
-        if let Some(cell) = self.cell.as_mut() {
-            cell.l += delta;
-        }
 
         // 4. Positions, accelerations.
         self.displacement.clear();
@@ -1162,8 +1163,8 @@ impl World {
         let mut cell_work = 0.0;
         let mut cell_gap_shift = Vec::new();
         if let Some(mut cell) = self.cell {
-            // The grains moved without the change δ of an implicit cell (the images with it).
-            let (h_old, l) = (cell.h, cell.l - delta);
+            // The grains moved with L⁻ (the images with L⁺ = L⁻ + δ under an implicit cell).
+            let (h_old, l) = (cell.h, cell.l);
             // Affine part of the step's displacements, for the outran check.
             let c = cell.centre();
             self.fluct_displacement.clear();
@@ -1172,7 +1173,7 @@ impl World {
                 let a = l * (x_old - c) * h;
                 self.fluct_displacement.push([d[0] - a.x, d[1] - a.y, d[2]]);
             }
-            cell.advance(h);
+            cell.advance_with(&(l + delta), h);
             // Gap change of each image contact from the cell's deformation, n·(Δh k).
             let dh = (cell.h - h_old) * cell_inverse(&h_old);
             for (row, geo) in self.contacts.rows.iter().zip(&self.contacts.geometry) {
@@ -1184,9 +1185,8 @@ impl World {
                 }
             }
             cell.remap();
-            // Until the grains follow it (6.), the affine field of their velocities is L⁻: the
+            // Until the grains follow δ (6.), the affine field of their velocities stays L⁻: the
             // wraps and the kinetic stress use it.
-            cell.l -= delta;
             self.cell = Some(cell);
             cell_work += self.wrap_grains();
             // Work of the impulses against the images' affine velocities.
@@ -1279,7 +1279,7 @@ impl World {
         if self.image_outran || self.detector.outran(&self.colliders, moved) {
             let mut fresh = std::mem::take(&mut self.fresh);
             let reach = 0.25 * self.smallest_radius().unwrap_or(0.0);
-            let detected = self.detect_into(reach, 0.0, 0.0, &mut fresh);
+            let detected = self.detect_into(reach, 0.0, 0.0, 0.0, &mut fresh);
             if detected.is_ok() {
                 let still = vec![[0.0; 3]; self.bodies.len()];
                 let second =
