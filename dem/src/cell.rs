@@ -345,6 +345,23 @@ impl CellControl {
         Ok(())
     }
 
+    /// The implicit control ([`CellControl::implicit`]) of xx, yy, xy with the gain `gain`
+    /// (1/(Pa·s)) and the reference-rate cap `max_rate` (1/s); the explicit law's fields
+    /// (`relaxation`, `tolerance`, `max_corrections`) are zero, unused.
+    pub fn implicit_law(xx: Imposed, yy: Imposed, xy: Imposed, gain: f64, max_rate: f64) -> Self {
+        CellControl {
+            xx,
+            yy,
+            xy,
+            gain,
+            max_rate,
+            relaxation: 0.0,
+            tolerance: 0.0,
+            max_corrections: 0,
+            implicit: true,
+        }
+    }
+
     /// What is imposed on xx, yy and xy, in that order ([`crate::cell_coupling::COMPONENTS`]).
     pub fn components(&self) -> [Imposed; 3] {
         [self.xx, self.yy, self.xy]

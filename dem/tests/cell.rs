@@ -291,22 +291,6 @@ fn stress_control_reaches_its_target() {
     );
 }
 
-/// The implicit control's stress-controlled components (`dem::cell_coupling`) with gain `gain`
-/// (1/(Pa·s)) and rate cap `max_rate` (1/s).
-fn implicit(xx: Imposed, yy: Imposed, xy: Imposed, gain: f64, max_rate: f64) -> CellControl {
-    CellControl {
-        xx,
-        yy,
-        xy,
-        gain,
-        max_rate,
-        relaxation: 0.0,
-        tolerance: 0.0,
-        max_corrections: 0,
-        implicit: true,
-    }
-}
-
 /// A square lattice of 5 × 4 equal frictionless touching disks (radius R) filling a periodic cell at rest,
 /// with σ_xx = −p_x and σ_yy = −p_y imposed by the implicit control (L_xy = 0): a rigid
 /// lattice cannot deform, so the cell stays at rest (|L| ≤ 10⁻⁹ of the rate cap) and the
@@ -336,7 +320,7 @@ fn implicit_control_holds_a_rigid_lattice_at_its_stress() {
     }
     w.set_cell(Some(Cell::rectangle(lx, ly).unwrap())).unwrap();
     let max_rate = 1.0;
-    w.cell_control = Some(implicit(
+    w.cell_control = Some(CellControl::implicit_law(
         Imposed::Stress(-px),
         Imposed::Stress(-py),
         Imposed::Rate(0.0),
@@ -402,7 +386,7 @@ fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
     let max_rate = 20.0 * rate;
     let gain = 10.0 * max_rate / p;
     // Isotropic compression to P, implicit on both normal components.
-    w.cell_control = Some(implicit(
+    w.cell_control = Some(CellControl::implicit_law(
         Imposed::Stress(-p),
         Imposed::Stress(-p),
         Imposed::Rate(0.0),
@@ -420,7 +404,7 @@ fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
         (s[(0, 0)] + p).abs() < 0.2 * p && (s[(1, 1)] + p).abs() < 0.2 * p,
         "isotropic stress {s}"
     );
-    let ctl = implicit(
+    let ctl = CellControl::implicit_law(
         Imposed::Stress(-p),
         Imposed::Rate(-rate),
         Imposed::Rate(0.0),

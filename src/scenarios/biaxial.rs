@@ -32,7 +32,9 @@ use identify::mohr_coulomb::{fit_mohr_coulomb_supported, YieldData};
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
-use super::common::{fit_keys, mean_diameter, parameter_lines, solver_keys, Stop, VtkFrames};
+use super::common::{
+    fit_keys, implicit_cell_control, mean_diameter, parameter_lines, solver_keys, Stop, VtkFrames,
+};
 use super::phased::{drive, PhasedRun, RunControl};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -100,14 +102,6 @@ const AXIAL_GAIN_FRACTION: f64 = 0.05;
 const AXIAL_RATE_CAP: f64 = 3.0;
 /// Filter time of the lateral control in the axial compression, in time steps.
 const AXIAL_FILTER_STEPS: f64 = 10.0;
-/// Gain of the implicit cell control (`dem::cell_coupling`) in units of `ε̇_max/p₀`: a cell
-/// without contacts closes at most at `(1 + K) ε̇_max`, and a jammed packing's stress misses its
-/// target by `p₀ ΔL/(K ε̇_max)`, `ΔL` the change of the rate it can follow over one step.
-/// Measured (100 disks, μ = 0.5, p₀ = 1 kPa, 5 % axial strain): K = 1, 10, 30 give a lateral
-/// stress of −p₀ ± 6 %, ± 1.8 %, ± 1.0 % (standard deviation over the steps) and 151, 119, 246
-/// of 475 steps at a sweep cap of 1000 (a lighter cell slows Gauss–Seidel; measured before the
-/// grains followed the cell's change at the end of each step, which cut the sweeps 5-fold).
-const IMPLICIT_GAIN: f64 = 10.0;
 /// Tolerance of the explicit law's correction of the cell control, as a fraction of p₀.
 const CONTROL_TOLERANCE: f64 = 0.5;
 /// Re-solves of a step at most by the implicit correction.
@@ -321,23 +315,14 @@ impl Biaxial<'_> {
             ),
         };
         if self.c.cell_control == CellControlMode::Implicit {
-            // The loose packing of the isotropic compression closes at (1 + K) ε̇_max until it
-            // jams: keep that within the cap.
-            let max_rate = match axial_rate {
-                None => max_rate / (1.0 + IMPLICIT_GAIN),
-                Some(_) => max_rate,
-            };
-            return CellControl {
-                xx: Imposed::Stress(target),
+            return implicit_cell_control(
+                Imposed::Stress(target),
                 yy,
-                xy: Imposed::Rate(0.0),
-                gain: IMPLICIT_GAIN * max_rate / p0,
+                Imposed::Rate(0.0),
                 max_rate,
-                relaxation: 0.0,
-                tolerance: 0.0,
-                max_corrections: 0,
-                implicit: true,
-            };
+                p0,
+                axial_rate.is_none(),
+            );
         }
         CellControl {
             xx: Imposed::Stress(target),

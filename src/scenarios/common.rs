@@ -385,3 +385,33 @@ mod tests {
         assert_eq!(short_number(1234.5), "1234");
     }
 }
+
+/// Gain of the implicit cell control of the cell scenarios (`dem::cell_coupling`), in units of
+/// `ε̇_max/p`: a cell without contacts closes at most at `(1 + K) ε̇_max`, and a jammed packing's
+/// stress misses its target by `p ΔL/(K ε̇_max)`, `ΔL` the change of the rate it can follow over
+/// one step. Measured (`biaxial`, 100 disks, μ = 0.5, p₀ = 1 kPa, 5 % axial strain): K = 1, 10,
+/// 30 give a lateral stress of −p₀ ± 6 %, ± 1.8 %, ± 1.0 % (standard deviation over the steps)
+/// and 151, 119, 246 of 475 steps at a sweep cap of 1000 (a lighter cell slows Gauss–Seidel;
+/// measured before the grains followed the cell's change at the end of each step, which cut the
+/// sweeps 5-fold).
+pub const IMPLICIT_GAIN: f64 = 10.0;
+
+/// The implicit cell control of a cell scenario (`dem::cell::CellControl::implicit_law`):
+/// `g = K ε̇_max/pressure` with [`IMPLICIT_GAIN`] and the rate cap `cap` (1/s); while a loose
+/// packing is compressed isotropically (`compressing`) the reference rate is capped at
+/// `cap/(1 + K)`, so that it closes at most at `cap` until it jams.
+pub fn implicit_cell_control(
+    xx: dem::Imposed,
+    yy: dem::Imposed,
+    xy: dem::Imposed,
+    cap: f64,
+    pressure: f64,
+    compressing: bool,
+) -> dem::CellControl {
+    let max_rate = if compressing {
+        cap / (1.0 + IMPLICIT_GAIN)
+    } else {
+        cap
+    };
+    dem::CellControl::implicit_law(xx, yy, xy, IMPLICIT_GAIN * max_rate / pressure, max_rate)
+}

@@ -21,7 +21,7 @@ use identify::mu_i::RheologySeries;
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
+use super::common::{implicit_cell_control, mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
 use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
@@ -56,9 +56,6 @@ const HISTORY: [&str; 18] = [
 
 /// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
 const GAIN_FRACTION: f64 = 0.3;
-/// Gain of the implicit cell control in units of `ε̇_max/P` (as in `biaxial`, whose constant
-/// documents the choice).
-const IMPLICIT_GAIN: f64 = 10.0;
 /// Tolerance of the implicit correction of the cell control, as a fraction of P.
 const CONTROL_TOLERANCE: f64 = 0.5;
 /// Re-solves of a step at most by the implicit correction.
@@ -145,23 +142,14 @@ impl Shear<'_> {
             Some(g) => (Imposed::Rate(0.0), Imposed::Rate(g), rate_cap.max(g)),
         };
         if c.cell_control == CellControlMode::Implicit {
-            // A packing without contacts closes at (1 + K) ε̇_max: in the isotropic compression
-            // keep that within the cap.
-            let max_rate = match gamma_dot {
-                None => max_rate / (1.0 + IMPLICIT_GAIN),
-                Some(_) => max_rate,
-            };
-            return CellControl {
+            return implicit_cell_control(
                 xx,
-                yy: Imposed::Stress(-p),
+                Imposed::Stress(-p),
                 xy,
-                gain: IMPLICIT_GAIN * max_rate / p,
                 max_rate,
-                relaxation: 0.0,
-                tolerance: 0.0,
-                max_corrections: 0,
-                implicit: true,
-            };
+                p,
+                gamma_dot.is_none(),
+            );
         }
         CellControl {
             xx,
