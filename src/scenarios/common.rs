@@ -371,21 +371,6 @@ pub fn add_fitted_curve(
     ));
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn fitted_parameters_print_with_their_intervals() {
-        let e = identify::Estimate::new("mu_s", "1", 0.3812, 0.01, 2.0);
-        let lines = parameter_lines("μ(I)", 0.9, &[e]);
-        assert_eq!(lines[0], "μ(I) (R² = 0.900)");
-        assert_eq!(lines[1], "  mu_s = 0.3812  (95 % CI 0.3612 … 0.4012)");
-        assert_eq!(short_number(1.2345e-5), "1.234e-5");
-        assert_eq!(short_number(1234.5), "1234");
-    }
-}
-
 /// Gain of the implicit cell control of the cell scenarios (`dem::cell_coupling`), in units of
 /// `ε̇_max/p`: a cell without contacts closes at most at `(1 + K) ε̇_max`, and a jammed packing's
 /// stress misses its target by `p ΔL/(K ε̇_max)`, `ΔL` the change of the rate it can follow over
@@ -414,4 +399,19 @@ pub fn implicit_cell_control(
         cap
     };
     dem::CellControl::implicit_law(xx, yy, xy, IMPLICIT_GAIN * max_rate / pressure, max_rate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fitted_parameters_print_with_their_intervals() {
+        let e = identify::Estimate::new("mu_s", "1", 0.3812, 0.01, 2.0);
+        let lines = parameter_lines("μ(I)", 0.9, &[e]);
+        assert_eq!(lines[0], "μ(I) (R² = 0.900)");
+        assert_eq!(lines[1], "  mu_s = 0.3812  (95 % CI 0.3612 … 0.4012)");
+        assert_eq!(short_number(1.2345e-5), "1.234e-5");
+        assert_eq!(short_number(1234.5), "1234");
+    }
 }
