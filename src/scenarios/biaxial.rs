@@ -33,7 +33,8 @@ use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
 use super::common::{
-    fit_keys, implicit_cell_control, mean_diameter, parameter_lines, solver_keys, Stop, VtkFrames,
+    fit_keys, implicit_cell_control, mean_diameter, parameter_lines, solver_keys, strain_bins,
+    Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::{PhaseEnv, RunContext, RunOutcome};
@@ -238,35 +239,15 @@ struct State {
 /// shear stress averaging 0 under L_xy = 0): `[ε_a, sin φ, ε_v, I, p, q_a]`. The mean of the
 /// tensor, not of the step's q/p, which the noise of the step biases upward.
 fn bin_history(history: &[Vec<f64>], width: f64) -> Vec<[f64; 6]> {
-    let mut out: Vec<[f64; 6]> = Vec::new();
-    let mut acc = [0.0; 6];
-    let mut n = 0usize;
-    let mut current = 0i64;
-    let flush = |acc: &mut [f64; 6], n: &mut usize, out: &mut Vec<[f64; 6]>| {
-        if *n > 0 {
-            let m = acc.map(|v| v / *n as f64);
+    let cols = [EA, EV, INERTIAL, SXX, SYY, P];
+    strain_bins(history, EA, width, &cols, |r| r[INERTIAL].is_finite())
+        .into_iter()
+        .map(|m| {
             // m: ε_a, ε_v, I, Σ_xx, Σ_yy, p
             let qa = 0.5 * (m[3] - m[4]);
-            out.push([m[0], qa / m[5], m[1], m[2], m[5], qa]);
-        }
-        *acc = [0.0; 6];
-        *n = 0;
-    };
-    for r in history {
-        let b = (r[EA] / width).floor() as i64;
-        if b != current {
-            flush(&mut acc, &mut n, &mut out);
-            current = b;
-        }
-        if r[INERTIAL].is_finite() {
-            for (a, j) in acc.iter_mut().zip([EA, EV, INERTIAL, SXX, SYY, P]) {
-                *a += r[j];
-            }
-            n += 1;
-        }
-    }
-    flush(&mut acc, &mut n, &mut out);
-    out
+            [m[0], qa / m[5], m[1], m[2], m[5], qa]
+        })
+        .collect()
 }
 
 /// Mean of `num/den` as the ratio of the means `⟨num⟩/⟨den⟩`, with its block-averaged standard

@@ -371,6 +371,45 @@ pub fn add_fitted_curve(
     ));
 }
 
+/// Means of the columns `cols` of a history over consecutive bins of `width` of its column
+/// `axis` (a strain growing along the rows; the first bin starts at 0): one row of means per bin
+/// with at least one row that `keep` accepts, in the order of `cols`. The means are of the step
+/// values; what is derived from them (a stress ratio of mean stresses, a peak) is the caller's.
+pub fn strain_bins(
+    history: &[Vec<f64>],
+    axis: usize,
+    width: f64,
+    cols: &[usize],
+    keep: impl Fn(&[f64]) -> bool,
+) -> Vec<Vec<f64>> {
+    let mut out = Vec::new();
+    let mut acc = vec![0.0; cols.len()];
+    let mut n = 0usize;
+    let mut current = 0i64;
+    let mut flush = |acc: &mut Vec<f64>, n: &mut usize| {
+        if *n > 0 {
+            out.push(acc.iter().map(|v| v / *n as f64).collect());
+        }
+        acc.iter_mut().for_each(|v| *v = 0.0);
+        *n = 0;
+    };
+    for r in history {
+        let b = (r[axis] / width).floor() as i64;
+        if b != current {
+            flush(&mut acc, &mut n);
+            current = b;
+        }
+        if keep(r) {
+            for (a, &j) in acc.iter_mut().zip(cols) {
+                *a += r[j];
+            }
+            n += 1;
+        }
+    }
+    flush(&mut acc, &mut n);
+    out
+}
+
 /// Gain of the implicit cell control of the cell scenarios (`dem::cell_coupling`), in units of
 /// `ε̇_max/p`: a cell without contacts closes at most at `(1 + K) ε̇_max`, and a jammed packing's
 /// stress misses its target by `p ΔL/(K ε̇_max)`, `ΔL` the change of the rate it can follow over

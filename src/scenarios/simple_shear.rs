@@ -21,7 +21,9 @@ use identify::mu_i::RheologySeries;
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{implicit_cell_control, mean_diameter, solver_keys, Stop, VtkFrames};
+use super::common::{
+    implicit_cell_control, mean_diameter, solver_keys, strain_bins, Stop, VtkFrames,
+};
 use super::phased::{drive, PhasedRun, RunControl};
 use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
@@ -103,25 +105,14 @@ const PEAK_BIN_STRAIN: f64 = 0.1;
 
 /// The peak stress ratio of a run's history (rows with the shear strain in column `strain` and
 /// μ in column `mu`): the largest mean of μ over bins of [`PEAK_BIN_STRAIN`] of shear strain
-/// (means of the noisy step values, as `biaxial`'s peak; NaN without data).
+/// ([`strain_bins`]; NaN without data).
 fn peak_mu(history: &[Vec<f64>], strain: usize, mu: usize) -> f64 {
-    let mut bins: Vec<(f64, usize)> = Vec::new();
-    for row in history {
-        let (g, m) = (row[strain], row[mu]);
-        if !(g.is_finite() && m.is_finite()) || g < 0.0 {
-            continue;
-        }
-        let b = (g / PEAK_BIN_STRAIN) as usize;
-        if bins.len() <= b {
-            bins.resize(b + 1, (0.0, 0));
-        }
-        bins[b].0 += m;
-        bins[b].1 += 1;
-    }
-    bins.iter()
-        .filter(|b| b.1 > 0)
-        .map(|b| b.0 / b.1 as f64)
-        .fold(f64::NAN, f64::max)
+    strain_bins(history, strain, PEAK_BIN_STRAIN, &[mu], |r| {
+        r[mu].is_finite() && r[strain].is_finite()
+    })
+    .iter()
+    .map(|m| m[0])
+    .fold(f64::NAN, f64::max)
 }
 
 struct Shear<'a> {
