@@ -146,15 +146,15 @@ fn stress_control_and_frictionless_critical_state() {
 
 /// The frictional biaxial test the implicit cell control makes possible (`dem::cell_coupling`;
 /// with the explicit law 179 of 190 axial steps stopped at the sweep cap, worst error 10⁻²):
-/// 100 disks, μ = 0.5, p₀ = 1 kPa, dense, to ε_a = 0.03. The isotropic compression ends at
-/// −p₀ within 3 % (its stress fluctuates by a few % from step to step once jammed; measured
-/// 0.05–1.2 % over builds that differ in rounding, 0.2 % with dt_max = 2.5·10⁻⁴ s; 14–29 %
-/// under the explicit law), the lateral stress of the axial compression averages −p₀
-/// within 1 % (measured 0.001 %), at most 3 % of its 570 steps end above the tolerance 10⁻⁴
-/// and none above 10× it (measured 2 steps, worst 2.0·10⁻⁴), and the mobilised friction has a
-/// peak above its value at the end, sin φ_peak in [0.35, 0.6] (measured 0.491, 29.4°; dense
-/// disks with μ = 0.5 peak at 25–35°, e.g. Azéma & Radjai, Phys. Rev. E 85, 2012). The explicit
-/// law on the same run: 125 unconverged steps, compression 29 % off, 20 times slower.
+/// 100 disks, μ = 0.5, p₀ = 1 kPa, dense, compressed for 0.3 s (twice the default, so that the
+/// jammed part over which the reached stress is averaged is long), then to ε_a = 0.03. The
+/// isotropic compression ends at −p₀ within 1 % (measured 0.002 %; 14–29 % under the explicit
+/// law), the lateral stress of the axial compression averages −p₀ within 1 %, at most 3 % of its
+/// 570 steps end above the tolerance 10⁻⁴ and none above 10× it (measured 0–2 steps, worst
+/// 2.0·10⁻⁴), and the mobilised friction has a peak above its value at the end, sin φ_peak in
+/// [0.35, 0.6] (measured 0.49, 29.4°; dense disks with μ = 0.5 peak at 25–35°, e.g. Azéma &
+/// Radjai, Phys. Rev. E 85, 2012). The explicit law on the same run: 125 unconverged steps,
+/// 20 times slower.
 #[test]
 fn frictional_biaxial_steps_converge_under_the_implicit_control() {
     let dir = tempfile::tempdir().unwrap();
@@ -173,6 +173,8 @@ fn frictional_biaxial_steps_converge_under_the_implicit_control() {
             "critical_strain=0.01",
             "--set",
             "bin_strain=0.0025",
+            "--set",
+            "compression_time=0.3",
             "-q",
         ],
         Some(&out),
@@ -185,7 +187,7 @@ fn frictional_biaxial_steps_converge_under_the_implicit_control() {
     let s = summary(&out);
     assert_eq!(s["cell_control"], "implicit");
     let comp = num(&s, "p1_compression_stress_error");
-    assert!(comp <= 0.03, "compression error {comp}");
+    assert!(comp <= 0.01, "compression error {comp}");
     let lat = num(&s, "p1_lateral_stress_error");
     assert!(lat <= 0.01, "lateral error {lat}");
     let unconverged = num(&s, "solver_unconverged_steps");
@@ -256,12 +258,12 @@ fn resume_is_bit_identical() {
 }
 
 /// 200 frictionless disks to ε_a = 0.3 (9 s under the implicit cell control; it took about
-/// 15 min under the explicit one): on the plateau (last 0.1) sin φ_c = 0.10 ± 0.04 (the
-/// frictionless value of 2D disks, Azéma & Radjai 2012; Peyneau & Roux 2008 for spheres;
-/// measured 0.124) and no dilatancy within the fluctuation of so small a cell, |sin ψ_c| ≤ 0.06:
-/// its volumetric strain wanders by ± 0.005 over the plateau (measured), a dilatancy
-/// `d = −Δε_v/Δε_a` of up to ± 0.1 over 0.1 of axial strain, i.e. |sin ψ| = |d/(2 + d)| up to
-/// 0.05 (measured 0.045), where μ = 0.5 dilates at sin ψ 0.25–0.34 before its peak.
+/// 15 min under the explicit one), the critical state taken over the last 0.2 of axial strain
+/// (a frictionless packing reaches it within a few %; the volumetric strain of so small a cell
+/// wanders by ± 0.005, which over a plateau of 0.1 alone makes |sin ψ| up to 0.05): sin φ_c =
+/// 0.10 ± 0.04 (the frictionless value of 2D disks, Azéma & Radjai 2012; Peyneau & Roux 2008
+/// for spheres; measured 0.104–0.110 over builds that differ in rounding) and no dilatancy,
+/// |sin ψ_c| ≤ 0.03 (measured 0.008–0.019).
 #[test]
 fn frictionless_critical_state_long() {
     let dir = tempfile::tempdir().unwrap();
@@ -274,6 +276,8 @@ fn frictionless_critical_state_long() {
             "confining_pressures=[1000.0]",
             "--set",
             "friction.grain_grain=0.0",
+            "--set",
+            "critical_strain=0.2",
             "-q",
         ],
         Some(&out),
@@ -287,5 +291,5 @@ fn frictionless_critical_state_long() {
     let sc = num(&s, "p1_friction_critical_sin_phi");
     assert!((sc - 0.10).abs() <= 0.04, "sin φ_c = {sc}");
     let psi = num(&s, "p1_dilatancy_critical_sin_psi");
-    assert!(psi.abs() <= 0.06, "sin ψ_c = {psi}");
+    assert!(psi.abs() <= 0.03, "sin ψ_c = {psi}");
 }
