@@ -26,6 +26,24 @@ fn summary(dir: &Path) -> serde_json::Value {
         .expect("json")
 }
 
+/// `grainlaw run biaxial -q` with each of `sets` as a `--set`, into `out`: a run with one
+/// pressure has no Mohr–Coulomb envelope, so its verdict may be refused (exit 3); any other
+/// exit fails. Returns its `summary.json`.
+fn run_biaxial(sets: &[&str], out: &Path) -> serde_json::Value {
+    let mut args = vec!["run", "biaxial"];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    args.push("-q");
+    let o = grainlaw(&args, Some(out));
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(3)),
+        "{}",
+        stderr(&o)
+    );
+    summary(out)
+}
+
 fn num(s: &serde_json::Value, key: &str) -> f64 {
     s[key]
         .as_f64()
@@ -92,33 +110,17 @@ fn bad_inputs_are_refused_with_one_line() {
 fn stress_control_and_frictionless_critical_state() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("f");
-    let o = grainlaw(
+    let s = run_biaxial(
         &[
-            "run",
-            "biaxial",
-            "--set",
             "grains=100",
-            "--set",
             "confining_pressures=[1000.0]",
-            "--set",
             "friction.grain_grain=0.0",
-            "--set",
             "max_axial_strain=0.015",
-            "--set",
             "critical_strain=0.01",
-            "--set",
             "bin_strain=0.0025",
-            "-q",
         ],
-        Some(&out),
+        &out,
     );
-    // one pressure: no Mohr–Coulomb envelope, the run's verdict is refused (exit 3)
-    assert!(
-        matches!(o.status.code(), Some(0) | Some(3)),
-        "{}",
-        stderr(&o)
-    );
-    let s = summary(&out);
     let comp = num(&s, "p1_compression_stress_error");
     assert!(comp <= 0.25, "compression error {comp}");
     let lat = num(&s, "p1_lateral_stress_error");
@@ -159,32 +161,17 @@ fn stress_control_and_frictionless_critical_state() {
 fn frictional_biaxial_steps_converge_under_the_implicit_control() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("mu");
-    let o = grainlaw(
+    let s = run_biaxial(
         &[
-            "run",
-            "biaxial",
-            "--set",
             "grains=100",
-            "--set",
             "confining_pressures=[1000.0]",
-            "--set",
             "max_axial_strain=0.03",
-            "--set",
             "critical_strain=0.01",
-            "--set",
             "bin_strain=0.0025",
-            "--set",
             "compression_time=0.3",
-            "-q",
         ],
-        Some(&out),
+        &out,
     );
-    assert!(
-        matches!(o.status.code(), Some(0) | Some(3)),
-        "{}",
-        stderr(&o)
-    );
-    let s = summary(&out);
     assert_eq!(s["cell_control"], "implicit");
     let comp = num(&s, "p1_compression_stress_error");
     assert!(comp <= 0.01, "compression error {comp}");
@@ -268,26 +255,14 @@ fn resume_is_bit_identical() {
 fn frictionless_critical_state_long() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("long");
-    let o = grainlaw(
+    let s = run_biaxial(
         &[
-            "run",
-            "biaxial",
-            "--set",
             "confining_pressures=[1000.0]",
-            "--set",
             "friction.grain_grain=0.0",
-            "--set",
             "critical_strain=0.2",
-            "-q",
         ],
-        Some(&out),
+        &out,
     );
-    assert!(
-        matches!(o.status.code(), Some(0) | Some(3)),
-        "{}",
-        stderr(&o)
-    );
-    let s = summary(&out);
     let sc = num(&s, "p1_friction_critical_sin_phi");
     assert!((sc - 0.10).abs() <= 0.04, "sin φ_c = {sc}");
     let psi = num(&s, "p1_dilatancy_critical_sin_psi");
