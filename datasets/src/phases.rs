@@ -41,6 +41,7 @@
 //! mechanical energy of a phase therefore changes by `Σ (δ + W_drive) + position_correction_energy`.
 
 pub use dem::energy::{load_energy_scale, EnergyProbe};
+use dem::step_control::{step_subdivided, Subdivision};
 use dem::{BodyKind, StepReport, World};
 use serde::{Deserialize, Serialize};
 
@@ -103,6 +104,19 @@ pub struct PhaseStats {
     /// what the step would have left without it.
     #[serde(default, with = "dem::serde_float")]
     pub max_corrected_overlap_ratio: f64,
+    /// Steps done in more than one sub-step because a solve at the full step did not converge
+    /// ([`dem::step_control::step_subdivided`]).
+    #[serde(default)]
+    pub subdivided_steps: u64,
+    /// Sub-steps kept over the phase (`steps` when none was subdivided).
+    #[serde(default)]
+    pub substeps: u64,
+    /// Largest number of halvings of a kept step.
+    #[serde(default)]
+    pub max_halvings_used: u32,
+    /// Sweeps of the attempts undone before a subdivision (included in `total_sweeps`).
+    #[serde(default)]
+    pub discarded_sweeps: u64,
     /// Whether the rest criterion was met (phases that look for rest).
     pub at_rest: bool,
     /// Translational kinetic energy over `Σ m g d` at the end (1).
@@ -120,6 +134,17 @@ fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
 }
 
 impl PhaseStats {
+    /// Accounts for one step's subdivision (`halvings` of the kept sub-steps, `discarded`
+    /// sweeps of the attempts undone); [`PhaseStats::record`] accounts for its solve.
+    pub fn record_subdivision(&mut self, halvings: u32, discarded: usize) {
+        self.substeps += 1u64 << halvings;
+        if halvings > 0 {
+            self.subdivided_steps += 1;
+        }
+        self.max_halvings_used = self.max_halvings_used.max(halvings);
+        self.discarded_sweeps += discarded as u64;
+    }
+
     /// Accounts for one step's solve and time.
     pub fn record(&mut self, r: &StepReport, dt: f64) {
         self.steps += 1;
@@ -188,6 +213,10 @@ impl PhaseStats {
         self.worst_energy_growth = self.worst_energy_growth.max(o.worst_energy_growth);
         self.position_corrected_steps += o.position_corrected_steps;
         self.position_correction_energy += o.position_correction_energy;
+        self.subdivided_steps += o.subdivided_steps;
+        self.substeps += o.substeps;
+        self.max_halvings_used = self.max_halvings_used.max(o.max_halvings_used);
+        self.discarded_sweeps += o.discarded_sweeps;
         self.max_corrected_overlap_ratio = self
             .max_corrected_overlap_ratio
             .max(o.max_corrected_overlap_ratio);
@@ -272,6 +301,10 @@ pub struct PhaseProgress {
     pub stats: PhaseStats,
     /// Consecutive steps the rest criterion has held.
     pub quiet_steps: usize,
+    /// Where the subdivision of non-converged steps stands
+    /// ([`dem::step_control::step_subdivided`]).
+    #[serde(default)]
+    pub subdivision: Subdivision,
 }
 
 impl PhaseProgress {
@@ -281,17 +314,28 @@ impl PhaseProgress {
     }
 }
 
-/// One step with its accounting: solve, time, overlap and energy balance.
+/// One step with its accounting: solve, time, overlap and energy balance. A step whose solve
+/// does not converge is done again in sub-steps as the solver parameters allow
+/// ([`step_subdivided`]); the energy balance is checked on each kept sub-step (the largest
+/// residual is the step's).
 fn accounted_step(
     world: &mut World,
     progress: &mut PhaseProgress,
     e_load: f64,
     min_radius: f64,
 ) -> Result<StepReport, dem::DemError> {
-    let probe = EnergyProbe::before(world);
-    let r = world.step()?;
-    progress.stats.record(&r, probe.dt);
-    let growth = probe.residual(world) / e_load;
+    let dt = world.params.dt;
+    let step = step_subdivided(world, &mut progress.subdivision)?;
+    let r = step.report;
+    progress.stats.record(&r, dt);
+    progress
+        .stats
+        .record_subdivision(step.halvings, step.discarded_sweeps);
+    let growth = step
+        .substeps
+        .iter()
+        .map(|s| s.energy_residual / e_load)
+        .fold(f64::NEG_INFINITY, f64::max);
     progress
         .stats
         .record_checks(&r, min_radius, growth.is_finite().then_some(growth));

@@ -118,6 +118,13 @@ pub struct SolverParams {
     /// 380-contact steps; raise it per phase to trade time for converged steps.
     #[serde(default = "lemke_max_contacts")]
     pub lemke_max_contacts: usize,
+    /// Largest number of halvings of a step whose solve does not converge: the step is done
+    /// again from its start as two half steps, recursively, up to `2^max_halvings` sub-steps
+    /// ([`crate::step_control::step_subdivided`]). Honoured by the steppers that call
+    /// `step_subdivided` (every scenario phase); [`crate::World::step`] itself does one step.
+    /// Default 0 (off).
+    #[serde(default)]
+    pub max_halvings: u32,
 }
 
 fn auto_sweeps() -> usize {
@@ -175,6 +182,7 @@ impl Default for SolverParams {
             auto_sweeps: auto_sweeps(),
             newton: NewtonParams::default(),
             lemke_max_contacts: lemke_max_contacts(),
+            max_halvings: 0,
         }
     }
 }

@@ -80,8 +80,17 @@ pub fn run_phase(
         Stop::UntilRest(_) => ", NOT at rest at the time limit",
         Stop::Steps(_) => "",
     };
+    let sub = if stats.subdivided_steps > 0 {
+        format!(
+            " ({} subdivided, up to {} sub-steps)",
+            stats.subdivided_steps,
+            1u64 << stats.max_halvings_used
+        )
+    } else {
+        String::new()
+    };
     bar.finish(&format!(
-        "{} steps of {:.2e} s, {:.3} s simulated, {:.0} sweeps/step on average{rest}",
+        "{} steps of {:.2e} s{sub}, {:.3} s simulated, {:.0} sweeps/step on average{rest}",
         stats.steps,
         dt,
         stats.simulated_time,
@@ -106,10 +115,15 @@ pub fn phase_warnings(
     let first = |s: Option<u64>| s.map_or_else(|| "?".to_string(), |s| s.to_string());
     if stats.unconverged_steps > 0 {
         lines.push(format!(
-            "{name}: {} of {} steps stopped at the sweep cap ({}) above the tolerance {:.0e}, first at step {}; worst error {:.2e}",
+            "{name}: {} of {} steps stopped at the sweep cap ({}{}) above the tolerance {:.0e}, first at step {}; worst error {:.2e}",
             stats.unconverged_steps,
             stats.steps,
             solver.max_iterations,
+            if solver.max_halvings > 0 {
+                format!(", in {} sub-steps", 1u64 << solver.max_halvings)
+            } else {
+                String::new()
+            },
             solver.tolerance,
             first(stats.first_unconverged_step),
             stats.worst_error
@@ -153,7 +167,10 @@ pub fn phase_warnings(
 /// scale); `position_corrected_steps` (steps where the position correction moved something),
 /// `position_correction_energy_J` (the potential energy it added, `−Σ f·Δq_c`) and
 /// `max_corrected_overlap_over_radius` (the largest overlap it removed, over the smallest grain
-/// radius). A first step is the world's step index, `null` when there is none.
+/// radius); `solver_subdivided_steps` (steps redone in sub-steps because their solve did not
+/// converge, `dem::step_control::step_subdivided`), `solver_substeps` (sub-steps kept),
+/// `solver_max_halvings_used` and `solver_discarded_sweeps` (sweeps of the undone attempts,
+/// included in the mean). A first step is the world's step index, `null` when there is none.
 pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
     let step = |v: Option<u64>| v.map_or(serde_json::Value::Null, serde_json::Value::from);
     s.int("solver_steps", stats.steps)
@@ -183,7 +200,14 @@ pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
         .num(
             "max_corrected_overlap_over_radius",
             stats.max_corrected_overlap_ratio,
-        );
+        )
+        .int("solver_subdivided_steps", stats.subdivided_steps)
+        .int("solver_substeps", stats.substeps)
+        .int(
+            "solver_max_halvings_used",
+            u64::from(stats.max_halvings_used),
+        )
+        .int("solver_discarded_sweeps", stats.discarded_sweeps);
 }
 
 /// VTK frames every `interval` seconds of simulated time, at most `max_frames` (the final

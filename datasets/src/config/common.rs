@@ -136,6 +136,18 @@ pub struct SolverSpec {
     /// not converge ([`dem::SolverParams::lemke_max_contacts`], default 0: off).
     #[serde(default = "dem::solver::lemke_max_contacts")]
     pub lemke_max_contacts: usize,
+    /// Largest number of halvings of a step whose solve does not converge (the step is undone
+    /// and done again in up to `2^max_halvings` sub-steps, [`dem::SolverParams::max_halvings`]),
+    /// in 0..=10. Default [`DEFAULT_MAX_HALVINGS`].
+    #[serde(default = "default_max_halvings")]
+    pub max_halvings: u32,
+}
+
+/// Default of [`SolverSpec::max_halvings`]: up to 8 sub-steps.
+pub const DEFAULT_MAX_HALVINGS: u32 = 3;
+
+fn default_max_halvings() -> u32 {
+    DEFAULT_MAX_HALVINGS
 }
 
 impl SolverSpec {
@@ -148,6 +160,11 @@ impl SolverSpec {
             1.0,
         )?;
         at_least(&format!("{prefix}.max_iterations"), self.max_iterations, 1)?;
+        limits::at_most(
+            &format!("{prefix}.max_halvings"),
+            self.max_halvings as usize,
+            10,
+        )?;
         Ok(())
     }
 
@@ -159,6 +176,7 @@ impl SolverSpec {
             parallel: self.parallel,
             method: self.method,
             lemke_max_contacts: self.lemke_max_contacts,
+            max_halvings: self.max_halvings,
             ..Default::default()
         }
     }

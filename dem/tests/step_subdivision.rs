@@ -1,0 +1,141 @@
+//! The subdivision of steps whose solve does not converge (`dem::step_control::step_subdivided`):
+//! an undone attempt leaves no trace (a subdivided step is bit for bit its sub-steps done from
+//! the same start), free fall stays exact across levels, and the level and pause rules.
+
+mod common;
+
+use common::{fingerprint, random_box};
+use dem::step_control::{step_subdivided, Subdivision, CALM_STEPS, FAILURES_BEFORE_BACKOFF};
+use dem::{ContactLaws, World, WorldParams};
+use nalgebra::Vector2;
+
+/// 60 disks in a box after 60 steps: a packing with contacts.
+fn settled_box() -> World {
+    let mut w = random_box(60, 0.03, 1e-3, 1.5e-3, 0.4, 1.0, 7);
+    w.params.solver.max_iterations = 2000;
+    w.params.solver.tolerance = 1e-6;
+    for _ in 0..60 {
+        w.step().unwrap();
+    }
+    assert!(w.contacts().rows.len() > 30, "the box should have contacts");
+    w
+}
+
+/// A solve that cannot converge: one sweep to 10⁻³⁰⁰.
+fn hopeless(w: &mut World, max_halvings: u32) {
+    w.params.solver.max_iterations = 1;
+    w.params.solver.tolerance = 1e-300;
+    w.params.solver.max_halvings = max_halvings;
+}
+
+/// A step that fails at every level is kept at the largest: 4 sub-steps of h/4 whose state is,
+/// bit for bit, that of 4 plain steps of h/4 from the same start (the two undone attempts left
+/// nothing behind: positions, velocities, impulses, solver back-off), with the time advanced
+/// by h and the step restored.
+#[test]
+fn a_subdivided_step_is_its_sub_steps_from_the_same_start() {
+    let mut a = settled_box();
+    hopeless(&mut a, 2);
+    let mut b = a.clone();
+    let h = a.params.dt;
+    let t0 = a.time;
+    let mut state = Subdivision::default();
+    let s = step_subdivided(&mut a, &mut state).unwrap();
+    assert_eq!((s.halvings, s.retries, s.substeps.len()), (2, 2, 4));
+    assert!(!s.report.solver.converged);
+    assert_eq!(a.params.dt, h);
+    assert_eq!(state.level, 2);
+
+    b.params.dt = h / 4.0;
+    let mut sweeps = 0;
+    for _ in 0..4 {
+        sweeps += b.step().unwrap().solver.iterations;
+    }
+    assert_eq!(fingerprint(&a), fingerprint(&b));
+    assert_eq!(a.time, b.time);
+    assert!((a.time - t0 - h).abs() <= 1e-15 * a.time);
+    assert_eq!(a.step_index, b.step_index);
+    // The report counts the sweeps of every attempt: 1 (h) + 1 (first h/2) + 4.
+    assert_eq!(s.discarded_sweeps, 2);
+    assert_eq!(s.report.solver.iterations, sweeps + 2);
+    assert_eq!(s.report.step, b.step_index);
+}
+
+/// With `max_halvings = 0` the stepper is `World::step`, bit for bit.
+#[test]
+fn without_halvings_it_is_the_plain_step() {
+    let mut a = settled_box();
+    hopeless(&mut a, 0);
+    let mut b = a.clone();
+    let mut state = Subdivision::default();
+    for _ in 0..5 {
+        let s = step_subdivided(&mut a, &mut state).unwrap();
+        let r = b.step().unwrap();
+        assert_eq!((s.halvings, s.retries, s.substeps.len()), (0, 0, 1));
+        assert_eq!(s.report, r);
+    }
+    assert_eq!(fingerprint(&a), fingerprint(&b));
+}
+
+/// A disk in free fall under θ = 1/2 follows `y₀ − g t²/2` exactly whatever the sub-steps: 32
+/// steps at 4 sub-steps each (the level it was given), then the calm rule drops to 2 sub-steps;
+/// the position after 40 steps agrees with the parabola to 10⁻¹² relative.
+#[test]
+fn free_fall_is_exact_across_levels_and_the_level_drops_after_calm_steps() {
+    let params = WorldParams {
+        dt: 1e-3,
+        theta: 0.5,
+        gravity: Vector2::new(0.0, -9.81),
+        ..Default::default()
+    };
+    let mut w = World::new(params, ContactLaws::new(&["m"], 0.3));
+    let y0 = 1.0;
+    w.add_grain(Vector2::new(0.0, y0), 1e-3, 2500.0, 0);
+    w.params.solver.max_halvings = 3;
+    let mut state = Subdivision {
+        level: 2,
+        ..Default::default()
+    };
+    let mut levels = Vec::new();
+    for _ in 0..40 {
+        let s = step_subdivided(&mut w, &mut state).unwrap();
+        assert!(s.report.solver.converged);
+        levels.push(s.halvings);
+    }
+    let calm = CALM_STEPS as usize;
+    assert!(levels[..calm].iter().all(|&l| l == 2), "{levels:?}");
+    assert!(levels[calm..].iter().all(|&l| l == 1), "{levels:?}");
+    let t = w.time;
+    assert!((t - 0.04).abs() < 1e-15);
+    let y = w.bodies[0].position.y;
+    let exact = y0 - 0.5 * 9.81 * t * t;
+    assert!(
+        ((y - exact) / (y0 - exact)).abs() < 1e-12,
+        "y = {y}, exact {exact}"
+    );
+    assert!((w.bodies[0].velocity.y + 9.81 * t).abs() < 1e-12);
+}
+
+/// Steps that fail even at the largest subdivision: after 4 in a row the subdivision pauses
+/// for 1 step, then 2, then 4 (each pause done whole), so an insoluble phase costs about what
+/// it costs without subdivision.
+#[test]
+fn subdivision_pauses_when_it_does_not_help() {
+    let mut w = settled_box();
+    hopeless(&mut w, 1);
+    let mut state = Subdivision::default();
+    let mut levels = Vec::new();
+    for _ in 0..22 {
+        let s = step_subdivided(&mut w, &mut state).unwrap();
+        assert!(!s.report.solver.converged);
+        levels.push(s.halvings);
+    }
+    let f = FAILURES_BEFORE_BACKOFF as usize;
+    let mut expect = Vec::new();
+    for pause in [1, 2, 4] {
+        expect.extend(std::iter::repeat_n(1, f));
+        expect.extend(std::iter::repeat_n(0, pause));
+    }
+    expect.extend(std::iter::repeat_n(1, 22 - expect.len()));
+    assert_eq!(levels, expect);
+}
