@@ -105,7 +105,8 @@ pub struct SubdividedStep {
 }
 
 /// Advances `world` by its time step `h = world.params.dt` in `2^L` equal sub-steps, `L`
-/// starting at `state.level` (capped at [`crate::SolverParams::max_halvings`]): when a
+/// starting at `state.level` (capped at [`crate::SolverParams::max_halvings`]; 0 under an
+/// implicit cell control, [`crate::CellControl::implicit`], whose law is written per step): when a
 /// sub-step's solve does not converge and `L` is below the cap, the world is restored to its
 /// state before the step and the step is done again with `L + 1` (module documentation). At the
 /// cap the sub-steps are kept whatever their convergence (the merged report says so). The level
@@ -123,7 +124,16 @@ pub fn step_subdivided(
     state: &mut Subdivision,
 ) -> Result<SubdividedStep, DemError> {
     let h = world.params.dt;
-    let configured = world.params.solver.max_halvings.min(20);
+    // The implicit law of a stress-controlled cell is written per step (its gain acts once a
+    // step): applied 2^L times over h it is another, stiffer law, and it ran away on a dilute
+    // sheared cell (the cell's expansion rate growing geometrically over sub-steps). Those
+    // steps are not subdivided; the coupled cell already makes them converge (physics.md §7).
+    let implicit_cell = world.cell_control.is_some_and(|c| c.implicit);
+    let configured = if implicit_cell {
+        0
+    } else {
+        world.params.solver.max_halvings.min(20)
+    };
     let paused = state.pause > 0;
     let max = if paused {
         state.pause -= 1;

@@ -456,3 +456,48 @@ fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
     let mean = mean / n as f64;
     assert!((mean + p).abs() < 0.1 * p, "mean σ_xx = {mean} Pa");
 }
+
+/// A world under an implicit cell control is never subdivided
+/// (`dem::step_control::step_subdivided`): its law is written per step, and applied over
+/// sub-steps it ran away on a dilute sheared cell. Even a solve that cannot converge (one sweep
+/// to 10⁻³⁰⁰) with `max_halvings = 3` is kept whole, as one step of `h` giving what
+/// `World::step` gives; without the cell control the same packing is subdivided 3 times.
+#[test]
+fn implicit_cell_steps_are_not_subdivided() {
+    use dem::step_control::{step_subdivided, Subdivision};
+    let p = 100.0;
+    let mut w = packing(5, 3, 0.5);
+    w.params.solver.max_iterations = 1;
+    w.params.solver.tolerance = 1e-300;
+    w.params.solver.max_halvings = 3;
+    // Compress the lattice into contact first (imposed gradient, no control).
+    w.set_velocity_gradient(Mat::new(-20.0, 0.0, 0.0, -20.0));
+    for _ in 0..40 {
+        w.step().unwrap();
+    }
+    assert!(!w.contacts().rows.is_empty());
+    let mut plain = w.clone();
+    let s = step_subdivided(&mut plain, &mut Subdivision::default()).unwrap();
+    assert_eq!(s.halvings, 3, "without the control the step is subdivided");
+
+    w.cell_control = Some(CellControl::implicit_law(
+        Imposed::Stress(-p),
+        Imposed::Stress(-p),
+        Imposed::Rate(0.0),
+        1.0,
+        1.0,
+    ));
+    let mut whole = w.clone();
+    let h = w.params.dt;
+    let t0 = w.time;
+    let s = step_subdivided(&mut w, &mut Subdivision::default()).unwrap();
+    assert_eq!((s.halvings, s.retries, s.substeps.len()), (0, 0, 1));
+    assert!(!s.report.solver.converged);
+    let r = whole.step().unwrap();
+    assert_eq!(s.report, r);
+    assert!((w.time - t0 - h).abs() <= 1e-15);
+    for (a, b) in w.bodies.iter().zip(&whole.bodies) {
+        assert_eq!(a.position, b.position);
+        assert_eq!(a.velocity, b.velocity);
+    }
+}
