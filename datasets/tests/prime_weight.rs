@@ -13,6 +13,7 @@ fn column(n: usize, seed: u64) -> dem::World {
         parallel: false,
         prime: false,
         max_time: 1.0,
+        max_halvings: 0,
     };
     janssen_column(n, Preparation::Deposit, &run, seed).unwrap()
 }

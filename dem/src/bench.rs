@@ -8,7 +8,7 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
-use crate::step_control::StepControl;
+use crate::step_control::{step_subdivided, StepControl, Subdivision};
 use crate::{ContactLaws, SolverParams, World, WorldParams};
 
 /// A box `width` wide holding `n` disks of radius in [1, 2] mm on a loose seeded grid, μ = 0.3,
@@ -130,7 +130,10 @@ pub fn energy_ratio(w: &World) -> f64 {
 }
 
 /// Steps `w` until [`energy_ratio`] < `target` (or `max_time` simulated seconds), timed; with
-/// `control`, the time step follows [`StepControl`] (starting from `w.params.dt`).
+/// `control`, the time step follows [`StepControl`] (starting from `w.params.dt`); without it,
+/// steps whose solve does not converge are subdivided as `w.params.solver.max_halvings` allows
+/// ([`step_subdivided`]; `unconverged_steps` counts those left unconverged at the largest
+/// subdivision, `dt_range` the sub-steps).
 pub fn settle(
     w: &mut World,
     target: f64,
@@ -141,14 +144,23 @@ pub fn settle(
     let (mut steps, mut sweeps, mut unconverged) = (0u64, 0u64, 0u64);
     let (mut simulated, mut dt_min, mut dt_max) = (0.0f64, f64::INFINITY, 0.0f64);
     let mut ratio = energy_ratio(w);
+    let mut subdivision = Subdivision::default();
     // half a step of slack: the sum of the steps must not add a step to a fixed-step run
     while simulated < max_time - 0.5 * w.params.dt {
         let h = w.params.dt;
-        let Ok(rep) = w.step() else { break };
+        let (rep, sub_h) = if control.is_some() {
+            let Ok(rep) = w.step() else { break };
+            (rep, h)
+        } else {
+            let Ok(s) = step_subdivided(w, &mut subdivision) else {
+                break;
+            };
+            (s.report, h / f64::from(1u32 << s.halvings))
+        };
         steps += 1;
         simulated += h;
-        dt_min = dt_min.min(h);
-        dt_max = dt_max.max(h);
+        dt_min = dt_min.min(sub_h);
+        dt_max = dt_max.max(sub_h);
         sweeps += rep.solver.iterations as u64;
         unconverged += u64::from(!rep.solver.converged);
         ratio = energy_ratio(w);
