@@ -20,6 +20,7 @@ use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_column, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
+use crate::verdict::WindowStats;
 
 /// Mean and standard deviation of a series.
 pub fn mean_std(v: &[f64]) -> (f64, f64) {
@@ -52,6 +53,13 @@ struct PushState {
     force: Vec<f64>,
     /// VTK frames of the current push.
     vtk: VtkFrames,
+    /// Numerics of the steps of the current push that feed its force statistics (the second
+    /// half).
+    #[serde(default)]
+    window: WindowStats,
+    /// Those of each finished push, in case order (the verdict judges them).
+    #[serde(default)]
+    windows: Vec<WindowStats>,
 }
 
 impl Push<'_> {
@@ -105,6 +113,7 @@ impl PhasedRun for Push<'_> {
             world.params.solver = c.solver.params();
             world.bodies[st.bottom].velocity = Vector2::new(0.0, c.push_velocity);
             st.force = Vec::with_capacity(self.steps() as usize);
+            st.window.reset();
             st.vtk = VtkFrames::with_prefix(&format!("{name}_"), c.push_duration / 20.0, 21);
             Ok(Some(PhasePlan {
                 name: format!("push {case}"),
@@ -119,11 +128,14 @@ impl PhasedRun for Push<'_> {
         st: &mut PushState,
         out: &mut OutputDir,
         w: &dem::World,
-        _r: &dem::StepReport,
-        _p: &datasets::phases::PhaseProgress,
+        r: &dem::StepReport,
+        p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
         if !k.is_multiple_of(2) {
             st.force.push(-w.contact_force(st.bottom).0.y);
+            // The force statistics are over the second half of the push (`leave`).
+            let in_window = st.force.len() as u64 > self.steps() / 2;
+            st.window.step(in_window, w, r, &p.stats);
             st.vtk.maybe(out, w)?;
         }
         Ok(())
@@ -145,6 +157,8 @@ impl PhasedRun for Push<'_> {
         let (name, friction) = &self.c.cases.list()[case];
         let weight = st.weights[case];
         std::mem::replace(&mut st.vtk, VtkFrames::new(f64::INFINITY, 1)).finish(out, world)?;
+        st.window.keys(&mut st.s, &format!("push_window_{name}"));
+        st.windows.push(st.window);
         let force = std::mem::take(&mut st.force);
         for (i, f) in force.iter().enumerate() {
             st.table.rows[i][case + 1] = *f;
@@ -220,6 +234,8 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         bottom: 0,
         force: Vec::new(),
         vtk: VtkFrames::new(f64::INFINITY, 1),
+        window: WindowStats::default(),
+        windows: Vec::new(),
     };
     // Each deposit phase builds its own column; the initial world is a placeholder.
     let empty = dem::World::new(dem::WorldParams::default(), dem::ContactLaws::new(&[], 0.0));
@@ -230,6 +246,7 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         headline,
         all,
         weights,
+        windows,
         ..
     } = st;
     let mut plots = Vec::new();
@@ -288,6 +305,12 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             )
         },
     );
+    // The forces of each case stand on the steps of the second half of its push: their
+    // solves must have converged (with μ = 0.8 on grains and walls most do not: the column
+    // wedges and such a step may have no solution, so its forces are not measurements).
+    for (w, (name, _)) in windows.iter().zip(c.cases.list()) {
+        checks.window(&format!("{name}, second half of the push"), w);
+    }
     Ok(RunOutcome {
         summary: s,
         headline,
