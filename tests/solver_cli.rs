@@ -46,6 +46,8 @@ fn bad_solver_settings_are_refused_with_the_key() {
         ("solver.tolerance=0", "solver.tolerance"),
         ("solver.tolerance=-1", "solver.tolerance"),
         ("solver.max_iterations=0", "solver.max_iterations"),
+        ("solver.max_halvings=11", "solver.max_halvings"),
+        ("solver.max_halvings=-1", "solver.max_halvings"),
     ] {
         let o = grainlaw(&["run", "shear-cell", "--out", "x", "--set", set], d);
         refused(&o, key);
