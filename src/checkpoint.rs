@@ -37,7 +37,11 @@ use crate::scenarios::common::Stop;
 /// Format tag of run checkpoints. v2: a biperiodic cell may be under the implicit control
 /// (`dem::cell::CellControl::implicit`), the default of `simple-shear` and `biaxial`, whose
 /// stored scenario of a v1 run would not say so: a v1 checkpoint is refused (run again).
-pub const FORMAT: &str = "grainlaw-run-checkpoint-v2";
+/// v3: steps whose solve does not converge are subdivided (`solver.max_halvings`, default 3,
+/// `dem::step_control::step_subdivided`), and the phase's progress holds where the
+/// subdivision stands; a v2 run did not subdivide, and its stored scenario would make the
+/// resumed part do so: a v2 checkpoint is refused (run again).
+pub const FORMAT: &str = "grainlaw-run-checkpoint-v3";
 
 /// Buffer between the gzip stream and the JSON deserialiser (bytes).
 const BUFFER: usize = 1 << 20;
