@@ -15,9 +15,12 @@
 //! thread count) → θ-method position update → [`stabilise`] (a frictionless projection of the
 //! positions that removes the overlaps deeper than a slop, without touching the velocities).
 //!
+//! Steps the solver cannot finish: [`step_control::step_subdivided`] undoes such a step and
+//! does it again in up to `2^max_halvings` sub-steps (every scenario phase steps through it).
+//!
 //! Helpers for runs that only want a state: [`hydrostatic`] (a weight-carrying first guess of
 //! the impulses of a packing generated at rest, [`world::World::prime_with_weight`]) and
-//! [`step_control`] (a time step adapted to the solver's convergence).
+//! [`step_control::StepControl`] (a time step adapted to the solver's convergence).
 //!
 //! Boundaries: walls, a periodic x direction ([`detection::Periodic`]), or a biperiodic
 //! deformable cell with mixed stress/strain-rate control ([`cell`], [`world::World::cell`]).
