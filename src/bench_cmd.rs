@@ -154,9 +154,12 @@ fn peer_line(peer: &crate::lammps_peer::PeerOutcome, column: &crate::lammps_peer
     use crate::lammps_peer::PeerOutcome;
     match peer {
         PeerOutcome::Ran(p) => println!(
-            "{:>7} LAMMPS: {:.1} s wall, {} steps of {:.3} µs ({:.3} s simulated), KE/PE {:.2e}: {}; overlap/r {:.4}",
+            "{:>7} LAMMPS: {:.1} s wall ({} in its loop), {} steps of {:.3} µs ({:.3} s simulated), KE/PE {:.2e}: {}; overlap/r {:.4}",
             "",
             p.wall_seconds,
+            p.log
+                .loop_seconds
+                .map_or_else(|| "?".to_string(), |t| format!("{t:.1} s")),
             p.log.steps,
             column.model.dt * 1e6,
             p.log.simulated_seconds,
