@@ -7,8 +7,10 @@
 //!    N ([`datasets::benchmarks::scaling_deposit`]), on 1 and 2 threads (colour-ordered parallel
 //!    solve, the same numbers on both), with the fitted exponent of `t ∝ Nᵃ`.
 //! 4. Janssen columns settled to kinetic / potential energy < 10⁻⁸
-//!    ([`datasets::benchmarks::settle_column`]) against the reference times of a soft-contact
-//!    code (LAMMPS, Hookean with history, one core).
+//!    ([`datasets::benchmarks::settle_column`]) against a soft-contact code, LAMMPS (Hookean
+//!    with history, one core), run in the same bench on the same initial column
+//!    ([`crate::lammps_peer`]) when `lmp` is found; otherwise against its quoted times,
+//!    labelled as quoted.
 //! 5. Biaxial RVEs (the `biaxial` scenario's cell, [`crate::scenarios::biaxial::bench_rve`]):
 //!    time per step and per percent of axial strain, with the solver counts.
 //! 6. Memory per grain and per contact ([`dem::bench::MemoryFootprint`]).
@@ -47,8 +49,9 @@ pub struct BenchPlan {
     pub biaxial_steps: usize,
 }
 
-/// Reference wall seconds (range) of a soft-contact DEM code for a settled column of `n` grains
-/// (issue 6: LAMMPS, Hookean with history, one core).
+/// Quoted wall seconds (range) of a soft-contact DEM code for a settled column of `n` grains
+/// (issue 6: LAMMPS, Hookean with history, one core): printed, labelled as quoted, only when
+/// LAMMPS is not there to be measured.
 fn lammps_reference(n: usize) -> Option<(f64, f64)> {
     match n {
         2000 => Some((15.0, 25.0)),
@@ -121,6 +124,64 @@ fn engine_rows(plan: &BenchPlan) -> Result<Vec<ScalingRow>> {
     Ok(one_thread)
 }
 
+/// The soft-contact peer's figure in the column table: its wall seconds and the ratio
+/// grainlaw / LAMMPS when it settled, a label otherwise (never a number that looks right).
+fn peer_cells(
+    peer: Option<&crate::lammps_peer::PeerOutcome>,
+    n: usize,
+    total: f64,
+) -> (String, String) {
+    use crate::lammps_peer::PeerOutcome;
+    match peer {
+        Some(PeerOutcome::Ran(p)) if p.settled => (
+            format!("{:.1}", p.wall_seconds),
+            format!("{:.3}", total / p.wall_seconds),
+        ),
+        Some(PeerOutcome::Ran(_)) => ("NOT settled".into(), "–".into()),
+        Some(PeerOutcome::Failed { .. }) => ("FAILED".into(), "–".into()),
+        None => match lammps_reference(n) {
+            Some((lo, hi)) => (
+                format!("quoted {lo:.0}–{hi:.0}"),
+                format!("{:.2}–{:.2}", total / hi, total / lo),
+            ),
+            None => ("–".into(), "–".into()),
+        },
+    }
+}
+
+/// The line under a column row that says what the peer did.
+fn peer_line(peer: &crate::lammps_peer::PeerOutcome, column: &crate::lammps_peer::PeerColumn) {
+    use crate::lammps_peer::PeerOutcome;
+    match peer {
+        PeerOutcome::Ran(p) => println!(
+            "{:>7} LAMMPS: {:.1} s wall ({} in its loop), {} steps of {:.3} µs ({:.3} s simulated), KE/PE {:.2e}: {}; overlap/r {:.4}",
+            "",
+            p.wall_seconds,
+            p.log
+                .loop_seconds
+                .map_or_else(|| "?".to_string(), |t| format!("{t:.1} s")),
+            p.log.steps,
+            column.model.dt * 1e6,
+            p.log.simulated_seconds,
+            p.log.energy_ratio,
+            if p.settled {
+                "settled".to_string()
+            } else {
+                format!(
+                    "NOT settled (limits {:.1} s simulated, {:.0} s wall)",
+                    column.max_time, column.wall_limit
+                )
+            },
+            p.overlap_ratio
+        ),
+        PeerOutcome::Failed { reason, dir } => println!(
+            "{:>7} LAMMPS FAILED: {reason} (files kept in {})",
+            "",
+            dir.display()
+        ),
+    }
+}
+
 fn columns(plan: &BenchPlan) -> Result<()> {
     let jobs: Vec<(usize, Preparation)> = plan
         .columns
@@ -131,10 +192,23 @@ fn columns(plan: &BenchPlan) -> Result<()> {
     if jobs.is_empty() {
         return Ok(());
     }
+    let lammps = crate::lammps_peer::find_lammps();
+    let wall_limit = crate::lammps_peer::wall_limit()?;
     println!(
         "\nJanssen column settled to KE/PE < 1e-8 (radius 1–2 mm, μ = 0.5, box 40 mean diameters; one thread below {} grains, else all):",
         datasets::benchmarks::PARALLEL_FROM_GRAINS
     );
+    match &lammps {
+        Some(lmp) => println!(
+            "LAMMPS peer measured in this run ({}, one core, serial): the same initial column, gran/hooke/history, k_n = 2e5 m g/d, k_t = 2/7 k_n,\n restitution 0.2 between mean grains, h = t_c/50, KE/PE checked every {} steps, at most {:.0} s wall (GRAINLAW_LAMMPS_TIMEOUT); ratio = grainlaw/LAMMPS",
+            lmp.display(),
+            crate::lammps_peer::CHECK_EVERY,
+            wall_limit
+        ),
+        None => println!(
+            "LAMMPS not found (PATH, GRAINLAW_LAMMPS; or disabled by GRAINLAW_LAMMPS=off): its times are QUOTED, not measured (Hookean with history, one core); ratio = grainlaw/quoted"
+        ),
+    }
     println!(
         "{:>7} {:>8} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9} {:>14} {:>9}",
         "grains",
@@ -153,13 +227,20 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         let run = ColumnRun::for_column(prep, n);
         let r = settle_column(n, prep, &run, 1)?;
         let total = r.total_seconds();
-        let (reference, ratio) = match lammps_reference(n) {
-            Some((lo, hi)) => (
-                format!("{lo:.0}–{hi:.0}"),
-                format!("{:.1}–{:.1}×", lo / total, hi / total),
-            ),
-            None => ("–".into(), "–".into()),
+        let peer = match &lammps {
+            Some(lmp) => {
+                let w = datasets::benchmarks::janssen_column(n, prep, &run, 1)?;
+                let column =
+                    crate::lammps_peer::PeerColumn::from_world(&w, 1e-8, run.max_time, wall_limit)?;
+                let dir = std::env::temp_dir().join(format!(
+                    "grainlaw-lammps-{}-{n}-{prep:?}",
+                    std::process::id()
+                ));
+                Some((crate::lammps_peer::run(lmp, &column, &dir)?, column))
+            }
+            None => None,
         };
+        let (reference, ratio) = peer_cells(peer.as_ref().map(|p| &p.0), n, total);
         println!(
             "{:>7} {:>8} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
             n,
@@ -189,6 +270,9 @@ fn columns(plan: &BenchPlan) -> Result<()> {
                 "  NOT settled"
             }
         );
+        if let Some((p, column)) = &peer {
+            peer_line(p, column);
+        }
     }
     println!(
         "(capped: steps that stopped at the cap of {} sweeps with their best iterate; overlap/r: largest overlap over the smallest radius;\n h: the step range used; a deposit starts from the weight-carrying impulses and adapts its step, halved after a capped step)",

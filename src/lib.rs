@@ -15,6 +15,7 @@ pub mod fc_cmd;
 pub mod fit_cmd;
 pub mod floats;
 pub mod homogenise_cmd;
+pub mod lammps_peer;
 pub mod output;
 pub mod plot;
 pub mod progress;
