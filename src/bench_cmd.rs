@@ -275,8 +275,10 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         }
     }
     println!(
-        "(capped: steps that stopped at the cap of {} sweeps with their best iterate; overlap/r: largest overlap over the smallest radius;\n h: the step range used; a deposit starts from the weight-carrying impulses and adapts its step, halved after a capped step)",
-        ColumnRun::for_preparation(Preparation::Deposit).max_sweeps
+        "(capped: steps that stopped at the cap of {} sweeps (deposit) or {} sweeps in up to {} sub-steps (pour) with their best iterate;\n overlap/r: largest overlap over the smallest radius; h: the step range used, sub-steps included; a deposit starts from the\n weight-carrying impulses and adapts its step, halved after a capped step)",
+        ColumnRun::for_preparation(Preparation::Deposit).max_sweeps,
+        ColumnRun::for_preparation(Preparation::Pour).max_sweeps,
+        1u32 << ColumnRun::for_preparation(Preparation::Pour).max_halvings
     );
     Ok(())
 }
