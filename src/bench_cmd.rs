@@ -1,7 +1,9 @@
 //! `grainlaw bench`: the performance figures of the project in one table.
 //!
-//! 1. Frictional-contact problems of `docs/formats.md` §1 solved to 10⁻⁶ against the
-//!    Siconos fc2d NSGS times ([`dem::fc::bench`]).
+//! 1. Frictional-contact problems of `docs/formats.md` §1 solved to 10⁻⁶ against Siconos fc2d
+//!    NSGS ([`dem::fc::bench`]), and the hard ones by Lemke's method against Siconos' NSGS and
+//!    Lemke: Siconos measured in the same run when it is installed ([`crate::siconos_peer`]),
+//!    else its quoted figures, labelled as quoted.
 //! 2. Bare Gauss–Seidel sweep throughput (contact updates per second, one core).
 //! 3. Engine time per step of a settled deposit about 25 grains deep in a box that widens with
 //!    N ([`datasets::benchmarks::scaling_deposit`]), on 1 and 2 threads (colour-ordered parallel
@@ -288,8 +290,9 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
     if plan.threads.is_empty() || plan.threads.contains(&0) {
         return Err(CliError::Usage("--threads must list counts ≥ 1".into()));
     }
-    run_fc(&plan.fc_dir)?;
-    hard_rows(&plan.fc_dir.join("hard"))?;
+    let peer = crate::siconos_peer::detect();
+    run_fc(&plan.fc_dir, &peer)?;
+    hard_rows(&plan.fc_dir.join("hard"), &peer)?;
     engine_rows(plan)?;
     columns(plan)?;
     homogenise_rows(plan)?;
@@ -316,27 +319,37 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
 }
 
 /// The hard problems (`DIR/hard`, where Gauss–Seidel and Newton stall): Lemke's method from a
-/// cold start to 10⁻⁸, pivots, error recomputed from `r`, seconds (one thread). Siconos' times
-/// on the same files (NSGS stalls; its dense Lemke takes 0.9–57 s or does not finish in 120 s)
-/// are in `datasets/fc-problems/hard/README.md`: Siconos is not needed to run this.
-fn hard_rows(dir: &Path) -> Result<()> {
+/// cold start to 10⁻⁸, pivots, error recomputed from `r`, seconds (one thread), beside Siconos
+/// 4.4 fc2d on the same files. With the peer (`peer = Ok(python)`, [`crate::siconos_peer`]),
+/// Siconos is run in this run: NSGS at tolerance 10⁻⁸ with at most 20 000 iterations and a
+/// 60 s wall-clock cap, and Lemke (`fc2d_lexicolemke`, dense) at 10⁻⁸ with a 60 s cap; its
+/// seconds are those of the solver call timed inside the script. Without it, the figures quoted
+/// from `datasets/fc-problems/hard/README.md` ([`crate::siconos_peer::QUOTED_HARD`]).
+/// `ratio` = Siconos Lemke seconds / ours, when both converged.
+fn hard_rows(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) -> Result<()> {
+    use crate::siconos_peer::{self as sp, SiconosCell};
     if !dir.is_dir() {
         return Ok(());
     }
     let files = dem::fc::bench::problem_files(dir)?;
     println!(
         "
-hard problems ({}), Lemke's method from a cold start to 1e-8, one thread:",
-        dir.display()
+hard problems ({}), Lemke's method from a cold start to 1e-8, one thread; {}:",
+        dir.display(),
+        match peer {
+            Ok(_) => "Siconos 4.4 fc2d MEASURED in this run (NSGS: 1e-8, at most 20000 iterations, 60 s cap; Lemke: 1e-8, 60 s cap; seconds of the solver call, one core)".to_string(),
+            Err(why) => format!("Siconos 4.4 fc2d QUOTED from datasets/fc-problems/hard/README.md (NSGS 1e-8, at most 20000 iterations; Lemke \"-\": not finished in 120 s or not measured), not measured: {why}"),
+        }
     );
     println!(
-        "{:<40} {:>8} {:>8} {:>10} {:>9}",
-        "problem", "contacts", "pivots", "error", "seconds"
+        "{:<30} {:>8} {:>7} {:>9} {:>8} | {:<8} {:>11} {:>6} {:>9} {:>4} | {:>11} {:>6} {:>9} {:>4} | {:>7}",
+        "problem", "contacts", "pivots", "error", "seconds", "siconos", "NSGS s", "its", "error", "conv", "Lemke s", "pivots", "error", "conv", "ratio"
     );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .map_err(|e| CliError::Usage(format!("cannot start a thread pool: {e}")))?;
+    let mut failures = Vec::new();
     for f in files {
         let problem = dem::fc::read_problem(&f)?;
         let t0 = std::time::Instant::now();
@@ -350,14 +363,57 @@ hard problems ({}), Lemke's method from a cold start to 1e-8, one thread:",
         })?;
         let seconds = t0.elapsed().as_secs_f64();
         let error = sol.map_or(f64::NAN, |s| dem::fc::fc_error(&problem, &s.r));
+        let name = dem::fc::bench::problem_name(dir, &f);
+        let (nsgs, lemke) = match peer {
+            Ok(python) => {
+                let req = |solver, max_iter| sp::PeerRequest {
+                    solver,
+                    tol: 1e-8,
+                    max_iter,
+                    repeat: 1,
+                    repeat_budget: 0.0,
+                    cap: std::time::Duration::from_secs(60),
+                };
+                (
+                    SiconosCell::Measured(sp::solve(python, &f, &req("NSGS", 20_000))),
+                    SiconosCell::Measured(sp::solve(python, &f, &req("LEMKE", 1_000_000))),
+                )
+            }
+            Err(_) => {
+                let q = sp::QUOTED_HARD.iter().find(|(n, _, _)| *n == name);
+                (
+                    SiconosCell::Quoted(q.map(|(_, (it, s, c), _)| (*it, *s, Some(*c)))),
+                    SiconosCell::Quoted(q.and_then(|(_, _, l)| l.map(|(p, s)| (p, s, Some(true))))),
+                )
+            }
+        };
+        for cell in [&nsgs, &lemke] {
+            if let Some(why) = cell.failure() {
+                failures.push(format!("{name} {}: {why}", cell.source()));
+            }
+        }
+        let [ns, ni, ne, nc] = nsgs.columns();
+        let [ls, li, le, lc] = lemke.columns();
+        let ours_ok = error <= 1e-8;
         println!(
-            "{:<40} {:>8} {:>8} {:>10.3e} {:>9.3}",
-            dem::fc::bench::problem_name(dir, &f),
+            "{:<30} {:>8} {:>7} {:>9.2e} {:>8.3} | {:<8} {:>11} {:>6} {:>9} {:>4} | {:>11} {:>6} {:>9} {:>4} | {:>7}{}",
+            name,
             problem.contacts(),
             report.pivots,
             error,
-            seconds
+            seconds,
+            nsgs.source(),
+            ns, ni, ne, nc, ls, li, le, lc,
+            lemke
+                .ratio(seconds)
+                .filter(|_| ours_ok)
+                .map(|v| format!("{v:.1}x"))
+                .unwrap_or_else(|| "-".into()),
+            if ours_ok { "" } else { "  OURS NOT CONVERGED" }
         );
+    }
+    for f in failures {
+        println!("  siconos failed: {f}");
     }
     Ok(())
 }
@@ -424,7 +480,14 @@ fn homogenise_rows(plan: &BenchPlan) -> Result<()> {
     Ok(())
 }
 
-fn run_fc(dir: &Path) -> Result<()> {
+/// The reference problems (`DIR`, tolerance 10⁻⁶ from `r = 0`, one thread) with
+/// [`dem::fc::bench::run_reference_benchmarks`], beside Siconos 4.4 fc2d NSGS (sparse block
+/// storage, 10⁻⁶, `r = 0`, one core): measured in this run when the peer is available
+/// (`peer = Ok(python)`, [`crate::siconos_peer`]: seconds of the solver call timed inside the
+/// script, best of up to 3 solves within 1 s, 300 s wall-clock cap per problem), else quoted
+/// from [`dem::fc::bench::SICONOS_REFERENCE`] and labelled so.
+fn run_fc(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) -> Result<()> {
+    use crate::siconos_peer::{self as sp, SiconosCell};
     // one thread: the comparison with Siconos is per core
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -434,10 +497,88 @@ fn run_fc(dir: &Path) -> Result<()> {
     if rows.is_empty() {
         return Err(CliError::io(dir, "no .json or .json.gz problems found"));
     }
+    let files = dem::fc::bench::problem_files(dir)?;
     println!(
-        "frictional-contact problems ({}), one thread:",
-        dir.display()
+        "frictional-contact problems ({}), one thread; {}:",
+        dir.display(),
+        match peer {
+            Ok(p) => format!("Siconos 4.4 fc2d NSGS MEASURED in this run ({} scripts/siconos_solve_fc.py, 1e-6 from r = 0, one core, seconds of the solver call, best of up to 3 solves within 1 s)", p.display()),
+            Err(why) => format!("Siconos 4.4 fc2d NSGS QUOTED from an earlier measurement (datasets/fc-problems/README.md), not measured: {why}"),
+        }
     );
-    print!("{}", dem::fc::bench::format_table(&rows));
+    println!(
+        "{:<48} {:>8} {:>6} {:>9} {:>9} {:>10} | {:<8} {:>10} {:>7} {:>9} {:>4} | {:>8}",
+        "problem",
+        "contacts",
+        "iters",
+        "error",
+        "seconds",
+        "Mupdates/s",
+        "siconos",
+        "seconds",
+        "iters",
+        "error",
+        "conv",
+        "ratio"
+    );
+    let mut failures = Vec::new();
+    for r in &rows {
+        let cell = match peer {
+            Ok(python) => {
+                let file = files
+                    .iter()
+                    .find(|f| dem::fc::bench::problem_name(dir, f) == r.problem);
+                SiconosCell::Measured(match file {
+                    Some(f) => sp::solve(
+                        python,
+                        f,
+                        &sp::PeerRequest {
+                            solver: "NSGS",
+                            tol: 1e-6,
+                            max_iter: 100_000,
+                            repeat: 3,
+                            repeat_budget: 1.0,
+                            cap: std::time::Duration::from_secs(300),
+                        },
+                    ),
+                    None => sp::PeerOutcome::Failed("problem file not found".into()),
+                })
+            }
+            Err(_) => SiconosCell::Quoted(
+                r.siconos_iterations
+                    .zip(r.siconos_seconds)
+                    .map(|(i, s)| (i, s, Some(true))),
+            ),
+        };
+        if let Some(why) = cell.failure() {
+            failures.push(format!("{}: {why}", r.problem));
+        }
+        let [s, i, e, c] = cell.columns();
+        println!(
+            "{:<48} {:>8} {:>6} {:>9.2e} {:>9.5} {:>10.1} | {:<8} {:>10} {:>7} {:>9} {:>4} | {:>8}{}",
+            r.problem,
+            r.contacts,
+            r.iterations,
+            r.error,
+            r.seconds,
+            r.updates_per_second / 1e6,
+            cell.source(),
+            s,
+            i,
+            e,
+            c,
+            cell.ratio(r.seconds)
+                .filter(|_| r.converged)
+                .map(|v| format!("{v:.1}x"))
+                .unwrap_or_else(|| "-".into()),
+            if r.converged { "" } else { "  NOT CONVERGED" }
+        );
+    }
+    for f in failures {
+        println!("  siconos failed: {f}");
+    }
+    println!(
+        "(ratio: Siconos seconds / ours, when both converged and Siconos' time is at least 1e-4 s)"
+    );
     Ok(())
 }

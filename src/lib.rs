@@ -22,6 +22,7 @@ pub mod progress;
 pub mod provenance;
 pub mod readers;
 pub mod scenarios;
+pub mod siconos_peer;
 pub mod verdict;
 
 pub use error::{CliError, Result};

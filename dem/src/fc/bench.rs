@@ -46,6 +46,9 @@ impl BenchRow {
 /// best of three repeats (one for the large pile) on the development machine (2 vCPU Xeon, shared), fastest of two rounds
 /// in the same session as the `dem::fc` figures of `datasets/fc-problems/README.md`:
 /// (problem, iterations, seconds). Times below 10⁻⁴ s were not resolved (stored as 0).
+/// These are *quoted* figures: `grainlaw bench` prints them, labelled as quoted, only when
+/// Siconos is not installed; otherwise it measures Siconos in the same run (the root
+/// package's `siconos_peer` module; `dem` spawns no process).
 pub const SICONOS_REFERENCE: &[(&str, usize, f64)] = &[
     ("large/pile_pert_10000", 5926, 14.67),
     ("piles/pile_pert_100", 118, 0.0022),
