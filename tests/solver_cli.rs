@@ -125,7 +125,13 @@ fn dumped_problems_read_back_and_solve() {
         ],
         d,
     );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // A finished run: 0, or 3 when the verdict refuses (the μ = 0.8 push of so short a run is
+    // mostly unconverged, and its forces are refused); the dumps are written either way.
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(3)),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let mut files: Vec<_> = std::fs::read_dir(d.join("p"))
         .unwrap()
         .map(|e| e.unwrap().path())
