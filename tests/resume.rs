@@ -124,6 +124,9 @@ fn stopped_and_resumed_runs_give_the_same_files() {
     let tmp = tempfile::tempdir().unwrap();
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
     let s = reference(&a);
+    // The run subdivides steps (its deposit from step 1 on), so the stops below fall where the
+    // subdivision's state is in the checkpoint.
+    assert!(s["solver_subdivided_steps"].as_u64().unwrap() > 0);
     assert!(
         !a.join("checkpoint").exists(),
         "a finished run keeps no checkpoint"

@@ -117,6 +117,10 @@ pub struct PhaseStats {
     /// Sweeps of the attempts undone before a subdivision (included in `total_sweeps`).
     #[serde(default)]
     pub discarded_sweeps: u64,
+    /// Steps done whole during a pause of the subdivision (after repeated failures at its
+    /// largest level; [`dem::step_control::FAILURES_BEFORE_BACKOFF`]).
+    #[serde(default)]
+    pub paused_steps: u64,
     /// Whether the rest criterion was met (phases that look for rest).
     pub at_rest: bool,
     /// Translational kinetic energy over `Σ m g d` at the end (1).
@@ -136,8 +140,9 @@ fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
 impl PhaseStats {
     /// Accounts for one step's subdivision (`halvings` of the kept sub-steps, `discarded`
     /// sweeps of the attempts undone); [`PhaseStats::record`] accounts for its solve.
-    pub fn record_subdivision(&mut self, halvings: u32, discarded: usize) {
+    pub fn record_subdivision(&mut self, halvings: u32, discarded: usize, paused: bool) {
         self.substeps += 1u64 << halvings;
+        self.paused_steps += u64::from(paused);
         if halvings > 0 {
             self.subdivided_steps += 1;
         }
@@ -217,6 +222,7 @@ impl PhaseStats {
         self.substeps += o.substeps;
         self.max_halvings_used = self.max_halvings_used.max(o.max_halvings_used);
         self.discarded_sweeps += o.discarded_sweeps;
+        self.paused_steps += o.paused_steps;
         self.max_corrected_overlap_ratio = self
             .max_corrected_overlap_ratio
             .max(o.max_corrected_overlap_ratio);
@@ -316,8 +322,8 @@ impl PhaseProgress {
 
 /// One step with its accounting: solve, time, overlap and energy balance. A step whose solve
 /// does not converge is done again in sub-steps as the solver parameters allow
-/// ([`step_subdivided`]); the energy balance is checked on each kept sub-step (the largest
-/// residual is the step's).
+/// ([`step_subdivided`]); the step's energy growth is the sum of the positive residuals of its
+/// kept sub-steps (so a subdivided step meets the same tolerance as a whole one).
 fn accounted_step(
     world: &mut World,
     progress: &mut PhaseProgress,
@@ -330,12 +336,16 @@ fn accounted_step(
     progress.stats.record(&r, dt);
     progress
         .stats
-        .record_subdivision(step.halvings, step.discarded_sweeps);
-    let growth = step
-        .substeps
-        .iter()
-        .map(|s| s.energy_residual / e_load)
-        .fold(f64::NEG_INFINITY, f64::max);
+        .record_subdivision(step.halvings, step.discarded_sweeps, step.paused);
+    let growth = if step.substeps.len() == 1 {
+        step.substeps[0].energy_residual / e_load
+    } else {
+        step.substeps
+            .iter()
+            .map(|s| s.energy_residual.max(0.0))
+            .sum::<f64>()
+            / e_load
+    };
     progress
         .stats
         .record_checks(&r, min_radius, growth.is_finite().then_some(growth));

@@ -102,6 +102,9 @@ pub struct SubdividedStep {
     pub retries: u32,
     /// Sweeps of the undone attempts.
     pub discarded_sweeps: usize,
+    /// Done whole during a pause of the subdivision (after repeated failures at its largest
+    /// level), so not tried in sub-steps.
+    pub paused: bool,
 }
 
 /// Advances `world` by its time step `h = world.params.dt` in `2^L` equal sub-steps, `L`
@@ -113,12 +116,18 @@ pub struct SubdividedStep {
 /// that was kept becomes the next step's; after [`CALM_STEPS`] steps converged at their first
 /// try it drops by one. After [`FAILURES_BEFORE_BACKOFF`] consecutive steps unconverged at the
 /// cap, the next steps are done whole (no subdivision) for a pause of 1, 2, 4, … up to
-/// [`MAX_BACKOFF`] steps, doubling while the failures go on and reset by a subdivided step that
-/// converges. `world.params.dt` is `h` again on return.
+/// [`MAX_BACKOFF`] steps, doubling while the failures go on and reset by any step that
+/// converges outside a pause. A non-finite state in an attempt that can still be halved is
+/// undone like a failed solve. `world.params.dt` is `h` again on return.
+///
+/// The convergence test of each sub-step uses its own step: the approach-speed limit
+/// `overlap_rate · R_min / (h/2^L)` lets a subdivided step's contacts creep by up to `2^L`
+/// times the overlap a whole step would allow; the position correction and the overlap checks
+/// of every run bound what is left.
 ///
 /// # Errors
-/// The first [`DemError`] of a sub-step (non-finite state); the world is then left where that
-/// sub-step stopped, with `params.dt = h`.
+/// The first [`DemError`] of a sub-step that cannot be halved further (non-finite state); the
+/// world is then left where that sub-step stopped, with `params.dt = h`.
 pub fn step_subdivided(
     world: &mut World,
     state: &mut Subdivision,
@@ -144,8 +153,16 @@ pub fn step_subdivided(
     let start = state.level.min(max);
     let mut level = start;
     let (mut retries, mut discarded) = (0u32, 0usize);
+    let mut backup: Option<World> = None;
     loop {
-        let backup = (level < max).then(|| world.clone());
+        if level < max {
+            match backup.as_mut() {
+                Some(b) => b.clone_from(world),
+                None => backup = Some(world.clone()),
+            }
+        } else {
+            backup = None;
+        }
         let n = 1usize << level;
         world.params.dt = h / n as f64;
         // An attempt that can still be subdivided is left to Gauss–Seidel: a smaller step is
@@ -160,10 +177,16 @@ pub fn step_subdivided(
             let probe = EnergyProbe::before(world);
             let report = match world.step() {
                 Ok(r) => r,
-                Err(e) => {
+                Err(e) if backup.is_none() => {
                     world.params.dt = h;
                     world.params.solver.method = method;
                     return Err(e);
+                }
+                // A non-finite state in an attempt that can still be halved: a smaller step
+                // is the usual cure, so it is undone like a failed solve.
+                Err(_) => {
+                    failed = true;
+                    break;
                 }
             };
             let energy_residual = probe.residual(world);
@@ -177,12 +200,12 @@ pub fn step_subdivided(
                 break;
             }
         }
-        if let (true, Some(b)) = (failed, backup) {
+        if let (true, Some(b)) = (failed, backup.as_ref()) {
             discarded += subs
                 .iter()
                 .map(|s| s.report.solver.iterations)
                 .sum::<usize>();
-            *world = b;
+            world.clone_from(b);
             retries += 1;
             level += 1;
             continue;
@@ -201,6 +224,7 @@ pub fn step_subdivided(
             halvings: level,
             retries,
             discarded_sweeps: discarded,
+            paused,
         });
     }
 }
@@ -211,18 +235,17 @@ fn update_subdivision(state: &mut Subdivision, start: u32, level: u32, converged
     if level > start || !converged {
         state.level = level;
         state.calm = 0;
-    } else {
+    } else if level > 0 {
         state.calm += 1;
-        if state.calm >= CALM_STEPS && level > 0 {
+        if state.calm >= CALM_STEPS {
             state.level = level - 1;
             state.calm = 0;
         }
     }
     if converged {
+        // A converged step ends a run of failures: the next burst starts its pauses at 1.
         state.failures = 0;
-        if level > 0 {
-            state.next_pause = 0;
-        }
+        state.next_pause = 0;
     } else {
         state.failures += 1;
         if state.failures >= FAILURES_BEFORE_BACKOFF {

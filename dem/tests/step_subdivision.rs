@@ -52,6 +52,13 @@ fn a_subdivided_step_is_its_sub_steps_from_the_same_start() {
         sweeps += b.step().unwrap().solver.iterations;
     }
     assert_eq!(fingerprint(&a), fingerprint(&b));
+    // The whole state (contact sets, warm starts, Lemke bases, solver back-off, detector,
+    // counters), as a checkpoint stores it; `b` has its step set back to h like `a`.
+    b.params.dt = h;
+    assert_eq!(
+        serde_json::to_string(&a.state()).unwrap(),
+        serde_json::to_string(&b.state()).unwrap()
+    );
     assert_eq!(a.time, b.time);
     assert!((a.time - t0 - h).abs() <= 1e-15 * a.time);
     assert_eq!(a.step_index, b.step_index);
@@ -117,8 +124,9 @@ fn free_fall_is_exact_across_levels_and_the_level_drops_after_calm_steps() {
 }
 
 /// Steps that fail even at the largest subdivision: after 4 in a row the subdivision pauses
-/// for 1 step, then 2, then 4 (each pause done whole), so an insoluble phase costs about what
-/// it costs without subdivision.
+/// for 1 step, then 2, then 4 (each pause done whole, and said so), so an insoluble phase
+/// costs about what it costs without subdivision; a step that converges ends the run of
+/// failures, and the next burst pauses for 1 step again.
 #[test]
 fn subdivision_pauses_when_it_does_not_help() {
     let mut w = settled_box();
@@ -128,6 +136,7 @@ fn subdivision_pauses_when_it_does_not_help() {
     for _ in 0..22 {
         let s = step_subdivided(&mut w, &mut state).unwrap();
         assert!(!s.report.solver.converged);
+        assert_eq!(s.paused, s.halvings == 0);
         levels.push(s.halvings);
     }
     let f = FAILURES_BEFORE_BACKOFF as usize;
@@ -138,4 +147,15 @@ fn subdivision_pauses_when_it_does_not_help() {
     }
     expect.extend(std::iter::repeat_n(1, 22 - expect.len()));
     assert_eq!(levels, expect);
+
+    // One easy step (a tolerance any iterate meets) that converges, then hopeless again.
+    w.params.solver.tolerance = 1.0;
+    let s = step_subdivided(&mut w, &mut state).unwrap();
+    assert!(s.report.solver.converged && !s.paused);
+    w.params.solver.tolerance = 1e-300;
+    let mut levels = Vec::new();
+    for _ in 0..6 {
+        levels.push(step_subdivided(&mut w, &mut state).unwrap().halvings);
+    }
+    assert_eq!(levels, [1, 1, 1, 1, 0, 1]);
 }

@@ -119,10 +119,13 @@ pub fn phase_warnings(
             stats.unconverged_steps,
             stats.steps,
             solver.max_iterations,
-            if solver.max_halvings > 0 {
-                format!(", in {} sub-steps", 1u64 << solver.max_halvings)
-            } else {
-                String::new()
+            match (stats.max_halvings_used, stats.paused_steps) {
+                (0, 0) => String::new(),
+                (l, 0) => format!(", in up to {} sub-steps", 1u64 << l),
+                (l, p) => format!(
+                    ", in up to {} sub-steps; {p} steps done whole while the subdivision paused",
+                    1u64 << l
+                ),
             },
             solver.tolerance,
             first(stats.first_unconverged_step),
@@ -169,8 +172,9 @@ pub fn phase_warnings(
 /// `max_corrected_overlap_over_radius` (the largest overlap it removed, over the smallest grain
 /// radius); `solver_subdivided_steps` (steps redone in sub-steps because their solve did not
 /// converge, `dem::step_control::step_subdivided`), `solver_substeps` (sub-steps kept),
-/// `solver_max_halvings_used` and `solver_discarded_sweeps` (sweeps of the undone attempts,
-/// included in the mean). A first step is the world's step index, `null` when there is none.
+/// `solver_max_halvings_used`, `solver_discarded_sweeps` (sweeps of the undone attempts,
+/// included in the mean) and `solver_paused_steps` (steps done whole while the subdivision
+/// paused after repeated failures at its largest level). A first step is the world's step index, `null` when there is none.
 pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
     let step = |v: Option<u64>| v.map_or(serde_json::Value::Null, serde_json::Value::from);
     s.int("solver_steps", stats.steps)
@@ -207,7 +211,8 @@ pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
             "solver_max_halvings_used",
             u64::from(stats.max_halvings_used),
         )
-        .int("solver_discarded_sweeps", stats.discarded_sweeps);
+        .int("solver_discarded_sweeps", stats.discarded_sweeps)
+        .int("solver_paused_steps", stats.paused_steps);
 }
 
 /// VTK frames every `interval` seconds of simulated time, at most `max_frames` (the final

@@ -70,23 +70,30 @@ impl ProblemDump {
             reason: e.to_string(),
         })?;
         let solver = &world.params.solver;
+        // The problem is the world's last (sub-)step's: its own time step and solve, which
+        // differ from the step's `r` when the step was subdivided (`r` merges its sub-steps).
+        let last = world.last_report();
         let meta = serde_json::json!({
             "source": "grainlaw run --dump-problems",
             "grainlaw_version": env!("CARGO_PKG_VERSION"),
             "scenario": self.scenario,
             "phase": phase,
-            "step": r.step,
-            "time_s": r.time,
-            "dt_s": world.params.dt,
+            "step": last.step,
+            "time_s": last.time,
+            "dt_s": world.contacts().dt,
+            "step_dt_s": world.params.dt,
             "tolerance": solver.tolerance,
             "method": solver.method.name(),
             "max_iterations": solver.max_iterations,
-            "engine_sweeps": r.solver.iterations,
-            "engine_newton_iterations": r.solver.newton_iterations,
-            "engine_lemke_pivots": r.solver.pivots,
+            "max_halvings": solver.max_halvings,
+            "engine_sweeps": last.solver.iterations,
+            "engine_newton_iterations": last.solver.newton_iterations,
+            "engine_lemke_pivots": last.solver.pivots,
             "lemke_max_contacts": solver.lemke_max_contacts,
-            "engine_error": r.solver.error,
-            "engine_converged": r.solver.converged,
+            "engine_error": last.solver.error,
+            "engine_converged": last.solver.converged,
+            "step_sweeps": r.solver.iterations,
+            "step_converged": r.solver.converged,
         });
         let name: String = phase
             .chars()
