@@ -322,8 +322,8 @@ impl PhaseProgress {
 
 /// One step with its accounting: solve, time, overlap and energy balance. A step whose solve
 /// does not converge is done again in sub-steps as the solver parameters allow
-/// ([`step_subdivided`]); the step's energy growth is the sum of the positive residuals of its
-/// kept sub-steps (so a subdivided step meets the same tolerance as a whole one).
+/// ([`step_subdivided`]); the step's energy residual is the sum of its kept sub-steps' (the
+/// balance is additive), judged against the same tolerance as a whole step's.
 fn accounted_step(
     world: &mut World,
     progress: &mut PhaseProgress,
@@ -337,15 +337,13 @@ fn accounted_step(
     progress
         .stats
         .record_subdivision(step.halvings, step.discarded_sweeps, step.paused);
-    let growth = if step.substeps.len() == 1 {
-        step.substeps[0].energy_residual / e_load
-    } else {
-        step.substeps
-            .iter()
-            .map(|s| s.energy_residual.max(0.0))
-            .sum::<f64>()
-            / e_load
-    };
+    // The energy balance is additive: the step's residual is the sum of its sub-steps'.
+    let growth = step
+        .substeps
+        .iter()
+        .map(|s| s.energy_residual)
+        .sum::<f64>()
+        / e_load;
     progress
         .stats
         .record_checks(&r, min_radius, growth.is_finite().then_some(growth));
