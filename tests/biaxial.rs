@@ -98,25 +98,27 @@ fn bad_inputs_are_refused_with_one_line() {
     }
 }
 
-/// 100 frictionless disks (dense: frictionless throughout), p₀ = 1 kPa, axial strain 0.015:
+/// 400 frictionless disks (dense: frictionless throughout), p₀ = 1 kPa, axial strain 0.05:
 /// the isotropic compression ends within the refusal tolerance of the control (25 %, measured
-/// 14 %), the lateral stress of the axial compression averages −p₀ within 5 % (measured
-/// 3.5 %), the test is quasi-static (I ≤ 10⁻³ with the mean pressure), and the plateau
-/// (last 0.01) has the frictionless critical-state friction sin φ_c ≈ 0.1 (2D disks: Azéma &
+/// 0.06 %), the lateral stress of the axial compression averages −p₀ within 5 % (measured
+/// 0.01 %), the test is quasi-static (I ≤ 10⁻³ with the mean pressure), and the plateau
+/// (last 0.03) has the frictionless critical-state friction sin φ_c ≈ 0.1 (2D disks: Azéma &
 /// Radjai, Phys. Rev. E 85, 2012; frictionless spheres: Peyneau & Roux, Phys. Rev. E 78, 2008,
-/// μ ≈ 0.1) within [0.03, 0.17] for so short a plateau (measured 0.090 ± 0.005), and the solid
-/// fraction of random close packing of these disks, 0.82–0.86 (measured 0.839).
+/// μ ≈ 0.1) within [0.03, 0.17] for so short a plateau (measured 0.131 ± 0.006; seeds 2 and 3:
+/// 0.084, 0.118), and the solid fraction of random close packing of these disks, 0.82–0.86
+/// (measured 0.837). With 100 disks and a plateau of 0.01 the critical friction scattered from
+/// 0.002 to 0.14 over seeds and solver tolerances (a finite-size fluctuation, not a law).
 #[test]
 fn stress_control_and_frictionless_critical_state() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("f");
     let s = run_biaxial(
         &[
-            "grains=100",
+            "grains=400",
             "confining_pressures=[1000.0]",
             "friction.grain_grain=0.0",
-            "max_axial_strain=0.015",
-            "critical_strain=0.01",
+            "max_axial_strain=0.05",
+            "critical_strain=0.03",
             "bin_strain=0.0025",
         ],
         &out,

@@ -41,7 +41,7 @@
 //! mechanical energy of a phase therefore changes by `Σ (δ + W_drive) + position_correction_energy`.
 
 pub use dem::energy::{load_energy_scale, EnergyProbe};
-use dem::step_control::{step_subdivided, Subdivision};
+use dem::step_control::{step_subdivided_checked, Subdivision};
 use dem::{BodyKind, StepReport, World};
 use serde::{Deserialize, Serialize};
 
@@ -121,6 +121,11 @@ pub struct PhaseStats {
     /// largest level; [`dem::step_control::FAILURES_BEFORE_BACKOFF`]).
     #[serde(default)]
     pub paused_steps: u64,
+    /// Converged steps whose energy grew beyond [`ENERGY_GROWTH_TOLERANCE`] · E_load and that
+    /// were solved again at a tighter tolerance, the tighter solve kept
+    /// ([`dem::step_control::step_subdivided_checked`]).
+    #[serde(default)]
+    pub polished_steps: u64,
     /// Whether the rest criterion was met (phases that look for rest).
     pub at_rest: bool,
     /// Translational kinetic energy over `Σ m g d` at the end (1).
@@ -223,6 +228,7 @@ impl PhaseStats {
         self.max_halvings_used = self.max_halvings_used.max(o.max_halvings_used);
         self.discarded_sweeps += o.discarded_sweeps;
         self.paused_steps += o.paused_steps;
+        self.polished_steps += o.polished_steps;
         self.max_corrected_overlap_ratio = self
             .max_corrected_overlap_ratio
             .max(o.max_corrected_overlap_ratio);
@@ -311,6 +317,11 @@ pub struct PhaseProgress {
     /// ([`dem::step_control::step_subdivided`]).
     #[serde(default)]
     pub subdivision: Subdivision,
+    /// The load energy scale `E_load` of the energy check ([`load_energy_scale`]), taken when
+    /// the phase starts: it depends on the state (a periodic cell's volume), so a resumed
+    /// phase keeps the one it started with.
+    #[serde(default)]
+    pub e_load: Option<f64>,
 }
 
 impl PhaseProgress {
@@ -322,8 +333,10 @@ impl PhaseProgress {
 
 /// One step with its accounting: solve, time, overlap and energy balance. A step whose solve
 /// does not converge is done again in sub-steps as the solver parameters allow
-/// ([`step_subdivided`]); the step's energy residual is the sum of its kept sub-steps' (the
-/// balance is additive), judged against the same tolerance as a whole step's.
+/// ([`step_subdivided_checked`]); the step's energy residual is the sum of its kept sub-steps'
+/// (the balance is additive), judged against the same tolerance as a whole step's. A converged
+/// step whose energy grew beyond that tolerance is solved again at a tenth of the solver
+/// tolerance before it is judged.
 fn accounted_step(
     world: &mut World,
     progress: &mut PhaseProgress,
@@ -331,19 +344,19 @@ fn accounted_step(
     min_radius: f64,
 ) -> Result<StepReport, dem::DemError> {
     let dt = world.params.dt;
-    let step = step_subdivided(world, &mut progress.subdivision)?;
+    let step = step_subdivided_checked(
+        world,
+        &mut progress.subdivision,
+        Some(ENERGY_GROWTH_TOLERANCE * e_load),
+    )?;
     let r = step.report;
     progress.stats.record(&r, dt);
     progress
         .stats
         .record_subdivision(step.halvings, step.discarded_sweeps, step.paused);
+    progress.stats.polished_steps += u64::from(step.polished);
     // The energy balance is additive: the step's residual is the sum of its sub-steps'.
-    let growth = step
-        .substeps
-        .iter()
-        .map(|s| s.energy_residual)
-        .sum::<f64>()
-        / e_load;
+    let growth = step.substeps.iter().map(|s| s.energy_residual).sum::<f64>() / e_load;
     progress
         .stats
         .record_checks(&r, min_radius, growth.is_finite().then_some(growth));
@@ -372,7 +385,9 @@ pub fn continue_until_rest(
     mut on_step: impl FnMut(&World, &StepReport, &PhaseProgress) -> bool,
 ) -> Result<PhaseStats, dem::DemError> {
     let scale = energy_scale(world);
-    let e_load = load_energy_scale(world);
+    let e_load = *progress
+        .e_load
+        .get_or_insert_with(|| load_energy_scale(world));
     let min_radius = min_grain_radius(world);
     let dt = world.params.dt;
     let max_steps = (run.max_time / dt).ceil() as u64;
@@ -419,7 +434,9 @@ pub fn continue_steps(
     mut on_step: impl FnMut(&World, &StepReport, &PhaseProgress) -> bool,
 ) -> Result<PhaseStats, dem::DemError> {
     let scale = energy_scale(world);
-    let e_load = load_energy_scale(world);
+    let e_load = *progress
+        .e_load
+        .get_or_insert_with(|| load_energy_scale(world));
     let min_radius = min_grain_radius(world);
     while progress.steps() < steps {
         let r = accounted_step(world, progress, e_load, min_radius)?;

@@ -125,6 +125,16 @@ pub struct SolverParams {
     /// Default 0 (off).
     #[serde(default)]
     pub max_halvings: u32,
+    /// Whether the attempts of a step that can still be halved are solved by Gauss–Seidel
+    /// alone (`auto` → `nlgs`, [`crate::step_control::step_subdivided`]): a smaller step is
+    /// cheaper than the global stages on stalled attempts. Default true; `false` tries the
+    /// whole step with the method asked for first (the Janssen measured step).
+    #[serde(default = "yes")]
+    pub gauss_seidel_attempts: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn auto_sweeps() -> usize {
@@ -183,6 +193,7 @@ impl Default for SolverParams {
             newton: NewtonParams::default(),
             lemke_max_contacts: lemke_max_contacts(),
             max_halvings: 0,
+            gauss_seidel_attempts: true,
         }
     }
 }

@@ -18,7 +18,9 @@
 //!   is solved by Gauss–Seidel alone (`auto` → `nlgs`): a smaller step is cheaper than the
 //!   global stages, which run at the largest subdivision. Steps that fail even there (a
 //!   problem without solution at any step) pause the subdivision ([`FAILURES_BEFORE_BACKOFF`],
-//!   [`MAX_BACKOFF`]).
+//!   [`MAX_BACKOFF`]). With an energy limit ([`step_subdivided_checked`]), a converged step
+//!   whose energy balance grew beyond it is solved again at a tenth of the tolerance
+//!   ([`POLISH_FACTOR`]).
 //! - [`StepControl`], for runs whose only goal is a state (settling a packing), not a
 //!   trajectory: the step itself shrinks and grows.
 //!
@@ -59,6 +61,10 @@ pub const FAILURES_BEFORE_BACKOFF: u32 = 4;
 /// after them keep failing at the largest subdivision.
 pub const MAX_BACKOFF: u32 = 64;
 
+/// Factor on the solver tolerance of a step solved again because its energy grew
+/// ([`step_subdivided_checked`]).
+pub const POLISH_FACTOR: f64 = 0.1;
+
 /// Where the subdivision of steps stands between steps; saved with the phase in checkpoints,
 /// so a resumed run subdivides as one never stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -98,13 +104,17 @@ pub struct SubdividedStep {
     pub substeps: Vec<SubStep>,
     /// Halvings of the kept sub-steps (`substeps.len() == 2^halvings`).
     pub halvings: u32,
-    /// Attempts undone because a sub-step did not converge.
+    /// Attempts undone: because a sub-step did not converge, or a converged solve whose energy
+    /// grew and was solved again ([`step_subdivided_checked`]; one whichever solve is kept).
     pub retries: u32,
-    /// Sweeps of the undone attempts.
+    /// Sweeps of the undone attempts (of the solve not kept, for a polished step).
     pub discarded_sweeps: usize,
     /// Done whole during a pause of the subdivision (after repeated failures at its largest
     /// level), so not tried in sub-steps.
     pub paused: bool,
+    /// Solved again at [`POLISH_FACTOR`] times the tolerance because its energy grew beyond the
+    /// limit of [`step_subdivided_checked`], and the tighter solve was kept.
+    pub polished: bool,
 }
 
 /// Advances `world` by its time step `h = world.params.dt` in `2^L` equal sub-steps, `L`
@@ -132,6 +142,30 @@ pub fn step_subdivided(
     world: &mut World,
     state: &mut Subdivision,
 ) -> Result<SubdividedStep, DemError> {
+    step_subdivided_checked(world, state, None)
+}
+
+/// [`step_subdivided`] with the energy balance of the step checked: when every kept sub-step
+/// converged but the step's energy residual `δ = Σ δ_k` ([`EnergyProbe::residual`], summed over
+/// the sub-steps: the balance is additive) exceeds `energy_limit` (J), the step is undone and
+/// solved again at the same subdivision with the tolerance multiplied by [`POLISH_FACTOR`].
+///
+/// For θ = 1 an exact solve gives `δ ≤ 0` (Moreau 1988); a solve accepted at a relative error
+/// `ε` may leave `uᵀR > 0` of order `ε` in every sub-step, and a packing near rest whose warm
+/// start already meets the tolerance (0–2 sweeps a sub-step) adds it up over the sub-steps
+/// (measured: the Janssen deposit, 8 sub-steps of +1.35·10⁻⁶ E_load each). The tighter solve is
+/// kept if all its sub-steps converge at the tighter tolerance (then the step is
+/// [`SubdividedStep::polished`]); otherwise the first solve is kept, its growth reported by the
+/// caller. At most one polish per step; its sweeps count as discarded when it is not kept, and
+/// the first solve's sweeps when it is.
+///
+/// # Errors
+/// As [`step_subdivided`].
+pub fn step_subdivided_checked(
+    world: &mut World,
+    state: &mut Subdivision,
+    energy_limit: Option<f64>,
+) -> Result<SubdividedStep, DemError> {
     let h = world.params.dt;
     // The implicit law of a stress-controlled cell is written per step (its gain acts once a
     // step): applied 2^L times over h it is another, stiffer law, and it ran away on a dilute
@@ -154,22 +188,35 @@ pub fn step_subdivided(
     let mut level = start;
     let (mut retries, mut discarded) = (0u32, 0usize);
     let mut backup: Option<World> = None;
+    let tolerance = world.params.solver.tolerance;
+    let method = world.params.solver.method;
+    let gauss_seidel_attempts = world.params.solver.gauss_seidel_attempts;
+    // The first solve of a step whose energy grew, while its polish is tried.
+    let mut first: Option<(World, Vec<SubStep>)> = None;
+    let restore = |world: &mut World| {
+        world.params.dt = h;
+        world.params.solver.method = method;
+        world.params.solver.tolerance = tolerance;
+    };
     loop {
-        if level < max {
+        let polishing = first.is_some();
+        let can_halve = level < max && !polishing;
+        if can_halve || (energy_limit.is_some() && !polishing) {
             match backup.as_mut() {
                 Some(b) => b.clone_from(world),
                 None => backup = Some(world.clone()),
             }
-        } else {
-            backup = None;
         }
         let n = 1usize << level;
         world.params.dt = h / n as f64;
         // An attempt that can still be subdivided is left to Gauss–Seidel: a smaller step is
-        // cheaper than the global stages of `auto`, which run at the largest subdivision.
-        let method = world.params.solver.method;
-        if backup.is_some() && method == SolverMethod::Auto {
+        // cheaper than the global stages of `auto`, which run at the largest subdivision. Its
+        // polish is solved the same way.
+        if level < max && gauss_seidel_attempts && method == SolverMethod::Auto {
             world.params.solver.method = SolverMethod::Nlgs;
+        }
+        if polishing {
+            world.params.solver.tolerance = tolerance * POLISH_FACTOR;
         }
         let mut subs = Vec::with_capacity(n);
         let mut failed = false;
@@ -177,9 +224,12 @@ pub fn step_subdivided(
             let probe = EnergyProbe::before(world);
             let report = match world.step() {
                 Ok(r) => r,
-                Err(e) if backup.is_none() => {
-                    world.params.dt = h;
-                    world.params.solver.method = method;
+                Err(_) if polishing => {
+                    failed = true;
+                    break;
+                }
+                Err(e) if !can_halve => {
+                    restore(world);
                     return Err(e);
                 }
                 // A non-finite state in an attempt that can still be halved: a smaller step
@@ -195,37 +245,92 @@ pub fn step_subdivided(
                 report,
                 energy_residual,
             });
-            if !converged && backup.is_some() {
+            if !converged && (can_halve || polishing) {
                 failed = true;
                 break;
             }
         }
-        if let (true, Some(b)) = (failed, backup.as_ref()) {
-            discarded += subs
-                .iter()
-                .map(|s| s.report.solver.iterations)
-                .sum::<usize>();
-            world.clone_from(b);
+        let sweeps =
+            |subs: &[SubStep]| -> usize { subs.iter().map(|s| s.report.solver.iterations).sum() };
+        if let Some((first_world, first_subs)) = first.take() {
+            // The polish: kept if every sub-step converged at the tighter tolerance.
+            let kept = !failed;
+            if kept {
+                discarded += sweeps(&first_subs);
+                // The back-off of `auto` continues from the first solve, as if the step had
+                // been solved once at the run's tolerance (a tolerance change resets it).
+                world.work.backoff = first_world.work.backoff;
+            } else {
+                discarded += sweeps(&subs);
+                world.clone_from(&first_world);
+                subs = first_subs;
+            }
+            restore(world);
+            return Ok(finish(
+                state,
+                subs,
+                start,
+                level,
+                retries + 1,
+                discarded,
+                paused,
+                configured,
+                kept,
+            ));
+        }
+        if failed && can_halve {
+            discarded += sweeps(&subs);
+            if let Some(b) = backup.as_ref() {
+                world.clone_from(b);
+            }
             retries += 1;
             level += 1;
             continue;
         }
-        world.params.dt = h;
-        world.params.solver.method = method;
         let all_converged = subs.iter().all(|s| s.report.solver.converged);
-        if !paused && configured > 0 {
-            update_subdivision(state, start, level, all_converged);
+        let residual: f64 = subs.iter().map(|s| s.energy_residual).sum();
+        if let (Some(limit), true, Some(b)) = (energy_limit, all_converged, backup.as_ref()) {
+            if residual > limit {
+                // Energy grew in a converged step: solve it again, tighter (doc comment).
+                first = Some((world.clone(), subs));
+                world.clone_from(b);
+                continue;
+            }
         }
-        let mut report = merge_reports(subs.iter().map(|s| &s.report));
-        report.solver.iterations += discarded;
-        return Ok(SubdividedStep {
-            report,
-            substeps: subs,
-            halvings: level,
-            retries,
-            discarded_sweeps: discarded,
-            paused,
-        });
+        restore(world);
+        return Ok(finish(
+            state, subs, start, level, retries, discarded, paused, configured, false,
+        ));
+    }
+}
+
+/// The kept sub-steps as a [`SubdividedStep`], the level rule applied.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    state: &mut Subdivision,
+    subs: Vec<SubStep>,
+    start: u32,
+    level: u32,
+    retries: u32,
+    discarded: usize,
+    paused: bool,
+    configured: u32,
+    polished: bool,
+) -> SubdividedStep {
+    let all_converged = subs.iter().all(|s| s.report.solver.converged);
+    if !paused && configured > 0 {
+        update_subdivision(state, start, level, all_converged);
+    }
+    let mut report = merge_reports(subs.iter().map(|s| &s.report));
+    report.solver.iterations += discarded;
+    SubdividedStep {
+        report,
+        substeps: subs,
+        halvings: level,
+        retries,
+        discarded_sweeps: discarded,
+        paused,
+        polished,
     }
 }
 

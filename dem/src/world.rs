@@ -171,7 +171,7 @@ pub struct World {
     layout: BlockLayout,
     colouring: ContactColouring,
     v_free: Vec<[f64; 3]>,
-    work: solver::SolverWork,
+    pub(crate) work: solver::SolverWork,
     displacement: Vec<[f64; 3]>,
     projection: Projection,
     /// Contacts detected again after a step whose disks outran their swept margins.

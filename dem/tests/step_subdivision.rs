@@ -5,7 +5,9 @@
 mod common;
 
 use common::{fingerprint, random_box};
-use dem::step_control::{step_subdivided, Subdivision, CALM_STEPS, FAILURES_BEFORE_BACKOFF};
+use dem::step_control::{
+    step_subdivided, step_subdivided_checked, Subdivision, CALM_STEPS, FAILURES_BEFORE_BACKOFF,
+};
 use dem::{ContactLaws, World, WorldParams};
 use nalgebra::Vector2;
 
@@ -158,4 +160,78 @@ fn subdivision_pauses_when_it_does_not_help() {
         levels.push(step_subdivided(&mut w, &mut state).unwrap().halvings);
     }
     assert_eq!(levels, [1, 1, 1, 1, 0, 1]);
+}
+
+/// The whole state as a checkpoint stores it (contact sets, warm starts, back-off, counters).
+fn state_json(w: &World) -> String {
+    serde_json::to_string(&w.state()).unwrap()
+}
+
+/// The energy check of `step_subdivided_checked` (Gauss–Seidel, so that the solves are
+/// comparable bit for bit). A limit no residual exceeds (+∞) leaves the step as
+/// `step_subdivided` does, bit for bit. A limit every residual exceeds (−∞) makes each
+/// converged step be solved again at a tenth of the tolerance: the step kept is then, bit for
+/// bit, the step solved at that tolerance from the same start (the first solve left no trace),
+/// its error within 10⁻⁷, the first solve's sweeps counted as discarded. A polish that cannot
+/// converge (its sweep cap is the first solve's count) is dropped: the state is the first
+/// solve's, with the step, the method and the tolerance as they were.
+#[test]
+fn energy_check_polishes_a_converged_step_at_a_tenth_of_the_tolerance() {
+    let mut base = settled_box();
+    base.params.solver.method = dem::solver::SolverMethod::Nlgs;
+    base.params.solver.tolerance = 1e-6;
+    base.params.solver.max_iterations = 20_000;
+    base.params.solver.max_halvings = 2;
+    let h = base.params.dt;
+
+    let mut a = base.clone();
+    let mut b = base.clone();
+    let (mut sa, mut sb) = (Subdivision::default(), Subdivision::default());
+    for _ in 0..3 {
+        let x = step_subdivided(&mut a, &mut sa).unwrap();
+        let y = step_subdivided_checked(&mut b, &mut sb, Some(f64::INFINITY)).unwrap();
+        assert_eq!(x, y);
+        assert!(!y.polished);
+    }
+    assert_eq!(state_json(&a), state_json(&b));
+
+    // Kept polish.
+    let mut p = base.clone();
+    let mut tight = base.clone();
+    tight.params.solver.tolerance = 1e-7;
+    let mut first = base.clone();
+    let mut state = Subdivision::default();
+    let s = step_subdivided_checked(&mut p, &mut state, Some(f64::NEG_INFINITY)).unwrap();
+    assert!(s.polished, "the tighter solve should converge here");
+    assert!(s.report.solver.converged);
+    assert!(s.report.solver.error <= 1e-7, "{}", s.report.solver.error);
+    assert_eq!(p.params.solver.tolerance, 1e-6, "the tolerance is restored");
+    let t = step_subdivided(&mut tight, &mut Subdivision::default()).unwrap();
+    assert_eq!(t.halvings, s.halvings);
+    tight.params.solver.tolerance = 1e-6;
+    assert_eq!(state_json(&p), state_json(&tight));
+    let f = step_subdivided(&mut first, &mut Subdivision::default()).unwrap();
+    assert_eq!(s.discarded_sweeps, f.report.solver.iterations);
+    assert_eq!(s.retries, 1);
+
+    // Dropped polish: the cap allows the first solve's sweeps only, short of 10⁻⁷.
+    let sweeps = f.report.solver.iterations;
+    assert!(sweeps > 0);
+    let mut q = base.clone();
+    q.params.solver.max_iterations = sweeps;
+    q.params.solver.max_halvings = 0;
+    let mut plain = q.clone();
+    let d = step_subdivided_checked(&mut q, &mut Subdivision::default(), Some(f64::NEG_INFINITY))
+        .unwrap();
+    let e = step_subdivided(&mut plain, &mut Subdivision::default()).unwrap();
+    assert!(e.report.solver.converged && e.report.solver.error > 1e-7);
+    assert!(!d.polished);
+    assert_eq!(d.substeps, e.substeps);
+    assert_eq!((q.params.dt, q.params.solver.tolerance), (h, 1e-6));
+    assert_eq!(q.params.solver.method, dem::solver::SolverMethod::Nlgs);
+    assert_eq!(state_json(&q), state_json(&plain));
+    assert_eq!(
+        d.discarded_sweeps, sweeps,
+        "the dropped polish ran to its cap"
+    );
 }

@@ -174,7 +174,8 @@ pub fn phase_warnings(
 /// converge, `dem::step_control::step_subdivided`), `solver_substeps` (sub-steps kept),
 /// `solver_max_halvings_used`, `solver_discarded_sweeps` (sweeps of the undone attempts,
 /// included in the mean) and `solver_paused_steps` (steps done whole while the subdivision
-/// paused after repeated failures at its largest level). A first step is the world's step index, `null` when there is none.
+/// paused after repeated failures at its largest level), `solver_polished_steps` (converged
+/// steps whose energy grew, solved again at a tenth of the tolerance). A first step is the world's step index, `null` when there is none.
 pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
     let step = |v: Option<u64>| v.map_or(serde_json::Value::Null, serde_json::Value::from);
     s.int("solver_steps", stats.steps)
@@ -212,7 +213,8 @@ pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
             u64::from(stats.max_halvings_used),
         )
         .int("solver_discarded_sweeps", stats.discarded_sweeps)
-        .int("solver_paused_steps", stats.paused_steps);
+        .int("solver_paused_steps", stats.paused_steps)
+        .int("solver_polished_steps", stats.polished_steps);
 }
 
 /// VTK frames every `interval` seconds of simulated time, at most `max_frames` (the final

@@ -243,6 +243,12 @@ struct ColumnState {
     /// Numerics of the measured step (the last step of the relaxation without release).
     #[serde(default)]
     measured: WindowStats,
+    /// World step index after the last step (the world counts sub-steps).
+    #[serde(default)]
+    last_step_index: u64,
+    /// Sub-steps of the measured step (1 unless it was subdivided).
+    #[serde(default)]
+    measured_substeps: u64,
 }
 
 impl Column<'_> {
@@ -323,6 +329,10 @@ impl PhasedRun for Column<'_> {
                     max_iterations: c.analysis.final_max_iterations,
                     method: c.relax.solver.method,
                     lemke_max_contacts: c.relax.solver.lemke_max_contacts,
+                    max_halvings: c.release.solver.max_halvings,
+                    // The whole step is tried with the method asked for (`auto`: Newton and
+                    // the exact finish after the sweeps), sub-steps only if that fails.
+                    gauss_seidel_attempts: false,
                     ..Default::default()
                 };
                 info(
@@ -357,6 +367,10 @@ impl PhasedRun for Column<'_> {
             st.measured.restart();
         }
         st.measured.step(measured, w, r, &p.stats);
+        if measured {
+            st.measured_substeps = r.step.saturating_sub(st.last_step_index);
+        }
+        st.last_step_index = r.step;
         let load = Self::floor_load(w, st);
         st.history.push(vec![
             w.time,
@@ -443,6 +457,8 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             deposit_load: f64::NAN,
             relaxed_load: f64::NAN,
             measured: WindowStats::default(),
+            last_step_index: 0,
+            measured_substeps: 0,
         };
         Ok((col.world, state))
     };
@@ -461,6 +477,8 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         deposit_load,
         relaxed_load,
         measured,
+        measured_substeps,
+        ..
     } = st;
     let final_report = world.last_report();
     if !final_report.solver.converged {
@@ -658,7 +676,8 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .num("final_kinetic_energy_ratio", relax.final_energy_ratio)
         .num("final_solver_error", final_report.solver.error)
         .int("final_solver_sweeps", final_report.solver.iterations as u64)
-        .flag("final_solver_converged", final_report.solver.converged);
+        .flag("final_solver_converged", final_report.solver.converged)
+        .int("final_step_substeps", measured_substeps);
     measured.keys(&mut s, "measured");
     s.int("vtk_frames", frames as u64);
 
