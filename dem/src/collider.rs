@@ -44,7 +44,8 @@ pub struct Collider {
 /// Rotation of `v` by `angle` (rad).
 #[inline]
 pub fn rotate(v: Vector2<f64>, angle: f64) -> Vector2<f64> {
-    if angle == 0.0 {
+    // A disk centred on its body (the common case) has a zero offset: no sin/cos per pair.
+    if angle == 0.0 || (v.x == 0.0 && v.y == 0.0) {
         return v;
     }
     let (s, c) = angle.sin_cos();

@@ -5,7 +5,7 @@ import sys
 
 import grainlaw
 
-grains = int(sys.argv[1]) if len(sys.argv) > 1 else 150
+grains = int(sys.argv[1]) if len(sys.argv) > 1 else 140
 result = grainlaw.run("janssen", overrides={"grains": grains})  # GIL released while it runs
 summary, profile = result["summary"], result["tables"]["wall_profile"]
 setup = result["constants"]["wall_profile"]  # width_m, bulk_density_kg_m3, wall_friction, ...

@@ -19,7 +19,7 @@ def run_example(name, cwd, *args):
 
 
 def test_janssen_pipeline_refits_the_runs_own_k(tmp_path):
-    out = run_example("janssen_pipeline.py", tmp_path, "120")
+    out = run_example("janssen_pipeline.py", tmp_path, "140")
     m = re.search(r"K\s+= (\d+\.\d+)\s+\(95 % CI (\d+\.\d+) … (\d+\.\d+)\); the run's own fit: (\d+\.\d+)", out)
     assert m, out
     k, lo, hi, run_k = (float(x) for x in m.groups())

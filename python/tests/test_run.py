@@ -16,7 +16,7 @@ import pytest
 import grainlaw
 
 # A small Janssen column: a few seconds per run.
-SMALL = {"grains": 120, "relax.max_time": 0.3, "release.floor_drop": 1e-4}
+SMALL = {"grains": 140, "relax.max_time": 0.3, "release.floor_drop": 1e-4}
 
 
 def cli_binary():
