@@ -594,9 +594,19 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             s.text("janssen_fit_mode", o.mode)
                 .flag("janssen_fit_uses_tau_w", o.uses_tau_w);
             if !o.uses_tau_w {
-                warn(
-                    "τ_w < 0 in a depth bin of the fit window: Janssen fitted to σ_v and σ_h only",
-                );
+                // Which bins, so the user can judge (a few wall contacts per bin in a narrow
+                // column: one slipping grain can turn a bin's mean).
+                let bins: Vec<String> = profile
+                    .z
+                    .iter()
+                    .zip(&profile.tau_w)
+                    .filter(|(z, t)| **z >= window.0 && **z <= window.1 && **t < 0.0)
+                    .map(|(z, t)| format!("{t:.0} Pa at z = {:.1} mm", z * 1e3))
+                    .collect();
+                warn(&format!(
+                    "τ_w < 0 in the fit window ({}): Janssen fitted to σ_v and σ_h only",
+                    bins.join(", ")
+                ));
             }
             let law = CalibratedLaw::from_janssen(
                 f,
