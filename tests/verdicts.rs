@@ -164,6 +164,20 @@ fn cases() -> Vec<Case> {
             absent: &["janssen_law.rejected.json"],
         },
         Case {
+            // The floor withdrawn at 0.1 m/s, faster than the column can follow it (a grain
+            // falls g h = 9.8 mm/s per step): the measured column is in free fall, nothing
+            // carries its weight, so the force balance refuses it (measured: −100 %).
+            name: "a column in free fall at the measured step: force balance refused, exit 3",
+            dir: "falling",
+            args: with(&["--set", "release.speed=0.1"]),
+            code: 3,
+            stderr: "janssen.force_balance (refused)",
+            verdict: Some("refused"),
+            reasons: &[("janssen.force_balance", "refused")],
+            laws: &[],
+            absent: &["janssen_law.json"],
+        },
+        Case {
             name: "shear cell whose highest target I is not reached: suspect, exit 3",
             dir: "shear",
             args: vec![

@@ -41,7 +41,7 @@
 //! mechanical energy of a phase therefore changes by `Σ (δ + W_drive) + position_correction_energy`.
 
 pub use dem::energy::{load_energy_scale, EnergyProbe};
-use dem::step_control::{step_subdivided_checked, Subdivision};
+use dem::step_control::{step_subdivided_checked, SubdividedStep, Subdivision};
 use dem::{BodyKind, StepReport, World};
 use serde::{Deserialize, Serialize};
 
@@ -143,16 +143,17 @@ fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
 }
 
 impl PhaseStats {
-    /// Accounts for one step's subdivision (`halvings` of the kept sub-steps, `discarded`
-    /// sweeps of the attempts undone); [`PhaseStats::record`] accounts for its solve.
-    pub fn record_subdivision(&mut self, halvings: u32, discarded: usize, paused: bool) {
-        self.substeps += 1u64 << halvings;
-        self.paused_steps += u64::from(paused);
-        if halvings > 0 {
+    /// Accounts for how one step was done (its sub-steps, the attempts undone, a pause, a
+    /// polish); [`PhaseStats::record`] accounts for its solve.
+    pub fn record_subdivision(&mut self, step: &SubdividedStep) {
+        self.substeps += step.substeps.len() as u64;
+        self.paused_steps += u64::from(step.paused);
+        self.polished_steps += u64::from(step.polished);
+        if step.halvings > 0 {
             self.subdivided_steps += 1;
         }
-        self.max_halvings_used = self.max_halvings_used.max(halvings);
-        self.discarded_sweeps += discarded as u64;
+        self.max_halvings_used = self.max_halvings_used.max(step.halvings);
+        self.discarded_sweeps += step.discarded_sweeps as u64;
     }
 
     /// Accounts for one step's solve and time.
@@ -351,12 +352,8 @@ fn accounted_step(
     )?;
     let r = step.report;
     progress.stats.record(&r, dt);
-    progress
-        .stats
-        .record_subdivision(step.halvings, step.discarded_sweeps, step.paused);
-    progress.stats.polished_steps += u64::from(step.polished);
-    // The energy balance is additive: the step's residual is the sum of its sub-steps'.
-    let growth = step.substeps.iter().map(|s| s.energy_residual).sum::<f64>() / e_load;
+    progress.stats.record_subdivision(&step);
+    let growth = step.energy_residual() / e_load;
     progress
         .stats
         .record_checks(&r, min_radius, growth.is_finite().then_some(growth));

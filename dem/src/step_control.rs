@@ -94,6 +94,11 @@ pub struct SubStep {
     pub energy_residual: f64,
 }
 
+/// The energy residual of consecutive sub-steps, `δ = Σ δ_k` (J): the balance is additive.
+pub fn energy_residual(substeps: &[SubStep]) -> f64 {
+    substeps.iter().map(|s| s.energy_residual).sum()
+}
+
 /// What [`step_subdivided`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SubdividedStep {
@@ -115,6 +120,13 @@ pub struct SubdividedStep {
     /// Solved again at [`POLISH_FACTOR`] times the tolerance because its energy grew beyond the
     /// limit of [`step_subdivided_checked`], and the tighter solve was kept.
     pub polished: bool,
+}
+
+impl SubdividedStep {
+    /// The step's energy residual ([`energy_residual`] of its kept sub-steps, J).
+    pub fn energy_residual(&self) -> f64 {
+        energy_residual(&self.substeps)
+    }
 }
 
 /// Advances `world` by its time step `h = world.params.dt` in `2^L` equal sub-steps, `L`
@@ -198,7 +210,8 @@ pub fn step_subdivided_checked(
         world.params.solver.method = method;
         world.params.solver.tolerance = tolerance;
     };
-    loop {
+    // The kept sub-steps, and whether they are a polish.
+    let (subs, polished) = loop {
         let polishing = first.is_some();
         let can_halve = level < max && !polishing;
         if can_halve || (energy_limit.is_some() && !polishing) {
@@ -265,18 +278,8 @@ pub fn step_subdivided_checked(
                 world.clone_from(&first_world);
                 subs = first_subs;
             }
-            restore(world);
-            return Ok(finish(
-                state,
-                subs,
-                start,
-                level,
-                retries + 1,
-                discarded,
-                paused,
-                configured,
-                kept,
-            ));
+            retries += 1;
+            break (subs, kept);
         }
         if failed && can_halve {
             discarded += sweeps(&subs);
@@ -288,42 +291,24 @@ pub fn step_subdivided_checked(
             continue;
         }
         let all_converged = subs.iter().all(|s| s.report.solver.converged);
-        let residual: f64 = subs.iter().map(|s| s.energy_residual).sum();
         if let (Some(limit), true, Some(b)) = (energy_limit, all_converged, backup.as_ref()) {
-            if residual > limit {
+            if energy_residual(&subs) > limit {
                 // Energy grew in a converged step: solve it again, tighter (doc comment).
                 first = Some((world.clone(), subs));
                 world.clone_from(b);
                 continue;
             }
         }
-        restore(world);
-        return Ok(finish(
-            state, subs, start, level, retries, discarded, paused, configured, false,
-        ));
-    }
-}
-
-/// The kept sub-steps as a [`SubdividedStep`], the level rule applied.
-#[allow(clippy::too_many_arguments)]
-fn finish(
-    state: &mut Subdivision,
-    subs: Vec<SubStep>,
-    start: u32,
-    level: u32,
-    retries: u32,
-    discarded: usize,
-    paused: bool,
-    configured: u32,
-    polished: bool,
-) -> SubdividedStep {
+        break (subs, false);
+    };
+    restore(world);
     let all_converged = subs.iter().all(|s| s.report.solver.converged);
     if !paused && configured > 0 {
         update_subdivision(state, start, level, all_converged);
     }
     let mut report = merge_reports(subs.iter().map(|s| &s.report));
     report.solver.iterations += discarded;
-    SubdividedStep {
+    Ok(SubdividedStep {
         report,
         substeps: subs,
         halvings: level,
@@ -331,7 +316,7 @@ fn finish(
         discarded_sweeps: discarded,
         paused,
         polished,
-    }
+    })
 }
 
 /// The level rule of [`step_subdivided`] after a step that started at `start` halvings and was
