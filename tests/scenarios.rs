@@ -8,6 +8,12 @@ use serde_json::Value;
 
 /// Runs `grainlaw run SCENARIO --out DIR --quiet --set ...` in `cwd`; panics with stderr on failure.
 fn run(scenario: &str, sets: &[&str], cwd: &Path) -> (PathBuf, Value) {
+    let (out, s, _) = run_with_stderr(scenario, sets, cwd);
+    (out, s)
+}
+
+/// [`run`], with what the run wrote on stderr (its `warning:` lines, `--quiet` keeps them).
+fn run_with_stderr(scenario: &str, sets: &[&str], cwd: &Path) -> (PathBuf, Value, String) {
     let out = cwd.join(scenario);
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_grainlaw"));
     cmd.current_dir(cwd)
@@ -36,7 +42,7 @@ fn run(scenario: &str, sets: &[&str], cwd: &Path) -> (PathBuf, Value) {
         o.status.code(),
         s["verdict"]
     );
-    (out, s)
+    (out, s, stderr.into_owned())
 }
 
 /// `grainlaw fit LAW FILE --out law.json` on a CSV a scenario wrote (as the scenario tells the
@@ -118,7 +124,11 @@ fn has_files(dir: &Path, names: &[&str]) {
 #[test]
 fn janssen_column() {
     let dir = tempfile::tempdir().unwrap();
-    let (out, s) = run("janssen", &[], dir.path());
+    let (out, s, stderr) = run_with_stderr("janssen", &[], dir.path());
+    // The main job: verdict ok, no warning, the measured step converged to 1e-6.
+    assert_eq!(s["verdict"], "ok");
+    assert!(stderr.trim().is_empty(), "warnings: {stderr}");
+    assert!(num(&s, "final_solver_error") <= 1e-6);
     has_files(
         &out,
         &[
@@ -228,12 +238,37 @@ fn janssen_measured_step_is_redone_in_sub_steps_when_capped() {
         ],
         dir.path(),
     );
-    assert!(num(&s, "final_step_substeps") >= 2.0);
+    assert!(num(&s, "measured_max_substeps") >= 2.0);
     assert!(num(&s, "final_solver_sweeps") <= 60.0);
     assert_eq!(s["final_solver_converged"], true);
     assert!(num(&s, "final_solver_error") <= 1e-6);
     assert_eq!(num(&s, "measured_unconverged_steps"), 1.0);
     assert_ne!(s["verdict"], "ok");
+}
+
+/// The measurement window averages its steps. A 60-grain column measured at rest (no release)
+/// over 4 steps counts 4 converged samples, and its window-averaged floor and wall loads carry
+/// the weight to 10⁻³: over a window, Σ impulses = weight × duration + change of the grains'
+/// momentum, and a column at rest does not change its momentum.
+#[test]
+fn janssen_measurement_window_of_a_column_at_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, s) = run(
+        "janssen",
+        &[
+            "grains=60",
+            "release.floor_drop=0",
+            "analysis.measure_steps=4",
+        ],
+        dir.path(),
+    );
+    assert_eq!(num(&s, "measure_steps"), 4.0);
+    assert_eq!(num(&s, "measured_steps"), 4.0);
+    assert_eq!(num(&s, "measured_unconverged_steps"), 0.0);
+    assert!(num(&s, "measured_worst_error") <= 1e-6);
+    let balance = num(&s, "force_balance_residual");
+    assert!(balance.abs() <= 1e-3, "force balance {balance}");
+    assert!(num(&s, "wall_contacts") > 0.0);
 }
 
 /// The rolling disk: acceleration (2/3) g sin φ, the mean stress with inertia equal to the

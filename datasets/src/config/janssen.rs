@@ -64,8 +64,20 @@ pub struct JanssenAnalysis {
     pub skip_bottom_diameters: f64,
     /// Largest number of VTK frames (one every 0.02 s of simulated time; the final state always).
     pub vtk_frames: usize,
-    /// Sweep cap of the measured step (solved to `relax.solver.tolerance`).
+    /// Sweep cap of each measured step (solved to `relax.solver.tolerance`).
     pub final_max_iterations: usize,
+    /// Steps of the measurement window that ends the release (the floor still sinking), each
+    /// solved to `relax.solver.tolerance`; the stresses, loads and mobilisations are averaged
+    /// over them. Absent from older scenario files: [`DEFAULT_MEASURE_STEPS`].
+    #[serde(default = "default_measure_steps")]
+    pub measure_steps: usize,
+}
+
+/// Default length of the measurement window (steps).
+pub const DEFAULT_MEASURE_STEPS: usize = 1;
+
+fn default_measure_steps() -> usize {
+    DEFAULT_MEASURE_STEPS
 }
 
 impl JanssenConfig {
@@ -87,6 +99,12 @@ impl JanssenConfig {
             "analysis.final_max_iterations",
             self.analysis.final_max_iterations,
             1,
+        )?;
+        at_least("analysis.measure_steps", self.analysis.measure_steps, 1)?;
+        limits::at_most(
+            "analysis.measure_steps",
+            self.analysis.measure_steps,
+            limits::MAX_STEPS as usize,
         )?;
         if self.release.floor_drop > 10.0 * self.grain.radius_mean {
             return Err(DatasetError::invalid(
