@@ -44,7 +44,7 @@ use crate::scenarios::common::Stop;
 /// v4: a converged step whose energy grew is solved again at a tenth of the tolerance
 /// (`dem::step_control::step_subdivided_checked`), judged on the phase's load energy scale
 /// stored in its progress; a v3 run did not, so a v3 checkpoint is refused (run again).
-pub const FORMAT: &str = "grainlaw-run-checkpoint-v4";
+pub const FORMAT: &str = "grainlaw-run-checkpoint-v5";
 
 /// Buffer between the gzip stream and the JSON deserialiser (bytes).
 const BUFFER: usize = 1 << 20;

@@ -578,6 +578,48 @@ fn shear_cell_short() {
     assert!(rows[4][2] > rows[0][2], "μ should grow with I");
     assert!(rows[4][3] < rows[0][3], "φ should fall with I");
     assert!(num(&s, "runs") == 5.0);
+    // The wall velocity of each run (2 corrections by default): each factor follows the
+    // control law from the bulk I its stage measured (1 within a factor 1.5 of the target,
+    // else √(I_target/I) bounded to [1/2, 2]), and the run's V over the uniform-shear estimate
+    // (rheology.csv) is their product (1e-12 relative).
+    let lead = std::fs::read_to_string(out.join("lead_stages.csv")).unwrap();
+    let lead: Vec<Vec<f64>> = lead
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|c| c.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    assert_eq!(lead.len(), 10, "two corrections for each of 5 runs");
+    let over_uniform = 14; // rheology.csv column wall_velocity_over_uniform
+    for r in &rows {
+        let mine: Vec<&Vec<f64>> = lead.iter().filter(|l| l[0] == r[0]).collect();
+        assert_eq!(mine.len(), 2);
+        let mut product = 1.0;
+        for l in mine {
+            let miss = l[0] / l[2];
+            let expect = if l[2].is_nan() || l[2] <= 0.0 || (1.0 / 1.5..=1.5).contains(&miss) {
+                1.0
+            } else {
+                miss.sqrt().clamp(0.5, 2.0)
+            };
+            assert!(
+                (l[3] - expect).abs() <= 1e-12,
+                "factor {} vs {expect}",
+                l[3]
+            );
+            product *= l[3];
+            assert!((l[4] - product).abs() <= 1e-12 * product);
+        }
+        assert!(
+            (r[over_uniform] - product).abs() <= 1e-12 * product,
+            "V/uniform {} vs {product}",
+            r[over_uniform]
+        );
+    }
 }
 
 /// Dense slow shear between rough walls (I = 0.005–0.02), where Gauss–Seidel alone leaves
@@ -587,7 +629,7 @@ fn shear_cell_short() {
 #[test]
 fn shear_cell_slow_shear_converges() {
     let dir = tempfile::tempdir().unwrap();
-    let (_, s) = run(
+    let (out, s) = run(
         "shear-cell",
         &[
             "grains=120",
@@ -595,6 +637,7 @@ fn shear_cell_slow_shear_converges() {
             "inertial_numbers=[0.005, 0.01, 0.02]",
             "strain=0.3",
             "average_strain=0.15",
+            "velocity_corrections=0",
         ],
         dir.path(),
     );
@@ -607,6 +650,8 @@ fn shear_cell_slow_shear_converges() {
     );
     assert!(num(&s, "solver_subdivided_steps") > 0.0);
     assert!(num(&s, "max_penetration_over_radius") <= 1e-3);
+    // Without corrections the wall keeps its uniform-shear velocity.
+    assert!(!out.join("lead_stages.csv").exists());
 }
 
 /// `grainlaw run rolling` without `--out` writes into `grainlaw-out/rolling`, and the same seed

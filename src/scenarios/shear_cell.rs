@@ -11,6 +11,7 @@
 //! best of three forms by AIC).
 
 use datasets::config::ShearCellConfig;
+use dem::snapshot::Snapshot;
 use homogenise::kinematics::{velocity_gradient, VelocityWeight};
 use homogenise::state::solid_fraction;
 use homogenise::walls::{near_wall_profile, NearWallSpec};
@@ -36,7 +37,7 @@ use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::progress::warn;
+use crate::progress::{info, warn};
 use crate::verdict::{export_law, max_solid_fraction, Checks, RunVerdict, Verdict, WindowStats};
 
 /// Averages of one run (sums of finite samples).
@@ -190,15 +191,41 @@ pub const STEADY_MU_TOLERANCE: f64 = 0.02;
 /// Difference of the window halves of φ that matters (absolute).
 pub const STEADY_PHI_TOLERANCE: f64 = 0.005;
 
-/// The phases: compression at zero shear, then one steady shear run per inertial number
-/// (lowest first, each from the previous steady state).
+/// Bounds of one correction of the wall velocity,
+/// `V ← V · clamp(√(I_target / I_measured), 1/2, 2)`: half the miss in log scale, because the
+/// bulk answers a change of V with a lag of a strain of order one (a run starts from the
+/// previous run's flow) and a shear localised at a slipping wall answers less than in
+/// proportion; a full correction overshot (I = 0.2: V raised 2.5 times from a lagging
+/// measurement, then the top wall slid at 4 m/s over the grains).
+pub const VELOCITY_CORRECTION_BOUNDS: (f64, f64) = (0.5, 2.0);
+
+/// A lead stage whose bulk I is within this factor of the target leaves V alone: the bulk I of
+/// half a stage is a noisy measurement (a small cell shears intermittently), and correcting
+/// within the noise drove the runs of a 120-grain cell away from their targets (I = 0.01
+/// ended at 0.015, I = 0.04 at 0.024); the misses the correction is for are systematic and
+/// larger (the default cell at I = 0.02: 2.3 times). Below the suspect limit
+/// [`I_FACTOR_SUSPECT`].
+pub const VELOCITY_DEAD_BAND: f64 = 1.5;
+
+/// The phases: compression at zero shear, then per inertial number (lowest first, each from the
+/// previous steady state) the lead stages, after each but the last of which the wall velocity
+/// is corrected towards the target, and the averaged stage.
 struct Shear<'a> {
     c: &'a ShearCellConfig,
     /// Target inertial numbers, sorted.
     targets: Vec<f64>,
 }
 
-/// The plan of the current shear run, fixed when it starts.
+/// The bulk inertial number measured over the second half of a lead stage (sums).
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+struct LeadAverages {
+    /// Σ γ̇ (1/s) and Σ P (Pa) of the bulk.
+    gamma_dot: f64,
+    pressure: f64,
+    samples: u64,
+}
+
+/// The plan of the current stage of a shear run, fixed when the stage starts.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
 struct ShearRun {
     /// Wall velocity V (m/s), gap H (m), time step (s).
@@ -211,6 +238,9 @@ struct ShearRun {
     every: u64,
     /// Steps done.
     n: u64,
+    /// The uniform-shear estimate of V, `γ̇_target H`, at the run's start (m/s).
+    #[serde(default)]
+    v_uniform: f64,
 }
 
 /// A run's mean velocity profile: heights above the bottom wall (m) and mean velocity (m/s,
@@ -243,6 +273,71 @@ struct ShearState {
     /// One per finished run.
     #[serde(default)]
     checks: Vec<RunCheckData>,
+    /// The current lead stage's bulk measurement.
+    #[serde(default)]
+    lead: LeadAverages,
+    /// One row per wall-velocity correction: `lead_stages.csv`.
+    #[serde(default, with = "crate::floats::table")]
+    lead_rows: Vec<Vec<f64>>,
+}
+
+/// The correction of the wall velocity after a lead stage whose bulk measurement is `lead`:
+/// `(I_measured, factor)` with `I_measured = |⟨γ̇⟩| d / √(⟨P⟩/ρ)` and
+/// `factor = clamp(√(I_target / I_measured), 1/2, 2)` ([`VELOCITY_CORRECTION_BOUNDS`]), or 1
+/// when `I_measured` is within [`VELOCITY_DEAD_BAND`] of the target or was not measured (NaN).
+fn velocity_correction(i_target: f64, lead: &LeadAverages, d: f64, rho: f64) -> (f64, f64) {
+    if lead.samples == 0 {
+        return (f64::NAN, 1.0);
+    }
+    let m = lead.samples as f64;
+    let i_measured = (lead.gamma_dot / m).abs() * d / (lead.pressure / m / rho).sqrt();
+    let miss = i_target / i_measured;
+    if !(i_measured.is_finite() && i_measured > 0.0)
+        || (1.0 / VELOCITY_DEAD_BAND..=VELOCITY_DEAD_BAND).contains(&miss)
+    {
+        return (i_measured, 1.0);
+    }
+    let (lo, hi) = VELOCITY_CORRECTION_BOUNDS;
+    (i_measured, miss.sqrt().clamp(lo, hi))
+}
+
+/// Which part of which run phase `k ≥ 1` is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Stage {
+    /// Index of the target inertial number.
+    target: usize,
+    /// Lead stage `0 … corrections`, or `None` for the averaged stage.
+    lead: Option<usize>,
+}
+
+impl Shear<'_> {
+    /// Lead stages of a run (the strain before the averaged part; one when it is not
+    /// corrected).
+    fn lead_stages(&self) -> usize {
+        self.c.velocity_corrections + 1
+    }
+
+    /// Strain of lead stage `j`: with corrections, the correcting stages share the first half
+    /// of the lead and the last stage, which lets the flow settle at the final V before the
+    /// averaged part, the second half; without, one stage.
+    fn lead_strain(&self, j: usize) -> f64 {
+        let c = self.c;
+        let lead = c.strain - c.average_strain;
+        match c.velocity_corrections {
+            0 => lead,
+            n if j < n => 0.5 * lead / n as f64,
+            _ => 0.5 * lead,
+        }
+    }
+
+    fn stage(&self, k: usize) -> Stage {
+        let per_run = self.lead_stages() + 1;
+        let (target, j) = ((k - 1) / per_run, (k - 1) % per_run);
+        Stage {
+            target,
+            lead: (j < self.lead_stages()).then_some(j),
+        }
+    }
 }
 
 const TOP: usize = 1;
@@ -251,13 +346,13 @@ impl PhasedRun for Shear<'_> {
     type State = ShearState;
 
     fn phase_count(&self) -> usize {
-        1 + self.targets.len()
+        1 + self.targets.len() * (self.lead_stages() + 1)
     }
 
     fn enter(
         &self,
         k: usize,
-        _env: &PhaseEnv,
+        env: &PhaseEnv,
         world: &mut dem::World,
         st: &mut ShearState,
         _out: &mut OutputDir,
@@ -270,15 +365,52 @@ impl PhasedRun for Shear<'_> {
                 stop: Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
             }));
         }
-        let i_target = self.targets[k - 1];
+        let stage = self.stage(k);
+        let i_target = self.targets[stage.target];
         let r = c.grain.radius_mean;
         let d = mean_diameter(world);
         let h = world.bodies[TOP].position.y - 2.0 * r;
-        let gamma_target = i_target * (c.pressure / c.grain.density).sqrt() / d;
-        let v = gamma_target * h;
+        // V: the uniform-shear estimate γ̇ H at a run's start; then corrected after each lead
+        // stage but the last by the bulk I it measured (its second half).
+        let (v_uniform, mut v) = if stage.lead == Some(0) {
+            let gamma_target = i_target * (c.pressure / c.grain.density).sqrt() / d;
+            (gamma_target * h, gamma_target * h)
+        } else {
+            (st.run.v_uniform, st.run.v)
+        };
+        if let Some(j) = stage
+            .lead
+            .filter(|&j| j >= 1 && j <= c.velocity_corrections)
+        {
+            let (i_measured, factor) = velocity_correction(i_target, &st.lead, d, c.grain.density);
+            v *= factor;
+            st.lead_rows
+                .push(vec![i_target, j as f64, i_measured, factor, v / v_uniform]);
+            if factor != 1.0 {
+                info(
+                    env.verbosity,
+                    &format!(
+                        "      I={i_target}: bulk I = {i_measured:.3e} over the lead's stage, wall velocity × {factor:.2} ({:.2} × uniform shear)",
+                        v / v_uniform
+                    ),
+                );
+            }
+        }
         let dt = c.dt_max.min(c.travel_per_step * r / v);
-        let steps = (c.strain * h / (v * dt)).ceil() as u64;
-        let avg_steps = (c.average_strain * h / (v * dt)).ceil() as u64;
+        let (strain, name) = match stage.lead {
+            Some(j) => (
+                self.lead_strain(j),
+                format!("I={i_target} lead {}/{}", j + 1, self.lead_stages()),
+            ),
+            None => (c.average_strain, format!("I={i_target}")),
+        };
+        let steps = ((strain * h / (v * dt)).ceil() as u64).max(1);
+        // The averaged stage samples all its steps; a lead stage, its second half.
+        let avg_steps = if stage.lead.is_some() {
+            steps / 2
+        } else {
+            steps
+        };
         world.params.dt = dt;
         world.bodies[TOP].velocity.x = v;
         st.run = ShearRun {
@@ -289,11 +421,17 @@ impl PhasedRun for Shear<'_> {
             avg_steps,
             every: (avg_steps / 40).max(1),
             n: 0,
+            v_uniform: if stage.lead == Some(0) {
+                v_uniform
+            } else {
+                st.run.v_uniform
+            },
         };
         st.acc = RunAverages::default();
+        st.lead = LeadAverages::default();
         st.window.reset();
         Ok(Some(PhasePlan {
-            name: format!("I={i_target}"),
+            name,
             stop: Stop::Steps(steps),
         }))
     }
@@ -310,13 +448,21 @@ impl PhasedRun for Shear<'_> {
         if k == 0 {
             return Ok(());
         }
+        let averaged = self.stage(k).lead.is_none();
         let run = &mut st.run;
         run.n += 1;
-        st.window
-            .step(run.n + run.avg_steps > run.steps, w, r, &p.stats);
-        if run.n + run.avg_steps > run.steps && run.n.is_multiple_of(run.every) {
+        let in_window = run.n + run.avg_steps > run.steps;
+        st.window.step(averaged && in_window, w, r, &p.stats);
+        if in_window && run.n.is_multiple_of(run.every) {
             let d = mean_diameter(w);
-            sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
+            if averaged {
+                sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
+            } else {
+                let (gamma_dot, pressure) = bulk_shear(w, self.c.grain.radius_mean, d)?;
+                st.lead.gamma_dot += gamma_dot;
+                st.lead.pressure += pressure;
+                st.lead.samples += 1;
+            }
         }
         Ok(())
     }
@@ -330,13 +476,19 @@ impl PhasedRun for Shear<'_> {
         stats: &PhaseStats,
     ) -> Result<()> {
         st.all.merge(stats);
-        if k == 0 {
+        if k == 0 || self.stage(k).lead.is_some() {
             return Ok(());
         }
-        let i_target = self.targets[k - 1];
+        let i_target = self.targets[self.stage(k).target];
         let rho = self.c.grain.density;
         let d = mean_diameter(world);
-        let ShearRun { v, h, dt, .. } = st.run;
+        let ShearRun {
+            v,
+            h,
+            dt,
+            v_uniform,
+            ..
+        } = st.run;
         let acc = std::mem::take(&mut st.acc);
         let m = acc.samples.max(1) as f64;
         let (sxy, syy, phi, gd) = (acc.sxy / m, acc.syy / m, acc.phi / m, acc.gamma_dot / m);
@@ -372,6 +524,7 @@ impl PhasedRun for Shear<'_> {
             vt,
             mut_,
             acc.samples as f64,
+            v / v_uniform,
         ]);
         st.profiles.push(MeanProfile {
             i: i_meas,
@@ -403,6 +556,8 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             acc: RunAverages::default(),
             window: WindowStats::default(),
             checks: Vec::new(),
+            lead: LeadAverages::default(),
+            lead_rows: Vec::new(),
         };
         Ok((world, state))
     };
@@ -413,6 +568,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             rows,
             profiles,
             checks: run_checks,
+            lead_rows,
             ..
         },
     ) = drive(ctx, ctl, &shear, fresh)?;
@@ -452,6 +608,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         "slip_velocity_top_m_s",
         "mu_eff_top",
         "samples",
+        "wall_velocity_over_uniform",
         "point_verdict",
     ];
     let grain = GrainScale {
@@ -466,6 +623,20 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         "steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip",
         grain,
     )?;
+    if c.velocity_corrections > 0 {
+        let mut lead = CsvTable::new(&[
+            "I_target",
+            "lead_stage",
+            "I_measured",
+            "velocity_factor",
+            "wall_velocity_over_uniform",
+        ]);
+        lead.comments.push("wall-velocity corrections: bulk I over the second half of each correcting lead stage, the factor applied to V after it (1 within the dead band), and V over the uniform-shear estimate after it".into());
+        for r in lead_rows {
+            lead.push(r);
+        }
+        lead.write(&mut ctx.out, "lead_stages.csv")?;
+    }
 
     // Fits.
     let series = RheologySeries {
@@ -647,17 +818,38 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
 }
 
 /// Adds one sample of the bulk and wall quantities to `acc`.
-fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<()> {
-    let snap = w.snapshot();
-    let top_y = w.bodies[1].position.y;
+/// The bulk of the cell: the slice two diameters away from each wall.
+fn bulk_region(w: &dem::World, r: f64, d: f64) -> Region {
+    let top_y = w.bodies[TOP].position.y;
     let (lo, hi) = (r + 2.0 * d, top_y - r - 2.0 * d);
-    let region = Region::Slice {
+    Region::Slice {
         y_min: lo,
         y_max: hi.max(lo + d),
-    };
-    let gs = homogenise::grain_stresses(&snap)?;
-    let st = homogenise::mean_stress(&snap, &gs, &region)?;
-    let sym = (st.total + st.total.transpose()) * 0.5;
+    }
+}
+
+/// Symmetric mean stress of the bulk (Pa, tension positive, inertia included).
+fn bulk_stress(snap: &Snapshot, region: &Region) -> Result<nalgebra::Matrix2<f64>> {
+    let gs = homogenise::grain_stresses(snap)?;
+    let st = homogenise::mean_stress(snap, &gs, region)?;
+    Ok((st.total + st.total.transpose()) * 0.5)
+}
+
+/// The bulk shear rate `γ̇ = ∂v_x/∂y` (1/s, mass-weighted affine fit of the grain velocities)
+/// and pressure `P = −σ_yy` (Pa) of one state: what the wall-velocity correction measures.
+fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, f64)> {
+    let snap = w.snapshot();
+    let region = bulk_region(w, r, d);
+    let sym = bulk_stress(&snap, &region)?;
+    let g = velocity_gradient(&snap, &region, VelocityWeight::Mass)?.gradient[(0, 1)];
+    Ok((g, -sym[(1, 1)]))
+}
+
+fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<()> {
+    let snap = w.snapshot();
+    let top_y = w.bodies[TOP].position.y;
+    let region = bulk_region(w, r, d);
+    let sym = bulk_stress(&snap, &region)?;
     acc.sxy += sym[(0, 1)];
     acc.syy += sym[(1, 1)];
     let phi = solid_fraction(&snap, &region)?;
@@ -696,4 +888,49 @@ fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<()> {
     }
     acc.samples += 1;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bulk sums giving `I = i` for `d = 1`, `ρ = 1`, `P = 4` over `n` samples.
+    fn lead_at(i: f64, n: u64) -> LeadAverages {
+        LeadAverages {
+            gamma_dot: -(i * 2.0) * n as f64,
+            pressure: 4.0 * n as f64,
+            samples: n,
+        }
+    }
+
+    /// The control law: half the miss in log scale beyond the dead band, bounded, none within
+    /// it or without a measurement (exact to rounding).
+    #[test]
+    fn velocity_correction_law() {
+        let (i, f) = velocity_correction(0.02, &lead_at(0.008, 10), 1.0, 1.0);
+        assert!((i - 0.008).abs() < 1e-15);
+        assert!((f - 2.5f64.sqrt()).abs() < 1e-12, "{f}");
+        // Within the dead band: 0.02 / 0.015 = 1.33 < 1.5.
+        assert_eq!(
+            velocity_correction(0.02, &lead_at(0.015, 10), 1.0, 1.0).1,
+            1.0
+        );
+        assert_eq!(
+            velocity_correction(0.02, &lead_at(0.027, 10), 1.0, 1.0).1,
+            1.0
+        );
+        // Too fast: 0.02 / 0.05 = 0.4 → √0.4.
+        let f = velocity_correction(0.02, &lead_at(0.05, 3), 1.0, 1.0).1;
+        assert!((f - 0.4f64.sqrt()).abs() < 1e-12, "{f}");
+        // Bounded: a bulk 100 times too slow or too fast.
+        assert_eq!(
+            velocity_correction(0.02, &lead_at(0.0002, 3), 1.0, 1.0).1,
+            2.0
+        );
+        assert_eq!(velocity_correction(0.02, &lead_at(2.0, 3), 1.0, 1.0).1, 0.5);
+        // No sample, a bulk at rest: V unchanged (a jammed bulk says nothing of the V needed).
+        let (i, f) = velocity_correction(0.02, &LeadAverages::default(), 1.0, 1.0);
+        assert!(i.is_nan() && f == 1.0);
+        assert_eq!(velocity_correction(0.02, &lead_at(0.0, 3), 1.0, 1.0).1, 1.0);
+    }
 }

@@ -33,6 +33,15 @@ pub struct ShearCellConfig {
     pub strain: f64,
     /// The last `average_strain` of each run is averaged.
     pub average_strain: f64,
+    /// Corrections of the wall velocity in the lead of each run (the strain before the
+    /// averaged part), so that the bulk reaches its target inertial number although the shear
+    /// localises and slips at the walls: the correcting stages share the first half of the lead;
+    /// after each, V is multiplied by `√(I_target / I_measured)` with the bulk I measured over
+    /// the stage's second half (bounded to [1/2, 2]; none within a factor 1.5 of the target);
+    /// the second half of the lead settles the flow at the final V. 0: V stays at its
+    /// uniform-shear estimate. Absent from older files: 2.
+    #[serde(default = "default_velocity_corrections")]
+    pub velocity_corrections: usize,
     /// Largest time step (s).
     pub dt_max: f64,
     /// Largest travel of the top wall per step, as a fraction of the mean radius (sets dt).
@@ -44,6 +53,16 @@ pub struct ShearCellConfig {
     /// Contact solver.
     pub solver: SolverSpec,
 }
+
+/// Default of [`ShearCellConfig::velocity_corrections`].
+pub const DEFAULT_VELOCITY_CORRECTIONS: usize = 2;
+
+fn default_velocity_corrections() -> usize {
+    DEFAULT_VELOCITY_CORRECTIONS
+}
+
+/// Largest number of wall-velocity corrections a run.
+pub const MAX_VELOCITY_CORRECTIONS: usize = 4;
 
 impl ShearCellConfig {
     /// Checks every value (key named in the error), and that no phase takes more than
@@ -83,6 +102,22 @@ impl ShearCellConfig {
                     "must not exceed strain ({}), got {}",
                     num(self.strain),
                     num(self.average_strain)
+                ),
+            ));
+        }
+        limits::at_most(
+            "velocity_corrections",
+            self.velocity_corrections,
+            MAX_VELOCITY_CORRECTIONS,
+        )?;
+        if self.velocity_corrections > 0 && self.average_strain >= self.strain {
+            return Err(DatasetError::invalid(
+                "velocity_corrections",
+                format!(
+                    "needs a lead before the averaged strain to correct the wall velocity in: \
+                     average_strain ({}) must be below strain ({}), or set 0",
+                    num(self.average_strain),
+                    num(self.strain)
                 ),
             ));
         }
