@@ -497,6 +497,20 @@ impl World {
         })
     }
 
+    /// Take the disk pairs of every detection from the cell grid (`true`) instead of from the
+    /// candidate list kept between detections (`false`, the default;
+    /// [`crate::detection::Detector::detect`]). The contacts, hence the whole run, are the same
+    /// bit for bit either way; only the time differs.
+    pub fn set_full_detection(&mut self, full: bool) {
+        self.detector.set_full_detection(full);
+    }
+
+    /// Detections and builds of their candidate list since this world was made (or restored
+    /// from a state): the list was reused by the detections that did not build it.
+    pub fn candidate_counts(&self) -> crate::detection::CandidateCounts {
+        self.detector.candidate_counts()
+    }
+
     /// Contacts of the last step.
     pub fn contacts(&self) -> &ContactSet {
         &self.contacts
