@@ -186,6 +186,66 @@ impl Detector {
         out: &mut ContactSet,
     ) -> Result<(), DemError> {
         out.clear();
+        self.detect_to(
+            bodies,
+            inv_mass,
+            colliders,
+            laws,
+            periodic,
+            detection_gap,
+            dt,
+            gravity,
+            out,
+        )
+    }
+
+    /// Whether [`Detector::detect`] with these arguments would find a contact that the
+    /// position correction counts as violated at the positions as they are
+    /// ([`crate::stabilise::Projection::project`] with no displacement: its gap below
+    /// `−(1 + TOLERANCE)` times its closed gap, with `W_nn > 0`), without making the contacts:
+    /// the same pairs, gaps and blocks, but only those deep enough are assembled. `Err` as
+    /// [`Detector::detect`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn finds_deep_overlap(
+        &mut self,
+        bodies: &[Body],
+        inv_mass: &[[f64; 3]],
+        colliders: &[Collider],
+        laws: &ContactLaws,
+        periodic: Option<Periodic>,
+        detection_gap: f64,
+        dt: f64,
+        gravity: f64,
+    ) -> Result<bool, DemError> {
+        let mut probe = DeepOverlapProbe { found: false };
+        self.detect_to(
+            bodies,
+            inv_mass,
+            colliders,
+            laws,
+            periodic,
+            detection_gap,
+            dt,
+            gravity,
+            &mut probe,
+        )?;
+        Ok(probe.found)
+    }
+
+    /// [`Detector::detect`] into any sink.
+    #[allow(clippy::too_many_arguments)]
+    fn detect_to<S: ContactSink>(
+        &mut self,
+        bodies: &[Body],
+        inv_mass: &[[f64; 3]],
+        colliders: &[Collider],
+        laws: &ContactLaws,
+        periodic: Option<Periodic>,
+        detection_gap: f64,
+        dt: f64,
+        gravity: f64,
+        out: &mut S,
+    ) -> Result<(), DemError> {
         self.candidates.detections += 1;
         self.collect_disks(bodies, colliders, periodic, dt, gravity);
         let nd = self.centre.len();
@@ -587,7 +647,7 @@ impl Detector {
 
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn disk_disk(
+    fn disk_disk<S: ContactSink>(
         &self,
         bodies: &[Body],
         inv_mass: &[[f64; 3]],
@@ -599,7 +659,7 @@ impl Detector {
         di: usize,
         cj: u32,
         dj: usize,
-        out: &mut ContactSet,
+        out: &mut S,
     ) {
         let (ca, cb) = (&colliders[ci as usize], &colliders[cj as usize]);
         if ca.body == cb.body {
@@ -636,8 +696,7 @@ impl Detector {
         let lever_b = -n * rb + off_b;
         let lever_a = Vector2::new(dx, dy) - n * rb + off_a;
         let point = Vector2::new(pb[0], pb[1]) - n * rb;
-        push_contact(
-            out,
+        out.contact(
             inv_mass,
             laws,
             ca,
@@ -658,7 +717,7 @@ impl Detector {
 
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn wall_disk(
+    fn wall_disk<S: ContactSink>(
         &self,
         bodies: &[Body],
         inv_mass: &[[f64; 3]],
@@ -669,7 +728,7 @@ impl Detector {
         cw: u32,
         shape: &WallShape,
         e: usize,
-        out: &mut ContactSet,
+        out: &mut S,
     ) {
         let cj = self.disk_collider[e];
         let (ca, cb) = (&colliders[cw as usize], &colliders[cj as usize]);
@@ -731,8 +790,7 @@ impl Detector {
         if let Some(per) = periodic {
             lever_a.x = per.min_image(lever_a.x);
         }
-        push_contact(
-            out,
+        out.contact(
             inv_mass,
             laws,
             ca,
@@ -775,6 +833,118 @@ impl Image {
     };
 }
 
+/// Where a detection puts the contacts it finds: a [`ContactSet`] keeps them
+/// ([`push_contact`]); a [`DeepOverlapProbe`] only notes whether one is deep.
+trait ContactSink {
+    /// One contact of the detection, as [`push_contact`] takes it.
+    #[allow(clippy::too_many_arguments)]
+    fn contact(
+        &mut self,
+        inv_mass: &[[f64; 3]],
+        laws: &ContactLaws,
+        ca: &Collider,
+        cb: &Collider,
+        ci: u32,
+        cj: u32,
+        ba: usize,
+        bb: usize,
+        n: Vector2<f64>,
+        point: Vector2<f64>,
+        lever_a: Vector2<f64>,
+        lever_b: Vector2<f64>,
+        gap: f64,
+        closed_gap: f64,
+        image: Image,
+    );
+}
+
+impl ContactSink for ContactSet {
+    #[inline]
+    fn contact(
+        &mut self,
+        inv_mass: &[[f64; 3]],
+        laws: &ContactLaws,
+        ca: &Collider,
+        cb: &Collider,
+        ci: u32,
+        cj: u32,
+        ba: usize,
+        bb: usize,
+        n: Vector2<f64>,
+        point: Vector2<f64>,
+        lever_a: Vector2<f64>,
+        lever_b: Vector2<f64>,
+        gap: f64,
+        closed_gap: f64,
+        image: Image,
+    ) {
+        push_contact(
+            self, inv_mass, laws, ca, cb, ci, cj, ba, bb, n, point, lever_a, lever_b, gap,
+            closed_gap, image,
+        );
+    }
+}
+
+/// Notes whether a detection finds a contact that the position correction would count as
+/// violated with no displacement ([`crate::stabilise::Projection::project`]: gap below
+/// `−(1 + TOLERANCE)` times the closed gap and `W_nn > 0`); only such a contact's block is
+/// computed, as [`push_contact`] does.
+struct DeepOverlapProbe {
+    found: bool,
+}
+
+impl ContactSink for DeepOverlapProbe {
+    #[inline]
+    fn contact(
+        &mut self,
+        inv_mass: &[[f64; 3]],
+        _laws: &ContactLaws,
+        _ca: &Collider,
+        _cb: &Collider,
+        _ci: u32,
+        _cj: u32,
+        ba: usize,
+        bb: usize,
+        n: Vector2<f64>,
+        _point: Vector2<f64>,
+        lever_a: Vector2<f64>,
+        lever_b: Vector2<f64>,
+        gap: f64,
+        closed_gap: f64,
+        _image: Image,
+    ) {
+        if gap < -(1.0 + crate::stabilise::TOLERANCE) * closed_gap {
+            let (_, w) = contact_block(inv_mass, ba, bb, n, lever_a, lever_b);
+            if w.nn > 0.0 {
+                self.found = true;
+            }
+        }
+    }
+}
+
+/// The lever cross products `[ρ_a×n, ρ_a×t, ρ_b×n, ρ_b×t]` and the local Delassus block of a
+/// contact of normal `n` between bodies `ba` and `bb`.
+#[inline(always)]
+fn contact_block(
+    inv_mass: &[[f64; 3]],
+    ba: usize,
+    bb: usize,
+    n: Vector2<f64>,
+    lever_a: Vector2<f64>,
+    lever_b: Vector2<f64>,
+) -> ([f64; 4], crate::local::Delassus2) {
+    let t = Vector2::new(-n.y, n.x);
+    let cross = |r: Vector2<f64>, v: Vector2<f64>| r.x * v.y - r.y * v.x;
+    let k = [
+        cross(lever_a, n),
+        cross(lever_a, t),
+        cross(lever_b, n),
+        cross(lever_b, t),
+    ];
+    let w = ContactRow::delassus([n.x, n.y], k, &inv_mass[ba], &inv_mass[bb]);
+    (k, w)
+}
+
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn push_contact(
@@ -796,15 +966,8 @@ fn push_contact(
     image: Image,
 ) {
     let t = Vector2::new(-n.y, n.x);
-    let cross = |r: Vector2<f64>, v: Vector2<f64>| r.x * v.y - r.y * v.x;
-    let k = [
-        cross(lever_a, n),
-        cross(lever_a, t),
-        cross(lever_b, n),
-        cross(lever_b, t),
-    ];
+    let (k, w) = contact_block(inv_mass, ba, bb, n, lever_a, lever_b);
     let nn = [n.x, n.y];
-    let w = ContactRow::delassus(nn, k, &inv_mass[ba], &inv_mass[bb]);
     out.rows.push(ContactRow {
         a: ba as u32,
         b: bb as u32,
@@ -1300,5 +1463,92 @@ mod tests {
         assert!(found > 1000, "{found}");
         let c = det.candidate_counts();
         assert!(c.builds >= 3 && 3 * c.builds < c.detections, "{c:?}");
+    }
+
+    /// Pairs of disks (radii 1–2 mm) overlapping by random depths around the correction's
+    /// threshold `(1 + TOLERANCE) · 10⁻⁴ R_min` (0.3 to 1.1 times it), in 400 random draws of
+    /// 8 pairs, one pair of them a fixed clump (glued disks of one body, never a contact) and
+    /// one disk of some pairs on the floor: [`Detector::finds_deep_overlap`] says true exactly
+    /// when the contacts of [`Detector::detect`] make the projection with no displacement find
+    /// a violated contact.
+    #[test]
+    fn the_deep_overlap_probe_agrees_with_the_projection() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let laws = ContactLaws::new(&["m"], 0.5);
+        let mut projection = crate::stabilise::Projection::default();
+        let (mut deep, mut shallow) = (0, 0);
+        let mut det = Detector::default();
+        for draw in 0..400 {
+            let mut bodies = vec![Body::wall("floor", Vector2::zeros(), Vector2::zeros())];
+            let mut colliders = vec![Collider {
+                body: 0,
+                shape: Shape::Line {
+                    point: Vector2::zeros(),
+                    normal: Vector2::new(0.0, 1.0),
+                },
+                material: 0,
+            }];
+            let threshold = (1.0 + crate::stabilise::TOLERANCE) * crate::contact::CLOSED_GAP;
+            for k in 0..8 {
+                let (ra, rb): (f64, f64) =
+                    (rng.random_range(1e-3..2e-3), rng.random_range(1e-3..2e-3));
+                let depth = rng.random_range(0.3..1.1) * threshold * ra.min(rb);
+                let (x, y) = (0.01 * k as f64, 0.005);
+                let angle: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+                let dir = Vector2::new(angle.cos(), angle.sin());
+                let a = Vector2::new(x, if rng.random_bool(0.2) { ra } else { y });
+                let b = a + dir * (ra + rb - depth);
+                if k == 0 {
+                    // A clump of the two disks, fixed: no contact between them.
+                    bodies.push(Body::wall("clump", (a + b) * 0.5, Vector2::zeros()));
+                    for (c, r) in [(a, ra), (b, rb)] {
+                        colliders.push(Collider {
+                            body: 1,
+                            shape: Shape::Disk {
+                                radius: r,
+                                offset: c - (a + b) * 0.5,
+                            },
+                            material: 0,
+                        });
+                    }
+                    continue;
+                }
+                for (c, r) in [(a, ra), (b, rb)] {
+                    colliders.push(Collider {
+                        body: bodies.len() as u32,
+                        shape: Shape::Disk {
+                            radius: r,
+                            offset: Vector2::zeros(),
+                        },
+                        material: 0,
+                    });
+                    bodies.push(Body::disk(c, r, 2500.0, 1.0));
+                }
+            }
+            let inv: Vec<[f64; 3]> = bodies.iter().map(Body::inverse_mass).collect();
+            let reach = 2.5e-4;
+            let probe = det
+                .finds_deep_overlap(&bodies, &inv, &colliders, &laws, None, reach, 0.0, 0.0)
+                .unwrap();
+            let mut set = ContactSet::default();
+            det.detect(
+                &bodies, &inv, &colliders, &laws, None, reach, 0.0, 0.0, &mut set,
+            )
+            .unwrap();
+            let still = vec![[0.0; 3]; bodies.len()];
+            let report = projection.project(&set.rows, &set.geometry, &still, &inv);
+            assert_eq!(
+                probe,
+                report.violated_contacts > 0,
+                "draw {draw}: {report:?}"
+            );
+            if probe {
+                deep += 1;
+            } else {
+                shallow += 1;
+            }
+        }
+        // Both outcomes are drawn.
+        assert!(deep > 50 && shallow > 50, "{deep} deep, {shallow} shallow");
     }
 }

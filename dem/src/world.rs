@@ -1293,12 +1293,36 @@ impl World {
         if self.image_outran || self.detector.outran(&self.colliders, moved) {
             let mut fresh = std::mem::take(&mut self.fresh);
             let reach = 0.25 * self.smallest_radius().unwrap_or(0.0);
-            let detected = self.detect_into(reach, 0.0, 0.0, 0.0, &mut fresh);
+            // The second projection moves nothing unless a contact is violated: look for one
+            // first (the same pairs and gaps, without making the contacts), and detect the
+            // contacts only then. Without one, its report is the empty one it would return.
+            let deep = self.cell.is_some()
+                || self
+                    .detector
+                    .finds_deep_overlap(
+                        &self.bodies,
+                        &self.inv,
+                        &self.colliders,
+                        &self.laws,
+                        self.periodic(),
+                        reach,
+                        0.0,
+                        0.0,
+                    )
+                    .unwrap_or(true);
+            let detected = if deep {
+                self.detect_into(reach, 0.0, 0.0, 0.0, &mut fresh)
+            } else {
+                Ok(())
+            };
             if detected.is_ok() {
-                let still = vec![[0.0; 3]; self.bodies.len()];
-                let second =
+                let second = if deep {
+                    let still = vec![[0.0; 3]; self.bodies.len()];
                     self.projection
-                        .project(&fresh.rows, &fresh.geometry, &still, &self.inv);
+                        .project(&fresh.rows, &fresh.geometry, &still, &self.inv)
+                } else {
+                    CorrectionReport::default()
+                };
                 if second.corrected_contacts > 0 {
                     report.load_work += self.apply_correction();
                 }
