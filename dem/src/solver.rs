@@ -904,6 +904,26 @@ pub struct SolverWork {
     pub backoff: NewtonBackoff,
 }
 
+impl SolverWork {
+    /// What carries over from one solve to the next (the back-off of `auto`, and the Newton
+    /// stage's buffers), without the Gauss–Seidel driver's buffers, which every solve fills
+    /// before it reads them (left empty).
+    pub(crate) fn carried(&self) -> SolverWork {
+        SolverWork {
+            newton: self.newton.clone(),
+            nlgs: DriveWork::default(),
+            backoff: self.backoff,
+        }
+    }
+
+    /// Sets what carries over from one solve to the next from `src` ([`SolverWork::carried`]),
+    /// keeping the driver's buffers.
+    pub(crate) fn restore_carried(&mut self, src: &SolverWork) {
+        self.newton.clone_from(&src.newton);
+        self.backoff = src.backoff;
+    }
+}
+
 /// Back-off of `auto`'s Newton stage: after a step where Newton did not converge, the next
 /// `skip` steps that stall use Gauss–Seidel alone; `skip` starts at 1 and doubles with every
 /// further failure (up to [`NewtonBackoff::MAX_SKIP`]); a converged Newton stage, or new solver
