@@ -778,6 +778,22 @@ impl SweepProblem for Step<'_> {
 
     /// `(r_α) ← x`, then the velocities rebuilt (O(N)).
     fn load(&mut self, x: &[f64]) {
+        if let (SweepOrder::Natural(_), None) = (&self.order, &self.cell) {
+            // One pass: each impulse set, then applied as `apply_impulses` applies it (the
+            // same contributions to the velocities in the same order, so the same bits).
+            self.vel.copy_from_slice(self.v_free);
+            for (c, r) in self.rows.iter_mut().zip(x.chunks_exact(2)) {
+                c.r = [r[0], r[1]];
+                if c.r != [0.0, 0.0] {
+                    let (a, b) = (c.a as usize, c.b as usize);
+                    let (mut va, mut vb) = (self.vel[a], self.vel[b]);
+                    c.apply(c.r, &mut va, &self.inv[a], &mut vb, &self.inv[b]);
+                    self.vel[a] = va;
+                    self.vel[b] = vb;
+                }
+            }
+            return;
+        }
         self.rows
             .par_chunks_mut(CHUNK)
             .zip(x.par_chunks(2 * CHUNK))
