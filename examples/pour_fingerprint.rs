@@ -3,6 +3,11 @@
 //! of every body's position, angle, velocity and spin and of every contact's key and impulse.
 //! Two builds that print the same fingerprint settled the column bit for bit the same way.
 //!
+//! Also printed: the subdivision's counts (kept sub-steps, undone attempts, discarded sweeps)
+//! and the detection's (detections, builds of the candidate list). `FULL_DETECTION=1` takes
+//! every detection's pairs from the cell grid (the same fingerprint, slower); `POUR_HIST=1`
+//! prints how many kept sub-steps took 0, 1, … 100 sweeps.
+//!
 //! `cargo run --release --example pour_fingerprint -- [grains (2000)] [seed (1)]`
 use datasets::benchmarks::{janssen_column, ColumnRun, Preparation};
 use std::time::Instant;
@@ -31,6 +36,7 @@ fn main() {
     let t0 = Instant::now();
     let mut sub = dem::step_control::Subdivision::default();
     let (mut steps, mut simulated, mut ratio) = (0u64, 0.0f64, dem::bench::energy_ratio(&w));
+    let mut hist = [0usize; 101];
     let (mut sweeps, mut discarded, mut capped, mut substeps, mut retries) = (0, 0, 0, 0, 0);
     while simulated < run.max_time - 0.5 * w.params.dt {
         let h = w.params.dt;
@@ -42,12 +48,20 @@ fn main() {
         capped += usize::from(!s.report.solver.converged);
         substeps += s.substeps.len();
         retries += s.retries;
+        if std::env::var_os("POUR_HIST").is_some() {
+            for sub in &s.substeps {
+                hist[sub.report.solver.iterations.min(100)] += 1;
+            }
+        }
         ratio = dem::bench::energy_ratio(&w);
         if ratio < 1e-8 {
             break;
         }
     }
     let secs = t0.elapsed().as_secs_f64();
+    if std::env::var_os("POUR_HIST").is_some() {
+        println!("sweeps per kept sub-step: {hist:?}");
+    }
     let mut h = 0xcbf2_9ce4_8422_2325u64;
     for b in &w.bodies {
         for x in [
