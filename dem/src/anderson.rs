@@ -71,6 +71,23 @@ impl Anderson {
         }
     }
 
+    /// Forgets the history and takes vectors of length `len` from now on, keeping the
+    /// buffers: the same as [`Anderson::new`] with the same memory (nothing of the old history
+    /// is read again: every entry is written before it is read), without allocating once the
+    /// buffers have grown to the largest length met (the contact count of a step changes from
+    /// step to step).
+    pub fn reset_to_length(&mut self, len: usize) {
+        if len != self.len {
+            for v in self.df.iter_mut().chain(self.dg.iter_mut()) {
+                v.resize(len, 0.0);
+            }
+            self.f_prev.resize(len, 0.0);
+            self.g_prev.resize(len, 0.0);
+            self.len = len;
+        }
+        self.reset();
+    }
+
     /// Forgets the history (after a change of regime, or when the step was rejected).
     pub fn reset(&mut self) {
         self.count = 0;
@@ -274,4 +291,44 @@ fn solve_dense(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
         b[k] = s / a[k * n + k];
     }
     b.iter().all(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Mixes 12 iterates of the affine map `x ← A x + b` (a fixed 3-term recurrence) of
+    /// length `len`, from `x = 0`, and returns the mixed iterates' bits.
+    fn mix(acc: &mut Anderson, len: usize) -> Vec<u64> {
+        let mut x = vec![0.0; len];
+        let mut out = Vec::new();
+        for _ in 0..12 {
+            let mut g: Vec<f64> = (0..len)
+                .map(|i| {
+                    let l = if i > 0 { x[i - 1] } else { 0.0 };
+                    let r = if i + 1 < len { x[i + 1] } else { 0.0 };
+                    0.45 * (l + r) + 1.0 + 0.1 * (i % 7) as f64
+                })
+                .collect();
+            acc.step(&x, &mut g);
+            out.extend(g.iter().map(|v| v.to_bits()));
+            x = g;
+        }
+        out
+    }
+
+    /// A history reset to another length gives the same iterates as a new one, bit for bit,
+    /// shorter or longer than the vectors it held (stale entries are never read).
+    #[test]
+    fn a_history_reset_to_a_length_mixes_as_a_new_one() {
+        for (first, then) in [(5000, 3000), (3000, 5000), (4096, 4096)] {
+            let mut reused = Anderson::new(4, first);
+            mix(&mut reused, first);
+            reused.reset_to_length(then);
+            assert_eq!(
+                mix(&mut reused, then),
+                mix(&mut Anderson::new(4, then), then)
+            );
+        }
+    }
 }

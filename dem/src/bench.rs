@@ -220,13 +220,15 @@ impl MemoryFootprint {
             + size_of::<crate::collider::Collider>()
             + 3 * size_of::<[f64; 3]>() // velocities, inverse masses, free velocities
             + 3 * size_of::<[f64; 3]>() // body forces
-            + 4 + 16 + 8 + 8 + 4 + 4 + 4; // detector: collider, centre, radius, margin, cells
+            + 4 + 16 + 8 + 8 + 4 + 4 + 4 // detector: collider, centre, radius, margin, cells
+            + 4 + 8 + 16 + 8 + 4; // candidate list: collider, radius, centre, reach, start
         let one_set = size_of::<crate::contact::ContactRow>()
             + size_of::<crate::contact::ContactGeometry>()
             + size_of::<crate::local::ContactStatus>();
         let per_contact = 2 * one_set // current and previous step
             + 4 // sweep order
             + 8 // detection neighbour list
+            + 10 // candidate pairs: 8 B each, 1.2 per contact in the settled poured column
             + 2 * 8 * (2 * anderson_memory + 2) // Anderson differences and iterates
             + 16; // best iterate
         MemoryFootprint {

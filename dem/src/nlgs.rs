@@ -142,7 +142,10 @@ impl DriveWork {
     /// A cleared Anderson history of memory `memory` for vectors of length `dim`.
     fn prepare(&mut self, memory: usize, dim: usize) {
         match self.anderson.as_mut() {
-            Some(a) if self.shape == (memory, dim) => a.reset(),
+            Some(a) if self.shape.0 == memory => {
+                a.reset_to_length(dim);
+                self.shape = (memory, dim);
+            }
             _ => {
                 self.anderson = Some(Anderson::new(memory, dim));
                 self.shape = (memory, dim);

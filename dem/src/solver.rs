@@ -778,6 +778,22 @@ impl SweepProblem for Step<'_> {
 
     /// `(r_α) ← x`, then the velocities rebuilt (O(N)).
     fn load(&mut self, x: &[f64]) {
+        if let (SweepOrder::Natural(_), None) = (&self.order, &self.cell) {
+            // One pass: each impulse set, then applied as `apply_impulses` applies it (the
+            // same contributions to the velocities in the same order, so the same bits).
+            self.vel.copy_from_slice(self.v_free);
+            for (c, r) in self.rows.iter_mut().zip(x.chunks_exact(2)) {
+                c.r = [r[0], r[1]];
+                if c.r != [0.0, 0.0] {
+                    let (a, b) = (c.a as usize, c.b as usize);
+                    let (mut va, mut vb) = (self.vel[a], self.vel[b]);
+                    c.apply(c.r, &mut va, &self.inv[a], &mut vb, &self.inv[b]);
+                    self.vel[a] = va;
+                    self.vel[b] = vb;
+                }
+            }
+            return;
+        }
         self.rows
             .par_chunks_mut(CHUNK)
             .zip(x.par_chunks(2 * CHUNK))
@@ -902,6 +918,26 @@ pub struct SolverWork {
     nlgs: DriveWork,
     /// When `auto` next tries Newton.
     pub backoff: NewtonBackoff,
+}
+
+impl SolverWork {
+    /// What carries over from one solve to the next (the back-off of `auto`, and the Newton
+    /// stage's buffers), without the Gauss–Seidel driver's buffers, which every solve fills
+    /// before it reads them (left empty).
+    pub(crate) fn carried(&self) -> SolverWork {
+        SolverWork {
+            newton: self.newton.clone(),
+            nlgs: DriveWork::default(),
+            backoff: self.backoff,
+        }
+    }
+
+    /// Sets what carries over from one solve to the next from `src` ([`SolverWork::carried`]),
+    /// keeping the driver's buffers.
+    pub(crate) fn restore_carried(&mut self, src: &SolverWork) {
+        self.newton.clone_from(&src.newton);
+        self.backoff = src.backoff;
+    }
 }
 
 /// Back-off of `auto`'s Newton stage: after a step where Newton did not converge, the next

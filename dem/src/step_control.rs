@@ -216,8 +216,9 @@ pub fn step_subdivided_checked(
         let can_halve = level < max && !polishing;
         if can_halve || (energy_limit.is_some() && !polishing) {
             match backup.as_mut() {
-                Some(b) => b.clone_from(world),
-                None => backup = Some(world.clone()),
+                // State only: the work space is filled again by the next attempt.
+                Some(b) => b.undo_to(world),
+                None => backup = Some(world.undo_point()),
             }
         }
         let n = 1usize << level;
@@ -275,7 +276,7 @@ pub fn step_subdivided_checked(
                 world.work.backoff = first_world.work.backoff;
             } else {
                 discarded += sweeps(&subs);
-                world.clone_from(&first_world);
+                world.undo_to(&first_world);
                 subs = first_subs;
             }
             retries += 1;
@@ -284,7 +285,7 @@ pub fn step_subdivided_checked(
         if failed && can_halve {
             discarded += sweeps(&subs);
             if let Some(b) = backup.as_ref() {
-                world.clone_from(b);
+                world.undo_to(b);
             }
             retries += 1;
             level += 1;
@@ -294,8 +295,8 @@ pub fn step_subdivided_checked(
         if let (Some(limit), true, Some(b)) = (energy_limit, all_converged, backup.as_ref()) {
             if energy_residual(&subs) > limit {
                 // Energy grew in a converged step: solve it again, tighter (doc comment).
-                first = Some((world.clone(), subs));
-                world.clone_from(b);
+                first = Some((world.undo_point(), subs));
+                world.undo_to(b);
                 continue;
             }
         }

@@ -235,6 +235,124 @@ impl World {
         }
     }
 
+    /// A copy of the world to come back to after steps that are undone ([`World::undo_to`];
+    /// [`crate::step_control::step_subdivided`]): everything a step reads from the world, but
+    /// not the work space that a step fills before reading it (the previous step's contact set,
+    /// detection, solver and projection buffers), which is left empty. Stepping the copy gives
+    /// the same bits as stepping the world; it is cheaper to make than a clone.
+    pub fn undo_point(&self) -> World {
+        // Listed field by field (no `..`): a new field must be sorted into state or work space.
+        let World {
+            params,
+            bodies,
+            colliders,
+            laws,
+            time,
+            step_index,
+            contacts,
+            previous: _,
+            detector: _,
+            vel: _,
+            inv,
+            body_force,
+            order: _,
+            mobile: _,
+            pos: _,
+            layout,
+            colouring,
+            v_free: _,
+            work,
+            displacement: _,
+            projection: _,
+            fresh: _,
+            last,
+            record_problems,
+            last_problem,
+            cell,
+            cell_control,
+            cell_sigma,
+            fluct_displacement: _,
+            last_wrap_energy: _,
+            image_outran: _,
+        } = self;
+        World {
+            bodies: bodies.clone(),
+            colliders: colliders.clone(),
+            time: *time,
+            step_index: *step_index,
+            contacts: contacts.clone(),
+            inv: inv.clone(),
+            body_force: body_force.clone(),
+            layout: layout.clone(),
+            colouring: colouring.clone(),
+            work: work.carried(),
+            last: *last,
+            record_problems: *record_problems,
+            last_problem: last_problem.clone(),
+            cell: *cell,
+            cell_control: *cell_control,
+            cell_sigma: *cell_sigma,
+            ..World::new(*params, laws.clone())
+        }
+    }
+
+    /// Returns the world to `point` ([`World::undo_point`]): its state is then that of the
+    /// world when the point was made, bit for bit; the work space is kept (no step reads it
+    /// before filling it), with its allocations.
+    pub fn undo_to(&mut self, point: &World) {
+        let World {
+            params,
+            bodies,
+            colliders,
+            laws,
+            time,
+            step_index,
+            contacts,
+            previous: _,
+            detector: _,
+            vel: _,
+            inv,
+            body_force,
+            order: _,
+            mobile: _,
+            pos: _,
+            layout,
+            colouring,
+            v_free: _,
+            work,
+            displacement: _,
+            projection: _,
+            fresh: _,
+            last,
+            record_problems,
+            last_problem,
+            cell,
+            cell_control,
+            cell_sigma,
+            fluct_displacement: _,
+            last_wrap_energy: _,
+            image_outran: _,
+        } = point;
+        self.params = *params;
+        self.bodies.clone_from(bodies);
+        self.colliders.clone_from(colliders);
+        self.laws.clone_from(laws);
+        self.time = *time;
+        self.step_index = *step_index;
+        self.contacts.clone_from(contacts);
+        self.inv.clone_from(inv);
+        self.body_force.clone_from(body_force);
+        self.layout.clone_from(layout);
+        self.colouring.clone_from(colouring);
+        self.work.restore_carried(work);
+        self.last = *last;
+        self.record_problems = *record_problems;
+        self.last_problem.clone_from(last_problem);
+        self.cell = *cell;
+        self.cell_control = *cell_control;
+        self.cell_sigma = *cell_sigma;
+    }
+
     /// The biperiodic deformable cell, if any.
     pub fn cell(&self) -> Option<&Cell> {
         self.cell.as_ref()
@@ -495,6 +613,20 @@ impl World {
             x_min: a,
             length: b - a,
         })
+    }
+
+    /// Take the disk pairs of every detection from the cell grid (`true`) instead of from the
+    /// candidate list kept between detections (`false`, the default;
+    /// [`crate::detection::Detector::detect`]). The contacts, hence the whole run, are the same
+    /// bit for bit either way; only the time differs.
+    pub fn set_full_detection(&mut self, full: bool) {
+        self.detector.set_full_detection(full);
+    }
+
+    /// Detections and builds of their candidate list since this world was made (or restored
+    /// from a state): the list was reused by the detections that did not build it.
+    pub fn candidate_counts(&self) -> crate::detection::CandidateCounts {
+        self.detector.candidate_counts()
     }
 
     /// Contacts of the last step.
@@ -1279,12 +1411,36 @@ impl World {
         if self.image_outran || self.detector.outran(&self.colliders, moved) {
             let mut fresh = std::mem::take(&mut self.fresh);
             let reach = 0.25 * self.smallest_radius().unwrap_or(0.0);
-            let detected = self.detect_into(reach, 0.0, 0.0, 0.0, &mut fresh);
+            // The second projection moves nothing unless a contact is violated: look for one
+            // first (the same pairs and gaps, without making the contacts), and detect the
+            // contacts only then. Without one, its report is the empty one it would return.
+            let deep = self.cell.is_some()
+                || self
+                    .detector
+                    .finds_deep_overlap(
+                        &self.bodies,
+                        &self.inv,
+                        &self.colliders,
+                        &self.laws,
+                        self.periodic(),
+                        reach,
+                        0.0,
+                        0.0,
+                    )
+                    .unwrap_or(true);
+            let detected = if deep {
+                self.detect_into(reach, 0.0, 0.0, 0.0, &mut fresh)
+            } else {
+                Ok(())
+            };
             if detected.is_ok() {
-                let still = vec![[0.0; 3]; self.bodies.len()];
-                let second =
+                let second = if deep {
+                    let still = vec![[0.0; 3]; self.bodies.len()];
                     self.projection
-                        .project(&fresh.rows, &fresh.geometry, &still, &self.inv);
+                        .project(&fresh.rows, &fresh.geometry, &still, &self.inv)
+                } else {
+                    CorrectionReport::default()
+                };
                 if second.corrected_contacts > 0 {
                     report.load_work += self.apply_correction();
                 }
