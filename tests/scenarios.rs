@@ -75,6 +75,22 @@ fn refit(dir: &Path, law: &str, file: &str) -> (i32, Vec<(String, f64)>) {
     (code, params)
 }
 
+/// The data rows of a CSV file the runs write (comment lines and the header skipped), empty
+/// cells as NaN.
+fn csv_rows(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|c| c.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect()
+}
+
 fn num(s: &Value, key: &str) -> f64 {
     s.get(key)
         .and_then(Value::as_f64)
@@ -559,17 +575,7 @@ fn shear_cell_short() {
             }
         }
     }
-    let text = std::fs::read_to_string(out.join("rheology.csv")).unwrap();
-    let rows: Vec<Vec<f64>> = text
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .skip(1)
-        .map(|l| {
-            l.split(',')
-                .map(|c| c.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
+    let rows = csv_rows(&out.join("rheology.csv"));
     assert_eq!(rows.len(), 5);
     for r in &rows {
         assert!(r[2] > 0.1 && r[2] < 0.9, "mu = {}", r[2]);
@@ -582,17 +588,7 @@ fn shear_cell_short() {
     // control law from the bulk I its stage measured (1 within a factor 1.5 of the target,
     // else √(I_target/I) bounded to [1/2, 2]), and the run's V over the uniform-shear estimate
     // (rheology.csv) is their product (1e-12 relative).
-    let lead = std::fs::read_to_string(out.join("lead_stages.csv")).unwrap();
-    let lead: Vec<Vec<f64>> = lead
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .skip(1)
-        .map(|l| {
-            l.split(',')
-                .map(|c| c.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
+    let lead = csv_rows(&out.join("lead_stages.csv"));
     assert_eq!(lead.len(), 10, "two corrections for each of 5 runs");
     let over_uniform = 14; // rheology.csv column wall_velocity_over_uniform
     for r in &rows {
