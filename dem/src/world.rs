@@ -1021,7 +1021,8 @@ impl World {
         if ctl.implicit || ctl.tolerance <= 0.0 || ctl.max_corrections == 0 {
             return self.step_plain();
         }
-        let backup = self.clone();
+        // State only: every re-solve starts from it ([`World::undo_point`]).
+        let backup = self.undo_point();
         let first = self.step_plain()?;
         let f0 = ctl.signed_error(&self.cell_sigma.unwrap_or_else(Mat::zeros));
         if f0.abs() <= ctl.tolerance {
@@ -1030,7 +1031,7 @@ impl World {
         let l0 = backup.cell.map_or_else(Mat::zeros, |c| c.l);
         let mut tries = 0u32;
         let attempt = |w: &mut World, delta: f64, tries: &mut u32| -> Result<f64, DemError> {
-            *w = backup.clone();
+            w.undo_to(&backup);
             let e = w.set_velocity_gradient(l0 + ctl.direction() * delta);
             let mut r = w.step_plain()?;
             r.cell_work += e;
