@@ -63,24 +63,10 @@ fn main() {
         println!("sweeps per kept sub-step: {hist:?}");
     }
     let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for b in &w.bodies {
-        for x in [
-            b.position.x,
-            b.position.y,
-            b.angle,
-            b.velocity.x,
-            b.velocity.y,
-            b.omega,
-        ] {
-            fnv(&mut h, x.to_bits());
-        }
+    for x in w.state_bits() {
+        fnv(&mut h, x);
     }
     let c = w.contacts();
-    for (row, g) in c.rows.iter().zip(&c.geometry) {
-        fnv(&mut h, g.key);
-        fnv(&mut h, row.r[0].to_bits());
-        fnv(&mut h, row.r[1].to_bits());
-    }
     let overlap = c.geometry.iter().map(|g| -g.gap).fold(0.0, f64::max);
     println!(
         "{n} grains: {steps} steps, {:.1} sweeps/step, {capped} capped, KE/PE {ratio:.3e}, \

@@ -629,6 +629,31 @@ impl World {
         self.detector.candidate_counts()
     }
 
+    /// Every number of the dynamic state, bit for bit, in a fixed order: position, angle,
+    /// velocity and spin of every body, then the key and the two impulse components of every
+    /// contact. Two runs that agree on it took the same trajectory (reproducibility and
+    /// bit-identity checks).
+    pub fn state_bits(&self) -> Vec<u64> {
+        let mut f = Vec::with_capacity(6 * self.bodies.len() + 3 * self.contacts.len());
+        for b in &self.bodies {
+            f.extend(
+                [
+                    b.position.x,
+                    b.position.y,
+                    b.angle,
+                    b.velocity.x,
+                    b.velocity.y,
+                    b.omega,
+                ]
+                .map(f64::to_bits),
+            );
+        }
+        for (row, g) in self.contacts.rows.iter().zip(&self.contacts.geometry) {
+            f.extend([g.key, row.r[0].to_bits(), row.r[1].to_bits()]);
+        }
+        f
+    }
+
     /// Contacts of the last step.
     pub fn contacts(&self) -> &ContactSet {
         &self.contacts

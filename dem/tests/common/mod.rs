@@ -63,23 +63,7 @@ pub fn random_box(
 /// Every number of the state, bit for bit: positions, angles, velocities of every body, and the
 /// impulses of every contact (for tests of bit-identical runs).
 pub fn fingerprint(w: &World) -> Vec<u64> {
-    let mut f = Vec::new();
-    for b in &w.bodies {
-        for x in [
-            b.position.x,
-            b.position.y,
-            b.angle,
-            b.velocity.x,
-            b.velocity.y,
-            b.omega,
-        ] {
-            f.push(x.to_bits());
-        }
-    }
-    for c in &w.contacts().rows {
-        f.extend([c.r[0].to_bits(), c.r[1].to_bits()]);
-    }
-    f
+    w.state_bits()
 }
 
 /// The `.json.gz` problems of `datasets/fc-problems/DIR`, sorted.

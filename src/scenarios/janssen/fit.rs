@@ -30,10 +30,7 @@ pub fn fit_profile(
     setup: &JanssenSetup,
     window: (f64, f64),
 ) -> std::result::Result<JanssenOutcome, IdentifyError> {
-    let uses_tau_w =
-        p.z.iter()
-            .zip(&p.tau_w)
-            .all(|(z, t)| *z < window.0 || *z > window.1 || *t >= 0.0);
+    let uses_tau_w = p.negative_tau_w(window).is_empty();
     let profile = JanssenProfile {
         z_m: p.z.clone(),
         sigma_v_pa: p.sigma_v.clone(),

@@ -44,6 +44,19 @@ pub struct ColumnProfile {
     pub surface: f64,
 }
 
+impl ColumnProfile {
+    /// The bins whose middle lies in the depth window `[z_min, z_max]` and whose wall shear
+    /// stress is negative (the wall holds the grains down there): `(z, τ_w)`.
+    pub fn negative_tau_w(&self, window: (f64, f64)) -> Vec<(f64, f64)> {
+        self.z
+            .iter()
+            .zip(&self.tau_w)
+            .filter(|(z, t)| **z >= window.0 && **z <= window.1 && **t < 0.0)
+            .map(|(z, t)| (*z, *t))
+            .collect()
+    }
+}
+
 /// Height of the free surface: the mean over one-diameter-wide columns of the highest grain
 /// top (m).
 pub fn surface_height(snap: &Snapshot, width: f64, d: f64) -> f64 {
@@ -100,13 +113,6 @@ fn profile_in(snap: &Snapshot, width: f64, db: &DepthBins, surface: f64) -> Resu
         z,
         surface,
     })
-}
-
-/// Measures the wall and vertical stress profiles of one state of a column, in `bins` bins
-/// below its own free surface.
-pub fn measure_profile(snap: &Snapshot, width: f64, bins: usize) -> Result<ColumnProfile> {
-    let surface = surface_height(snap, width, mean_grain_diameter(snap));
-    profile_in(snap, width, &depth_bins(surface, bins)?, surface)
 }
 
 /// Vertical loads of one state (N per metre of thickness, upward on the grains positive).

@@ -42,7 +42,7 @@ pub mod fit;
 pub mod measure;
 
 pub use fit::{fit_band, fit_profile, JanssenOutcome};
-pub use measure::{measure_profile, surface_height, ColumnLoads, ColumnProfile, MeasureWindow};
+pub use measure::{surface_height, ColumnLoads, ColumnProfile, MeasureWindow};
 
 /// Simulated seconds between two VTK frames.
 const VTK_INTERVAL: f64 = 0.02;
@@ -435,12 +435,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 .flag("janssen_fit_uses_tau_w", o.uses_tau_w)
                 .int(
                     "tau_w_negative_bins",
-                    profile
-                        .z
-                        .iter()
-                        .zip(&profile.tau_w)
-                        .filter(|(z, t)| **z >= window.0 && **z <= window.1 && **t < 0.0)
-                        .count() as u64,
+                    profile.negative_tau_w(window).len() as u64,
                 );
             let law = CalibratedLaw::from_janssen(
                 f,
@@ -613,25 +608,20 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
 /// measured state, reported with the fit rather than as a warning: the fit to σ_v and σ_h
 /// still separates K (σ_h = K σ_v) and μ_w (the curvature of σ_v), and its checks are the same.
 fn fit_data_line(profile: &ColumnProfile, window: (f64, f64), uses_tau_w: bool) -> String {
-    let in_window: Vec<(f64, f64)> = profile
+    let n = profile
         .z
         .iter()
-        .zip(&profile.tau_w)
-        .filter(|(z, _)| **z >= window.0 && **z <= window.1)
-        .map(|(z, t)| (*z, *t))
-        .collect();
-    let n = in_window.len();
+        .filter(|z| **z >= window.0 && **z <= window.1)
+        .count();
     if uses_tau_w {
         return format!("fitted to σ_v, σ_h and τ_w in {n} depth bins");
     }
-    let negative: Vec<String> = in_window
+    let negative = profile.negative_tau_w(window);
+    let (lo, hi) = profile
+        .z
         .iter()
-        .filter(|(_, t)| *t < 0.0)
-        .map(|(z, t)| format!("{t:.0} Pa at z = {:.1} mm", z * 1e3))
-        .collect();
-    let (lo, hi) = in_window
-        .iter()
-        .filter(|(_, t)| *t >= 0.0)
+        .zip(&profile.tau_w)
+        .filter(|(z, t)| **z >= window.0 && **z <= window.1 && **t >= 0.0)
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, t)| {
             (a.min(*t), b.max(*t))
         });
@@ -640,6 +630,10 @@ fn fit_data_line(profile: &ColumnProfile, window: (f64, f64), uses_tau_w: bool) 
     } else {
         String::new()
     };
+    let named: Vec<String> = negative
+        .iter()
+        .map(|(z, t)| format!("{t:.0} Pa at z = {:.1} mm", z * 1e3))
+        .collect();
     format!(
         "fitted to σ_v and σ_h in {n} depth bins; τ_w left out, < 0 in {} ({}{others})",
         if negative.len() == 1 {
@@ -647,6 +641,6 @@ fn fit_data_line(profile: &ColumnProfile, window: (f64, f64), uses_tau_w: bool) 
         } else {
             format!("{} bins", negative.len())
         },
-        negative.join(", ")
+        named.join(", ")
     )
 }
