@@ -17,7 +17,7 @@
 
 use rayon::prelude::*;
 
-use crate::parallel::MIN_CHUNKS_PER_TASK;
+use crate::parallel::{runs_inline, MIN_CHUNKS_PER_TASK};
 
 /// Anderson acceleration state for vectors of a fixed length.
 #[derive(Debug, Clone)]
@@ -138,36 +138,57 @@ impl Anderson {
         partials.resize(self.len.div_ceil(CHUNK) * 2 * m, 0.0);
         {
             let (df, old) = (&self.df, &old);
-            dfj.par_chunks_mut(CHUNK)
-                .zip(dgj.par_chunks_mut(CHUNK))
-                .zip(self.f_prev.par_chunks_mut(CHUNK))
-                .zip(self.g_prev.par_chunks_mut(CHUNK))
-                .zip(partials.par_chunks_mut(2 * m))
-                .with_min_len(MIN_CHUNKS_PER_TASK)
-                .enumerate()
-                .for_each(|(ci, ((((dfc, dgc), fpc), gpc), part))| {
-                    let r = ci * CHUNK..ci * CHUNK + dfc.len();
-                    for ((((dfi, dgi), (&gi, &xi)), fp), gp) in dfc
-                        .iter_mut()
-                        .zip(dgc.iter_mut())
-                        .zip(g[r.clone()].iter().zip(&x[r.clone()]))
-                        .zip(fpc.iter_mut())
-                        .zip(gpc.iter_mut())
-                    {
-                        let f = gi - xi;
-                        *dfi = f - *fp;
-                        *dgi = gi - *gp;
-                        *fp = f;
-                        *gp = gi;
-                    }
-                    part[j] = dot(dfc, dfc);
-                    part[m + j] = dot(dfc, fpc);
-                    for &k in old {
-                        let dk = &df[k][r.clone()];
-                        part[k] = dot(dfc, dk);
-                        part[m + k] = dot(dk, fpc);
-                    }
-                });
+            type Item<'v> = (
+                usize,
+                (
+                    (
+                        ((&'v mut [f64], &'v mut [f64]), &'v mut [f64]),
+                        &'v mut [f64],
+                    ),
+                    &'v mut [f64],
+                ),
+            );
+            let pass = |(ci, ((((dfc, dgc), fpc), gpc), part)): Item| {
+                let r = ci * CHUNK..ci * CHUNK + dfc.len();
+                for ((((dfi, dgi), (&gi, &xi)), fp), gp) in dfc
+                    .iter_mut()
+                    .zip(dgc.iter_mut())
+                    .zip(g[r.clone()].iter().zip(&x[r.clone()]))
+                    .zip(fpc.iter_mut())
+                    .zip(gpc.iter_mut())
+                {
+                    let f = gi - xi;
+                    *dfi = f - *fp;
+                    *dgi = gi - *gp;
+                    *fp = f;
+                    *gp = gi;
+                }
+                part[j] = dot(dfc, dfc);
+                part[m + j] = dot(dfc, fpc);
+                for &k in old {
+                    let dk = &df[k][r.clone()];
+                    part[k] = dot(dfc, dk);
+                    part[m + k] = dot(dk, fpc);
+                }
+            };
+            if runs_inline(self.len.div_ceil(CHUNK)) {
+                dfj.chunks_mut(CHUNK)
+                    .zip(dgj.chunks_mut(CHUNK))
+                    .zip(self.f_prev.chunks_mut(CHUNK))
+                    .zip(self.g_prev.chunks_mut(CHUNK))
+                    .zip(partials.chunks_mut(2 * m))
+                    .enumerate()
+                    .for_each(pass);
+            } else {
+                dfj.par_chunks_mut(CHUNK)
+                    .zip(dgj.par_chunks_mut(CHUNK))
+                    .zip(self.f_prev.par_chunks_mut(CHUNK))
+                    .zip(self.g_prev.par_chunks_mut(CHUNK))
+                    .zip(partials.par_chunks_mut(2 * m))
+                    .with_min_len(MIN_CHUNKS_PER_TASK)
+                    .enumerate()
+                    .for_each(pass);
+            }
         }
         // Partial sums added in chunk order: the same bits on any number of threads.
         gram_j.iter_mut().for_each(|v| *v = 0.0);
@@ -217,18 +238,23 @@ impl Anderson {
         slots.clear();
         slots.extend((0..c).map(|p| self.slot(p)));
         let (dg, gamma) = (&self.dg, &self.b[..c]);
-        g.par_chunks_mut(CHUNK)
-            .with_min_len(MIN_CHUNKS_PER_TASK)
-            .enumerate()
-            .for_each(|(ci, gc)| {
-                let start = ci * CHUNK;
-                for (p, &gam) in gamma.iter().enumerate() {
-                    let dgp = &dg[slots[p]][start..start + gc.len()];
-                    for (gi, &a) in gc.iter_mut().zip(dgp) {
-                        *gi -= gam * a;
-                    }
+        let combine = |(ci, gc): (usize, &mut [f64])| {
+            let start = ci * CHUNK;
+            for (p, &gam) in gamma.iter().enumerate() {
+                let dgp = &dg[slots[p]][start..start + gc.len()];
+                for (gi, &a) in gc.iter_mut().zip(dgp) {
+                    *gi -= gam * a;
                 }
-            });
+            }
+        };
+        if runs_inline(self.len.div_ceil(CHUNK)) {
+            g.chunks_mut(CHUNK).enumerate().for_each(combine);
+        } else {
+            g.par_chunks_mut(CHUNK)
+                .with_min_len(MIN_CHUNKS_PER_TASK)
+                .enumerate()
+                .for_each(combine);
+        }
         self.slots = slots;
     }
 

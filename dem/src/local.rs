@@ -148,7 +148,7 @@ pub fn natural_map_residual(r: [f64; 2], u: [f64; 2], mu: f64) -> [f64; 2] {
 ///
 /// If rounding leaves no candidate valid (only possible for nearly singular blocks with large
 /// `W_nt`), the iterated predictor–corrector [`solve_local_uzawa`] is used. Cost: O(1).
-#[inline]
+#[inline(always)]
 pub fn solve_local(w: &Delassus2, q: [f64; 2], mu: f64) -> ([f64; 2], ContactStatus) {
     let [qn, qt] = q;
     if qn >= 0.0 {

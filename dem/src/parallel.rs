@@ -22,8 +22,21 @@ use crate::local::{project_on_cone, solve_local};
 pub const CHUNK: usize = 1024;
 /// Fewest chunks per parallel task of the chunked passes: below `2 × 4 × CHUNK` contacts a pass
 /// runs on the calling thread (the same partial sums in the same order, so the same bits),
-/// where forking would cost more than the pass.
+/// where forking would cost more than the pass ([`runs_inline`]).
 pub const MIN_CHUNKS_PER_TASK: usize = 4;
+
+/// Whether a chunked pass of `chunks` chunks runs as a plain loop on the calling thread: when
+/// it is one task's worth (fewer than `2 ×` [`MIN_CHUNKS_PER_TASK`] chunks, which rayon would
+/// not split either) or the pool has one thread. Handing such a pass to rayon from a thread
+/// outside its pool (the main thread of a run) is not free even when it makes one task: the job
+/// is injected into the pool, a worker is woken to run it and the caller sleeps until it is
+/// done, a round trip of microseconds per pass. Measured on the poured 2000-grain column
+/// (about 4000 contacts, 6 such passes per sweep): 16 % of the run. The chunks and the order in
+/// which their partial results are combined are the same either way, so are the bits.
+#[inline]
+pub fn runs_inline(chunks: usize) -> bool {
+    chunks < 2 * MIN_CHUNKS_PER_TASK || rayon::current_num_threads() == 1
+}
 /// Fewest contacts per parallel task inside a colour class (rayon splits adaptively above).
 pub const TASK: usize = 256;
 /// Classes with fewer contacts than this are swept on the calling thread (the same numbers, no
@@ -187,10 +200,7 @@ pub fn scatter_velocities(
         rows.len(),
         "colouring of other rows"
     );
-    vel.par_chunks_mut(CHUNK)
-        .zip(v_free.par_chunks(CHUNK))
-        .with_min_len(MIN_CHUNKS_PER_TASK)
-        .for_each(|(v, f)| v.copy_from_slice(f));
+    vel.copy_from_slice(v_free);
     let pv = Shared(vel.as_mut_ptr());
     let n_rows = rows.len();
     for_each_coloured(colouring, |i| {
@@ -219,9 +229,16 @@ pub fn scatter_velocities(
 
 /// `max_α f(α)` over the contacts, chunk by chunk on the rayon pool (−∞ when there is none).
 pub fn max_over(rows: &[ContactRow], f: impl Fn(&ContactRow) -> f64 + Sync) -> f64 {
+    let chunk_max = |ch: &[ContactRow]| ch.iter().map(&f).fold(f64::NEG_INFINITY, f64::max);
+    if runs_inline(rows.len().div_ceil(CHUNK)) {
+        return rows
+            .chunks(CHUNK)
+            .map(chunk_max)
+            .fold(f64::NEG_INFINITY, f64::max);
+    }
     rows.par_chunks(CHUNK)
         .with_min_len(MIN_CHUNKS_PER_TASK)
-        .map(|ch| ch.iter().map(&f).fold(f64::NEG_INFINITY, f64::max))
+        .map(chunk_max)
         .reduce(|| f64::NEG_INFINITY, f64::max)
 }
 
@@ -244,6 +261,12 @@ pub fn reduce_chunks<const N: usize>(
     let mut total = [0.0; N];
     if rows.len() <= CHUNK {
         total = partial(rows);
+    } else if runs_inline(rows.len().div_ceil(CHUNK)) {
+        for p in rows.chunks(CHUNK).map(partial) {
+            for k in 0..N {
+                total[k] += p[k];
+            }
+        }
     } else {
         let parts: Vec<[f64; N]> = rows
             .par_chunks(CHUNK)

@@ -43,7 +43,7 @@ use crate::fc::FcOptions;
 use crate::local::{natural_map_residual, ContactStatus};
 use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
 use crate::parallel::{
-    coloured_sweep, local_update, max_over, reduce_chunks, scatter_velocities, CHUNK,
+    coloured_sweep, local_update, max_over, reduce_chunks, runs_inline, scatter_velocities, CHUNK,
     MIN_CHUNKS_PER_TASK,
 };
 
@@ -764,16 +764,24 @@ impl SweepProblem for Step<'_> {
 
     /// `x ← (r_α)` flattened, in parallel over fixed chunks.
     fn save(&self, x: &mut [f64]) {
-        self.rows
-            .par_chunks(CHUNK)
-            .zip(x.par_chunks_mut(2 * CHUNK))
-            .with_min_len(MIN_CHUNKS_PER_TASK)
-            .for_each(|(rs, x)| {
-                for (c, x) in rs.iter().zip(x.chunks_exact_mut(2)) {
-                    x[0] = c.r[0];
-                    x[1] = c.r[1];
-                }
-            });
+        let copy = |(rs, x): (&[ContactRow], &mut [f64])| {
+            for (c, x) in rs.iter().zip(x.chunks_exact_mut(2)) {
+                x[0] = c.r[0];
+                x[1] = c.r[1];
+            }
+        };
+        if runs_inline(self.rows.len().div_ceil(CHUNK)) {
+            self.rows
+                .chunks(CHUNK)
+                .zip(x.chunks_mut(2 * CHUNK))
+                .for_each(copy);
+        } else {
+            self.rows
+                .par_chunks(CHUNK)
+                .zip(x.par_chunks_mut(2 * CHUNK))
+                .with_min_len(MIN_CHUNKS_PER_TASK)
+                .for_each(copy);
+        }
     }
 
     /// `(r_α) ← x`, then the velocities rebuilt (O(N)).
@@ -794,15 +802,23 @@ impl SweepProblem for Step<'_> {
             }
             return;
         }
-        self.rows
-            .par_chunks_mut(CHUNK)
-            .zip(x.par_chunks(2 * CHUNK))
-            .with_min_len(MIN_CHUNKS_PER_TASK)
-            .for_each(|(rs, x)| {
-                for (c, r) in rs.iter_mut().zip(x.chunks_exact(2)) {
-                    c.r = [r[0], r[1]];
-                }
-            });
+        let copy = |(rs, x): (&mut [ContactRow], &[f64])| {
+            for (c, r) in rs.iter_mut().zip(x.chunks_exact(2)) {
+                c.r = [r[0], r[1]];
+            }
+        };
+        if runs_inline(self.rows.len().div_ceil(CHUNK)) {
+            self.rows
+                .chunks_mut(CHUNK)
+                .zip(x.chunks(2 * CHUNK))
+                .for_each(copy);
+        } else {
+            self.rows
+                .par_chunks_mut(CHUNK)
+                .zip(x.par_chunks(2 * CHUNK))
+                .with_min_len(MIN_CHUNKS_PER_TASK)
+                .for_each(copy);
+        }
         self.rebuild();
     }
 
