@@ -39,6 +39,8 @@ pub struct BenchPlan {
     pub columns: Vec<usize>,
     /// Grain counts of poured columns.
     pub pour: Vec<usize>,
+    /// Seeds `1..=seeds` of the deposited and poured columns.
+    pub seeds: u64,
     /// Steps that relax each engine deposit before the timed steps.
     pub relax_steps: usize,
     /// Grain counts of the read-and-homogenise rows (synthetic LAMMPS dumps); none by default.
@@ -212,9 +214,10 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         ),
     }
     println!(
-        "{:>7} {:>8} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9} {:>14} {:>9}",
+        "{:>7} {:>8} {:>4} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9} {:>14} {:>9}",
         "grains",
         "prepare",
+        "seed",
         "steps",
         "sweeps",
         "capped",
@@ -227,53 +230,96 @@ fn columns(plan: &BenchPlan) -> Result<()> {
     );
     for (n, prep) in jobs {
         let run = ColumnRun::for_column(prep, n);
-        let r = settle_column(n, prep, &run, 1)?;
-        let total = r.total_seconds();
-        let peer = match &lammps {
-            Some(lmp) => {
-                let w = datasets::benchmarks::janssen_column(n, prep, &run, 1)?;
-                let column =
-                    crate::lammps_peer::PeerColumn::from_world(&w, 1e-8, run.max_time, wall_limit)?;
-                let dir = std::env::temp_dir().join(format!(
-                    "grainlaw-lammps-{}-{n}-{prep:?}",
-                    std::process::id()
-                ));
-                Some((crate::lammps_peer::run(lmp, &column, &dir)?, column))
-            }
-            None => None,
-        };
-        let (reference, ratio) = peer_cells(peer.as_ref().map(|p| &p.0), n, total);
-        println!(
-            "{:>7} {:>8} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
-            n,
-            match prep {
-                Preparation::Pour => "pour",
-                Preparation::Deposit => "deposit",
-            },
-            r.settle.steps,
-            r.settle.mean_sweeps,
-            r.settle.unconverged_steps,
-            r.final_overlap_ratio,
-            r.solid_fraction,
-            {
-                let [lo, hi] = r.settle.dt_range;
-                if lo < hi {
-                    format!("{:.3}–{:.2}", lo * 1e3, hi * 1e3)
-                } else {
-                    format!("{:.2}", lo * 1e3)
+        // Over the seeds: grainlaw's seconds, and LAMMPS' where every peer run settled.
+        let (mut ours, mut theirs, mut all_settled, mut capped) = (0.0, Some(0.0), true, 0);
+        for seed in 1..=plan.seeds.max(1) {
+            let r = settle_column(n, prep, &run, seed)?;
+            let total = r.total_seconds();
+            let peer = match &lammps {
+                Some(lmp) => {
+                    let w = datasets::benchmarks::janssen_column(n, prep, &run, seed)?;
+                    let column = crate::lammps_peer::PeerColumn::from_world(
+                        &w,
+                        1e-8,
+                        run.max_time,
+                        wall_limit,
+                    )?;
+                    let dir = std::env::temp_dir().join(format!(
+                        "grainlaw-lammps-{}-{n}-{prep:?}-{seed}",
+                        std::process::id()
+                    ));
+                    Some((crate::lammps_peer::run(lmp, &column, &dir)?, column))
                 }
-            },
-            total,
-            reference,
-            ratio,
-            if r.settle.settled {
-                ""
-            } else {
-                "  NOT settled"
+                None => None,
+            };
+            ours += total;
+            all_settled &= r.settle.settled;
+            capped += r.settle.unconverged_steps;
+            theirs = match (theirs, peer.as_ref().map(|p| &p.0)) {
+                (Some(t), Some(crate::lammps_peer::PeerOutcome::Ran(p))) if p.settled => {
+                    Some(t + p.wall_seconds)
+                }
+                _ => None,
+            };
+            let (reference, ratio) = peer_cells(peer.as_ref().map(|p| &p.0), n, total);
+            println!(
+                "{:>7} {:>8} {:>4} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
+                n,
+                match prep {
+                    Preparation::Pour => "pour",
+                    Preparation::Deposit => "deposit",
+                },
+                seed,
+                r.settle.steps,
+                r.settle.mean_sweeps,
+                r.settle.unconverged_steps,
+                r.final_overlap_ratio,
+                r.solid_fraction,
+                {
+                    let [lo, hi] = r.settle.dt_range;
+                    if lo < hi {
+                        format!("{:.3}–{:.2}", lo * 1e3, hi * 1e3)
+                    } else {
+                        format!("{:.2}", lo * 1e3)
+                    }
+                },
+                total,
+                reference,
+                ratio,
+                if r.settle.settled {
+                    ""
+                } else {
+                    "  NOT settled"
+                }
+            );
+            if let Some((p, column)) = &peer {
+                peer_line(p, column);
             }
-        );
-        if let Some((p, column)) = &peer {
-            peer_line(p, column);
+        }
+        if plan.seeds > 1 {
+            let (reference, ratio) = match theirs {
+                Some(t) if lammps.is_some() => (format!("{t:.1}"), format!("{:.3}", ours / t)),
+                _ => ("–".into(), "–".into()),
+            };
+            println!(
+                "{:>7} {:>8} {:>4} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9.2} {:>14} {:>9}{}",
+                n,
+                match prep {
+                    Preparation::Pour => "pour",
+                    Preparation::Deposit => "deposit",
+                },
+                format!("1–{}", plan.seeds),
+                "",
+                "",
+                capped,
+                "",
+                "",
+                "total",
+                ours,
+                reference,
+                ratio,
+                if all_settled { "" } else { "  NOT all settled" }
+            );
         }
     }
     println!(

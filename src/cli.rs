@@ -129,6 +129,11 @@ pub enum Command {
         /// Grain counts of the poured Janssen columns (slower); none by default.
         #[arg(long, value_name = "N", num_args = 0..)]
         pour: Vec<usize>,
+        /// Seeds of the deposited and poured columns: 1 to K, each run by grainlaw and by the
+        /// LAMMPS peer, with the totals (the time to settle follows the grains' chaotic
+        /// trajectory: a single seed's ratio moves by tens of percent).
+        #[arg(long, value_name = "K", default_value_t = 1)]
+        seeds: u64,
         /// Steps relaxing each engine deposit before the timed steps.
         #[arg(long, value_name = "STEPS", default_value_t = 30)]
         relax_steps: usize,
@@ -365,6 +370,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             threads,
             columns,
             pour,
+            seeds,
             relax_steps,
             homogenise_grains,
             biaxial_grains,
@@ -376,6 +382,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             threads,
             columns,
             pour,
+            seeds,
             relax_steps,
             homogenise_grains,
             biaxial_grains,

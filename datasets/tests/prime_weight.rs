@@ -14,6 +14,7 @@ fn column(n: usize, seed: u64) -> dem::World {
         prime: false,
         max_time: 1.0,
         max_halvings: 0,
+        check_every: 0,
     };
     janssen_column(n, Preparation::Deposit, &run, seed).unwrap()
 }

@@ -774,6 +774,15 @@ impl World {
                 format!("must be at most 64, got {}", p.solver.anderson_memory),
             ));
         }
+        if !(1..=1000).contains(&p.solver.last_level_sweeps) {
+            return Err(perr(
+                "solver.last_level_sweeps",
+                format!(
+                    "must lie in 1..=1000 (multiples of max_iterations), got {}",
+                    p.solver.last_level_sweeps
+                ),
+            ));
+        }
         for &mu in self.laws.friction_table() {
             if !(mu.is_finite() && mu >= 0.0) {
                 return Err(perr("friction", format!("must be ≥ 0, got {mu}")));

@@ -194,6 +194,14 @@ fn validation_rejects_bad_worlds() {
     assert!(
         matches!(w.validate(1e-9), Err(DemError::Parameter { ref name, .. }) if name == "friction")
     );
+    // A last-level sweep budget of 0 or beyond 1000 times the cap.
+    for bad in [0, 1001] {
+        let mut w = base();
+        w.params.solver.last_level_sweeps = bad;
+        assert!(
+            matches!(w.validate(1e-9), Err(DemError::Parameter { ref name, .. }) if name == "solver.last_level_sweeps")
+        );
+    }
     // A valid world passes.
     let mut w = base();
     w.add_grain(Vector2::new(0.0, 0.02), 0.01, 2500.0, 0);

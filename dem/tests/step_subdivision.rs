@@ -272,3 +272,40 @@ fn a_world_returned_to_its_undo_point_steps_as_a_clone() {
     }
     assert_eq!(state_json(&w), state_json(&reference));
 }
+
+/// `last_level_sweeps`: with Gauss–Seidel capped at 3 sweeps, a step of the settled box does
+/// not converge whole nor in two halves; given 100 times the cap at the largest subdivision
+/// (the halves), its sub-steps converge there, the whole-step attempt still stops at 3 sweeps,
+/// and the solver settings are the run's again afterwards. Without it, the halves are kept
+/// unconverged at 3 sweeps each.
+#[test]
+fn the_largest_subdivision_may_sweep_a_multiple_of_the_cap() {
+    let mut base = settled_box();
+    base.params.solver.method = dem::solver::SolverMethod::Nlgs;
+    base.params.solver.max_iterations = 3;
+    base.params.solver.max_halvings = 1;
+    let mut capped = base.clone();
+    let s = step_subdivided(&mut capped, &mut Subdivision::default()).unwrap();
+    assert_eq!((s.halvings, s.substeps.len()), (1, 2));
+    assert!(!s.report.solver.converged, "{:?}", s.report.solver);
+    assert!(s.substeps.iter().all(|k| k.report.solver.iterations <= 3));
+
+    let mut w = base.clone();
+    w.params.solver.last_level_sweeps = 100;
+    let params = w.params;
+    let s = step_subdivided(&mut w, &mut Subdivision::default()).unwrap();
+    assert_eq!((s.halvings, s.substeps.len(), s.retries), (1, 2, 1));
+    assert!(s.report.solver.converged, "{:?}", s.report.solver);
+    assert!(s.report.solver.error <= 1e-6);
+    assert!(s.discarded_sweeps <= 3, "{}", s.discarded_sweeps);
+    let kept: Vec<usize> = s
+        .substeps
+        .iter()
+        .map(|k| k.report.solver.iterations)
+        .collect();
+    assert!(
+        kept.iter().any(|&n| n > 3) && kept.iter().all(|&n| n <= 300),
+        "{kept:?}"
+    );
+    assert_eq!(w.params, params);
+}
