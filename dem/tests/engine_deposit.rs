@@ -2,6 +2,15 @@
 
 mod common;
 
+/// The energy scale `Σ m g d` of the grains (J per metre).
+fn energy_scale(w: &dem::World) -> f64 {
+    w.bodies
+        .iter()
+        .filter(|b| b.mass.is_finite())
+        .map(|b| b.mass * 9.81 * 2.0 * b.radius)
+        .sum()
+}
+
 /// Total mechanical energy (kinetic + gravitational) never increases in an undriven deposit of
 /// 200 random disks. With θ = 1 the exact scheme dissipates `−R·u⁺ + ½‖v⁺ − v⁻‖²_M ≥ 0` per
 /// step; with θ = 1/2 free flight is exact and an inelastic contact dissipates. An inexact
@@ -18,12 +27,7 @@ fn energy_never_increases(theta: f64, allowance: f64) {
     w.params.solver.tolerance = 1e-6;
     w.params.solver.max_iterations = 5_000;
     w.validate(1e-12).unwrap();
-    let scale = w
-        .bodies
-        .iter()
-        .filter(|b| b.mass.is_finite())
-        .map(|b| b.mass * 9.81 * 2.0 * b.radius)
-        .sum::<f64>();
+    let scale = energy_scale(&w);
     let e0 = w.kinetic_energy() + w.potential_energy();
     let mut e_prev = e0;
     let mut worst = f64::MIN;
@@ -112,12 +116,7 @@ fn predicted_error_checks_keep_every_step_converged() {
         w.params.solver.max_iterations = 5_000;
         w.params.solver.method = dem::solver::SolverMethod::Nlgs;
         w.params.solver.check_every = check_every;
-        let scale = w
-            .bodies
-            .iter()
-            .filter(|b| b.mass.is_finite())
-            .map(|b| b.mass * 9.81 * 2.0 * b.radius)
-            .sum::<f64>();
+        let scale = energy_scale(&w);
         let (mut sweeps, mut worst, mut unconverged) = (0, f64::MIN, 0);
         let mut e_prev = w.kinetic_energy() + w.potential_energy();
         for _ in 0..800 {
