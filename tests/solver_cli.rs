@@ -48,6 +48,9 @@ fn bad_solver_settings_are_refused_with_the_key() {
         ("solver.max_iterations=0", "solver.max_iterations"),
         ("solver.max_halvings=11", "solver.max_halvings"),
         ("solver.max_halvings=-1", "solver.max_halvings"),
+        ("solver.check_every=1001", "solver.check_every"),
+        ("solver.last_level_sweeps=0", "solver.last_level_sweeps"),
+        ("solver.last_level_sweeps=1001", "solver.last_level_sweeps"),
     ] {
         let o = grainlaw(&["run", "shear-cell", "--out", "x", "--set", set], d);
         refused(&o, key);

@@ -805,7 +805,7 @@ impl Step<'_> {
 /// without an error evaluation, between which the error is evaluated only when the sweeps'
 /// change predicts convergence. An evaluation costs about two thirds of a sweep; after every
 /// sweep, as the growing schedule does for the first twenty, the evaluations took 24 % of the
-/// poured 2000-grain column's run (most solves end within 20 sweeps), 10 % with this schedule
+/// poured 2000-grain column's run (most solves end within 20 sweeps), 11 % with this schedule
 /// (6 seeds: 15 % less time in all, with the copies of the Anderson mixing made by the sweep).
 /// Not the default: the scenarios' trajectories, validated with the growing schedule, would
 /// change (the Janssen main job's default column then settles into a state its checks refuse,

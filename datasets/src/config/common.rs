@@ -141,6 +141,19 @@ pub struct SolverSpec {
     /// in 0..=10. Default [`DEFAULT_MAX_HALVINGS`].
     #[serde(default = "default_max_halvings")]
     pub max_halvings: u32,
+    /// When the error is evaluated ([`dem::SolverParams::check_every`]): 0 (default) after each
+    /// of a solve's first twenty sweeps, then sparser; `N` in 1..=1000, where the sweeps'
+    /// measured change predicts convergence and at least every `N` sweeps (natural order).
+    #[serde(default)]
+    pub check_every: usize,
+    /// With `method = "nlgs"`, the sweep cap at the largest subdivision in multiples of
+    /// `max_iterations` ([`dem::SolverParams::last_level_sweeps`]), in 1..=1000. Default 1.
+    #[serde(default = "one")]
+    pub last_level_sweeps: usize,
+}
+
+fn one() -> usize {
+    1
 }
 
 /// Default of [`SolverSpec::max_halvings`]: up to 8 sub-steps.
@@ -151,7 +164,8 @@ fn default_max_halvings() -> u32 {
 }
 
 impl SolverSpec {
-    /// Checks `0 < tolerance < 1` and `max_iterations ≥ 1`.
+    /// Checks `0 < tolerance < 1`, `max_iterations ≥ 1`, `max_halvings ≤ 10`,
+    /// `check_every ≤ 1000` and `1 ≤ last_level_sweeps ≤ 1000`.
     pub fn validate(&self, prefix: &str) -> Result<()> {
         in_range(
             &format!("{prefix}.tolerance"),
@@ -165,6 +179,17 @@ impl SolverSpec {
             self.max_halvings as usize,
             10,
         )?;
+        limits::at_most(&format!("{prefix}.check_every"), self.check_every, 1000)?;
+        at_least(
+            &format!("{prefix}.last_level_sweeps"),
+            self.last_level_sweeps,
+            1,
+        )?;
+        limits::at_most(
+            &format!("{prefix}.last_level_sweeps"),
+            self.last_level_sweeps,
+            1000,
+        )?;
         Ok(())
     }
 
@@ -177,6 +202,8 @@ impl SolverSpec {
             method: self.method,
             lemke_max_contacts: self.lemke_max_contacts,
             max_halvings: self.max_halvings,
+            check_every: self.check_every,
+            last_level_sweeps: self.last_level_sweeps,
             ..Default::default()
         }
     }
