@@ -186,6 +186,14 @@ fn peer_line(peer: &crate::lammps_peer::PeerOutcome, column: &crate::lammps_peer
     }
 }
 
+/// The column table's name of a preparation.
+fn preparation_name(prep: Preparation) -> &'static str {
+    match prep {
+        Preparation::Pour => "pour",
+        Preparation::Deposit => "deposit",
+    }
+}
+
 fn columns(plan: &BenchPlan) -> Result<()> {
     let jobs: Vec<(usize, Preparation)> = plan
         .columns
@@ -265,10 +273,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
             println!(
                 "{:>7} {:>8} {:>4} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
                 n,
-                match prep {
-                    Preparation::Pour => "pour",
-                    Preparation::Deposit => "deposit",
-                },
+                preparation_name(prep),
                 seed,
                 r.settle.steps,
                 r.settle.mean_sweeps,
@@ -304,10 +309,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
             println!(
                 "{:>7} {:>8} {:>4} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9.2} {:>14} {:>9}{}",
                 n,
-                match prep {
-                    Preparation::Pour => "pour",
-                    Preparation::Deposit => "deposit",
-                },
+                preparation_name(prep),
                 format!("1–{}", plan.seeds),
                 "",
                 "",

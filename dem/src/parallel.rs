@@ -30,9 +30,9 @@ pub const MIN_CHUNKS_PER_TASK: usize = 4;
 /// not split either) or the pool has one thread. Handing such a pass to rayon from a thread
 /// outside its pool (the main thread of a run) is not free even when it makes one task: the job
 /// is injected into the pool, a worker is woken to run it and the caller sleeps until it is
-/// done, a round trip of microseconds per pass. Measured on the poured 2000-grain column
-/// (about 4000 contacts, 6 such passes per sweep): 16 % of the run. The chunks and the order in
-/// which their partial results are combined are the same either way, so are the bits.
+/// done, a round trip of microseconds per pass (a step that forks runs on a worker instead,
+/// `World::step`). The chunks and the order in which their partial results are combined are the
+/// same either way, so are the bits.
 #[inline]
 pub fn runs_inline(chunks: usize) -> bool {
     chunks < 2 * MIN_CHUNKS_PER_TASK || rayon::current_num_threads() == 1

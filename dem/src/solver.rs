@@ -340,21 +340,10 @@ pub fn sweep(
     }
 }
 
-/// [`sweep`], measuring the change it makes: returns `(Σ_α ‖Δr_α‖², Σ_α ‖r_α‖²)` over the
-/// sweep (the new impulses), the same impulses and velocities as [`sweep`] bit for bit.
-#[inline]
-pub fn sweep_measured(
-    rows: &mut [ContactRow],
-    order: &[u32],
-    vel: &mut [[f64; 3]],
-    inv: &[[f64; 3]],
-    omega: f64,
-) -> (f64, f64) {
-    sweep_recorded(rows, order, vel, inv, omega, |_, _, _| {})
-}
-
-/// [`sweep_measured`], handing `record(α, r_before, r_after)` each contact's impulses as it
-/// goes (the drive's copies before and after a sweep, without two more passes).
+/// [`sweep`] (the same impulses and velocities, bit for bit), handing `record(α, r_before,
+/// r_after)` each contact's impulses as it goes (the drive's copies before and after a sweep,
+/// without two more passes) and returning `(Σ_α ‖Δr_α‖², Σ_α ‖r_α‖²)` over the sweep (the
+/// new impulses): the change that [`SolverParams::check_every`] predicts from.
 #[inline(always)]
 fn sweep_recorded(
     rows: &mut [ContactRow],
@@ -375,6 +364,11 @@ fn sweep_recorded(
         r2 += c.r[0] * c.r[0] + c.r[1] * c.r[1];
     }
     (d2, r2)
+}
+
+/// `‖Δr‖ / ‖r‖` from the sums of [`sweep_recorded`].
+fn relative_change((d2, r2): (f64, f64)) -> f64 {
+    d2.sqrt() / r2.sqrt().max(f64::MIN_POSITIVE)
 }
 
 /// Plain sweeps before Anderson mixing starts (easy, warm-started steps never pay for it).
@@ -501,6 +495,7 @@ pub fn solve(
         omega: params.relaxation,
         seed: SHUFFLE_SEED,
         cell,
+        measure: false,
     };
     let report = solve_step(&mut step, params, work);
     if let Some(c) = step.cell.as_deref_mut() {
@@ -775,6 +770,9 @@ struct Step<'a> {
     seed: u64,
     /// The cell's stress-controlled components as unknowns, if any ([`crate::cell_coupling`]).
     cell: Option<&'a mut CellCoupling>,
+    /// Whether the sweeps measure their change (set by [`nlgs`]: `check_every ≥ 1` and
+    /// [`Step::can_measure`]); otherwise the contact loop does no more than [`sweep`]'s.
+    measure: bool,
 }
 
 impl Step<'_> {
@@ -795,8 +793,8 @@ impl Step<'_> {
         approach_speed(self.rows, self.vel)
     }
 
-    /// Whether [`SweepProblem::sweep`] measures its change (natural order, no coupled cell).
-    fn measures_sweeps(&self) -> bool {
+    /// Whether the sweeps can measure their change (natural order, no coupled cell).
+    fn can_measure(&self) -> bool {
         matches!((&self.order, &self.cell), (SweepOrder::Natural(_), None))
     }
 }
@@ -817,17 +815,23 @@ impl SweepProblem for Step<'_> {
         2 * self.rows.len()
     }
 
-    /// The relative change `‖Δr‖ / ‖r‖` of a sweep in natural order (measured as it goes, for
-    /// the check schedule of [`nlgs`]); `None` for the colour-ordered and the coupled sweeps.
+    /// The relative change `‖Δr‖ / ‖r‖` of the sweep when [`Step::measure`] (measured as it
+    /// goes, for the check schedule of [`nlgs`]); `None` otherwise.
     fn sweep(&mut self) -> Option<f64> {
         match (self.cell.as_deref_mut(), &mut self.order) {
             (Some(cell), SweepOrder::Natural(order)) => {
                 cell.sweep(self.rows, order, self.vel, self.inv, self.omega);
                 None
             }
-            (None, SweepOrder::Natural(order)) => {
-                let (d2, r2) = sweep_measured(self.rows, order, self.vel, self.inv, self.omega);
-                Some(d2.sqrt() / r2.sqrt().max(f64::MIN_POSITIVE))
+            (None, SweepOrder::Natural(order)) if self.measure => {
+                Some(relative_change(sweep_recorded(
+                    self.rows,
+                    order,
+                    self.vel,
+                    self.inv,
+                    self.omega,
+                    |_, _, _| {},
+                )))
             }
             (cell, order) => {
                 debug_assert!(cell.is_none(), "a coupled step is swept on one thread");
@@ -845,7 +849,7 @@ impl SweepProblem for Step<'_> {
             self.save(after);
             return change;
         };
-        let (d2, r2) = sweep_recorded(
+        let sums = sweep_recorded(
             self.rows,
             order,
             self.vel,
@@ -858,7 +862,7 @@ impl SweepProblem for Step<'_> {
                 after[2 * i + 1] = r1[1];
             },
         );
-        Some(d2.sqrt() / r2.sqrt().max(f64::MIN_POSITIVE))
+        self.measure.then(|| relative_change(sums))
     }
 
     fn error(&mut self) -> f64 {
@@ -1016,6 +1020,7 @@ fn nlgs(
         };
     }
     step.seed = SHUFFLE_SEED;
+    step.measure = params.check_every > 0 && step.can_measure();
     let report = drive(
         step,
         &DriveParams {
@@ -1023,7 +1028,7 @@ fn nlgs(
             max_sweeps,
             anderson_memory: params.anderson_memory,
             plain_sweeps: PLAIN_SWEEPS,
-            schedule: if params.check_every > 0 && step.measures_sweeps() {
+            schedule: if step.measure {
                 CheckSchedule::Every(params.check_every)
             } else {
                 CheckSchedule::Growing
