@@ -73,6 +73,9 @@ pub struct Detector {
     /// The change of a biperiodic cell's `L` within the step that the last detection's swept
     /// margins cover (1/s; [`Detector::detect_cell`]'s `rate_bound`, capped).
     image_rate: f64,
+    /// Detection gap `g_d ≥ 0` of the last detection that set the swept margins (m): with
+    /// them, it bounds how far a disk may travel before [`Detector::outran`] holds.
+    swept_gap: f64,
     /// Disk pairs kept between detections ([`Detector::detect`]).
     candidates: Candidates,
     /// Bin every detection on the grid instead of reusing the candidate list.
@@ -248,6 +251,7 @@ impl Detector {
     ) -> Result<(), DemError> {
         self.candidates.detections += 1;
         self.collect_disks(bodies, colliders, periodic, dt, gravity);
+        self.swept_gap = detection_gap.max(0.0);
         let nd = self.centre.len();
         let listed = !self.full_detection
             && (self.candidates_cover(periodic, detection_gap)
@@ -625,23 +629,40 @@ impl Detector {
         self.image_rate
     }
 
-    /// Whether some disk moved, over a step whose contacts the last [`Detector::detect`] found,
-    /// farther than the swept margin that detection allowed it (`displacement` per body,
-    /// `[Δx, Δy, Δθ]`): a disk kicked by a contact impulse can travel beyond the bound its
-    /// velocity and loads gave at the start of the step, and then meet a disk no contact of the
-    /// step knew about.
-    pub fn outran(&self, colliders: &[Collider], displacement: &[[f64; 3]]) -> bool {
+    /// Whether some disk may have met, over a step whose contacts the last [`Detector::detect`]
+    /// (or [`Detector::detect_cell`]) found, a disk or wall that no contact of the step knew
+    /// about: a disk kicked by a contact impulse can travel beyond the bound its velocity and
+    /// loads gave at the start of the step. `displacement` is each body's travel over the step
+    /// (`[Δx, Δy, Δθ]`) and `correction` the position correction applied after it (same layout,
+    /// empty for none).
+    ///
+    /// A pair that the detection left out had a gap `g > g_d + m_a + m_b` (`g_d` the detection
+    /// gap, `m` the swept margins), so it can only close if the two travels `δ_a + δ_b` exceed
+    /// `g_d + m_a + m_b`. The test is therefore `δ > m + g_d/2` for some disk, with
+    /// `δ = |Δx + Δx_corr| + |Δθ + Δθ_corr| ρ` (ρ the disk's offset from its body's centre):
+    /// when no disk outran, no pair unknown to the step can overlap.
+    pub fn outran(
+        &self,
+        colliders: &[Collider],
+        displacement: &[[f64; 3]],
+        correction: &[[f64; 3]],
+    ) -> bool {
+        let slack = 0.5 * self.swept_gap;
         self.disk_collider
             .iter()
             .zip(&self.margin)
             .any(|(&ci, &m)| {
                 let col = &colliders[ci as usize];
-                let d = displacement[col.body as usize];
+                let body = col.body as usize;
+                let mut d = displacement[body];
+                if let Some(c) = correction.get(body) {
+                    d = [d[0] + c[0], d[1] + c[1], d[2] + c[2]];
+                }
                 let arm = match col.shape {
                     Shape::Disk { offset, .. } => offset.norm(),
                     _ => 0.0,
                 };
-                d[0].hypot(d[1]) + d[2].abs() * arm > m
+                (d[0] * d[0] + d[1] * d[1]).sqrt() + d[2].abs() * arm > m + slack
             })
     }
 
@@ -1033,6 +1054,7 @@ impl Detector {
         self.radius.clear();
         self.margin.clear();
         self.reduced.clear();
+        self.swept_gap = detection_gap.max(0.0);
         let inv = cell.inverse();
         let l_norm = cell.l.norm();
         let mut r_max = 0.0f64;

@@ -127,6 +127,10 @@ pub struct DriveParams {
     pub plain_sweeps: usize,
     /// When the error is evaluated.
     pub schedule: CheckSchedule,
+    /// Sweep once before the first evaluation (when `max_sweeps > 0`): for warm-started
+    /// problems that almost never meet the tolerance as they come, where an evaluation costs
+    /// about as much as a sweep. A problem that already met it then returns after one sweep.
+    pub sweep_first: bool,
 }
 
 /// Outcome of [`drive`].
@@ -290,8 +294,13 @@ pub fn drive<P: SweepProblem + ?Sized>(
     work: &mut DriveWork,
 ) -> DriveReport {
     let tol = params.tolerance;
-    let mut error = problem.error();
-    if problem.converged(error, tol) {
+    // Unknown until the first evaluation when the first sweep comes before it.
+    let mut error = if params.sweep_first && params.max_sweeps > 0 {
+        f64::INFINITY
+    } else {
+        problem.error()
+    };
+    if error.is_finite() && problem.converged(error, tol) {
         return DriveReport {
             iterations: 0,
             error,
@@ -455,6 +464,7 @@ mod tests {
             anderson_memory: memory,
             plain_sweeps: 0,
             schedule,
+            sweep_first: false,
         }
     }
 
@@ -569,5 +579,46 @@ mod tests {
         };
         let r = drive(&mut p, &tol, &mut DriveWork::default());
         assert_eq!((r.iterations, r.converged), (0, true));
+    }
+
+    #[test]
+    fn sweep_first_skips_the_evaluation_before_the_first_sweep() {
+        // A converged start still sweeps once, then stops at the first evaluation (no ratio
+        // known yet: the measured schedule evaluates after the sweep).
+        let mut p = Poisson::new(10, None);
+        p.measured = true;
+        let loose = DriveParams {
+            tolerance: 1.0,
+            sweep_first: true,
+            ..params(4, 10, CheckSchedule::Every(16))
+        };
+        let r = drive(&mut p, &loose, &mut DriveWork::default());
+        assert_eq!((r.iterations, r.converged, p.evaluations), (1, true, 1));
+        // A hard problem: the same sweeps and error as without, one evaluation fewer.
+        let schedule = CheckSchedule::Growing;
+        let (mut a, mut b) = (Poisson::new(40, None), Poisson::new(40, None));
+        let ra = drive(
+            &mut a,
+            &params(4, 2000, schedule),
+            &mut DriveWork::default(),
+        );
+        let first = DriveParams {
+            sweep_first: true,
+            ..params(4, 2000, schedule)
+        };
+        let rb = drive(&mut b, &first, &mut DriveWork::default());
+        assert!(ra.converged && rb.converged);
+        assert_eq!(ra.iterations, rb.iterations);
+        assert_eq!(ra.error.to_bits(), rb.error.to_bits());
+        assert_eq!(b.evaluations + 1, a.evaluations);
+        // No sweep allowed: the start is evaluated all the same.
+        let mut c = Poisson::new(10, None);
+        let none = DriveParams {
+            sweep_first: true,
+            ..params(4, 0, schedule)
+        };
+        let r = drive(&mut c, &none, &mut DriveWork::default());
+        assert_eq!((r.iterations, r.converged, c.evaluations), (0, false, 1));
+        assert!(r.error.is_finite());
     }
 }

@@ -1033,6 +1033,10 @@ fn nlgs(
             } else {
                 CheckSchedule::Growing
             },
+            // With the measured schedule, the warm start is not evaluated: a step's problem
+            // almost never meets the tolerance as it comes (the poured column: 43 of 5657
+            // sub-steps), and an evaluation costs more than a sweep.
+            sweep_first: step.measure,
         },
         drive_work,
     );

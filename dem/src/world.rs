@@ -1440,8 +1440,9 @@ impl World {
         if report.corrected_contacts > 0 {
             report.load_work = self.apply_correction();
         }
-        // A disk that travelled beyond its swept margin may overlap one that no contact of the
-        // step knew: detect again at the corrected positions (nothing moves now, so no swept
+        // A disk that travelled beyond its swept margin plus half the detection gap, with the
+        // correction, may overlap one that no contact of the step knew (`Detector::outran`):
+        // detect again at the corrected positions (nothing moves now, so no swept
         // margin; pairs up to a quarter of the smallest radius apart, which the projection can
         // push into contact) and project the actual gaps.
         let moved = if self.cell.is_some() {
@@ -1449,7 +1450,12 @@ impl World {
         } else {
             &self.displacement
         };
-        if self.image_outran || self.detector.outran(&self.colliders, moved) {
+        let correction = if report.corrected_contacts > 0 {
+            self.projection.correction()
+        } else {
+            &[]
+        };
+        if self.image_outran || self.detector.outran(&self.colliders, moved, correction) {
             let mut fresh = std::mem::take(&mut self.fresh);
             let reach = 0.25 * self.smallest_radius().unwrap_or(0.0);
             // The second projection moves nothing unless a contact is violated: look for one

@@ -377,6 +377,7 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
             anderson_memory: memory,
             plain_sweeps: 0,
             schedule: CheckSchedule::Every(options.check_every),
+            sweep_first: false,
         },
         &mut DriveWork::default(),
     );
