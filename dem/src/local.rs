@@ -131,10 +131,30 @@ pub fn predictor_corrector(
 /// Natural-map residual of one contact, `r − proj_K(r − ū)` with ρ = 1: the per-contact term of
 /// the error measure of `docs/formats.md` §1.2 (Siconos' fc2d error).
 #[inline(always)]
+///
+/// The projection is computed without a branch (its outcomes computed, the valid one selected
+/// on the bits): the outcome changes from contact to contact at random. The same values as
+/// [`project_on_cone`] but for the sign of a zero (an open outcome may come out as `−0`), so
+/// the squared residual is the same bit for bit; a NaN in `r` or `u` gives a NaN.
 pub fn natural_map_residual(r: [f64; 2], u: [f64; 2], mu: f64) -> [f64; 2] {
     let ub = modified_velocity(u, mu);
-    let (p, _) = project_on_cone([r[0] - ub[0], r[1] - ub[1]], mu);
-    [r[0] - p[0], r[1] - p[1]]
+    let [tn, tt] = [r[0] - ub[0], r[1] - ub[1]];
+    let at = tt.abs();
+    let stick = tn >= 0.0 && at <= mu * tn;
+    // Sliding, or open where this is ≤ 0 (`μ|τ_t| ≤ −τ_n` exactly when `τ_n + μ|τ_t| ≤ 0` in
+    // floating point too); a NaN stays NaN.
+    let rn = (tn + mu * at) / (1.0 + mu * mu);
+    let rn = select(rn < 0.0, 0.0, rn);
+    let pn = select(stick, tn, rn);
+    let pt = select(stick, tt, mu * rn * tt.signum());
+    [r[0] - pn, r[1] - pt]
+}
+
+/// `if c { a } else { b }` on the bits, so that it compiles to a select rather than a branch.
+#[inline(always)]
+fn select(c: bool, a: f64, b: f64) -> f64 {
+    let mask = u64::from(c).wrapping_neg();
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 /// Exact solution of the one-contact problem `u = W r + q`, `(u, r)` an extremal pair of the
