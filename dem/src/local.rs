@@ -150,9 +150,10 @@ pub fn natural_map_residual(r: [f64; 2], u: [f64; 2], mu: f64) -> [f64; 2] {
     [r[0] - pn, r[1] - pt]
 }
 
-/// `if c { a } else { b }` on the bits, so that it compiles to a select rather than a branch.
+/// `if c { a } else { b }` on the bits, so that it compiles to a select rather than a branch
+/// (for passes over contacts whose outcome changes at random from one to the next).
 #[inline(always)]
-fn select(c: bool, a: f64, b: f64) -> f64 {
+pub fn select(c: bool, a: f64, b: f64) -> f64 {
     let mask = u64::from(c).wrapping_neg();
     f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }

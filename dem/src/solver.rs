@@ -40,7 +40,7 @@ use crate::contact::ContactRow;
 use crate::fc::method::{exact_finish, Finish};
 use crate::fc::newton::{self, NewtonParams, NewtonWork};
 use crate::fc::FcOptions;
-use crate::local::{natural_map_residual, ContactStatus};
+use crate::local::{natural_map_residual, select, ContactStatus};
 use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
 use crate::parallel::{
     coloured_sweep, local_update, max_over, reduce_chunks, runs_inline, scatter_velocities, CHUNK,
@@ -286,11 +286,8 @@ pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 
 /// gap shift, so `u_n ≥ 0` already means "stops at contact").
 pub fn approach_speed(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
     max_over(rows, |c| {
-        if c.shift <= 0.0 || c.r[0] > 0.0 {
-            -c.velocity(&vel[c.a as usize], &vel[c.b as usize])[0]
-        } else {
-            0.0
-        }
+        let un = c.velocity(&vel[c.a as usize], &vel[c.b as usize])[0];
+        select(c.shift <= 0.0 || c.r[0] > 0.0, -un, 0.0)
     })
     .max(0.0)
 }
@@ -874,6 +871,7 @@ impl SweepProblem for Step<'_> {
     fn converged(&self, error: f64, tolerance: f64) -> bool {
         error <= tolerance && self.approach_speed() <= self.approach_limit
     }
+
 
     /// `x ← (r_α)` flattened, in parallel over fixed chunks.
     fn save(&self, x: &mut [f64]) {
