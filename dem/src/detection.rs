@@ -74,8 +74,13 @@ pub struct Detector {
     /// margins cover (1/s; [`Detector::detect_cell`]'s `rate_bound`, capped).
     image_rate: f64,
     /// Detection gap `g_d ≥ 0` of the last detection that set the swept margins (m): with
-    /// them, it bounds how far a disk may travel before [`Detector::outran`] holds.
+    /// them, it bounds how far a disk may travel before [`Detector::outran`] holds (0 after a
+    /// biperiodic cell's detection, whose margins include the cell's own deformation).
     swept_gap: f64,
+    /// Per line or segment at the last [`Detector::detect`]: its collider, swept margin (m)
+    /// and the farthest distance of its shape's reference points from the body's centre (m),
+    /// for [`Detector::outran`] (an imposed motion may start within the step).
+    walls: Vec<(u32, f64, f64)>,
     /// Disk pairs kept between detections ([`Detector::detect`]).
     candidates: Candidates,
     /// Bin every detection on the grid instead of reusing the candidate list.
@@ -252,6 +257,7 @@ impl Detector {
         self.candidates.detections += 1;
         self.collect_disks(bodies, colliders, periodic, dt, gravity);
         self.swept_gap = detection_gap.max(0.0);
+        self.walls.clear();
         let nd = self.centre.len();
         let listed = !self.full_detection
             && (self.candidates_cover(periodic, detection_gap)
@@ -326,6 +332,7 @@ impl Detector {
                     };
                     let wall_margin =
                         dt * (wb.velocity.norm() + dt * acc + wb.omega.abs() * extent);
+                    self.walls.push((ci as u32, wall_margin, extent));
                     let shape = match &col.shape {
                         Shape::Line { point, normal } => WallShape::Line {
                             p: wb.position + rotate(*point, wb.angle),
@@ -638,9 +645,12 @@ impl Detector {
     ///
     /// A pair that the detection left out had a gap `g > g_d + m_a + m_b` (`g_d` the detection
     /// gap, `m` the swept margins), so it can only close if the two travels `δ_a + δ_b` exceed
-    /// `g_d + m_a + m_b`. The test is therefore `δ > m + g_d/2` for some disk, with
-    /// `δ = |Δx + Δx_corr| + |Δθ + Δθ_corr| ρ` (ρ the disk's offset from its body's centre):
-    /// when no disk outran, no pair unknown to the step can overlap.
+    /// `g_d + m_a + m_b`. The test is therefore `δ > m + g_d/2` for some disk, line or segment,
+    /// with `δ = |Δx + Δx_corr| + |Δθ + Δθ_corr| ρ`
+    /// (ρ the shape's distance from its body's centre, as in its swept margin): when nothing
+    /// outran, no pair unknown to the step can overlap. In a biperiodic cell the margins
+    /// include the cell's deformation, which the travels given (relative to the affine field)
+    /// do not, so there the test is `δ > m`.
     pub fn outran(
         &self,
         colliders: &[Collider],
@@ -648,21 +658,28 @@ impl Detector {
         correction: &[[f64; 3]],
     ) -> bool {
         let slack = 0.5 * self.swept_gap;
-        self.disk_collider
+        let travel = |body: usize, arm: f64| {
+            let mut d = displacement[body];
+            if let Some(c) = correction.get(body) {
+                d = [d[0] + c[0], d[1] + c[1], d[2] + c[2]];
+            }
+            (d[0] * d[0] + d[1] * d[1]).sqrt() + d[2].abs() * arm
+        };
+        let disks = self
+            .disk_collider
             .iter()
             .zip(&self.margin)
             .any(|(&ci, &m)| {
                 let col = &colliders[ci as usize];
-                let body = col.body as usize;
-                let mut d = displacement[body];
-                if let Some(c) = correction.get(body) {
-                    d = [d[0] + c[0], d[1] + c[1], d[2] + c[2]];
-                }
                 let arm = match col.shape {
                     Shape::Disk { offset, .. } => offset.norm(),
                     _ => 0.0,
                 };
-                (d[0] * d[0] + d[1] * d[1]).sqrt() + d[2].abs() * arm > m + slack
+                travel(col.body as usize, arm) > m + slack
+            });
+        disks
+            || self.walls.iter().any(|&(ci, m, extent)| {
+                travel(colliders[ci as usize].body as usize, extent) > m + slack
             })
     }
 
@@ -1054,7 +1071,10 @@ impl Detector {
         self.radius.clear();
         self.margin.clear();
         self.reduced.clear();
-        self.swept_gap = detection_gap.max(0.0);
+        // The margins below include the cell's deformation over the step, which the travels
+        // `outran` is given (relative to the affine field) do not: no slack is added to them.
+        self.swept_gap = 0.0;
+        self.walls.clear();
         let inv = cell.inverse();
         let l_norm = cell.l.norm();
         let mut r_max = 0.0f64;

@@ -130,12 +130,12 @@ pub fn predictor_corrector(
 
 /// Natural-map residual of one contact, `r − proj_K(r − ū)` with ρ = 1: the per-contact term of
 /// the error measure of `docs/formats.md` §1.2 (Siconos' fc2d error).
-#[inline(always)]
 ///
 /// The projection is computed without a branch (its outcomes computed, the valid one selected
 /// on the bits): the outcome changes from contact to contact at random. The same values as
 /// [`project_on_cone`] but for the sign of a zero (an open outcome may come out as `−0`), so
 /// the squared residual is the same bit for bit; a NaN in `r` or `u` gives a NaN.
+#[inline(always)]
 pub fn natural_map_residual(r: [f64; 2], u: [f64; 2], mu: f64) -> [f64; 2] {
     let ub = modified_velocity(u, mu);
     let [tn, tt] = [r[0] - ub[0], r[1] - ub[1]];

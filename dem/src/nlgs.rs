@@ -286,8 +286,9 @@ impl Stall {
 
 /// Runs the safeguarded, Anderson-accelerated Gauss–Seidel iteration of the module
 /// documentation on `problem`, from the impulses it holds, for at most `params.max_sweeps`
-/// sweeps. On return the problem holds the converged impulses, or else the best iterate seen;
-/// the report's error is the true error there.
+/// sweeps. On return the problem holds the converged impulses, or else the best iterate whose
+/// error was evaluated (with [`DriveParams::sweep_first`] the start is not, unless a blow-up
+/// sends the iteration back to it); the report's error is the true error there.
 pub fn drive<P: SweepProblem + ?Sized>(
     problem: &mut P,
     params: &DriveParams,
@@ -352,6 +353,10 @@ pub fn drive<P: SweepProblem + ?Sized>(
             } else if !error.is_finite() || error > BLOW_UP * best_error {
                 problem.load(&work.best);
                 error = problem.error();
+                if !best_error.is_finite() {
+                    // The start, never evaluated under `sweep_first`, is the best there is.
+                    best_error = error;
+                }
                 guard.plain_phase(it, work.anderson.as_mut());
             }
             if problem.converged(error, tol) {

@@ -872,7 +872,6 @@ impl SweepProblem for Step<'_> {
         error <= tolerance && self.approach_speed() <= self.approach_limit
     }
 
-
     /// `x ← (r_α)` flattened, in parallel over fixed chunks.
     fn save(&self, x: &mut [f64]) {
         let copy = |(rs, x): (&[ContactRow], &mut [f64])| {
