@@ -129,7 +129,7 @@ pub struct DriveParams {
     pub schedule: CheckSchedule,
     /// Sweep once before the first evaluation (when `max_sweeps > 0`): for warm-started
     /// problems that almost never meet the tolerance as they come, where an evaluation costs
-    /// about as much as a sweep. A problem that already met it then returns after one sweep.
+    /// nearly as much as a sweep. A problem that already met it then returns after one sweep.
     pub sweep_first: bool,
 }
 

@@ -1450,6 +1450,7 @@ impl World {
         } else {
             &self.displacement
         };
+        // The correction that was applied (none when no contact kept a projection impulse).
         let correction = if report.corrected_contacts > 0 {
             self.projection.correction()
         } else {

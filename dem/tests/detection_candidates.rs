@@ -95,7 +95,10 @@ fn lockstep(
 /// the full grid detection at every step. The kicks (up to 0.3 mm a step, more than half the
 /// skin) and the settling keep the grains moving, so the list is rebuilt at about half of the
 /// detections (the steps' and the few a position correction makes); the assertion is that it
-/// is still reused by at least 40 % of them (measured: 216 of 455).
+/// is still reused by at least 45 % of them (measured: 216 of 455). Until the second
+/// detection after a step was limited to disks that outran their margin by half the detection
+/// gap, about 300 more detections per run (all reusing the list) were counted, and the
+/// assertion was "fewer than half build it".
 #[test]
 fn candidate_reuse_finds_the_contacts_of_full_detection_in_a_shaken_box() {
     let mut w = random_box(300, 0.04, 1e-3, 2e-3, 0.5, 1.0, 7);
@@ -105,9 +108,9 @@ fn candidate_reuse_finds_the_contacts_of_full_detection_in_a_shaken_box() {
     assert!(reused_often(&c), "{c:?}");
 }
 
-/// At least ten builds (the kicks are seen), and at least 40 % of the detections reuse the list.
+/// At least ten builds (the kicks are seen), and at least 45 % of the detections reuse the list.
 fn reused_often(c: &dem::detection::CandidateCounts) -> bool {
-    c.builds >= 10 && 5 * (c.detections - c.builds) >= 2 * c.detections
+    c.builds >= 10 && 20 * (c.detections - c.builds) >= 9 * c.detections
 }
 
 /// The same along a periodic x (no side walls; pairs across the boundary), with a rough floor
@@ -133,6 +136,6 @@ fn candidate_reuse_finds_the_contacts_of_full_detection_in_a_periodic_strip() {
         }
     }
     let c = lockstep(p.clone(), p, 400, 0.3, 5);
-    // Measured: 219 of 467 detections reuse the list.
+    // Measured: 219 of 467 detections reuse the list (46.9 %).
     assert!(reused_often(&c), "{c:?}");
 }
