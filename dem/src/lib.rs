@@ -54,6 +54,7 @@ pub mod snapshot;
 pub mod solver;
 pub mod stabilise;
 pub mod step_control;
+pub mod wavefront;
 pub mod world;
 
 pub use body::{Body, BodyKind, Dof};

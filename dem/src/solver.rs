@@ -46,6 +46,7 @@ use crate::parallel::{
     coloured_sweep, local_update, max_over, reduce_chunks, runs_inline, scatter_velocities, CHUNK,
     MIN_CHUNKS_PER_TASK,
 };
+use crate::wavefront::Wavefront;
 
 /// Which algorithm solves the contact problem of a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -481,6 +482,16 @@ pub fn solve(
     if let Some(c) = cell.as_deref_mut() {
         c.attach(rows);
     }
+    // Natural order without a coupled cell (whose unknowns every update touches): the sweeps
+    // run in the wavefront schedule of that order, the same sweeps bit for bit.
+    let mut wave = std::mem::take(&mut work.wavefront);
+    let scheduled = match (&order, cell.is_none()) {
+        (SweepOrder::Natural(given), true) if rows.len() >= WAVEFRONT_MIN_CONTACTS => {
+            wave.build(rows, given, vel.len());
+            true
+        }
+        _ => false,
+    };
     let mut step = Step {
         rows,
         order,
@@ -493,13 +504,20 @@ pub fn solve(
         seed: SHUFFLE_SEED,
         cell,
         measure: false,
+        wave: scheduled.then_some(wave.order.as_slice()),
     };
     let report = solve_step(&mut step, params, work);
     if let Some(c) = step.cell.as_deref_mut() {
         c.detach(step.rows);
     }
+    work.wavefront = wave;
     report
 }
+
+/// Fewest contacts for which [`solve`] sweeps in the wavefront schedule
+/// ([`crate::wavefront`]); below, the given order (building the schedule would cost more than
+/// the overlap saves).
+pub const WAVEFRONT_MIN_CONTACTS: usize = 16;
 
 /// [`solve`] on the assembled step.
 fn solve_step(step: &mut Step, params: &SolverParams, work: &mut SolverWork) -> SolveReport {
@@ -507,6 +525,7 @@ fn solve_step(step: &mut Step, params: &SolverParams, work: &mut SolverWork) -> 
         newton: newton_work,
         nlgs: drive_work,
         backoff,
+        ..
     } = work;
     if params.method == SolverMethod::Nlgs {
         return nlgs(step, params, params.max_iterations, drive_work);
@@ -770,6 +789,9 @@ struct Step<'a> {
     /// Whether the sweeps measure their change (set by [`nlgs`]: `check_every ≥ 1` and
     /// [`Step::can_measure`]); otherwise the contact loop does no more than [`sweep`]'s.
     measure: bool,
+    /// The wavefront schedule of the natural order ([`crate::wavefront`]), used by its sweeps
+    /// until a stall shuffles the order.
+    wave: Option<&'a [u32]>,
 }
 
 impl Step<'_> {
@@ -824,7 +846,7 @@ impl SweepProblem for Step<'_> {
             (None, SweepOrder::Natural(order)) if self.measure => {
                 Some(relative_change(sweep_recorded(
                     self.rows,
-                    order,
+                    self.wave.unwrap_or(order),
                     self.vel,
                     self.inv,
                     self.omega,
@@ -833,7 +855,12 @@ impl SweepProblem for Step<'_> {
             }
             (cell, order) => {
                 debug_assert!(cell.is_none(), "a coupled step is swept on one thread");
-                order.sweep(self.rows, self.vel, self.inv, self.omega);
+                match (self.wave, order) {
+                    (Some(wave), SweepOrder::Natural(_)) => {
+                        sweep(self.rows, wave, self.vel, self.inv, self.omega)
+                    }
+                    (_, order) => order.sweep(self.rows, self.vel, self.inv, self.omega),
+                }
                 None
             }
         }
@@ -849,7 +876,7 @@ impl SweepProblem for Step<'_> {
         };
         let sums = sweep_recorded(
             self.rows,
-            order,
+            self.wave.unwrap_or(order),
             self.vel,
             self.inv,
             self.omega,
@@ -933,7 +960,10 @@ impl SweepProblem for Step<'_> {
         self.rebuild();
     }
 
+    /// Shuffles the given order (the wavefront schedule is left from then on, so a shuffled
+    /// solve is the one it was before the schedule existed).
     fn shuffle(&mut self) {
+        self.wave = None;
         self.order.shuffle(&mut self.seed);
     }
 }
@@ -1054,6 +1084,8 @@ fn nlgs(
 pub struct SolverWork {
     newton: NewtonWork,
     nlgs: DriveWork,
+    /// The sweep schedule's buffers ([`crate::wavefront`]).
+    wavefront: Wavefront,
     /// When `auto` next tries Newton.
     pub backoff: NewtonBackoff,
 }
@@ -1066,6 +1098,7 @@ impl SolverWork {
         SolverWork {
             newton: self.newton.clone(),
             nlgs: DriveWork::default(),
+            wavefront: Wavefront::default(),
             backoff: self.backoff,
         }
     }
