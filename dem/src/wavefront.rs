@@ -116,7 +116,7 @@ mod tests {
                 if b == n && i % 4 != 0 {
                     continue;
                 }
-                let ang: f64 = 6.283 * next();
+                let ang: f64 = std::f64::consts::TAU * next();
                 let n_ = [ang.cos(), ang.sin()];
                 let k = [0.4 * next(), 0.3 * next(), -0.2 * next(), 0.5 * next()];
                 let ia = [1.0, 1.0, 3.0];
