@@ -203,7 +203,8 @@ pub fn settle(
 
 /// Bytes held by the engine per grain and per contact, from the sizes of its data structures
 /// (bodies, colliders, solver and detection buffers; contact rows, geometry, status, the previous
-/// step's copy kept for warm starting, sweep order, Anderson history with memory `m`).
+/// step's copy kept for warm starting, sweep order and its wavefront schedule, Anderson history
+/// with memory `m`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MemoryFootprint {
     /// Bytes per grain (B).
@@ -221,12 +222,14 @@ impl MemoryFootprint {
             + 3 * size_of::<[f64; 3]>() // velocities, inverse masses, free velocities
             + 3 * size_of::<[f64; 3]>() // body forces
             + 4 + 16 + 8 + 8 + 4 + 4 + 4 // detector: collider, centre, radius, margin, cells
-            + 4 + 8 + 16 + 8 + 4; // candidate list: collider, radius, centre, reach, start
+            + 4 + 8 + 16 + 8 + 4 // candidate list: collider, radius, centre, reach, start
+            + 4; // wavefront schedule: depth
         let one_set = size_of::<crate::contact::ContactRow>()
             + size_of::<crate::contact::ContactGeometry>()
             + size_of::<crate::local::ContactStatus>();
         let per_contact = 2 * one_set // current and previous step
             + 4 // sweep order
+            + 4 + 4 // wavefront schedule: order, key
             + 8 // detection neighbour list
             + 10 // candidate pairs: 8 B each, 1.2 per contact in the settled poured column
             + 2 * 8 * (2 * anderson_memory + 2) // Anderson differences and iterates
