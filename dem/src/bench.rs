@@ -229,7 +229,7 @@ impl MemoryFootprint {
             + size_of::<crate::local::ContactStatus>();
         let per_contact = 2 * one_set // current and previous step
             + 4 // sweep order
-            + 4 + 4 // wavefront schedule: order, key
+            + 4 + 4 + 12 // wavefront schedule: order, key, offsets (3 a depth: at most)
             + 8 // detection neighbour list
             + 10 // candidate pairs: 8 B each, 1.2 per contact in the settled poured column
             + 2 * 8 * (2 * anderson_memory + 2) // Anderson differences and iterates

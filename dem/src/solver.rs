@@ -468,8 +468,11 @@ impl SweepOrder<'_> {
 /// [`CellCoupling::delta`] is the change of `L` that goes with the returned impulses.
 ///
 /// Without a cell, the sweeps of [`SweepOrder::Natural`] run in the wavefront schedule of the
-/// given order ([`crate::wavefront`], from [`WAVEFRONT_MIN_CONTACTS`] contacts): the same
-/// impulses and velocities bit for bit, faster; a stall shuffle returns to the given order.
+/// given order ([`crate::wavefront`], from [`WAVEFRONT_MIN_CONTACTS`] contacts): each sweep
+/// gives the same impulses and velocities bit for bit, faster, and so does the solve with
+/// `check_every = 0`; with `check_every ≥ 1` the sweeps' measured change is summed in the
+/// schedule's order, which may (rarely) move an error check by a sweep. A stall shuffle
+/// returns to the given order.
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     rows: &mut [ContactRow],
