@@ -468,9 +468,8 @@ impl SweepOrder<'_> {
 /// [`CellCoupling::delta`] is the change of `L` that goes with the returned impulses.
 ///
 /// Without a cell, the sweeps of [`SweepOrder::Natural`] run in the wavefront schedule of the
-/// given order ([`crate::wavefront`], from [`WAVEFRONT_MIN_CONTACTS`] contacts): each sweep
-/// gives the same impulses and velocities bit for bit, faster, and so does the solve with
-/// `check_every = 0`; with `check_every ≥ 1` the sweeps' measured change is summed in the
+/// given order ([`crate::wavefront`]): each sweep gives the same impulses and velocities bit
+/// for bit, faster, and so does the solve with `check_every = 0`; with `check_every ≥ 1` the sweeps' measured change is summed in the
 /// schedule's order, which may (rarely) move an error check by a sweep. A stall shuffle
 /// returns to the given order.
 #[allow(clippy::too_many_arguments)]
@@ -493,7 +492,7 @@ pub fn solve(
     // run in the wavefront schedule of that order, the same sweeps bit for bit.
     let mut wave = std::mem::take(&mut work.wavefront);
     let scheduled = match (&order, cell.is_none()) {
-        (SweepOrder::Natural(given), true) if rows.len() >= WAVEFRONT_MIN_CONTACTS => {
+        (SweepOrder::Natural(given), true) => {
             wave.build(rows, given, vel.len());
             true
         }
@@ -520,11 +519,6 @@ pub fn solve(
     work.wavefront = wave;
     report
 }
-
-/// Fewest contacts for which [`solve`] sweeps in the wavefront schedule
-/// ([`crate::wavefront`]); below, the given order (building the schedule would cost more than
-/// the overlap saves).
-pub const WAVEFRONT_MIN_CONTACTS: usize = 16;
 
 /// [`solve`] on the assembled step.
 fn solve_step(step: &mut Step, params: &SolverParams, work: &mut SolverWork) -> SolveReport {
@@ -1172,16 +1166,22 @@ impl NewtonBackoff {
     }
 }
 
-/// Status of each contact from its impulse: open when `r = 0`, sliding when on the cone's
-/// boundary (`|r_t| ≥ μ r_n (1 − 10⁻⁹)`), sticking otherwise.
+/// Status of each contact from its impulse ([`status`]).
 pub fn classify(rows: &[ContactRow], status: &mut [ContactStatus]) {
     for (c, s) in rows.iter().zip(status.iter_mut()) {
-        *s = if c.r[0] <= 0.0 {
-            ContactStatus::Open
-        } else if c.r[1].abs() >= c.mu * c.r[0] * (1.0 - 1e-9) {
-            ContactStatus::Slide
-        } else {
-            ContactStatus::Stick
-        };
+        *s = self::status(c);
+    }
+}
+
+/// Status of a contact from its impulse: open when `r_n ≤ 0`, sliding when on the cone's
+/// boundary (`|r_t| ≥ μ r_n (1 − 10⁻⁹)`), sticking otherwise.
+#[inline]
+pub fn status(c: &ContactRow) -> ContactStatus {
+    if c.r[0] <= 0.0 {
+        ContactStatus::Open
+    } else if c.r[1].abs() >= c.mu * c.r[0] * (1.0 - 1e-9) {
+        ContactStatus::Slide
+    } else {
+        ContactStatus::Stick
     }
 }

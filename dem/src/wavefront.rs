@@ -25,9 +25,8 @@
 //! the start of the solve (open, sticking, sliding), which makes the branches of the exact
 //! local solve ([`crate::local::solve_local`]) predictable; the order within a depth changes no
 //! bit. Built by a counting sort, O(n + bodies), once a solve, by [`crate::solver::solve`] for
-//! its natural-order sweeps without a coupled cell (whose unknowns every update touches), from
-//! [`crate::solver::WAVEFRONT_MIN_CONTACTS`] contacts; a stall shuffle returns to the given
-//! order.
+//! its natural-order sweeps without a coupled cell (whose unknowns every update touches); a
+//! stall shuffle returns to the given order.
 //!
 //! One number is not the same: the sums of a sweep's measured change (`‖Δr‖²`, `‖r‖²`, with
 //! [`crate::SolverParams::check_every`] ≥ 1) are added in the schedule's order, so their last
@@ -43,6 +42,7 @@
 //! Computing 1 (1989) 73–95), used here for instruction-level parallelism on one core.
 
 use crate::contact::ContactRow;
+use crate::local::ContactStatus;
 
 /// Buffers of [`Wavefront::build`], kept between solves.
 #[derive(Debug, Clone, Default)]
@@ -67,6 +67,8 @@ impl Wavefront {
         self.depth.resize(bodies, 0);
         self.key.clear();
         self.key.resize(rows.len(), 0);
+        // `start[k + 1]` counts the contacts of key `k` (grown as deeper keys appear).
+        self.start.clear();
         let mut depths = 0u32;
         for &i in given {
             let c = &rows[i as usize];
@@ -75,20 +77,17 @@ impl Wavefront {
             self.depth[a] = d + 1;
             self.depth[b] = d + 1;
             depths = depths.max(d + 1);
-            // As `solver::classify`.
-            let status = if c.r[0] <= 0.0 {
-                0
-            } else if c.r[1].abs() < c.mu * c.r[0] * (1.0 - 1e-9) {
-                1
-            } else {
-                2
+            let status = match crate::solver::status(c) {
+                ContactStatus::Open => 0,
+                ContactStatus::Stick => 1,
+                ContactStatus::Slide => 2,
             };
-            self.key[i as usize] = 3 * d + status;
-        }
-        self.start.clear();
-        self.start.resize(3 * depths as usize + 1, 0);
-        for &i in given {
-            self.start[self.key[i as usize] as usize + 1] += 1;
+            let key = 3 * d + status;
+            self.key[i as usize] = key;
+            if self.start.len() < key as usize + 2 {
+                self.start.resize(key as usize + 2, 0);
+            }
+            self.start[key as usize + 1] += 1;
         }
         for k in 1..self.start.len() {
             self.start[k] += self.start[k - 1];
@@ -154,6 +153,40 @@ mod tests {
         inv
     }
 
+    /// Velocities of the `n` disks (the wall, body `n`, at rest).
+    fn velocities(n: usize) -> Vec<[f64; 3]> {
+        (0..=n)
+            .map(|i| {
+                let x = i as f64;
+                if i == n {
+                    [0.0; 3]
+                } else {
+                    [
+                        (0.7 * x).sin(),
+                        (1.3 * x).cos() - 0.5,
+                        0.1 * (2.1 * x).sin(),
+                    ]
+                }
+            })
+            .collect()
+    }
+
+    /// Warm impulses on every other contact, for a mix of statuses when the schedule is built.
+    fn warm(rows: &mut [ContactRow]) {
+        for (k, c) in rows.iter_mut().enumerate().filter(|(k, _)| k % 2 == 0) {
+            c.r = [0.01 * (k % 7) as f64, 0.004 * ((k % 5) as f64 - 2.0)];
+        }
+    }
+
+    /// The bits of the impulses and velocities.
+    fn bits(rows: &[ContactRow], v: &[[f64; 3]]) -> Vec<u64> {
+        rows.iter()
+            .flat_map(|c| c.r)
+            .chain(v.iter().flatten().copied())
+            .map(f64::to_bits)
+            .collect()
+    }
+
     /// Contacts of one depth share no body; contacts sharing a body keep their given order;
     /// within a depth the statuses come open, sticking, sliding.
     #[test]
@@ -211,38 +244,15 @@ mod tests {
     fn wavefront_sweeps_equal_the_given_order_bit_for_bit() {
         let n = 60;
         let mut a = rows(n);
+        warm(&mut a);
         let inv = inverse(n);
-        let mut va: Vec<[f64; 3]> = (0..=n)
-            .map(|i| {
-                if i == n {
-                    [0.0; 3]
-                } else {
-                    let x = i as f64;
-                    [
-                        (0.7 * x).sin(),
-                        (1.3 * x).cos() - 0.5,
-                        0.1 * (2.1 * x).sin(),
-                    ]
-                }
-            })
-            .collect();
-        // Warm impulses on half of the contacts, for a status mix at the build.
-        for (k, c) in a.iter_mut().enumerate() {
-            if k % 2 == 0 {
-                c.r = [0.01 * (k % 7) as f64, 0.004 * ((k % 5) as f64 - 2.0)];
-            }
-        }
-        let mut b = a.clone();
-        let mut vb = va.clone();
-        // A scrambled given order (a shuffle by the LCG of `rows`'s kind).
-        let mut given: Vec<u32> = (0..a.len() as u32).collect();
-        let mut state = 99u64;
-        for i in (1..given.len()).rev() {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            given.swap(i, ((state >> 33) as usize) % (i + 1));
-        }
+        let mut va = velocities(n);
+        let (mut b, mut vb) = (a.clone(), va.clone());
+        // A scrambled given order: k ↦ 7919 k mod m, a permutation (7919 is a prime not
+        // dividing m).
+        let m = a.len() as u32;
+        assert_ne!(m % 7919, 0);
+        let given: Vec<u32> = (0..m).map(|k| (7919 * k) % m).collect();
         let mut w = Wavefront::default();
         w.build(&b, &given, n + 1);
         assert_ne!(w.order, given, "the schedule reorders");
@@ -250,51 +260,25 @@ mod tests {
             sweep(&mut a, &given, &mut va, &inv, 1.0);
             sweep(&mut b, &w.order, &mut vb, &inv, 1.0);
         }
-        let bits = |rows: &[ContactRow], v: &[[f64; 3]]| -> Vec<u64> {
-            rows.iter()
-                .flat_map(|c| c.r)
-                .chain(v.iter().flatten().copied())
-                .map(f64::to_bits)
-                .collect()
-        };
         assert_eq!(bits(&a, &va), bits(&b, &vb));
         let moved = a.iter().filter(|c| c.r != [0.0, 0.0]).count();
         assert!(moved > a.len() / 4, "{moved} contacts carry an impulse");
     }
 
-    /// `solver::solve` in natural order (scheduled: more than `WAVEFRONT_MIN_CONTACTS`
-    /// contacts) returns the impulses and velocities of plain sweeps in the given order, bit
-    /// for bit: eight sweeps, no acceleration, the error evaluated after each and the best
-    /// iterate returned (the drive's rule for a solve that does not converge).
+    /// `solver::solve` in natural order returns the impulses and velocities of plain sweeps in
+    /// the given order, bit for bit: eight sweeps, no acceleration, the error evaluated after
+    /// each and the best iterate returned (the drive's rule for a solve that does not converge).
     #[test]
     fn solve_in_natural_order_equals_sweeps_in_the_given_order() {
         use crate::solver::{
             apply_impulses, error_measure, free_velocity_norm, solve, SolverMethod, SolverParams,
-            SolverWork, SweepOrder, WAVEFRONT_MIN_CONTACTS,
+            SolverWork, SweepOrder,
         };
         let n = 60;
         let mut rows0 = rows(n);
-        assert!(rows0.len() > WAVEFRONT_MIN_CONTACTS);
-        for (k, c) in rows0.iter_mut().enumerate() {
-            if k % 2 == 0 {
-                c.r = [0.01 * (k % 7) as f64, 0.004 * ((k % 5) as f64 - 2.0)];
-            }
-        }
+        warm(&mut rows0);
         let inv = inverse(n);
-        let v_free: Vec<[f64; 3]> = (0..=n)
-            .map(|i| {
-                let x = i as f64;
-                if i == n {
-                    [0.0; 3]
-                } else {
-                    [
-                        (0.7 * x).sin(),
-                        (1.3 * x).cos() - 0.5,
-                        0.1 * (2.1 * x).sin(),
-                    ]
-                }
-            })
-            .collect();
+        let v_free = velocities(n);
         let q_norm = free_velocity_norm(&rows0, &v_free);
         let mut given: Vec<u32> = (0..rows0.len() as u32).collect();
         given.reverse();
@@ -343,13 +327,6 @@ mod tests {
         );
         assert_eq!(report.iterations, sweeps);
         assert!(!report.converged);
-        let bits = |rows: &[ContactRow], v: &[[f64; 3]]| -> Vec<u64> {
-            rows.iter()
-                .flat_map(|c| c.r)
-                .chain(v.iter().flatten().copied())
-                .map(f64::to_bits)
-                .collect()
-        };
         assert_eq!(bits(&a, &va), bits(&b, &vb));
         assert_eq!(
             report.error.to_bits(),
