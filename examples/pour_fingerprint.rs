@@ -6,7 +6,8 @@
 //! Also printed: the subdivision's counts (kept sub-steps, undone attempts, discarded sweeps)
 //! and the detection's (detections, builds of the candidate list). `FULL_DETECTION=1` takes
 //! every detection's pairs from the cell grid (the same fingerprint, slower); `POUR_HIST=1`
-//! prints how many kept sub-steps took 0, 1, … 100 sweeps.
+//! prints how many kept sub-steps took 0, 1, … 100 sweeps; `POUR_TRACE=1` writes one line a
+//! step on stderr: step, kept sub-steps, sweeps, KE/PE after it, seconds since the start.
 //!
 //! With a step count, the run stops after that many steps whether settled or not: the time to
 //! settle follows a chaotic trajectory (391 to 874 steps over seeds 1–6), so two builds whose
@@ -59,6 +60,14 @@ fn main() {
             }
         }
         ratio = dem::bench::energy_ratio(&w);
+        if std::env::var_os("POUR_TRACE").is_some() {
+            eprintln!(
+                "{steps} {} {} {ratio:.3e} {:.3}",
+                s.substeps.len(),
+                s.report.solver.iterations,
+                t0.elapsed().as_secs_f64()
+            );
+        }
         if ratio < 1e-8 {
             break;
         }

@@ -250,6 +250,7 @@ fn janssen_measured_step_is_redone_in_sub_steps_when_capped() {
         &[
             "grains=60",
             "analysis.final_max_iterations=60",
+            "analysis.measure_steps=1",
             "relax.solver.method=nlgs",
         ],
         dir.path(),

@@ -74,7 +74,7 @@ pub struct JanssenAnalysis {
 }
 
 /// Default length of the measurement window (steps).
-pub const DEFAULT_MEASURE_STEPS: usize = 1;
+pub const DEFAULT_MEASURE_STEPS: usize = 4;
 
 fn default_measure_steps() -> usize {
     DEFAULT_MEASURE_STEPS
