@@ -43,6 +43,7 @@ fn main() {
     let mut sub = dem::step_control::Subdivision::default();
     let (mut steps, mut simulated, mut ratio) = (0u64, 0.0f64, dem::bench::energy_ratio(&w));
     let mut hist = [0usize; 101];
+    let trace = std::env::var_os("POUR_TRACE").is_some();
     let (mut sweeps, mut discarded, mut capped, mut substeps, mut retries) = (0, 0, 0, 0, 0);
     while simulated < run.max_time - 0.5 * w.params.dt && steps < max_steps {
         let h = w.params.dt;
@@ -60,7 +61,7 @@ fn main() {
             }
         }
         ratio = dem::bench::energy_ratio(&w);
-        if std::env::var_os("POUR_TRACE").is_some() {
+        if trace {
             eprintln!(
                 "{steps} {} {} {ratio:.3e} {:.3}",
                 s.substeps.len(),

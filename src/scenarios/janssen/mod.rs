@@ -432,7 +432,6 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 s.num(&k, v);
             }
             s.text("janssen_fit_mode", o.mode)
-                .text("janssen_fit_fallback", o.fallback.as_deref().unwrap_or(""))
                 .flag("janssen_fit_uses_tau_w", o.uses_tau_w)
                 .int(
                     "tau_w_negative_bins",
@@ -454,9 +453,8 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 ));
             } else {
                 headline.push(format!(
-                    "μ_w  = {:.3}  (the wall friction: fitted with full mobilisation, K only; {})",
-                    f.mu_w.value,
-                    o.fallback.as_deref().unwrap_or("")
+                    "μ_w  = {:.3}  (at the wall friction: fitted with full mobilisation, K only)",
+                    f.mu_w.value
                 ));
             }
             headline.push(format!(
