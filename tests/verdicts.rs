@@ -28,11 +28,12 @@ fn json(path: &Path) -> Value {
 const JANSSEN: &[&str] = &["run", "janssen", "-q", "--set", "grains=100"];
 
 /// The same with a loose solver: the relaxation to 10⁻⁵ and the release to 10⁻², and one
-/// measured step (the built-in window is 4) stopped after one Gauss–Seidel sweep, whole (no sub-steps: the release's
-/// `max_halvings` is 0; `auto` would finish it with Newton): its error is then about 700 times
-/// its tolerance (measured 7.05e-3), so suspect. (Without Lemke's finish, as when these
-/// expectations were measured: with it the deposit ends in another, exactly solved state, from
-/// which the loose release gives a column whose Janssen fit is refused outright.)
+/// measured step (the built-in window is 4) stopped after one Gauss–Seidel sweep, whole (no
+/// sub-steps: the release's `max_halvings` is 0; `auto` would finish it with Newton): its error
+/// is then about 700 times its tolerance (measured 7.05e-3), so suspect. (Without Lemke's
+/// finish, as when these expectations were measured: with it the deposit ends in another,
+/// exactly solved state, from which the loose release gives a column whose Janssen fit is
+/// refused outright.)
 const LOOSE: &[&str] = &[
     "--set",
     "deposit.solver.lemke_max_contacts=0",

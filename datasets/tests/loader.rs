@@ -42,6 +42,29 @@ fn overrides_reach_the_typed_config() {
     assert_eq!(again.scenario, Scenario::Janssen(c));
 }
 
+/// The built-in Janssen column averages its measurement over 4 steps; a scenario file written
+/// before `analysis.measure_steps` existed (without the key) keeps the one measured step it was
+/// run with, so an archived run runs again the same.
+#[test]
+fn janssen_measurement_window_of_builtin_and_of_older_files() {
+    let builtin = load("janssen", &[]).unwrap();
+    let Scenario::Janssen(c) = &builtin.scenario else {
+        panic!()
+    };
+    assert_eq!(c.analysis.measure_steps, 4);
+    let older: String = builtin
+        .effective_toml
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("measure_steps"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(!older.contains("measure_steps"));
+    let Scenario::Janssen(c) = from_text("older", "older", &older, &[]).unwrap().scenario else {
+        panic!()
+    };
+    assert_eq!(c.analysis.measure_steps, 1);
+}
+
 #[test]
 fn errors_name_the_key_or_line() {
     let t = datasets::builtin("rolling").unwrap().toml;
