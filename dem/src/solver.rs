@@ -469,9 +469,9 @@ impl SweepOrder<'_> {
 ///
 /// Without a cell, the sweeps of [`SweepOrder::Natural`] run in the wavefront schedule of the
 /// given order ([`crate::wavefront`]): each sweep gives the same impulses and velocities bit
-/// for bit, faster, and so does the solve with `check_every = 0`; with `check_every ≥ 1` the sweeps' measured change is summed in the
-/// schedule's order, which may (rarely) move an error check by a sweep. A stall shuffle
-/// returns to the given order.
+/// for bit, faster, and so does the solve with `check_every = 0`; with `check_every ≥ 1` the
+/// sweeps' measured change is summed in the schedule's order, which may (rarely) move an error
+/// check by a sweep. A stall shuffle returns to the given order.
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     rows: &mut [ContactRow],
@@ -844,24 +844,26 @@ impl SweepProblem for Step<'_> {
                 cell.sweep(self.rows, order, self.vel, self.inv, self.omega);
                 None
             }
-            (None, SweepOrder::Natural(order)) if self.measure => {
-                Some(relative_change(sweep_recorded(
-                    self.rows,
-                    self.wave.unwrap_or(order),
-                    self.vel,
-                    self.inv,
-                    self.omega,
-                    |_, _, _| {},
-                )))
+            // One thread: in the wavefront schedule of the order while there is one.
+            (None, SweepOrder::Natural(order)) => {
+                let order = self.wave.unwrap_or(order);
+                if self.measure {
+                    Some(relative_change(sweep_recorded(
+                        self.rows,
+                        order,
+                        self.vel,
+                        self.inv,
+                        self.omega,
+                        |_, _, _| {},
+                    )))
+                } else {
+                    sweep(self.rows, order, self.vel, self.inv, self.omega);
+                    None
+                }
             }
             (cell, order) => {
                 debug_assert!(cell.is_none(), "a coupled step is swept on one thread");
-                match (self.wave, order) {
-                    (Some(wave), SweepOrder::Natural(_)) => {
-                        sweep(self.rows, wave, self.vel, self.inv, self.omega)
-                    }
-                    (_, order) => order.sweep(self.rows, self.vel, self.inv, self.omega),
-                }
+                order.sweep(self.rows, self.vel, self.inv, self.omega);
                 None
             }
         }
