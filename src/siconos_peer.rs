@@ -31,6 +31,11 @@ pub const SCRIPT: &str = include_str!("../scripts/siconos_solve_fc.py");
 /// The first word of the script's result line.
 pub const LINE_TAG: &str = "siconos-fc-v1";
 
+/// The modules the script needs, imported by [`detect`]'s probe: a Python with Siconos but
+/// without numpy or scipy (Debian's `python3-siconos` does not pull `python3-scipy`) is
+/// reported once as unusable, not as a failure per problem.
+pub const PROBE_IMPORTS: &str = "siconos.numerics, numpy, scipy.sparse";
+
 /// Interpreter tried when `GRAINLAW_SICONOS_PYTHON` is not set.
 pub const DEFAULT_PYTHON: &str = "/usr/bin/python3";
 
@@ -82,8 +87,10 @@ pub struct PeerRequest {
 }
 
 /// The interpreter to use, or why the peer is off: `GRAINLAW_SICONOS_PYTHON` (`off` disables),
-/// else [`DEFAULT_PYTHON`]; `Err(reason)` when it cannot `import siconos.numerics` within 60 s.
+/// else [`DEFAULT_PYTHON`]; `Err(reason)` when it cannot import what the script imports
+/// ([`PROBE_IMPORTS`]: Siconos numerics, numpy and scipy's sparse matrices) within 60 s.
 pub fn detect() -> Result<PathBuf, String> {
+    let probe = format!("import {PROBE_IMPORTS}");
     let python = match std::env::var("GRAINLAW_SICONOS_PYTHON") {
         Ok(v) if v.trim().eq_ignore_ascii_case("off") => {
             return Err("GRAINLAW_SICONOS_PYTHON=off".into())
@@ -92,18 +99,18 @@ pub fn detect() -> Result<PathBuf, String> {
         _ => PathBuf::from(DEFAULT_PYTHON),
     };
     let mut cmd = Command::new(&python);
-    cmd.args(["-c", "import siconos.numerics"]);
+    cmd.args(["-c", &probe]);
     match run_capped(cmd, None, Duration::from_secs(60)) {
         Ok((true, _, _)) => Ok(python),
         Ok((false, _, err)) => Err(format!(
-            "{} cannot import siconos.numerics{}",
+            "{} cannot import {PROBE_IMPORTS}{}",
             python.display(),
             last_line(&err)
                 .map(|l| format!(" ({l})"))
                 .unwrap_or_default()
         )),
         Err(RunError::TimedOut) => Err(format!(
-            "{} -c 'import siconos.numerics' took more than 60 s",
+            "{} -c '{probe}' took more than 60 s",
             python.display()
         )),
         Err(RunError::Spawn(e)) => Err(format!("cannot run {}: {e}", python.display())),
@@ -381,6 +388,37 @@ fn run_capped(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every module outside Python's standard library that the script imports is imported by
+    /// the probe of [`detect`] (a Python with Siconos but without scipy failed every problem
+    /// one by one, 2026-12-03).
+    #[test]
+    fn the_probe_imports_what_the_script_imports() {
+        let stdlib = ["argparse", "gzip", "json", "os", "sys", "time", "math"];
+        let probed: Vec<&str> = PROBE_IMPORTS.split(',').map(str::trim).collect();
+        let mut third_party = Vec::new();
+        for line in SCRIPT.lines() {
+            let module = match line.split_whitespace().collect::<Vec<_>>()[..] {
+                ["import", m, ..] | ["from", m, "import", ..] => m,
+                _ => continue,
+            };
+            let top = module.split('.').next().unwrap_or(module);
+            if !stdlib.contains(&top) {
+                third_party.push(module.to_string());
+            }
+        }
+        assert!(
+            third_party.len() >= 3,
+            "the script's imports were not found: {third_party:?}"
+        );
+        for m in &third_party {
+            let top = m.split('.').next().unwrap_or(m);
+            assert!(
+                probed.iter().any(|p| p.split('.').next() == Some(top)),
+                "the script imports {m}, which the probe ({PROBE_IMPORTS}) does not check"
+            );
+        }
+    }
 
     #[test]
     fn parses_a_captured_line() {
