@@ -60,6 +60,12 @@ impl Periodic {
 #[derive(Debug, Default, Clone)]
 pub struct Detector {
     disk_collider: Vec<u32>,
+    /// Per disk of the last [`Detector::collect_disks`]: its body, whether that body is
+    /// kinematic, and its offset from the body's centre in the world frame, so that the pair
+    /// tests read dense arrays rather than the bodies.
+    disk_body: Vec<u32>,
+    disk_kinematic: Vec<bool>,
+    disk_offset: Vec<Vector2<f64>>,
     centre: Vec<[f64; 2]>,
     radius: Vec<f64>,
     margin: Vec<f64>,
@@ -282,7 +288,6 @@ impl Detector {
                         for k in 0..self.neighbours.len() {
                             let (cj, e) = self.neighbours[k];
                             self.disk_disk(
-                                bodies,
                                 inv_mass,
                                 colliders,
                                 laws,
@@ -300,7 +305,6 @@ impl Detector {
                         for k in list.start[d] as usize..list.start[d + 1] as usize {
                             let (cj, e) = self.candidates.partners[k];
                             self.disk_disk(
-                                bodies,
                                 inv_mass,
                                 colliders,
                                 laws,
@@ -602,17 +606,24 @@ impl Detector {
         gravity: f64,
     ) {
         self.disk_collider.clear();
+        self.disk_body.clear();
+        self.disk_kinematic.clear();
+        self.disk_offset.clear();
         self.centre.clear();
         self.radius.clear();
         self.margin.clear();
         for (ci, col) in colliders.iter().enumerate() {
             if let Shape::Disk { radius, offset } = col.shape {
                 let b = &bodies[col.body as usize];
-                let mut c = b.position + rotate(offset, b.angle);
+                let arm = rotate(offset, b.angle);
+                let mut c = b.position + arm;
                 if let Some(p) = periodic {
                     c.x = p.wrap(c.x);
                 }
                 self.disk_collider.push(ci as u32);
+                self.disk_body.push(col.body);
+                self.disk_kinematic.push(b.is_kinematic());
+                self.disk_offset.push(arm);
                 self.centre.push([c.x, c.y]);
                 self.radius.push(radius);
                 // Acceleration bound: gravity plus the applied force per unit mass.
@@ -687,7 +698,6 @@ impl Detector {
     #[inline]
     fn disk_disk<S: ContactSink>(
         &self,
-        bodies: &[Body],
         inv_mass: &[[f64; 3]],
         colliders: &[Collider],
         laws: &ContactLaws,
@@ -699,12 +709,8 @@ impl Detector {
         dj: usize,
         out: &mut S,
     ) {
-        let (ca, cb) = (&colliders[ci as usize], &colliders[cj as usize]);
-        if ca.body == cb.body {
-            return;
-        }
-        let (ba, bb) = (ca.body as usize, cb.body as usize);
-        if bodies[ba].is_kinematic() && bodies[bb].is_kinematic() {
+        let (ba, bb) = (self.disk_body[di] as usize, self.disk_body[dj] as usize);
+        if ba == bb || (self.disk_kinematic[di] && self.disk_kinematic[dj]) {
             return;
         }
         let (pa, pb) = (self.centre[di], self.centre[dj]);
@@ -729,11 +735,10 @@ impl Detector {
         };
         let gap = dist - ra - rb;
         // Contact point on the surface of b; levers from the bodies' centres of mass.
-        let off_a = disk_offset(&bodies[ba], ca);
-        let off_b = disk_offset(&bodies[bb], cb);
-        let lever_b = -n * rb + off_b;
-        let lever_a = Vector2::new(dx, dy) - n * rb + off_a;
+        let lever_b = -n * rb + self.disk_offset[dj];
+        let lever_a = Vector2::new(dx, dy) - n * rb + self.disk_offset[di];
         let point = Vector2::new(pb[0], pb[1]) - n * rb;
+        let (ca, cb) = (&colliders[ci as usize], &colliders[cj as usize]);
         out.contact(
             inv_mass,
             laws,
