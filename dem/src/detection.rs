@@ -1072,6 +1072,11 @@ impl Detector {
     ) -> Result<(), DemError> {
         out.clear();
         self.disk_collider.clear();
+        // Not used by the cell's pair test (`disk_disk_cell` reads the bodies): emptied so that
+        // nothing reads them stale.
+        self.disk_body.clear();
+        self.disk_kinematic.clear();
+        self.disk_offset.clear();
         self.centre.clear();
         self.radius.clear();
         self.margin.clear();
