@@ -240,6 +240,8 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         let run = ColumnRun::for_column(prep, n);
         // Over the seeds: grainlaw's seconds, and LAMMPS' where every peer run settled.
         let (mut ours, mut theirs, mut all_settled, mut capped) = (0.0, Some(0.0), true, 0);
+        // (grainlaw s, LAMMPS s) of each seed, while every peer run settled.
+        let mut pairs: Vec<(f64, f64)> = Vec::new();
         for seed in 1..=plan.seeds.max(1) {
             let r = settle_column(n, prep, &run, seed)?;
             let total = r.total_seconds();
@@ -265,6 +267,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
             capped += r.settle.unconverged_steps;
             theirs = match (theirs, peer.as_ref().map(|p| &p.0)) {
                 (Some(t), Some(crate::lammps_peer::PeerOutcome::Ran(p))) if p.settled => {
+                    pairs.push((total, p.wall_seconds));
                     Some(t + p.wall_seconds)
                 }
                 _ => None,
@@ -322,6 +325,24 @@ fn columns(plan: &BenchPlan) -> Result<()> {
                 ratio,
                 if all_settled { "" } else { "  NOT all settled" }
             );
+            if let (Some(_), Some(e)) = (theirs, RatioOfTotals::estimate(&pairs)) {
+                println!(
+                    "        ratio of the totals {:.3}: standard error {:.3} over the {} seeds, 95 % interval {:.3}–{:.3} \
+                     (ratio estimator, t with {} degrees of freedom; {:.1}× to {} faster than LAMMPS)",
+                    e.ratio,
+                    e.standard_error,
+                    pairs.len(),
+                    e.interval[0],
+                    e.interval[1],
+                    pairs.len() - 1,
+                    1.0 / e.interval[1],
+                    if e.interval[0] > 0.0 {
+                        format!("{:.1}×", 1.0 / e.interval[0])
+                    } else {
+                        "any factor".to_string()
+                    },
+                );
+            }
         }
     }
     println!(
@@ -331,6 +352,50 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         1u32 << ColumnRun::for_preparation(Preparation::Pour).max_halvings
     );
     Ok(())
+}
+
+/// The ratio of two totals over paired samples, `R = Σ x_i / Σ y_i` (here grainlaw's and LAMMPS'
+/// seconds over the seeds of a column), with its standard error by the ratio estimator's
+/// linearisation (W. G. Cochran, *Sampling Techniques*, 3rd ed., Wiley 1977, §6.3):
+///
+/// ```text
+/// se(R) = √( Σ (x_i − R y_i)² / (n (n − 1)) ) / ȳ,      ȳ = Σ y_i / n,
+/// ```
+///
+/// and the interval `R ∓ t_{0.975, n−1} se(R)`. The seeds' times scatter because each column
+/// settles along its own chaotic trajectory; the interval says how far the ratio of another set
+/// of seeds may fall, which a single ratio of totals does not.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RatioOfTotals {
+    /// `Σ x / Σ y`.
+    pub ratio: f64,
+    /// Its standard error.
+    pub standard_error: f64,
+    /// The 95 % interval.
+    pub interval: [f64; 2],
+}
+
+impl RatioOfTotals {
+    /// The estimate from `(x_i, y_i)` pairs; `None` with fewer than two pairs or a total of `y`
+    /// that is not positive.
+    pub fn estimate(pairs: &[(f64, f64)]) -> Option<Self> {
+        let n = pairs.len();
+        let (sx, sy) = pairs
+            .iter()
+            .fold((0.0, 0.0), |(a, b), &(x, y)| (a + x, b + y));
+        if n < 2 || sy.is_nan() || sy <= 0.0 || !sx.is_finite() {
+            return None;
+        }
+        let ratio = sx / sy;
+        let ss: f64 = pairs.iter().map(|&(x, y)| (x - ratio * y).powi(2)).sum();
+        let standard_error = (ss / (n * (n - 1)) as f64).sqrt() / (sy / n as f64);
+        let t = identify::stats::student_t_quantile(0.975, (n - 1) as f64);
+        Some(Self {
+            ratio,
+            standard_error,
+            interval: [ratio - t * standard_error, ratio + t * standard_error],
+        })
+    }
 }
 
 /// Runs the benchmark plan and prints the tables.
@@ -629,4 +694,36 @@ fn run_fc(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) ->
         "(ratio: Siconos seconds / ours, when both converged and Siconos' time is at least 1e-4 s)"
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod ratio_tests {
+    use super::RatioOfTotals;
+
+    /// Times proportional to the peer's: the ratio exactly, no spread.
+    #[test]
+    fn proportional_times_have_no_spread() {
+        let pairs = [(2.0, 10.0), (6.0, 30.0), (4.4, 22.0)];
+        let e = RatioOfTotals::estimate(&pairs).unwrap();
+        assert!((e.ratio - 0.2).abs() < 1e-15);
+        assert!(e.standard_error < 1e-15);
+    }
+
+    /// Two seeds worked by hand: R = 4/20 = 0.2, residuals −1 and 1, se = √(2/2)/10 = 0.1, and
+    /// t_{0.975,1} = 12.7062 (tables), so the interval is 0.2 ∓ 1.27062.
+    #[test]
+    fn two_seeds_by_hand() {
+        let e = RatioOfTotals::estimate(&[(1.0, 10.0), (3.0, 10.0)]).unwrap();
+        assert!((e.ratio - 0.2).abs() < 1e-15);
+        assert!((e.standard_error - 0.1).abs() < 1e-12);
+        assert!((e.interval[1] - (0.2 + 1.270_62)).abs() < 1e-4);
+        assert!((e.interval[0] - (0.2 - 1.270_62)).abs() < 1e-4);
+    }
+
+    /// Fewer than two seeds, or no peer time: no estimate.
+    #[test]
+    fn too_few_seeds_give_none() {
+        assert!(RatioOfTotals::estimate(&[(1.0, 5.0)]).is_none());
+        assert!(RatioOfTotals::estimate(&[(1.0, 0.0), (1.0, 0.0)]).is_none());
+    }
 }
