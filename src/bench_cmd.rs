@@ -238,10 +238,10 @@ fn columns(plan: &BenchPlan) -> Result<()> {
     );
     for (n, prep) in jobs {
         let run = ColumnRun::for_column(prep, n);
-        // Over the seeds: grainlaw's seconds, and LAMMPS' where every peer run settled.
-        let (mut ours, mut theirs, mut all_settled, mut capped) = (0.0, Some(0.0), true, 0);
-        // (grainlaw s, LAMMPS s) of each seed, while every peer run settled.
-        let mut pairs: Vec<(f64, f64)> = Vec::new();
+        // Over the seeds: grainlaw's seconds, and `(grainlaw s, LAMMPS s)` of each seed while
+        // every peer run settled (`peer_settled`; LAMMPS' total is the sum of the pairs').
+        let (mut ours, mut all_settled, mut capped) = (0.0, true, 0);
+        let (mut pairs, mut peer_settled): (Vec<(f64, f64)>, bool) = (Vec::new(), true);
         for seed in 1..=plan.seeds.max(1) {
             let r = settle_column(n, prep, &run, seed)?;
             let total = r.total_seconds();
@@ -265,13 +265,12 @@ fn columns(plan: &BenchPlan) -> Result<()> {
             ours += total;
             all_settled &= r.settle.settled;
             capped += r.settle.unconverged_steps;
-            theirs = match (theirs, peer.as_ref().map(|p| &p.0)) {
-                (Some(t), Some(crate::lammps_peer::PeerOutcome::Ran(p))) if p.settled => {
-                    pairs.push((total, p.wall_seconds));
-                    Some(t + p.wall_seconds)
+            match peer.as_ref().map(|p| &p.0) {
+                Some(crate::lammps_peer::PeerOutcome::Ran(p)) if p.settled && peer_settled => {
+                    pairs.push((total, p.wall_seconds))
                 }
-                _ => None,
-            };
+                _ => peer_settled = false,
+            }
             let (reference, ratio) = peer_cells(peer.as_ref().map(|p| &p.0), n, total);
             println!(
                 "{:>7} {:>8} {:>4} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
@@ -305,9 +304,11 @@ fn columns(plan: &BenchPlan) -> Result<()> {
             }
         }
         if plan.seeds > 1 {
-            let (reference, ratio) = match theirs {
-                Some(t) if lammps.is_some() => (format!("{t:.1}"), format!("{:.3}", ours / t)),
-                _ => ("–".into(), "–".into()),
+            let theirs = pairs.iter().map(|p| p.1).sum::<f64>();
+            let (reference, ratio) = if peer_settled && lammps.is_some() {
+                (format!("{theirs:.1}"), format!("{:.3}", ours / theirs))
+            } else {
+                ("–".into(), "–".into())
             };
             println!(
                 "{:>7} {:>8} {:>4} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9.2} {:>14} {:>9}{}",
@@ -325,7 +326,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
                 ratio,
                 if all_settled { "" } else { "  NOT all settled" }
             );
-            if let (Some(_), Some(e)) = (theirs, RatioOfTotals::estimate(&pairs)) {
+            if let Some(e) = RatioOfTotals::estimate(&pairs).filter(|_| peer_settled) {
                 println!(
                     "        ratio of the totals {:.3}: standard error {:.3} over the {} seeds, 95 % interval {:.3}–{:.3} \
                      (ratio estimator, t with {} degrees of freedom; {:.1}× to {} faster than LAMMPS)",
