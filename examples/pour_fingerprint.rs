@@ -69,7 +69,7 @@ fn main() {
                 t0.elapsed().as_secs_f64()
             );
         }
-        if ratio < 1e-8 {
+        if ratio < 1e-8 && s.report.solver.converged {
             break;
         }
     }
