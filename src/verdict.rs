@@ -298,6 +298,10 @@ pub struct WindowStats {
     /// Largest error measure at the end of a solve (1).
     #[serde(with = "dem::serde_float")]
     pub worst_error: f64,
+    /// Largest error of a solve over a scale without the gap-closing shifts of open pairs
+    /// (`dem::SolveReport::error_without_gap_shifts`; 1).
+    #[serde(default, with = "dem::serde_float")]
+    pub worst_error_without_gap_shifts: f64,
     /// Largest solver tolerance of the window's steps (1).
     #[serde(with = "dem::serde_float")]
     pub tolerance: f64,
@@ -330,6 +334,9 @@ impl WindowStats {
             self.unconverged += 1;
         }
         self.worst_error = self.worst_error.max(r.solver.error);
+        self.worst_error_without_gap_shifts = self
+            .worst_error_without_gap_shifts
+            .max(r.solver.error_without_gap_shifts);
         self.tolerance = self.tolerance.max(world.params.solver.tolerance);
         if grew {
             self.energy_growth += 1;
@@ -358,17 +365,25 @@ impl WindowStats {
         self.steps += o.steps;
         self.unconverged += o.unconverged;
         self.worst_error = self.worst_error.max(o.worst_error);
+        self.worst_error_without_gap_shifts = self
+            .worst_error_without_gap_shifts
+            .max(o.worst_error_without_gap_shifts);
         self.tolerance = self.tolerance.max(o.tolerance);
         self.energy_growth += o.energy_growth;
         self.max_overlap_ratio = self.max_overlap_ratio.max(o.max_overlap_ratio);
     }
 
     /// Summary keys `PREFIX_steps`, `PREFIX_unconverged_steps`, `PREFIX_worst_error`,
-    /// `PREFIX_energy_growth_steps`, `PREFIX_max_overlap_over_radius`.
+    /// `PREFIX_worst_error_without_gap_shifts`, `PREFIX_energy_growth_steps`,
+    /// `PREFIX_max_overlap_over_radius`.
     pub fn keys(&self, s: &mut Summary, prefix: &str) {
         s.int(&format!("{prefix}_steps"), self.steps)
             .int(&format!("{prefix}_unconverged_steps"), self.unconverged)
             .num(&format!("{prefix}_worst_error"), self.worst_error)
+            .num(
+                &format!("{prefix}_worst_error_without_gap_shifts"),
+                self.worst_error_without_gap_shifts,
+            )
             .int(&format!("{prefix}_energy_growth_steps"), self.energy_growth)
             .num(
                 &format!("{prefix}_max_overlap_over_radius"),

@@ -167,6 +167,7 @@ fn stopped_and_resumed_runs_give_the_same_files() {
         "solver_unconverged_steps",
         "solver_first_unconverged_step",
         "solver_worst_error",
+        "solver_worst_error_without_gap_shifts",
         "max_penetration_m",
         "max_penetration_over_radius",
         "penetration_flagged_steps",

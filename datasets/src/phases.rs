@@ -71,6 +71,11 @@ pub struct PhaseStats {
     /// Largest error measure at the end of a step's solve (1).
     #[serde(with = "dem::serde_float")]
     pub worst_error: f64,
+    /// Largest error measure of a step's solve over a scale that leaves out the gap-closing
+    /// shifts of open pairs (`dem::SolveReport::error_without_gap_shifts`): what `worst_error`
+    /// is on the loaded contacts (1; a diagnostic, convergence is decided on the error).
+    #[serde(default, with = "dem::serde_float")]
+    pub worst_error_without_gap_shifts: f64,
     /// Largest number of sweeps of one step.
     pub max_sweeps: usize,
     /// Sum of sweeps over the steps.
@@ -165,6 +170,9 @@ impl PhaseStats {
             self.first_unconverged_step = earliest(self.first_unconverged_step, Some(r.step));
         }
         self.worst_error = self.worst_error.max(r.solver.error);
+        self.worst_error_without_gap_shifts = self
+            .worst_error_without_gap_shifts
+            .max(r.solver.error_without_gap_shifts);
         self.max_sweeps = self.max_sweeps.max(r.solver.iterations);
         self.total_sweeps += r.solver.iterations as u64;
         self.max_penetration = self.max_penetration.max(r.max_penetration);
@@ -211,6 +219,9 @@ impl PhaseStats {
         self.first_unconverged_step =
             earliest(self.first_unconverged_step, o.first_unconverged_step);
         self.worst_error = self.worst_error.max(o.worst_error);
+        self.worst_error_without_gap_shifts = self
+            .worst_error_without_gap_shifts
+            .max(o.worst_error_without_gap_shifts);
         self.max_sweeps = self.max_sweeps.max(o.max_sweeps);
         self.total_sweeps += o.total_sweeps;
         self.max_penetration = self.max_penetration.max(o.max_penetration);

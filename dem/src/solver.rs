@@ -243,6 +243,12 @@ pub struct SolveReport {
     /// Pivots of Lemke's method (0 unless it ran).
     #[serde(default)]
     pub pivots: usize,
+    /// The error measure at the returned impulses with a scale that leaves out the gap-closing
+    /// shifts of open pairs ([`error_measures`]): the residual relative to the velocities of
+    /// the bodies and the impulses alone, above `error` wherever open pairs dominate the scale
+    /// (a diagnostic; convergence is decided on `error`). 0 without contacts.
+    #[serde(default)]
+    pub error_without_gap_shifts: f64,
 }
 
 pub use crate::nlgs::{STAGNATION_WINDOW, STALL_SWEEPS};
@@ -264,21 +270,39 @@ pub fn apply_impulses(rows: &[ContactRow], vel: &mut [[f64; 3]], inv: &[[f64; 3]
 /// Error measure of the current state: `‖r − proj_K(r − ū)‖ / max(q_norm, ‖r‖, ‖u‖)`.
 /// Summed over fixed chunks ([`reduce_chunks`]): the same bits on any number of threads.
 pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 {
-    let [e2, r2, u2] = reduce_chunks(rows, |c| {
+    error_measures(rows, vel, [q_norm, q_norm])[0]
+}
+
+/// The error measure ([`error_measure`], first) and the same residual over a scale that
+/// leaves out the positive gap-closing shifts `s⁺_α = max(s_α, 0)` of §1.3 (physics.md),
+/// second:
+///
+/// ```text
+/// e  = ‖r − proj_K(r − ū)‖ / max(‖q‖, ‖r‖, ‖u‖),
+/// e' = ‖r − proj_K(r − ū)‖ / max(‖q − s⁺‖, ‖r‖, ‖u − s⁺‖),
+/// ```
+///
+/// `q_norms = [‖q‖, ‖q − s⁺‖]` ([`free_velocity_norms`]). An open pair within the detection gap
+/// adds `g / (θ h)` to `q_n` and `u_n` and nothing to the residual: it inflates the first scale,
+/// by up to hundreds of times at small steps (physics.md §1.6), not the second. One pass; the
+/// first value's sums are those of the measure alone, bit for bit.
+pub fn error_measures(rows: &[ContactRow], vel: &[[f64; 3]], q_norms: [f64; 2]) -> [f64; 2] {
+    let [e2, r2, u2, w2] = reduce_chunks(rows, |c| {
         let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
         let e = natural_map_residual(c.r, u, c.mu);
+        let w = u[0] - c.shift.max(0.0);
         [
             e[0] * e[0] + e[1] * e[1],
             c.r[0] * c.r[0] + c.r[1] * c.r[1],
             u[0] * u[0] + u[1] * u[1],
+            w * w + u[1] * u[1],
         ]
     });
-    let den = q_norm.max(r2.sqrt()).max(u2.sqrt());
-    if den > 0.0 {
-        e2.sqrt() / den
-    } else {
-        0.0
-    }
+    let relative = |den: f64| if den > 0.0 { e2.sqrt() / den } else { 0.0 };
+    [
+        relative(q_norms[0].max(r2.sqrt()).max(u2.sqrt())),
+        relative(q_norms[1].max(r2.sqrt()).max(w2.sqrt())),
+    ]
 }
 
 /// Largest approach speed `max(0, −u_n)` (m/s) over the contacts that are closed (no
@@ -296,11 +320,18 @@ pub fn approach_speed(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
 /// Norm of the free local velocities `‖q‖`, `q_α = H_α v_free + shift_α`, computed from the
 /// velocities *before* the warm-start impulses are applied.
 pub fn free_velocity_norm(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
-    let [s] = reduce_chunks(rows, |c| {
+    free_velocity_norms(rows, vel)[0]
+}
+
+/// `[‖q‖, ‖q − s⁺‖]`: [`free_velocity_norm`] and the same norm without the positive
+/// gap-closing shifts, the two scales of [`error_measures`]. One pass.
+pub fn free_velocity_norms(rows: &[ContactRow], vel: &[[f64; 3]]) -> [f64; 2] {
+    let [s, w] = reduce_chunks(rows, |c| {
         let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
-        [u[0] * u[0] + u[1] * u[1]]
+        let wn = u[0] - c.shift.max(0.0);
+        [u[0] * u[0] + u[1] * u[1], wn * wn + u[1] * u[1]]
     });
-    s.sqrt()
+    [s.sqrt(), w.sqrt()]
 }
 
 /// Update of one contact: exact local solve, optional relaxation projected back on the cone,
@@ -479,7 +510,7 @@ pub fn solve(
     vel: &mut [[f64; 3]],
     v_free: &[[f64; 3]],
     inv: &[[f64; 3]],
-    q_norm: f64,
+    q_norms: [f64; 2],
     approach_limit: f64,
     params: &SolverParams,
     work: &mut SolverWork,
@@ -504,7 +535,8 @@ pub fn solve(
         vel,
         v_free,
         inv,
-        q_norm,
+        q_norms,
+        error_without_gap_shifts: f64::NAN,
         approach_limit,
         omega: params.relaxation,
         seed: SHUFFLE_SEED,
@@ -512,7 +544,13 @@ pub fn solve(
         measure: false,
         wave: scheduled.then_some(wave.order.as_slice()),
     };
-    let report = solve_step(&mut step, params, work);
+    let mut report = solve_step(&mut step, params, work);
+    // Every stage ends on an evaluation of the impulses it returns; a solve that evaluated
+    // none (no contact, or no sweep allowed) is evaluated here.
+    if step.error_without_gap_shifts.is_nan() {
+        step.error();
+    }
+    report.error_without_gap_shifts = step.error_without_gap_shifts;
     if let Some(c) = step.cell.as_deref_mut() {
         c.detach(step.rows);
     }
@@ -779,7 +817,10 @@ struct Step<'a> {
     vel: &'a mut [[f64; 3]],
     v_free: &'a [[f64; 3]],
     inv: &'a [[f64; 3]],
-    q_norm: f64,
+    /// `[‖q‖, ‖q − s⁺‖]`, the scales of [`error_measures`].
+    q_norms: [f64; 2],
+    /// The second measure of [`error_measures`] at the last evaluation (NaN before any).
+    error_without_gap_shifts: f64,
     approach_limit: f64,
     /// Relaxation factor of the contact updates.
     omega: f64,
@@ -894,7 +935,9 @@ impl SweepProblem for Step<'_> {
     }
 
     fn error(&mut self) -> f64 {
-        error_measure(self.rows, self.vel, self.q_norm)
+        let [e, e_shift_free] = error_measures(self.rows, self.vel, self.q_norms);
+        self.error_without_gap_shifts = e_shift_free;
+        e
     }
 
     /// The error within the tolerance and no closed or loaded contact approaching faster than
@@ -1017,6 +1060,7 @@ fn global(
         approach_speed: approach,
         newton_iterations,
         pivots: 0,
+        error_without_gap_shifts: 0.0,
     }
 }
 
@@ -1078,6 +1122,7 @@ fn nlgs(
         approach_speed: step.approach_speed(),
         newton_iterations: 0,
         pivots: 0,
+        error_without_gap_shifts: 0.0,
     }
 }
 
@@ -1185,5 +1230,59 @@ pub fn status(c: &ContactRow) -> ContactStatus {
         ContactStatus::Slide
     } else {
         ContactStatus::Stick
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::local::Delassus2;
+
+    /// A frictional contact row between bodies `a` and `b` along `n = (0, 1)`, no levers.
+    fn row(a: u32, b: u32, shift: f64, r: [f64; 2]) -> ContactRow {
+        ContactRow {
+            a,
+            b,
+            n: [0.0, 1.0],
+            k: [0.0; 4],
+            w: Delassus2 {
+                nn: 1.0,
+                nt: 0.0,
+                tt: 1.0,
+            },
+            shift,
+            affine: [-0.0, -0.0],
+            mu: 0.5,
+            r,
+            basis: 0,
+        }
+    }
+
+    /// Worked by hand. Body 0 is a fixed wall. Contact 0 (wall–body 1) is loaded, `r = (1, 0)`,
+    /// its bodies separating at `u = (0.01, 0)`: the natural-map residual is `(0.01, 0)`.
+    /// Contact 1 (wall–body 2) is open with a gap-closing shift of 2 m/s, body 2 falling at
+    /// 0.1 m/s: `u = (1.9, 0)`, no residual. So `‖e‖ = 0.01`, `‖r‖ = 1`,
+    /// `‖u‖ = √(0.01² + 1.9²)` and without the shift `√(0.01² + 0.1²)`. With the scales
+    /// `‖q‖ = 2`, `‖q − s⁺‖ = 0.5`: `e = 0.01 / 2 = 0.005` and `e' = 0.01 / max(0.5, 1) = 0.01`.
+    /// The norms of the free velocities (here the velocities themselves) are those of `u` with
+    /// and without the shift.
+    #[test]
+    fn the_error_without_gap_shifts_leaves_the_open_pairs_out_of_its_scale() {
+        let rows = [row(0, 1, 0.0, [1.0, 0.0]), row(0, 2, 2.0, [0.0, 0.0])];
+        let vel = [[0.0; 3], [0.0, 0.01, 0.0], [0.0, -0.1, 0.0]];
+        let [e, e_free] = error_measures(&rows, &vel, [2.0, 0.5]);
+        assert!((e - 0.005).abs() <= 1e-15, "{e}");
+        assert!((e_free - 0.01).abs() <= 1e-15, "{e_free}");
+        assert_eq!(error_measure(&rows, &vel, 2.0), e);
+        let [q, q_free] = free_velocity_norms(&rows, &vel);
+        assert!((q - (0.01f64.powi(2) + 1.9f64.powi(2)).sqrt()).abs() <= 1e-15);
+        assert!((q_free - (0.01f64.powi(2) + 0.1f64.powi(2)).sqrt()).abs() <= 1e-15);
+        assert_eq!(free_velocity_norm(&rows, &vel), q);
+        // Without the open pair's shift the two measures are one.
+        let closed = [row(0, 1, 0.0, [1.0, 0.0])];
+        let [q, q_free] = free_velocity_norms(&closed, &vel);
+        assert_eq!(q, q_free);
+        let [e, e_free] = error_measures(&closed, &vel, [q, q_free]);
+        assert_eq!(e, e_free);
     }
 }

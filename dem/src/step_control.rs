@@ -379,6 +379,9 @@ pub fn merge_reports<'a>(reports: impl IntoIterator<Item = &'a StepReport>) -> S
         s.newton_iterations += r.solver.newton_iterations;
         s.pivots += r.solver.pivots;
         s.error = s.error.max(r.solver.error);
+        s.error_without_gap_shifts = s
+            .error_without_gap_shifts
+            .max(r.solver.error_without_gap_shifts);
         s.approach_speed = s.approach_speed.max(r.solver.approach_speed);
         s.converged &= r.solver.converged;
         m.step = r.step;

@@ -271,8 +271,8 @@ mod tests {
     #[test]
     fn solve_in_natural_order_equals_sweeps_in_the_given_order() {
         use crate::solver::{
-            apply_impulses, error_measure, free_velocity_norm, solve, SolverMethod, SolverParams,
-            SolverWork, SweepOrder,
+            apply_impulses, error_measure, free_velocity_norm, free_velocity_norms, solve,
+            SolverMethod, SolverParams, SolverWork, SweepOrder,
         };
         let n = 60;
         let mut rows0 = rows(n);
@@ -319,7 +319,7 @@ mod tests {
             &mut vb,
             &v_free,
             &inv,
-            q_norm,
+            [q_norm, free_velocity_norms(&rows0, &v_free)[1]],
             f64::INFINITY,
             &params,
             &mut SolverWork::default(),

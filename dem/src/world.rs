@@ -1195,7 +1195,7 @@ impl World {
 
         // 3. Contact solve (with the cell's stress-controlled components as unknowns under an
         //    implicit control, `crate::cell_coupling`).
-        let q_norm = solver::free_velocity_norm(&self.contacts.rows, &self.vel);
+        let q_norms = solver::free_velocity_norms(&self.contacts.rows, &self.vel);
         let thickness = self.grain_thickness();
         let mut coupling = match (self.cell_control, self.cell, free_change) {
             (Some(ctl), Some(cell), Some(delta0)) => CellCoupling::new(
@@ -1259,7 +1259,7 @@ impl World {
                 &mut l.vel,
                 &l.v_free,
                 &l.inv,
-                q_norm,
+                q_norms,
                 approach_limit,
                 &self.params.solver,
                 &mut self.work,
@@ -1284,7 +1284,7 @@ impl World {
                 &mut self.vel,
                 &self.v_free,
                 &self.inv,
-                q_norm,
+                q_norms,
                 approach_limit,
                 &self.params.solver,
                 &mut self.work,

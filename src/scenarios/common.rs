@@ -162,7 +162,10 @@ pub fn phase_warnings(
 }
 
 /// Solver and numerics keys of `summary.json`: `solver_steps`, `solver_unconverged_steps`,
-/// `solver_first_unconverged_step`, `solver_worst_error`, `solver_mean_sweeps`, `solver_max_sweeps`; `max_penetration_m`,
+/// `solver_first_unconverged_step`, `solver_worst_error`, `solver_worst_error_without_gap_shifts`
+/// (the same residuals over a scale that leaves out the gap-closing shifts of open pairs:
+/// what the error is on the loaded contacts, docs/physics.md §1.6), `solver_mean_sweeps`,
+/// `solver_max_sweeps`; `max_penetration_m`,
 /// `max_penetration_over_radius` (over the smallest grain radius), `penetration_flagged_steps`
 /// (overlap above [`PENETRATION_LIMIT`] of it) and `penetration_first_step`;
 /// `energy_growth_steps` (energy residual above [`ENERGY_GROWTH_TOLERANCE`] of the load energy
@@ -185,6 +188,10 @@ pub fn solver_keys(s: &mut Summary, stats: &PhaseStats) {
             step(stats.first_unconverged_step),
         )
         .num("solver_worst_error", stats.worst_error)
+        .num(
+            "solver_worst_error_without_gap_shifts",
+            stats.worst_error_without_gap_shifts,
+        )
         .num("solver_mean_sweeps", stats.mean_sweeps())
         .int("solver_max_sweeps", stats.max_sweeps as u64)
         .num("max_penetration_m", stats.max_penetration)

@@ -507,6 +507,10 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .int("release_unconverged_steps", release.unconverged_steps)
         .int("release_energy_growth_steps", release.energy_growth_steps)
         .num("release_worst_error", release.worst_error)
+        .num(
+            "release_worst_error_without_gap_shifts",
+            release.worst_error_without_gap_shifts,
+        )
         .int("relax_steps", relax.steps)
         .num("relax_time_s", relax.simulated_time)
         .int("relax_unconverged_steps", relax.unconverged_steps)
@@ -515,6 +519,10 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .flag("relax_at_rest", relax.at_rest)
         .num("final_kinetic_energy_ratio", relax.final_energy_ratio)
         .num("final_solver_error", final_report.solver.error)
+        .num(
+            "final_solver_error_without_gap_shifts",
+            final_report.solver.error_without_gap_shifts,
+        )
         .int("final_solver_sweeps", final_report.solver.iterations as u64)
         .flag("final_solver_converged", final_report.solver.converged)
         .int("measure_steps", measure_window.samples)
