@@ -147,12 +147,10 @@ fn janssen_column() {
     assert!(num(&s, "final_solver_error") <= 1e-6);
     // On the loaded contacts (the scale without the open pairs' gap-closing shifts) the
     // measured steps' residual is within 10 times their tolerance (2.8e-6 at seed 1, the
-    // scales 2.8 apart); over the whole run the same measure is what the open pairs hide: at
-    // least the run's worst error.
+    // scales 2.8 apart); the last of them is one of the window's.
     let loaded = num(&s, "measured_worst_error_without_gap_shifts");
     assert!(loaded > 0.0 && loaded <= 1e-5, "{loaded}");
     assert!(num(&s, "final_solver_error_without_gap_shifts") <= loaded);
-    assert!(num(&s, "solver_worst_error_without_gap_shifts") >= num(&s, "solver_worst_error"));
     has_files(
         &out,
         &[

@@ -245,8 +245,10 @@ pub struct SolveReport {
     pub pivots: usize,
     /// The error measure at the returned impulses with a scale that leaves out the gap-closing
     /// shifts of open pairs ([`error_measures`]): the residual relative to the velocities of
-    /// the bodies and the impulses alone, above `error` wherever open pairs dominate the scale
-    /// (a diagnostic; convergence is decided on `error`). 0 without contacts.
+    /// the bodies and the impulses alone: above `error` where open pairs far from closing
+    /// dominate the scale, possibly below it where pairs close within the step (their shift
+    /// then enters `‖u − s⁺‖` and not `‖u‖`). A diagnostic; convergence is decided on `error`.
+    /// 0 without contacts.
     #[serde(default)]
     pub error_without_gap_shifts: f64,
 }
@@ -284,8 +286,9 @@ pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 
 ///
 /// `q_norms = [‖q‖, ‖q − s⁺‖]` ([`free_velocity_norms`]). An open pair within the detection gap
 /// adds `g / (θ h)` to `q_n` and `u_n` and nothing to the residual: it inflates the first scale,
-/// by up to hundreds of times at small steps (physics.md §1.6), not the second. One pass; the
-/// first value's sums are those of the measure alone, bit for bit.
+/// by up to hundreds of times at small steps (physics.md §1.6), not the second. (A pair that
+/// closes within the step, or approaches fast, can make the second scale the larger.) One
+/// pass; the first value's sums are those of the measure alone, bit for bit.
 pub fn error_measures(rows: &[ContactRow], vel: &[[f64; 3]], q_norms: [f64; 2]) -> [f64; 2] {
     let [e2, r2, u2, w2] = reduce_chunks(rows, |c| {
         let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
@@ -484,8 +487,8 @@ impl SweepOrder<'_> {
 /// [`approach_speed`] `≤ approach_limit` (m/s): the relative error alone is normalised by the
 /// largest velocities of the step, so while some grains fall fast it lets resting contacts
 /// approach at up to `tolerance × ‖q‖`, and their overlaps add up over the steps. On entry `vel`
-/// must equal `v_free + M⁻¹ Hᵀ R` for those impulses (see [`apply_impulses`]); `q_norm` is
-/// [`free_velocity_norm`]. On return `vel` matches the returned impulses.
+/// must equal `v_free + M⁻¹ Hᵀ R` for those impulses (see [`apply_impulses`]); `q_norms` is
+/// [`free_velocity_norms`]. On return `vel` matches the returned impulses.
 ///
 /// `nlgs` sweeps up to `max_iterations` times ([`crate::nlgs::drive`]); `newton` assembles the
 /// step's problem ([`crate::assemble::contact_problem`]) and runs [`crate::fc::newton`] from the
@@ -785,6 +788,9 @@ impl AutoStages for EngineStages<'_, '_> {
                 c.r = [x[0], x[1]];
             }
             step.rebuild();
+            // Evaluated again so that the measures the solve reports are those of the impulses
+            // it returns (`error_without_gap_shifts` was just set for the rejected ones).
+            step.error();
             return Ok((false, out.lemke_ran));
         }
         // The basis of an accepted Lemke solution is the next step's warm start.
@@ -1070,7 +1076,7 @@ fn global(
 /// is normalised by the largest velocities of the step, so while some grains fall fast it lets
 /// resting contacts approach at up to `tolerance × ‖q‖`, and their overlaps add up over the
 /// steps. On entry the velocities must equal `v_free + M⁻¹ Hᵀ R` for those impulses (see
-/// [`apply_impulses`]); `q_norm` is [`free_velocity_norm`].
+/// [`apply_impulses`]); its `q_norms` are [`free_velocity_norms`].
 ///
 /// The error is evaluated after every sweep during the first ten, then every
 /// `max(1, iterations/10)` sweeps (at most 16, [`CheckSchedule::Growing`]), or, with

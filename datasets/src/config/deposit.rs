@@ -11,7 +11,8 @@ use crate::limits;
 /// The phase runs with the time step `dt / substeps` (sub-stepping keeps each grain's travel
 /// per step below about a tenth of the smallest radius during the collapse, where the contact
 /// solver then needs few sweeps) until the grains are at rest,
-/// `E_kin < rest_energy · Σ m g d` (d the grain's diameter), or until `max_time`.
+/// `E_kin < rest_energy · Σ m g d` (d the grain's diameter) after 20 consecutive steps whose
+/// solves converged ([`crate::phases::RunUntilRest`]), or until `max_time`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DepositSpec {
@@ -57,7 +58,8 @@ pub struct RelaxSpec {
     pub min_time: f64,
     /// Longest relaxation (s).
     pub max_time: f64,
-    /// Rest criterion: kinetic energy over `Σ m g d` (1).
+    /// Rest criterion: kinetic energy over `Σ m g d` (1), after 20 consecutive converged steps
+    /// ([`crate::phases::RunUntilRest`]).
     pub rest_energy: f64,
     /// Contact solver of the relaxation (tight, e.g. 1e-6: the measured state).
     pub solver: SolverSpec,

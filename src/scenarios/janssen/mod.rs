@@ -516,6 +516,10 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .int("relax_unconverged_steps", relax.unconverged_steps)
         .int("relax_energy_growth_steps", relax.energy_growth_steps)
         .num("relax_worst_error", relax.worst_error)
+        .num(
+            "relax_worst_error_without_gap_shifts",
+            relax.worst_error_without_gap_shifts,
+        )
         .flag("relax_at_rest", relax.at_rest)
         .num("final_kinetic_energy_ratio", relax.final_energy_ratio)
         .num("final_solver_error", final_report.solver.error)
