@@ -398,7 +398,9 @@ impl World {
     ///
     /// Advances `n` time steps with the GIL released; returns the report of the last one:
     /// ``step``, ``time`` (s), ``contacts``, ``active_contacts``, ``iterations`` (sweeps),
-    /// ``error`` (solver error measure), ``converged``, ``max_penetration`` (m). The world is
+    /// ``error`` (solver error measure), ``error_without_gap_shifts`` (the same residual over
+    /// a scale without the open pairs' gap-closing shifts: the error on the loaded contacts),
+    /// ``converged``, ``max_penetration`` (m). The world is
     /// checked (parameters, bodies, no initial overlap) before its first step and after a
     /// change. Raises InputError for a world that cannot be stepped, SolverError when a step
     /// fails (non-finite state).
@@ -430,6 +432,7 @@ impl World {
         d.set_item("active_contacts", r.active_contacts)?;
         d.set_item("iterations", r.solver.iterations)?;
         d.set_item("error", r.solver.error)?;
+        d.set_item("error_without_gap_shifts", r.solver.error_without_gap_shifts)?;
         d.set_item("converged", r.solver.converged)?;
         d.set_item("max_penetration", r.max_penetration)?;
         Ok(d)

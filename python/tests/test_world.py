@@ -59,6 +59,16 @@ def test_disk_resting_on_a_floor_carries_its_weight():
     assert abs(w.velocities[1, 1]) <= 1e-9
 
 
+def test_error_without_gap_shifts_equals_the_error_without_open_pairs():
+    # one closed contact (gap 0, no gap-closing shift): both scales are the same, so are the
+    # two measures, to the bit
+    w = resting_disk()
+    report = w.step()
+    assert report["contacts"] == 1 and report["converged"]
+    assert report["error_without_gap_shifts"] == report["error"]
+    assert report["error"] <= 1e-12
+
+
 def test_love_weber_stress_of_a_disk_on_a_floor():
     m, r = 0.2, 0.01
     s = resting_disk(r, m).snapshot()

@@ -91,6 +91,7 @@ impl ProblemDump {
             "engine_lemke_pivots": last.solver.pivots,
             "lemke_max_contacts": solver.lemke_max_contacts,
             "engine_error": last.solver.error,
+            "engine_error_without_gap_shifts": last.solver.error_without_gap_shifts,
             "engine_converged": last.solver.converged,
             "step_sweeps": r.solver.iterations,
             "step_converged": r.solver.converged,
