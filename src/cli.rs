@@ -220,7 +220,7 @@ pub struct RunArgs {
     /// whose solve did not converge.
     #[arg(long, value_name = "DIR")]
     pub dump_problems: Option<PathBuf>,
-    /// With --dump-problems: write the steps FIRST..LAST (inclusive global step indices).
+    /// With --dump-problems: write the steps FIRST..LAST (inclusive indices of the world's steps, a subdivided step counting its sub-steps, as in the names of the files written).
     #[arg(
         long,
         value_name = "FIRST..LAST",
