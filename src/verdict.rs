@@ -16,9 +16,17 @@
 //! |---|---|---|
 //! | unconverged steps in the window ([`SOLVER_UNCONVERGED_SUSPECT`], [`SOLVER_UNCONVERGED_REFUSED`]) | 1 % of its steps | 25 % (windows of ≥ [`MIN_STEPS_FOR_FRACTION_REFUSAL`] steps) |
 //! | worst solver error in the window / tolerance ([`SOLVER_ERROR_SUSPECT`], [`SOLVER_ERROR_REFUSED`]) | 10 | 1000 |
+//! | the same over the loaded contacts' scale (`dem::SolveReport::error_without_gap_shifts`) / tolerance | 10 | 1000 |
 //! | steps of the window whose energy grew beyond `ENERGY_GROWTH_TOLERANCE` | 1 % | 25 % (≥ 20 steps) |
 //! | largest overlap in the window / smallest radius ([`OVERLAP_SUSPECT`], [`OVERLAP_REFUSED`]) | 0.1 % | 1 % |
 //! | solid fraction | — | outside (0, [`max_solid_fraction`]) |
+//!
+//! The second error check reads the same residuals over a scale that leaves out the
+//! gap-closing shifts `g / (θ h)` of the pairs open within the detection gap
+//! (`dem::SolveReport::error_without_gap_shifts`, docs/physics.md §1.6): those shifts enter the
+//! error's scale `max(‖q‖, ‖r‖, ‖u‖)` and nothing else, so a solve can meet its tolerance while
+//! the contacts that carry the load are solved tens of times less accurately (the Janssen
+//! release: 56×). A window must meet both.
 //!
 //! and the scenario's own checks (force balance, inertial number against its target, steady
 //! state), documented where they are made.
@@ -252,6 +260,21 @@ impl Checks {
                 format!(
                     "{label}: worst solver error {:.2e} is {e:.0} times the tolerance {:.0e} (limit {t:.0}×)",
                     w.worst_error, w.tolerance
+                )
+            },
+        );
+        // The same residuals over the loaded contacts' scale: a window whose solves met the
+        // tolerance only because open pairs' gap-closing shifts inflate the error's scale.
+        let e0 = w.worst_error_without_gap_shifts / w.tolerance;
+        self.at_most(
+            "solver.loaded_error_over_tolerance",
+            e0,
+            SOLVER_ERROR_SUSPECT,
+            Some(SOLVER_ERROR_REFUSED),
+            |t| {
+                format!(
+                    "{label}: worst solver error over the loaded contacts' scale (without the gap-closing shifts of open pairs) {:.2e} is {e0:.0} times the tolerance {:.0e} (limit {t:.0}×)",
+                    w.worst_error_without_gap_shifts, w.tolerance
                 )
             },
         );
@@ -691,6 +714,31 @@ mod tests {
         assert_eq!(d, 0.0);
         assert_eq!(z, 0.0);
         assert!(halves_drift(&ramp[..15]).is_none());
+    }
+
+    #[test]
+    fn converged_steps_are_judged_on_the_loaded_contacts_scale_too() {
+        // Every step converged on the error measure (1e-6 at a tolerance of 1e-6); the same
+        // residuals over the loaded contacts' scale are 2.8 (the main job's measured steps),
+        // 50 and 2000 times the tolerance: ok, suspect (above 10×), refused (above 1000×).
+        let judge = |loaded: f64| {
+            let w = WindowStats {
+                steps: 4,
+                worst_error: 1e-6,
+                worst_error_without_gap_shifts: loaded,
+                tolerance: 1e-6,
+                ..Default::default()
+            };
+            let mut c = Checks::new();
+            c.window("measured steps", &w);
+            c
+        };
+        assert_eq!(judge(2.8e-6).verdict(), Verdict::Ok);
+        let c = judge(5e-5);
+        assert_eq!(c.verdict(), Verdict::Suspect);
+        assert_eq!(c.reasons[0].check, "solver.loaded_error_over_tolerance");
+        assert!((c.reasons[0].value - 50.0).abs() < 1e-9);
+        assert_eq!(judge(2e-3).verdict(), Verdict::Refused);
     }
 
     #[test]

@@ -51,6 +51,8 @@ fn bad_solver_settings_are_refused_with_the_key() {
         ("solver.check_every=1001", "solver.check_every"),
         ("solver.last_level_sweeps=0", "solver.last_level_sweeps"),
         ("solver.last_level_sweeps=1001", "solver.last_level_sweeps"),
+        ("solver.error_scale=contacts", "solver.error_scale"),
+        ("solver.error_scale=1", "solver.error_scale"),
     ] {
         let o = grainlaw(&["run", "shear-cell", "--out", "x", "--set", set], d);
         refused(&o, key);

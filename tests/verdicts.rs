@@ -28,9 +28,11 @@ fn json(path: &Path) -> Value {
 const JANSSEN: &[&str] = &["run", "janssen", "-q", "--set", "grains=100"];
 
 /// The same with a loose solver: the relaxation to 10⁻⁵ and the release to 10⁻², and one
-/// measured step (the built-in window is 4) stopped after one Gauss–Seidel sweep, whole (no
+/// measured step (the built-in window is 4) stopped after twenty Gauss–Seidel sweeps, whole (no
 /// sub-steps: the release's `max_halvings` is 0; `auto` would finish it with Newton): its error
-/// is then about 700 times its tolerance (measured 7.05e-3), so suspect. (Without Lemke's
+/// is then about 240 times its tolerance (measured 2.40e-3), and 455 times over the loaded
+/// contacts' scale (4.55e-3), so suspect on both (one sweep: 705 and 1335 times, refused on
+/// the second; ten: 322 and 609, forty: 187 and 354). (Without Lemke's
 /// finish, as when these expectations were measured: with it the deposit ends in another,
 /// exactly solved state, from which the loose release gives a column whose Janssen fit is
 /// refused outright.)
@@ -46,7 +48,7 @@ const LOOSE: &[&str] = &[
     "--set",
     "release.solver.tolerance=1e-2",
     "--set",
-    "analysis.final_max_iterations=1",
+    "analysis.final_max_iterations=20",
     "--set",
     "relax.solver.method=nlgs",
     "--set",
@@ -150,6 +152,7 @@ fn cases() -> Vec<Case> {
             verdict: Some("suspect"),
             reasons: &[
                 ("solver.worst_error_over_tolerance", "suspect"),
+                ("solver.loaded_error_over_tolerance", "suspect"),
                 ("solver.unconverged_fraction", "suspect"),
             ],
             laws: &[("janssen_law.rejected.json", "suspect")],

@@ -83,6 +83,44 @@ impl SolverMethod {
     }
 }
 
+/// The scale a solve's convergence is judged on ([`SolverParams::error_scale`]).
+///
+/// Both measures share the residual `‖r − proj_K(r − ū)‖` of the natural map; they differ by
+/// their scale ([`error_measures`], docs/physics.md §1.6):
+/// `Problem` divides by `max(‖q‖, ‖r‖, ‖u‖)`, the measure of Siconos and of the fc-problem
+/// files, in which the gap-closing shifts `s_α = g⁻_α / (θ h)` of the pairs open within the
+/// detection gap enter `q` and `u` and nothing else; `Loaded` requires the same residual over
+/// `max(‖q − s⁺‖, ‖r‖, ‖u − s⁺‖)` too, the scale of the contacts that carry the load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ErrorScale {
+    /// The error measure of the step's problem, open pairs' shifts included (the default).
+    #[default]
+    Problem,
+    /// The larger of the two measures: the tolerance holds on the loaded contacts' scale.
+    Loaded,
+}
+
+impl ErrorScale {
+    /// The name used in TOML files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorScale::Problem => "problem",
+            ErrorScale::Loaded => "loaded",
+        }
+    }
+
+    /// The error a solve is judged on, from both measures `[e, e']` of [`error_measures`].
+    pub fn governing(self, errors: [f64; 2]) -> f64 {
+        match self {
+            ErrorScale::Problem => errors[0],
+            // NaN-propagating: a NaN in either measure fails the test.
+            ErrorScale::Loaded if errors[1].is_nan() => errors[1],
+            ErrorScale::Loaded => errors[0].max(errors[1]),
+        }
+    }
+}
+
 /// Parameters of the contact solver of a step.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -151,6 +189,11 @@ pub struct SolverParams {
     /// the poured benchmark column uses [`crate::step_control::LAST_LEVEL_SWEEPS`].
     #[serde(default = "one_usize")]
     pub last_level_sweeps: usize,
+    /// The scale the tolerance applies to ([`ErrorScale`]): `problem` (default), or `loaded`,
+    /// where a solve converges only when its error over the loaded contacts' scale meets the
+    /// tolerance too, and reports the larger of the two as its error.
+    #[serde(default)]
+    pub error_scale: ErrorScale,
 }
 
 fn one_usize() -> usize {
@@ -220,6 +263,7 @@ impl Default for SolverParams {
             gauss_seidel_attempts: true,
             check_every: 0,
             last_level_sweeps: 1,
+            error_scale: ErrorScale::Problem,
         }
     }
 }
@@ -536,6 +580,7 @@ pub fn solve(
         inv,
         q_norms,
         last_errors: [f64::NAN; 2],
+        scale: params.error_scale,
         approach_limit,
         omega: params.relaxation,
         seed: SHUFFLE_SEED,
@@ -547,7 +592,7 @@ pub fn solve(
     // The second measure of the last evaluation belongs to the returned impulses when that
     // evaluation gave the reported error; otherwise (none made, or the last one of impulses
     // a stage rejected and put back) they are evaluated here.
-    if step.last_errors[0].to_bits() != report.error.to_bits() {
+    if step.scale.governing(step.last_errors).to_bits() != report.error.to_bits() {
         step.error();
     }
     report.error_without_gap_shifts = step.last_errors[1];
@@ -821,6 +866,8 @@ struct Step<'a> {
     q_norms: [f64; 2],
     /// Both measures of [`error_measures`] at the last evaluation (NaN before any).
     last_errors: [f64; 2],
+    /// Which of them (or their larger) [`SweepProblem::error`] returns.
+    scale: ErrorScale,
     approach_limit: f64,
     /// Relaxation factor of the contact updates.
     omega: f64,
@@ -936,7 +983,7 @@ impl SweepProblem for Step<'_> {
 
     fn error(&mut self) -> f64 {
         self.last_errors = error_measures(self.rows, self.vel, self.q_norms);
-        self.last_errors[0]
+        self.scale.governing(self.last_errors)
     }
 
     /// The error within the tolerance and no closed or loaded contact approaching faster than

@@ -150,6 +150,10 @@ pub struct SolverSpec {
     /// `max_iterations` ([`dem::SolverParams::last_level_sweeps`]), in 1..=1000. Default 1.
     #[serde(default = "one")]
     pub last_level_sweeps: usize,
+    /// The scale the tolerance applies to: `"problem"` (default) or `"loaded"`, the loaded
+    /// contacts' scale too ([`dem::solver::ErrorScale`]).
+    #[serde(default)]
+    pub error_scale: dem::solver::ErrorScale,
 }
 
 fn one() -> usize {
@@ -204,6 +208,7 @@ impl SolverSpec {
             max_halvings: self.max_halvings,
             check_every: self.check_every,
             last_level_sweeps: self.last_level_sweeps,
+            error_scale: self.error_scale,
             ..Default::default()
         }
     }
