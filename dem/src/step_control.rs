@@ -91,6 +91,9 @@ pub struct Subdivision {
     pub next_pause: u32,
 }
 
+/// A sub-step's problem and report ([`World::problem_of_last_step`]).
+type Unconverged = (crate::fc::FcProblem, StepReport);
+
 /// One kept sub-step of a [`SubdividedStep`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SubStep {
@@ -212,7 +215,7 @@ pub fn step_subdivided_checked(
     let method = world.params.solver.method;
     let gauss_seidel_attempts = world.params.solver.gauss_seidel_attempts;
     // The first solve of a step whose energy grew, while its polish is tried.
-    let mut first: Option<(World, Vec<SubStep>)> = None;
+    let mut first: Option<(World, Vec<SubStep>, Option<Unconverged>)> = None;
     let max_iterations = world.params.solver.max_iterations;
     let restore = |world: &mut World| {
         world.params.dt = h;
@@ -221,7 +224,7 @@ pub fn step_subdivided_checked(
         world.params.solver.max_iterations = max_iterations;
     };
     // The kept sub-steps, and whether they are a polish.
-    let (subs, polished) = loop {
+    let (subs, polished, unconverged) = loop {
         let polishing = first.is_some();
         let can_halve = level < max && !polishing;
         if can_halve || (energy_limit.is_some() && !polishing) {
@@ -247,6 +250,8 @@ pub fn step_subdivided_checked(
                 max_iterations.saturating_mul(world.params.solver.last_level_sweeps.max(1));
         }
         let mut subs = Vec::with_capacity(n);
+        // The first unconverged sub-step's problem, when problems are recorded (for a dump).
+        let mut unconverged: Option<Unconverged> = None;
         let mut failed = false;
         for _ in 0..n {
             let probe = EnergyProbe::before(world);
@@ -269,6 +274,9 @@ pub fn step_subdivided_checked(
             };
             let energy_residual = probe.residual(world);
             let converged = report.solver.converged;
+            if !converged && unconverged.is_none() {
+                unconverged = world.last_problem().map(|p| (p.clone(), report));
+            }
             subs.push(SubStep {
                 report,
                 energy_residual,
@@ -280,7 +288,7 @@ pub fn step_subdivided_checked(
         }
         let sweeps =
             |subs: &[SubStep]| -> usize { subs.iter().map(|s| s.report.solver.iterations).sum() };
-        if let Some((first_world, first_subs)) = first.take() {
+        if let Some((first_world, first_subs, first_unconverged)) = first.take() {
             // The polish: kept if every sub-step converged at the tighter tolerance.
             let kept = !failed;
             if kept {
@@ -292,9 +300,10 @@ pub fn step_subdivided_checked(
                 discarded += sweeps(&subs);
                 world.undo_to(&first_world);
                 subs = first_subs;
+                unconverged = first_unconverged;
             }
             retries += 1;
-            break (subs, kept);
+            break (subs, kept, unconverged);
         }
         if failed && can_halve {
             discarded += sweeps(&subs);
@@ -309,14 +318,15 @@ pub fn step_subdivided_checked(
         if let (Some(limit), true, Some(b)) = (energy_limit, all_converged, backup.as_ref()) {
             if energy_residual(&subs) > limit {
                 // Energy grew in a converged step: solve it again, tighter (doc comment).
-                first = Some((world.undo_point(), subs));
+                first = Some((world.undo_point(), subs, unconverged));
                 world.undo_to(b);
                 continue;
             }
         }
-        break (subs, false);
+        break (subs, false, unconverged);
     };
     restore(world);
+    world.unconverged_problem = unconverged;
     let all_converged = subs.iter().all(|s| s.report.solver.converged);
     if !paused && configured > 0 {
         update_subdivision(state, start, level, all_converged);

@@ -181,6 +181,11 @@ pub struct World {
     /// to a file (`grainlaw run --dump-problems`). Costs one assembly of `W` per step.
     pub record_problems: bool,
     last_problem: Option<FcProblem>,
+    /// When problems are recorded: the problem and report of the first kept sub-step of the
+    /// last subdivided step whose solve did not converge
+    /// ([`crate::step_control::step_subdivided`]; a later sub-step may converge and be the
+    /// last problem). Work space: a step clears it.
+    pub(crate) unconverged_problem: Option<(FcProblem, StepReport)>,
     /// Biperiodic deformable cell ([`crate::cell`]); `None`: walls and `periodic_x` only.
     /// Set it with [`World::set_cell`].
     cell: Option<Cell>,
@@ -226,6 +231,7 @@ impl World {
             last: StepReport::default(),
             record_problems: false,
             last_problem: None,
+            unconverged_problem: None,
             cell: None,
             cell_control: None,
             cell_sigma: None,
@@ -268,6 +274,7 @@ impl World {
             last,
             record_problems,
             last_problem,
+            unconverged_problem: _,
             cell,
             cell_control,
             cell_sigma,
@@ -326,6 +333,7 @@ impl World {
             last,
             record_problems,
             last_problem,
+            unconverged_problem: _,
             cell,
             cell_control,
             cell_sigma,
@@ -503,6 +511,18 @@ impl World {
     /// impulses in N·s), when [`World::record_problems`] was set for it.
     pub fn last_problem(&self) -> Option<&FcProblem> {
         self.last_problem.as_ref()
+    }
+
+    /// The problem that stands for the last step, with the report of its own solve: after a
+    /// step of [`crate::step_control::step_subdivided`] some kept sub-step of which did not
+    /// converge, the first such sub-step's (the step's failure, where the last sub-step may
+    /// have converged); otherwise the last (sub-)step's ([`World::last_problem`],
+    /// [`World::last_report`]). `None` unless [`World::record_problems`] was set.
+    pub fn problem_of_last_step(&self) -> Option<(&FcProblem, StepReport)> {
+        match &self.unconverged_problem {
+            Some((p, r)) => Some((p, *r)),
+            None => self.last_problem.as_ref().map(|p| (p, self.last)),
+        }
     }
 
     /// Add a free disk grain (thickness 1 m); returns its body index.
@@ -1036,6 +1056,7 @@ impl World {
     /// it kept a second worker spinning beside it for nothing (the poured 2000-grain column,
     /// 4614 sub-steps: about 15 % slower on two cores, same bits).
     pub fn step(&mut self) -> Result<StepReport, DemError> {
+        self.unconverged_problem = None;
         let forks = self.params.solver.parallel
             || !crate::parallel::runs_inline(self.contacts.len().div_ceil(crate::parallel::CHUNK));
         if forks && rayon::current_thread_index().is_none() {

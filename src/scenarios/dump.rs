@@ -59,10 +59,12 @@ impl ProblemDump {
         }
     }
 
-    /// Writes the last problem of `world` (which must have recorded it) for the step `r` of
-    /// phase `phase`.
+    /// Writes the problem that stands for the step `r` of phase `phase`
+    /// ([`World::problem_of_last_step`]: of a subdivided step, the first kept sub-step that did
+    /// not converge, if one did not), when `world` recorded it; `meta` holds that (sub-)step's
+    /// index, time and solve, and the whole step's sweeps and convergence.
     pub fn write(&self, phase: &str, world: &World, r: &StepReport) -> Result<()> {
-        let Some(problem) = world.last_problem() else {
+        let Some((problem, last)) = world.problem_of_last_step() else {
             return Ok(());
         };
         std::fs::create_dir_all(&self.dir).map_err(|e| CliError::Io {
@@ -70,9 +72,10 @@ impl ProblemDump {
             reason: e.to_string(),
         })?;
         let solver = &world.params.solver;
-        // The problem is the world's last (sub-)step's: its own time step and solve, which
-        // differ from the step's `r` when the step was subdivided (`r` merges its sub-steps).
-        let last = world.last_report();
+        // The problem is one (sub-)step's, with its own time step and solve, which differ from
+        // the step's `r` when the step was subdivided (`r` merges its sub-steps): the first
+        // sub-step that did not converge if one did not, else the last. Kept sub-steps share
+        // one time step, the contacts' `dt`.
         let meta = serde_json::json!({
             "source": "grainlaw run --dump-problems",
             "grainlaw_version": env!("CARGO_PKG_VERSION"),
