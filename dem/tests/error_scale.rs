@@ -8,8 +8,11 @@
 //! hundreds of times less accurately; with `error_scale = "loaded"` the same tolerance holds on
 //! the loaded contacts' scale `max(‖q − s⁺‖, ‖r‖, ‖u − s⁺‖)`.
 
-use dem::solver::{ErrorScale, SolverMethod};
-use dem::{ContactLaws, SolverParams, World, WorldParams};
+mod common;
+
+use common::{column, nlgs};
+use dem::solver::ErrorScale;
+use dem::{SolverParams, World};
 use nalgebra::Vector2;
 
 const TOLERANCE: f64 = 1e-6;
@@ -17,27 +20,13 @@ const TOLERANCE: f64 = 1e-6;
 const STACK: usize = 30;
 
 fn scene(scale: ErrorScale) -> World {
-    let params = WorldParams {
-        dt: 1e-4,
-        solver: SolverParams {
-            tolerance: TOLERANCE,
-            max_iterations: 100_000,
-            method: SolverMethod::Nlgs,
+    let mut w = column(
+        STACK,
+        SolverParams {
             error_scale: scale,
-            ..Default::default()
+            ..nlgs(TOLERANCE, 100_000)
         },
-        ..Default::default()
-    };
-    let mut w = World::new(params, ContactLaws::new(&["grain"], 0.5));
-    w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    for k in 0..STACK {
-        w.add_grain(
-            Vector2::new(0.0, 1e-3 * (1.0 + 2.0 * k as f64)),
-            1e-3,
-            2500.0,
-            0,
-        );
-    }
+    );
     // The detection gap is a tenth of the smallest radius (1e-4 m): this pair is detected,
     // open by 2.5e-5 m.
     w.add_grain(Vector2::new(5e-3, 1e-3 + 2.5e-5), 1e-3, 2500.0, 0);

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{fingerprint, random_box};
+use common::{column, fingerprint, nlgs, random_box};
 use dem::step_control::{
     step_subdivided, step_subdivided_checked, Subdivision, CALM_STEPS, FAILURES_BEFORE_BACKOFF,
 };
@@ -310,32 +310,6 @@ fn the_largest_subdivision_may_sweep_a_multiple_of_the_cap() {
     assert_eq!(w.params, params);
 }
 
-/// A stack of three disks at rest on a floor, swept once a step to 10⁻¹⁰ (`nlgs`).
-fn stack_swept_once(max_halvings: u32) -> World {
-    let params = WorldParams {
-        dt: 1e-4,
-        solver: dem::SolverParams {
-            tolerance: 1e-10,
-            max_iterations: 1,
-            method: dem::solver::SolverMethod::Nlgs,
-            max_halvings,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    let mut w = World::new(params, ContactLaws::new(&["grain"], 0.5));
-    w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    for k in 0..3 {
-        w.add_grain(
-            Vector2::new(0.0, 1e-3 * (1.0 + 2.0 * k as f64)),
-            1e-3,
-            2500.0,
-            0,
-        );
-    }
-    w
-}
-
 /// The problem that stands for a step (`World::problem_of_last_step`, what `--dump-problems`
 /// writes) is its first failure: the stack's first step fails at every level and is kept in 8
 /// sub-steps of h/8 solved by one sweep each (measured: the sixth converges, the others stop
@@ -343,7 +317,13 @@ fn stack_swept_once(max_halvings: u32) -> World {
 /// that sub-step's report, not the last one's; a plain step afterwards stands for itself.
 #[test]
 fn the_problem_of_a_failed_subdivided_step_is_its_first_failed_sub_step() {
-    let mut w = stack_swept_once(3);
+    let mut w = column(
+        3,
+        dem::SolverParams {
+            max_halvings: 3,
+            ..nlgs(1e-10, 1)
+        },
+    );
     w.record_problems = true;
     let mut state = Subdivision::default();
     let s = step_subdivided(&mut w, &mut state).unwrap();

@@ -110,3 +110,34 @@ pub fn stack(cols: usize, rows: usize, method: SolverMethod, tol: f64) -> (World
     let weight: f64 = w.bodies.iter().map(|b| b.mass).sum::<f64>() * 9.81;
     (w, weight)
 }
+
+/// `disks` touching equal disks (radius 1 mm, 2500 kg/m³) stacked on a floor, at rest, μ = 0.5,
+/// step 10⁻⁴ s, solved with `solver`.
+pub fn column(disks: usize, solver: SolverParams) -> World {
+    let params = WorldParams {
+        dt: 1e-4,
+        solver,
+        ..Default::default()
+    };
+    let mut w = World::new(params, ContactLaws::new(&["grain"], 0.5));
+    w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
+    for k in 0..disks {
+        w.add_grain(
+            Vector2::new(0.0, 1e-3 * (1.0 + 2.0 * k as f64)),
+            1e-3,
+            2500.0,
+            0,
+        );
+    }
+    w
+}
+
+/// Gauss–Seidel alone (`nlgs`) to `tolerance` with at most `sweeps` sweeps.
+pub fn nlgs(tolerance: f64, sweeps: usize) -> SolverParams {
+    SolverParams {
+        tolerance,
+        max_iterations: sweeps,
+        method: SolverMethod::Nlgs,
+        ..Default::default()
+    }
+}
