@@ -115,7 +115,7 @@ impl ErrorScale {
         match self {
             ErrorScale::Problem => errors[0],
             // NaN-propagating: a NaN in either measure fails the test.
-            ErrorScale::Loaded if errors[1].is_nan() => errors[1],
+            ErrorScale::Loaded if errors[0].is_nan() || errors[1].is_nan() => f64::NAN,
             ErrorScale::Loaded => errors[0].max(errors[1]),
         }
     }

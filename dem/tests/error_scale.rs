@@ -74,3 +74,15 @@ fn an_unknown_error_scale_is_refused() {
     assert!(e.contains("unknown variant `contacts`"), "{e}");
     assert!(e.contains("problem") && e.contains("loaded"), "{e}");
 }
+
+/// The governing error: the problem's measure, or the larger of both; a NaN in either fails
+/// the `loaded` test (`f64::max` alone would hide it).
+#[test]
+fn the_governing_error_of_each_scale() {
+    assert_eq!(ErrorScale::Problem.governing([1e-6, 3e-5]), 1e-6);
+    assert_eq!(ErrorScale::Loaded.governing([1e-6, 3e-5]), 3e-5);
+    assert_eq!(ErrorScale::Loaded.governing([2e-6, 1e-6]), 2e-6);
+    assert!(ErrorScale::Loaded.governing([f64::NAN, 1e-6]).is_nan());
+    assert!(ErrorScale::Loaded.governing([1e-6, f64::NAN]).is_nan());
+    assert_eq!(ErrorScale::Loaded.name(), "loaded");
+}
