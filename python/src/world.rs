@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use dem::snapshot::BodyKind;
-use dem::solver::SolverMethod;
+use dem::solver::{ErrorScale, SolverMethod};
 use dem::{ContactLaws, SolverParams, WorldParams};
 
 use crate::arrays::{finite1, out1, out2, rows2};
@@ -34,7 +34,8 @@ fn pair(v: (f64, f64), name: &str) -> PyResult<Vector2<f64>> {
 
 /// World(dt=1e-3, gravity=(0.0, -9.81), theta=1.0, materials=("grain", "wall"), friction=0.5,
 ///       restitution=0.0, tolerance=1e-6, max_iterations=10000, method="auto",
-///       periodic_x=None, detection_gap=1e-4, position_correction=True, parallel=False)
+///       periodic_x=None, detection_gap=1e-4, position_correction=True, parallel=False,
+///       error_scale="problem")
 /// --
 ///
 /// A 2D world of rigid disks and walls stepped by the Moreau–Jean θ-scheme with Coulomb
@@ -69,6 +70,11 @@ fn pair(v: (f64, f64), name: &str) -> PyResult<Vector2<f64>> {
 ///     Remove overlaps deeper than the slop after each step without changing velocities.
 /// parallel : bool
 ///     Solve on all rayon threads (same numbers on any thread count).
+/// error_scale : str
+///     "problem": the tolerance applies to the error measure of the step's problem, whose
+///     scale the gap-closing shifts of open pairs inflate; "loaded": it holds on the loaded
+///     contacts' scale too, and the step's ``error`` is the larger of the two
+///     (docs/physics.md §1.6).
 #[pyclass(module = "grainlaw")]
 pub struct World {
     world: dem::World,
@@ -109,7 +115,7 @@ impl World {
 #[pymethods]
 impl World {
     #[new]
-    #[pyo3(signature = (dt=1e-3, gravity=(0.0, -9.81), theta=1.0, materials=vec!["grain".to_string(), "wall".to_string()], friction=0.5, restitution=0.0, tolerance=1e-6, max_iterations=10_000, method="auto", periodic_x=None, detection_gap=1e-4, position_correction=true, parallel=false))]
+    #[pyo3(signature = (dt=1e-3, gravity=(0.0, -9.81), theta=1.0, materials=vec!["grain".to_string(), "wall".to_string()], friction=0.5, restitution=0.0, tolerance=1e-6, max_iterations=10_000, method="auto", periodic_x=None, detection_gap=1e-4, position_correction=true, parallel=false, error_scale="problem"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         dt: f64,
@@ -125,7 +131,17 @@ impl World {
         detection_gap: f64,
         position_correction: bool,
         parallel: bool,
+        error_scale: &str,
     ) -> PyResult<Self> {
+        let error_scale = match error_scale {
+            "problem" => ErrorScale::Problem,
+            "loaded" => ErrorScale::Loaded,
+            other => {
+                return Err(input(format!(
+                    "error_scale `{other}`: one of problem, loaded"
+                )))
+            }
+        };
         let method = match method {
             "nlgs" => SolverMethod::Nlgs,
             "newton" => SolverMethod::Newton,
@@ -157,6 +173,7 @@ impl World {
                 max_iterations,
                 parallel,
                 method,
+                error_scale,
                 ..SolverParams::default()
             },
             ..WorldParams::default()

@@ -59,6 +59,31 @@ def test_disk_resting_on_a_floor_carries_its_weight():
     assert abs(w.velocities[1, 1]) <= 1e-9
 
 
+def test_loaded_error_scale_holds_the_tolerance_on_the_loaded_contacts():
+    # the scene of dem/tests/error_scale.rs: 30 disks (radius 1 mm) stacked on a floor, and a
+    # disk hanging 2.5e-5 m above it, within the detection gap (1e-4 m): its gap-closing shift
+    # dilutes the error's scale. On the problem's scale the first step converges at 4.9e-7
+    # with 8.7e-5 on the loaded contacts; on the loaded scale both meet 1e-6 (measured 5.0e-7).
+    def scene(scale):
+        w = grainlaw.World(dt=1e-4, friction=0.5, tolerance=1e-6, max_iterations=100_000,
+                           method="nlgs", error_scale=scale)
+        w.add_wall((0.0, 0.0), (0.0, 1.0), name="floor")
+        r = 1e-3
+        mass = 2500.0 * np.pi * r * r
+        centres = [[0.0, r * (1 + 2 * k)] for k in range(30)] + [[5e-3, r + 2.5e-5]]
+        w.add_disks(centres, [r] * 31, masses=[mass] * 31)
+        return w
+
+    diluted = scene("problem").step()
+    assert diluted["converged"] and diluted["error"] <= 1e-6
+    assert diluted["error_without_gap_shifts"] > 10 * 1e-6
+    loaded = scene("loaded").step()
+    assert loaded["converged"] and loaded["error_without_gap_shifts"] <= 1e-6
+    assert loaded["error"] == max(loaded["error"], loaded["error_without_gap_shifts"])
+    with pytest.raises(grainlaw.InputError, match="error_scale"):
+        grainlaw.World(error_scale="contacts")
+
+
 def test_error_without_gap_shifts_equals_the_error_without_open_pairs():
     # one closed contact (gap 0, no gap-closing shift): both scales are the same, so are the
     # two measures, to the bit
