@@ -33,7 +33,7 @@
 
 use std::fmt;
 
-use datasets::phases::PhaseStats;
+use datasets::phases::{worst, PhaseStats};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -356,10 +356,11 @@ impl WindowStats {
         if !r.solver.converged {
             self.unconverged += 1;
         }
-        self.worst_error = self.worst_error.max(r.solver.error);
-        self.worst_error_without_gap_shifts = self
-            .worst_error_without_gap_shifts
-            .max(r.solver.error_without_gap_shifts);
+        self.worst_error = worst(self.worst_error, r.solver.error);
+        self.worst_error_without_gap_shifts = worst(
+            self.worst_error_without_gap_shifts,
+            r.solver.error_without_gap_shifts,
+        );
         self.tolerance = self.tolerance.max(world.params.solver.tolerance);
         if grew {
             self.energy_growth += 1;
@@ -387,10 +388,11 @@ impl WindowStats {
     pub fn merge(&mut self, o: &WindowStats) {
         self.steps += o.steps;
         self.unconverged += o.unconverged;
-        self.worst_error = self.worst_error.max(o.worst_error);
-        self.worst_error_without_gap_shifts = self
-            .worst_error_without_gap_shifts
-            .max(o.worst_error_without_gap_shifts);
+        self.worst_error = worst(self.worst_error, o.worst_error);
+        self.worst_error_without_gap_shifts = worst(
+            self.worst_error_without_gap_shifts,
+            o.worst_error_without_gap_shifts,
+        );
         self.tolerance = self.tolerance.max(o.tolerance);
         self.energy_growth += o.energy_growth;
         self.max_overlap_ratio = self.max_overlap_ratio.max(o.max_overlap_ratio);

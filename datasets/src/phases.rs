@@ -45,6 +45,16 @@ use dem::step_control::{step_subdivided_checked, SubdividedStep, Subdivision};
 use dem::{BodyKind, StepReport, World};
 use serde::{Deserialize, Serialize};
 
+/// The larger of two errors, NaN if either is (`f64::max` returns the other number, which
+/// would hide a solve that produced NaN).
+pub fn worst(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
 /// A step whose energy residual δ exceeds this fraction of [`load_energy_scale`] is counted as
 /// an energy growth (1). At this rate, 10⁵ steps would inject the energy of lifting every grain
 /// by one diameter; the inexactness of a converged contact solve stays well below it (the
@@ -169,10 +179,11 @@ impl PhaseStats {
             self.unconverged_steps += 1;
             self.first_unconverged_step = earliest(self.first_unconverged_step, Some(r.step));
         }
-        self.worst_error = self.worst_error.max(r.solver.error);
-        self.worst_error_without_gap_shifts = self
-            .worst_error_without_gap_shifts
-            .max(r.solver.error_without_gap_shifts);
+        self.worst_error = worst(self.worst_error, r.solver.error);
+        self.worst_error_without_gap_shifts = worst(
+            self.worst_error_without_gap_shifts,
+            r.solver.error_without_gap_shifts,
+        );
         self.max_sweeps = self.max_sweeps.max(r.solver.iterations);
         self.total_sweeps += r.solver.iterations as u64;
         self.max_penetration = self.max_penetration.max(r.max_penetration);
@@ -218,10 +229,11 @@ impl PhaseStats {
         self.unconverged_steps += o.unconverged_steps;
         self.first_unconverged_step =
             earliest(self.first_unconverged_step, o.first_unconverged_step);
-        self.worst_error = self.worst_error.max(o.worst_error);
-        self.worst_error_without_gap_shifts = self
-            .worst_error_without_gap_shifts
-            .max(o.worst_error_without_gap_shifts);
+        self.worst_error = worst(self.worst_error, o.worst_error);
+        self.worst_error_without_gap_shifts = worst(
+            self.worst_error_without_gap_shifts,
+            o.worst_error_without_gap_shifts,
+        );
         self.max_sweeps = self.max_sweeps.max(o.max_sweeps);
         self.total_sweeps += o.total_sweeps;
         self.max_penetration = self.max_penetration.max(o.max_penetration);
@@ -461,6 +473,22 @@ pub fn continue_steps(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_worst_of_two_errors_keeps_a_nan() {
+        assert_eq!(worst(1e-6, 3e-5), 3e-5);
+        assert_eq!(worst(0.0, 1e-6), 1e-6);
+        assert!(worst(f64::NAN, 1e-6).is_nan());
+        assert!(worst(1e-6, f64::NAN).is_nan());
+        // A NaN step in a phase stays in its worst error (f64::max would drop it).
+        let mut s = PhaseStats::default();
+        let mut r = dem::StepReport::default();
+        r.solver.error = f64::NAN;
+        s.record(&r, 1e-3);
+        r.solver.error = 1e-6;
+        s.record(&r, 1e-3);
+        assert!(s.worst_error.is_nan());
+    }
     use dem::{ContactLaws, WorldParams};
     use nalgebra::Vector2;
 

@@ -273,7 +273,9 @@ impl Default for SolverParams {
 pub struct SolveReport {
     /// Sweeps done.
     pub iterations: usize,
-    /// Error measure at the returned impulses.
+    /// The error at the returned impulses that convergence is judged on
+    /// ([`ErrorScale::governing`]): the error measure of the step's problem, or with
+    /// [`ErrorScale::Loaded`] the larger of it and [`SolveReport::error_without_gap_shifts`].
     pub error: f64,
     /// Whether `error ≤ tolerance` and the approach speed is within its limit.
     pub converged: bool,
@@ -291,8 +293,8 @@ pub struct SolveReport {
     /// shifts of open pairs ([`error_measures`]): the residual relative to the velocities of
     /// the bodies and the impulses alone: above `error` where open pairs far from closing
     /// dominate the scale, possibly below it where pairs close within the step (their shift
-    /// then enters `‖u − s⁺‖` and not `‖u‖`). A diagnostic; convergence is decided on `error`.
-    /// 0 without contacts.
+    /// then enters `‖u − s⁺‖` and not `‖u‖`). Convergence is decided on `error`, which
+    /// includes it with [`ErrorScale::Loaded`]. 0 without contacts.
     #[serde(default)]
     pub error_without_gap_shifts: f64,
 }
@@ -804,7 +806,7 @@ impl AutoStages for EngineStages<'_, '_> {
             &problem,
             &r,
             error_now,
-            self.params.tolerance,
+            step.problem_tolerance(self.params.tolerance),
             max_contacts,
             Some(&warm_basis),
             self.newton_work,
@@ -889,6 +891,21 @@ impl Step<'_> {
         rebuild_velocities(self.rows, self.vel, self.v_free, self.inv, &self.order);
         if let Some(c) = self.cell.as_deref_mut() {
             c.refresh(self.rows);
+        }
+    }
+
+    /// The tolerance on the assembled problem's own measure that stands for `tolerance` on
+    /// the governing error, for the methods that measure on the assembled problem (Newton, the
+    /// exact finish): under [`ErrorScale::Loaded`], when the loaded measure `e'` of the last
+    /// evaluation is the larger, `tolerance · e / e'` (the same residual over the two scales:
+    /// below it on the problem's scale is below `tolerance` on the loaded one, to the change
+    /// of the scales over the stage, which the engine's own evaluation after it judges);
+    /// otherwise `tolerance`.
+    fn problem_tolerance(&self, tolerance: f64) -> f64 {
+        let [e, e_loaded] = self.last_errors;
+        match self.scale {
+            ErrorScale::Loaded if e_loaded > e && e > 0.0 => tolerance * (e / e_loaded),
+            _ => tolerance,
         }
     }
 
@@ -1071,8 +1088,12 @@ fn global(
     newton_work: &mut NewtonWork,
 ) -> SolveReport {
     let problem = step.problem();
+    if params.error_scale == ErrorScale::Loaded {
+        // Both measures of the starting impulses, for the problem's tolerance.
+        step.error();
+    }
     let options = FcOptions {
-        tolerance: params.tolerance,
+        tolerance: step.problem_tolerance(params.tolerance),
         max_iterations: max_sweeps,
         initial_guess: Some(step.rows.iter().flat_map(|c| c.r).collect()),
         ..FcOptions::default()

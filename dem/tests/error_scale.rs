@@ -1,7 +1,7 @@
 //! `solver.error_scale`: the tolerance on the loaded contacts' scale (docs/physics.md §1.6).
 //!
-//! A stack of thirty disks rests on a floor (Gauss–Seidel needs tens of sweeps for it), and beside it a fourth disk hangs a quarter of the
-//! detection gap above the floor, at rest: its pair with the floor is in the step's problem with
+//! A stack of thirty disks rests on a floor (Gauss–Seidel needs tens of sweeps for it), and
+//! beside it one more disk hangs a quarter of the detection gap above the floor, at rest: its pair with the floor is in the step's problem with
 //! a gap-closing shift `g / (θ h)` of about 0.4 m/s, against the stack's velocities of order
 //! `g h ≈ 10⁻³ m/s`. That shift enters the error's scale `max(‖q‖, ‖r‖, ‖u‖)` and nothing else,
 //! so on the problem's scale a solve meets its tolerance with the stack's contacts solved
@@ -36,7 +36,7 @@ fn scene(scale: ErrorScale) -> World {
 /// On the problem's scale the first step converges with the stack's contacts far above the
 /// tolerance on their own scale (measured: 79 sweeps, error 4.9e-7, 8.7e-5 without the open
 /// pair's shift); on the loaded scale it goes on until both meet the tolerance (94 sweeps,
-/// 5.0e-7) and reports the larger. The factor of 10 is the assertion's margin.
+/// 5.0e-7). The factor of 10 is the assertion's margin.
 #[test]
 fn the_loaded_scale_holds_the_tolerance_where_the_problem_scale_is_diluted() {
     let mut w = scene(ErrorScale::Problem);
@@ -53,10 +53,6 @@ fn the_loaded_scale_holds_the_tolerance_where_the_problem_scale_is_diluted() {
     assert!(loaded.converged, "{loaded:?}");
     assert!(loaded.error_without_gap_shifts <= TOLERANCE, "{loaded:?}");
     assert!(loaded.error <= TOLERANCE, "{loaded:?}");
-    assert!(
-        loaded.error >= loaded.error_without_gap_shifts,
-        "{loaded:?}"
-    );
     assert!(
         loaded.iterations > diluted.iterations,
         "{loaded:?} {diluted:?}"

@@ -79,7 +79,9 @@ def test_loaded_error_scale_holds_the_tolerance_on_the_loaded_contacts():
     assert diluted["error_without_gap_shifts"] > 10 * 1e-6
     loaded = scene("loaded").step()
     assert loaded["converged"] and loaded["error_without_gap_shifts"] <= 1e-6
-    assert loaded["error"] == max(loaded["error"], loaded["error_without_gap_shifts"])
+    assert loaded["error"] <= 1e-6
+    # measured: 94 sweeps against 79
+    assert loaded["iterations"] > diluted["iterations"]
     with pytest.raises(grainlaw.InputError, match="error_scale"):
         grainlaw.World(error_scale="contacts")
 

@@ -93,6 +93,7 @@ impl ProblemDump {
             "engine_newton_iterations": last.solver.newton_iterations,
             "engine_lemke_pivots": last.solver.pivots,
             "lemke_max_contacts": solver.lemke_max_contacts,
+            "error_scale": solver.error_scale.name(),
             "engine_error": last.solver.error,
             "engine_error_without_gap_shifts": last.solver.error_without_gap_shifts,
             "engine_converged": last.solver.converged,

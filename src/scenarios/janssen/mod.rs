@@ -172,16 +172,15 @@ impl PhasedRun for Column<'_> {
             // solved to the tight tolerance while the floor still moves (at rest without
             // release).
             MEASURE => {
+                // The relaxation's settings (tolerance, method, Lemke, error scale, …) with
+                // the measured steps' sweep cap and the release's subdivision.
                 world.params.solver = dem::SolverParams {
-                    tolerance: c.relax.solver.tolerance,
                     max_iterations: c.analysis.final_max_iterations,
-                    method: c.relax.solver.method,
-                    lemke_max_contacts: c.relax.solver.lemke_max_contacts,
                     max_halvings: c.release.solver.max_halvings,
                     // The whole step is tried with the method asked for (`auto`: Newton and
                     // the exact finish after the sweeps), sub-steps only if that fails.
                     gauss_seidel_attempts: false,
-                    ..Default::default()
+                    ..c.relax.solver.params()
                 };
                 let (tol, cap) = (c.relax.solver.tolerance, c.analysis.final_max_iterations);
                 info(
