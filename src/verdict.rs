@@ -26,14 +26,16 @@
 //! (`dem::SolveReport::error_without_gap_shifts`, docs/physics.md §1.6): those shifts enter the
 //! error's scale `max(‖q‖, ‖r‖, ‖u‖)` and nothing else, so a solve can meet its tolerance while
 //! the contacts that carry the load are solved tens of times less accurately (the Janssen
-//! release: 56×). A window must meet both.
+//! release: 56×). A window must meet both; the second is judged only where it exceeds the
+//! first (under `solver.error_scale = "loaded"` the error already includes it).
 //!
 //! and the scenario's own checks (force balance, inertial number against its target, steady
 //! state), documented where they are made.
 
 use std::fmt;
 
-use datasets::phases::{worst, PhaseStats};
+use datasets::phases::PhaseStats;
+use dem::solver::worst;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -265,19 +267,24 @@ impl Checks {
         );
         // The same residuals over the loaded contacts' scale: a window whose solves met the
         // tolerance only because open pairs' gap-closing shifts inflate the error's scale.
-        let e0 = w.worst_error_without_gap_shifts / w.tolerance;
-        self.at_most(
-            "solver.loaded_error_over_tolerance",
-            e0,
-            SOLVER_ERROR_SUSPECT,
-            Some(SOLVER_ERROR_REFUSED),
-            |t| {
-                format!(
-                    "{label}: worst solver error over the loaded contacts' scale (without the gap-closing shifts of open pairs) {:.2e} is {e0:.0} times the tolerance {:.0e} (limit {t:.0}×)",
-                    w.worst_error_without_gap_shifts, w.tolerance
-                )
-            },
-        );
+        // Judged where it exceeds the error (not under `error_scale = "loaded"`, whose error
+        // already includes it): one cause, one reason.
+        let loaded = w.worst_error_without_gap_shifts;
+        if loaded > w.worst_error || loaded.is_nan() {
+            let e0 = loaded / w.tolerance;
+            self.at_most(
+                "solver.loaded_error_over_tolerance",
+                e0,
+                SOLVER_ERROR_SUSPECT,
+                Some(SOLVER_ERROR_REFUSED),
+                |t| {
+                    format!(
+                        "{label}: worst solver error over the loaded contacts' scale (without the gap-closing shifts of open pairs) {loaded:.2e} is {e0:.0} times the tolerance {:.0e} (limit {t:.0}×)",
+                        w.tolerance
+                    )
+                },
+            );
+        }
         let g = w.energy_growth as f64 / n;
         self.at_most(
             "energy.growth_fraction",
@@ -741,6 +748,18 @@ mod tests {
         assert_eq!(c.reasons[0].check, "solver.loaded_error_over_tolerance");
         assert!((c.reasons[0].value - 50.0).abs() < 1e-9);
         assert_eq!(judge(2e-3).verdict(), Verdict::Refused);
+        // Under `error_scale = "loaded"` the error is the larger measure: one cause, one reason.
+        let w = WindowStats {
+            steps: 4,
+            worst_error: 5e-5,
+            worst_error_without_gap_shifts: 5e-5,
+            tolerance: 1e-6,
+            ..Default::default()
+        };
+        let mut c = Checks::new();
+        c.window("measured steps", &w);
+        assert_eq!(c.reasons.len(), 1, "{:?}", c.reasons);
+        assert_eq!(c.reasons[0].check, "solver.worst_error_over_tolerance");
     }
 
     #[test]

@@ -41,19 +41,10 @@
 //! mechanical energy of a phase therefore changes by `Σ (δ + W_drive) + position_correction_energy`.
 
 pub use dem::energy::{load_energy_scale, EnergyProbe};
+use dem::solver::worst;
 use dem::step_control::{step_subdivided_checked, SubdividedStep, Subdivision};
 use dem::{BodyKind, StepReport, World};
 use serde::{Deserialize, Serialize};
-
-/// The larger of two errors, NaN if either is (`f64::max` returns the other number, which
-/// would hide a solve that produced NaN).
-pub fn worst(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
-    }
-}
 
 /// A step whose energy residual δ exceeds this fraction of [`load_energy_scale`] is counted as
 /// an energy growth (1). At this rate, 10⁵ steps would inject the energy of lifting every grain
@@ -83,7 +74,7 @@ pub struct PhaseStats {
     pub worst_error: f64,
     /// Largest error measure of a step's solve over a scale that leaves out the gap-closing
     /// shifts of open pairs (`dem::SolveReport::error_without_gap_shifts`): what `worst_error`
-    /// is on the loaded contacts (1; a diagnostic, convergence is decided on the error).
+    /// is on the loaded contacts (1; with `solver.error_scale = "loaded"` the error includes it).
     #[serde(default, with = "dem::serde_float")]
     pub worst_error_without_gap_shifts: f64,
     /// Largest number of sweeps of one step.
@@ -473,14 +464,12 @@ pub fn continue_steps(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dem::{ContactLaws, WorldParams};
+    use nalgebra::Vector2;
 
     #[test]
-    fn the_worst_of_two_errors_keeps_a_nan() {
-        assert_eq!(worst(1e-6, 3e-5), 3e-5);
-        assert_eq!(worst(0.0, 1e-6), 1e-6);
-        assert!(worst(f64::NAN, 1e-6).is_nan());
-        assert!(worst(1e-6, f64::NAN).is_nan());
-        // A NaN step in a phase stays in its worst error (f64::max would drop it).
+    fn a_nan_error_stays_in_the_phase_worst() {
+        // f64::max would drop it.
         let mut s = PhaseStats::default();
         let mut r = dem::StepReport::default();
         r.solver.error = f64::NAN;
@@ -489,8 +478,6 @@ mod tests {
         s.record(&r, 1e-3);
         assert!(s.worst_error.is_nan());
     }
-    use dem::{ContactLaws, WorldParams};
-    use nalgebra::Vector2;
 
     fn params(theta: f64) -> WorldParams {
         WorldParams {

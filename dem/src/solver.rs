@@ -114,10 +114,19 @@ impl ErrorScale {
     pub fn governing(self, errors: [f64; 2]) -> f64 {
         match self {
             ErrorScale::Problem => errors[0],
-            // NaN-propagating: a NaN in either measure fails the test.
-            ErrorScale::Loaded if errors[0].is_nan() || errors[1].is_nan() => f64::NAN,
-            ErrorScale::Loaded => errors[0].max(errors[1]),
+            // A NaN in either measure fails the test.
+            ErrorScale::Loaded => worst(errors[0], errors[1]),
         }
+    }
+}
+
+/// The larger of two errors, NaN if either is: the worst of several solves (`f64::max` returns
+/// the other number, which would hide a solve that produced NaN).
+pub fn worst(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
     }
 }
 

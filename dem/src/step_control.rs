@@ -388,10 +388,11 @@ pub fn merge_reports<'a>(reports: impl IntoIterator<Item = &'a StepReport>) -> S
         s.iterations += r.solver.iterations;
         s.newton_iterations += r.solver.newton_iterations;
         s.pivots += r.solver.pivots;
-        s.error = s.error.max(r.solver.error);
-        s.error_without_gap_shifts = s
-            .error_without_gap_shifts
-            .max(r.solver.error_without_gap_shifts);
+        s.error = crate::solver::worst(s.error, r.solver.error);
+        s.error_without_gap_shifts = crate::solver::worst(
+            s.error_without_gap_shifts,
+            r.solver.error_without_gap_shifts,
+        );
         s.approach_speed = s.approach_speed.max(r.solver.approach_speed);
         s.converged &= r.solver.converged;
         m.step = r.step;
