@@ -16,7 +16,10 @@
 //! |---|---|---|
 //! | unconverged steps in the window ([`SOLVER_UNCONVERGED_SUSPECT`], [`SOLVER_UNCONVERGED_REFUSED`]) | 1 % of its steps | 25 % (windows of ≥ [`MIN_STEPS_FOR_FRACTION_REFUSAL`] steps) |
 //! | worst solver error in the window / tolerance ([`SOLVER_ERROR_SUSPECT`], [`SOLVER_ERROR_REFUSED`]) | 10 | 1000 |
-//! | the same over the loaded contacts' scale (`dem::SolveReport::error_without_gap_shifts`) / tolerance | 10 | 1000 |
+//! | the same over the loaded contacts' scale (`dem::SolveReport::error_without_gap_shifts`) / tolerance | 10 (unless the sensitivity below was measured and passed) | 1000 |
+//! | change of the window's μ when its samples' steps are solved to 10⁻⁸ ([`Sensitivity`]) | 0.005 | 0.02 |
+//! | relative change of its pressure under the same re-solve | 1 % | 5 % |
+//! | samples whose re-solve did not reach 10⁻⁸ | 10 % | — |
 //! | steps of the window whose energy grew beyond `ENERGY_GROWTH_TOLERANCE` | 1 % | 25 % (≥ 20 steps) |
 //! | largest overlap in the window / smallest radius ([`OVERLAP_SUSPECT`], [`OVERLAP_REFUSED`]) | 0.1 % | 1 % |
 //! | solid fraction | — | outside (0, [`max_solid_fraction`]) |
@@ -28,6 +31,18 @@
 //! the contacts that carry the load are solved tens of times less accurately (the Janssen
 //! release: 56×). A window must meet both; the second is judged only where it exceeds the
 //! first (under `solver.error_scale = "loaded"` the error already includes it).
+//!
+//! Where a scenario measures it ([`Sensitivity`]: the shear cell), the solver's effect on what
+//! the window reports is measured instead of bounded by a proxy: the step of every sample that
+//! feeds the window's mean stress is solved again from the same state to
+//! [`SENSITIVITY_TOLERANCE`] (`dem::World::last_step_problem`, `dem::fc::solve_by` with `auto`
+//! and Lemke's method, `dem::World::snapshot_with_last_impulses`), and the window's μ and
+//! pressure are taken both ways. When at least [`SENSITIVITY_MIN_SAMPLES`] samples were
+//! re-solved, at most [`SENSITIVITY_UNRESOLVED_SUSPECT`] of them failed, and both changes are
+//! within their suspect limits, the loaded-scale error is judged only against its refusal
+//! limit: its residual was shown not to move the numbers. The re-solve measures the solver's
+//! effect on the forces of each sampled state, not on the trajectory that led there (positions
+//! move by `θ h Δv` only); the trajectory's drift is what the overlap and energy checks bound.
 //!
 //! and the scenario's own checks (force balance, inertial number against its target, steady
 //! state), documented where they are made.
@@ -53,6 +68,28 @@ pub const MIN_STEPS_FOR_FRACTION_REFUSAL: u64 = 20;
 pub const SOLVER_ERROR_SUSPECT: f64 = 10.0;
 /// Worst error over the tolerance above which the result is refused (1).
 pub const SOLVER_ERROR_REFUSED: f64 = 1000.0;
+/// Change of a window's μ = |σ_xy| / (−σ_yy) when its samples' steps are solved to
+/// [`SENSITIVITY_TOLERANCE`] above which the result is suspect (absolute): half the
+/// interval half-width of the shear cell's μ₀ (±0.01), a quarter of the change that its steady
+/// check calls a drift (0.02).
+pub const SENSITIVITY_MU_SUSPECT: f64 = 0.005;
+/// The same, above which the result is refused (absolute).
+pub const SENSITIVITY_MU_REFUSED: f64 = 0.02;
+/// Relative change of a window's pressure `−σ_yy` under the same re-solve above which the
+/// result is suspect (1).
+pub const SENSITIVITY_PRESSURE_SUSPECT: f64 = 0.01;
+/// The same, above which the result is refused (1).
+pub const SENSITIVITY_PRESSURE_REFUSED: f64 = 0.05;
+/// Tolerance of the re-solve of a sample's step (the error measure of the step's problem,
+/// `dem::fc::fc_error`): 10⁻⁸, tens of thousands of times below the runs' 10⁻⁴ and, with the
+/// open pairs' shifts at most a few hundred times the loaded contacts' scale, below 10⁻⁵ on it.
+pub const SENSITIVITY_TOLERANCE: f64 = 1e-8;
+/// Fewest re-solved samples for a measured sensitivity to stand in for the loaded-scale error
+/// check.
+pub const SENSITIVITY_MIN_SAMPLES: u64 = 10;
+/// Largest fraction of samples whose re-solve may fail (left out of the measure) for the
+/// measure to stand; beyond it the check is suspect.
+pub const SENSITIVITY_UNRESOLVED_SUSPECT: f64 = 0.1;
 /// Fraction of window steps whose energy grew above which the result is suspect (1).
 pub const ENERGY_GROWTH_SUSPECT: f64 = 0.01;
 /// Fraction of window steps whose energy grew above which the result is refused (1).
@@ -228,6 +265,64 @@ impl Checks {
         }
     }
 
+    /// The measured solver sensitivity of a window ([`Sensitivity`], module documentation):
+    /// its μ change, relative pressure change and failed re-solves against their limits.
+    /// Returns whether it was measured and passed (then it stands in for the loaded-scale
+    /// error's suspect limit). Nothing is checked where nothing was re-solved.
+    pub fn sensitivity(&mut self, label: &str, s: &Sensitivity) -> bool {
+        let tried = s.samples + s.unresolved;
+        if tried == 0 {
+            return false;
+        }
+        let before = self.reasons.len();
+        let failed = s.unresolved as f64 / tried as f64;
+        self.at_most(
+            "solver.sensitivity_unresolved",
+            failed,
+            SENSITIVITY_UNRESOLVED_SUSPECT,
+            None,
+            |t| {
+                format!(
+                    "{label}: the re-solve to {SENSITIVITY_TOLERANCE:.0e} failed on {} of {tried} samples ({:.0} %, limit {:.0} %)",
+                    s.unresolved,
+                    100.0 * failed,
+                    100.0 * t
+                )
+            },
+        );
+        if s.samples > 0 {
+            let dmu = s.mu_change();
+            self.at_most(
+                "solver.sensitivity_mu",
+                dmu,
+                SENSITIVITY_MU_SUSPECT,
+                Some(SENSITIVITY_MU_REFUSED),
+                |t| {
+                    format!(
+                        "{label}: μ moves by {dmu:.4} when its {} samples are solved to {SENSITIVITY_TOLERANCE:.0e} (limit {t})",
+                        s.samples
+                    )
+                },
+            );
+            let dp = s.pressure_change();
+            self.at_most(
+                "solver.sensitivity_pressure",
+                dp,
+                SENSITIVITY_PRESSURE_SUSPECT,
+                Some(SENSITIVITY_PRESSURE_REFUSED),
+                |t| {
+                    format!(
+                        "{label}: the pressure moves by {:.2} % when its {} samples are solved to {SENSITIVITY_TOLERANCE:.0e} (limit {:.0} %)",
+                        100.0 * dp,
+                        s.samples,
+                        100.0 * t
+                    )
+                },
+            );
+        }
+        self.reasons.len() == before && s.samples >= SENSITIVITY_MIN_SAMPLES
+    }
+
     /// The numerics of the steps that feed a result: unconverged steps and worst error over the
     /// tolerance, energy growth, largest overlap ([module documentation](self)).
     pub fn window(&mut self, label: &str, w: &WindowStats) {
@@ -269,13 +364,19 @@ impl Checks {
         // tolerance only because open pairs' gap-closing shifts inflate the error's scale.
         // Judged where it exceeds the error (not under `error_scale = "loaded"`, whose error
         // already includes it): one cause, one reason.
+        let measured = self.sensitivity(label, &w.sensitivity);
         let loaded = w.worst_error_without_gap_shifts;
         if loaded > w.worst_error || loaded.is_nan() {
             let e0 = loaded / w.tolerance;
             self.at_most(
                 "solver.loaded_error_over_tolerance",
                 e0,
-                SOLVER_ERROR_SUSPECT,
+                // A measured sensitivity that passed stands in for the suspect limit.
+                if measured {
+                    SOLVER_ERROR_REFUSED
+                } else {
+                    SOLVER_ERROR_SUSPECT
+                },
                 Some(SOLVER_ERROR_REFUSED),
                 |t| {
                     format!(
@@ -342,6 +443,73 @@ pub struct WindowStats {
     pub max_overlap_ratio: f64,
     /// The phase's energy-growth count after the last step seen (to count this step's).
     seen_growth: u64,
+    /// The solver's measured effect on the window's stress, where the scenario measures it.
+    #[serde(default)]
+    pub sensitivity: Sensitivity,
+}
+
+/// The solver's effect on an averaging window's stress (module documentation): the sums of the
+/// bulk stress components of its samples as the run solved them and as re-solved to
+/// [`SENSITIVITY_TOLERANCE`], over the samples whose re-solve converged.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Sensitivity {
+    /// Samples re-solved to the tolerance.
+    pub samples: u64,
+    /// Samples whose re-solve did not reach it (left out of the sums).
+    pub unresolved: u64,
+    /// Σ σ_xy, Σ σ_yy of the re-solved samples as run (Pa, tension positive).
+    pub sxy: f64,
+    /// See `sxy`.
+    pub syy: f64,
+    /// The same sums with the re-solved impulses (Pa).
+    pub sxy_resolved: f64,
+    /// See `sxy_resolved`.
+    pub syy_resolved: f64,
+}
+
+impl Sensitivity {
+    /// Adds a sample: its bulk `[σ_xy, σ_yy]` as run and, when the re-solve converged, as
+    /// re-solved (`None`: counted as unresolved).
+    pub fn add(&mut self, run: [f64; 2], resolved: Option<[f64; 2]>) {
+        match resolved {
+            Some([xy, yy]) => {
+                self.samples += 1;
+                self.sxy += run[0];
+                self.syy += run[1];
+                self.sxy_resolved += xy;
+                self.syy_resolved += yy;
+            }
+            None => self.unresolved += 1,
+        }
+    }
+
+    /// `|Δμ|`, μ = |Σσ_xy| / (−Σσ_yy) of the re-solved samples against the same as run (NaN
+    /// without samples).
+    pub fn mu_change(&self) -> f64 {
+        let mu = |xy: f64, yy: f64| xy.abs() / -yy;
+        if self.samples == 0 {
+            return f64::NAN;
+        }
+        (mu(self.sxy_resolved, self.syy_resolved) - mu(self.sxy, self.syy)).abs()
+    }
+
+    /// `|ΔP| / P` of the pressure `P = −Σσ_yy / n` (NaN without samples).
+    pub fn pressure_change(&self) -> f64 {
+        if self.samples == 0 {
+            return f64::NAN;
+        }
+        ((self.syy_resolved - self.syy) / self.syy).abs()
+    }
+
+    /// Adds another window's samples.
+    pub fn merge(&mut self, o: &Sensitivity) {
+        self.samples += o.samples;
+        self.unresolved += o.unresolved;
+        self.sxy += o.sxy;
+        self.syy += o.syy;
+        self.sxy_resolved += o.sxy_resolved;
+        self.syy_resolved += o.syy_resolved;
+    }
 }
 
 impl WindowStats {
@@ -403,11 +571,14 @@ impl WindowStats {
         self.tolerance = self.tolerance.max(o.tolerance);
         self.energy_growth += o.energy_growth;
         self.max_overlap_ratio = self.max_overlap_ratio.max(o.max_overlap_ratio);
+        self.sensitivity.merge(&o.sensitivity);
     }
 
     /// Summary keys `PREFIX_steps`, `PREFIX_unconverged_steps`, `PREFIX_worst_error`,
     /// `PREFIX_worst_error_without_gap_shifts`, `PREFIX_energy_growth_steps`,
-    /// `PREFIX_max_overlap_over_radius`.
+    /// `PREFIX_max_overlap_over_radius`; where the solver sensitivity was measured
+    /// ([`Sensitivity`]), `PREFIX_resolved_samples`, `PREFIX_unresolved_samples`,
+    /// `PREFIX_resolved_mu_change`, `PREFIX_resolved_pressure_change`.
     pub fn keys(&self, s: &mut Summary, prefix: &str) {
         s.int(&format!("{prefix}_steps"), self.steps)
             .int(&format!("{prefix}_unconverged_steps"), self.unconverged)
@@ -421,6 +592,16 @@ impl WindowStats {
                 &format!("{prefix}_max_overlap_over_radius"),
                 self.max_overlap_ratio,
             );
+        let sens = &self.sensitivity;
+        if sens.samples + sens.unresolved > 0 {
+            s.int(&format!("{prefix}_resolved_samples"), sens.samples)
+                .int(&format!("{prefix}_unresolved_samples"), sens.unresolved)
+                .num(&format!("{prefix}_resolved_mu_change"), sens.mu_change())
+                .num(
+                    &format!("{prefix}_resolved_pressure_change"),
+                    sens.pressure_change(),
+                );
+        }
     }
 }
 
@@ -760,6 +941,107 @@ mod tests {
         c.window("measured steps", &w);
         assert_eq!(c.reasons.len(), 1, "{:?}", c.reasons);
         assert_eq!(c.reasons[0].check, "solver.worst_error_over_tolerance");
+    }
+
+    /// `n` samples of a window at μ = 0.1, P = 100 Pa as run; re-solved, σ_xy scaled by
+    /// `1 + dmu / 0.1` (μ moves by `dmu`) and σ_yy by `1 + dp` (P moves by `dp`); `failed`
+    /// re-solves that did not converge.
+    fn resolved(n: u64, dmu: f64, dp: f64, failed: u64) -> Sensitivity {
+        let mut s = Sensitivity::default();
+        for _ in 0..n {
+            let (xy, yy) = (-10.0, -100.0);
+            s.add(
+                [xy, yy],
+                Some([xy * (1.0 + dmu / 0.1) * (1.0 + dp), yy * (1.0 + dp)]),
+            );
+        }
+        for _ in 0..failed {
+            s.add([-10.0, -100.0], None);
+        }
+        s
+    }
+
+    #[test]
+    fn a_measured_sensitivity_is_the_ratio_of_the_sums() {
+        let s = resolved(40, 0.01, 0.02, 3);
+        assert_eq!((s.samples, s.unresolved), (40, 3));
+        // μ 0.1 → 0.11 whatever the pressure; P 100 → 102 Pa.
+        assert!((s.mu_change() - 0.01).abs() < 1e-12, "{}", s.mu_change());
+        assert!((s.pressure_change() - 0.02).abs() < 1e-12);
+        let mut m = s;
+        m.merge(&resolved(40, 0.01, 0.02, 1));
+        assert_eq!((m.samples, m.unresolved), (80, 4));
+        assert!((m.mu_change() - 0.01).abs() < 1e-12);
+        assert!(Sensitivity::default().mu_change().is_nan());
+    }
+
+    #[test]
+    fn a_measured_sensitivity_stands_in_for_the_loaded_scale_limit() {
+        // The shear cell's windows: converged at 1e-4 on the problem's scale, 20 times that on
+        // the loaded contacts' scale (suspect by the proxy).
+        let judge = |loaded: f64, sens: Sensitivity| {
+            let w = WindowStats {
+                steps: 2000,
+                worst_error: 1e-4,
+                worst_error_without_gap_shifts: loaded,
+                tolerance: 1e-4,
+                sensitivity: sens,
+                ..Default::default()
+            };
+            let mut c = Checks::new();
+            c.window("I = 0.005", &w);
+            c
+        };
+        let names = |c: &Checks| {
+            c.reasons
+                .iter()
+                .map(|r| r.check.clone())
+                .collect::<Vec<_>>()
+        };
+        // Not measured: the proxy's suspect.
+        let c = judge(2e-3, Sensitivity::default());
+        assert_eq!(names(&c), ["solver.loaded_error_over_tolerance"]);
+        // Measured on 40 samples, μ moved by 4e-5 and P by 0.3 % (the default cell): ok.
+        let c = judge(2e-3, resolved(40, 4e-5, 0.003, 1));
+        assert_eq!(c.verdict(), Verdict::Ok, "{:?}", c.reasons);
+        // Too few samples to stand in: the proxy judges.
+        let c = judge(2e-3, resolved(5, 4e-5, 0.003, 0));
+        assert_eq!(names(&c), ["solver.loaded_error_over_tolerance"]);
+        // μ moves by 0.01 (suspect) or 0.03 (refused); the proxy's suspect stays.
+        let c = judge(2e-3, resolved(40, 0.01, 0.0, 0));
+        assert_eq!(
+            names(&c),
+            [
+                "solver.sensitivity_mu",
+                "solver.loaded_error_over_tolerance"
+            ]
+        );
+        assert_eq!(c.verdict(), Verdict::Suspect);
+        assert_eq!(
+            judge(2e-3, resolved(40, 0.03, 0.0, 0)).verdict(),
+            Verdict::Refused
+        );
+        // P moves by 2 %: suspect; 6 %: refused.
+        let c = judge(2e-3, resolved(40, 0.0, 0.02, 0));
+        assert_eq!(c.reasons[0].check, "solver.sensitivity_pressure");
+        assert_eq!(c.verdict(), Verdict::Suspect);
+        assert_eq!(
+            judge(2e-3, resolved(40, 0.0, 0.06, 0)).verdict(),
+            Verdict::Refused
+        );
+        // 6 of 40 re-solves failed (13 %): suspect, and the proxy judges.
+        let c = judge(2e-3, resolved(34, 0.0, 0.0, 6));
+        assert_eq!(
+            names(&c),
+            [
+                "solver.sensitivity_unresolved",
+                "solver.loaded_error_over_tolerance"
+            ]
+        );
+        // A residual beyond the refusal limit is refused whatever the measure says.
+        let c = judge(0.2, resolved(40, 0.0, 0.0, 0));
+        assert_eq!(c.verdict(), Verdict::Refused);
+        assert_eq!(names(&c), ["solver.loaded_error_over_tolerance"]);
     }
 
     #[test]

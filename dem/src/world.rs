@@ -359,6 +359,8 @@ impl World {
         self.cell = *cell;
         self.cell_control = *cell_control;
         self.cell_sigma = *cell_sigma;
+        // The free velocities belong to the undone step ([`World::last_step_problem`]).
+        self.v_free.clear();
     }
 
     /// The biperiodic deformable cell, if any.
@@ -523,6 +525,101 @@ impl World {
             Some((p, r)) => Some((p, *r)),
             None => self.last_problem.as_ref().map(|p| (p, self.last)),
         }
+    }
+
+    /// The frictional-contact problem of the last step, assembled on demand from its contacts
+    /// and free velocities (`u = W r + q`, [`crate::assemble::contact_problem`]; the contacts in
+    /// the order of [`World::snapshot`]), with the impulses its solve returned (N·s, interleaved
+    /// `(r_n, r_t)`): what [`World::snapshot_with_last_impulses`] takes other impulses for.
+    /// Needs no [`World::record_problems`]. `None` before a step, after [`World::undo_to`] or a
+    /// resume (the free velocities are work space), and in a world with a deformable cell,
+    /// whose step does more than the contact solve (its stress control and wraps).
+    pub fn last_step_problem(&self) -> Option<(FcProblem, Vec<f64>)> {
+        if self.cell.is_some()
+            || self.v_free.len() != self.bodies.len()
+            || self.inv.len() != self.bodies.len()
+        {
+            return None;
+        }
+        let rows = &self.contacts.rows;
+        let problem = crate::assemble::contact_problem(rows, &self.v_free, &self.inv);
+        Some((problem, rows.iter().flat_map(|c| c.r).collect()))
+    }
+
+    /// The world's [`World::snapshot`] as if the last step's contact solve had returned the
+    /// impulses `r` (N·s, interleaved `(r_n, r_t)` in the contacts' order) instead of its own:
+    /// with `Δv = M⁻¹ Hᵀ (r − r_solved)` per body (Moreau–Jean, `v⁺ = v_free + M⁻¹ Hᵀ r`),
+    ///
+    /// ```text
+    /// v⁺' = v⁺ + Δv,   a' = a + Δv / h,   q⁺' = q⁺ + θ h Δv,   f' = r / h,
+    /// ```
+    ///
+    /// and the contacts' statuses read from `r`. The step's position correction is kept as it
+    /// was made (it depends on the positions only through overlaps, a change of order `θ h Δv`).
+    /// This is how a measurement tells what the solver's residual does to it: the same step,
+    /// solved tighter (`grainlaw`'s solver-sensitivity check).
+    ///
+    /// # Errors
+    /// [`DemError::Parameter`] when the last step's problem is not available
+    /// ([`World::last_step_problem`]) or `r` does not have two entries per contact.
+    pub fn snapshot_with_last_impulses(&self, r: &[f64]) -> Result<Snapshot, DemError> {
+        let bad = |reason: String| DemError::Parameter {
+            name: "impulses".into(),
+            reason,
+        };
+        if self.cell.is_some() || self.v_free.len() != self.bodies.len() {
+            return Err(bad(
+                "the last step's problem is not available (no step since the last undo or \
+                 resume, or a deformable cell)"
+                    .into(),
+            ));
+        }
+        let rows = &self.contacts.rows;
+        if r.len() != 2 * rows.len() {
+            return Err(bad(format!(
+                "{} values for {} contacts (two per contact)",
+                r.len(),
+                rows.len()
+            )));
+        }
+        let mut dv = vec![[0.0; 3]; self.bodies.len()];
+        for (c, x) in rows.iter().zip(r.chunks_exact(2)) {
+            let d = [x[0] - c.r[0], x[1] - c.r[1]];
+            if d != [0.0, 0.0] {
+                let (a, b) = (c.a as usize, c.b as usize);
+                let (mut va, mut vb) = (dv[a], dv[b]);
+                c.apply(d, &mut va, &self.inv[a], &mut vb, &self.inv[b]);
+                dv[a] = va;
+                dv[b] = vb;
+            }
+        }
+        let h = self.impulse_dt();
+        let theta = self.params.theta;
+        let periodic = self.periodic();
+        let mut snap = self.snapshot();
+        for (b, d) in snap.bodies.iter_mut().zip(&dv) {
+            if *d == [0.0, 0.0, 0.0] {
+                continue;
+            }
+            b.velocity += Vector2::new(d[0], d[1]);
+            b.omega += d[2];
+            b.acceleration += Vector2::new(d[0], d[1]) / h;
+            b.angular_acceleration += d[2] / h;
+            b.position += Vector2::new(d[0], d[1]) * (theta * h);
+            b.angle += theta * h * d[2];
+            if let (Some(p), BodyKind::Grain) = (periodic, b.kind) {
+                b.position.x = p.wrap(b.position.x);
+            }
+        }
+        for ((c, row), x) in snap.contacts.iter_mut().zip(rows).zip(r.chunks_exact(2)) {
+            c.force_n = x[0] / h;
+            c.force_t = x[1] / h;
+            c.status = solver::status(&crate::contact::ContactRow {
+                r: [x[0], x[1]],
+                ..*row
+            });
+        }
+        Ok(snap)
     }
 
     /// Add a free disk grain (thickness 1 m); returns its body index.

@@ -11,6 +11,7 @@ pub mod janssen;
 pub mod phased;
 pub mod rheology_fit;
 pub mod rolling;
+pub mod sensitivity;
 pub mod shear_cell;
 pub mod simple_shear;
 pub mod stick_slip;

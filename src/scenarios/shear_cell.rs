@@ -456,7 +456,9 @@ impl PhasedRun for Shear<'_> {
         if in_window && run.n.is_multiple_of(run.every) {
             let d = mean_diameter(w);
             if averaged {
-                sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
+                let (sxy, syy) = sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
+                let resolved = resolved_stress(w, self.c.grain.radius_mean, d)?;
+                st.window.sensitivity.add([sxy, syy], resolved);
             } else {
                 let (gamma_dot, pressure) = bulk_shear(w, self.c.grain.radius_mean, d)?;
                 st.lead.gamma_dot += gamma_dot;
@@ -817,7 +819,6 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     })
 }
 
-/// Adds one sample of the bulk and wall quantities to `acc`.
 /// The bulk of the cell: the slice two diameters away from each wall.
 fn bulk_region(w: &dem::World, r: f64, d: f64) -> Region {
     let top_y = w.bodies[TOP].position.y;
@@ -845,7 +846,21 @@ fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, f64)> {
     Ok((g, -sym[(1, 1)]))
 }
 
-fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<()> {
+/// The bulk `[σ_xy, σ_yy]` (Pa) of the world with its last step's contact problem solved to
+/// [`crate::verdict::SENSITIVITY_TOLERANCE`] (the solver-sensitivity measure,
+/// [`crate::verdict::Sensitivity`]); `None` when that solve did not converge or the problem
+/// is not available.
+fn resolved_stress(w: &dem::World, r: f64, d: f64) -> Result<Option<[f64; 2]>> {
+    let Some(snap) = super::sensitivity::resolved_snapshot(w)? else {
+        return Ok(None);
+    };
+    let sym = bulk_stress(&snap, &bulk_region(w, r, d))?;
+    Ok(Some([sym[(0, 1)], sym[(1, 1)]]))
+}
+
+/// Adds one sample of the bulk and wall quantities to `acc`; returns its bulk
+/// `(σ_xy, σ_yy)` (Pa).
+fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<(f64, f64)> {
     let snap = w.snapshot();
     let top_y = w.bodies[TOP].position.y;
     let region = bulk_region(w, r, d);
@@ -887,7 +902,7 @@ fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<()> {
         }
     }
     acc.samples += 1;
-    Ok(())
+    Ok((sym[(0, 1)], sym[(1, 1)]))
 }
 
 #[cfg(test)]

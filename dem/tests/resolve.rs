@@ -1,0 +1,114 @@
+//! The last step's problem re-solved (`World::last_step_problem`,
+//! `World::snapshot_with_last_impulses`): the state the engine would have reached with other
+//! impulses obeys Newton's law with them, and the run's own impulses give its own snapshot.
+
+mod common;
+
+use common::random_box;
+use dem::fc::{solve_by, FcOptions, NewtonParams, SolverMethod};
+use dem::snapshot::BodyKind;
+use nalgebra::Vector2;
+
+/// The box after 40 steps solved loosely (Gauss–Seidel stopped at 10⁻³).
+fn loose_box() -> dem::World {
+    let mut w = random_box(60, 0.04, 1e-3, 1.5e-3, 0.5, 1.0, 7);
+    w.params.solver.tolerance = 1e-3;
+    w.params.solver.method = SolverMethod::Nlgs;
+    for _ in 0..40 {
+        w.step().unwrap();
+    }
+    w
+}
+
+#[test]
+fn the_run_s_own_impulses_give_its_own_snapshot() {
+    let w = loose_box();
+    let (problem, r) = w.last_step_problem().expect("a step was made");
+    assert_eq!(problem.contacts() * 2, r.len());
+    assert!(problem.contacts() > 60, "{} contacts", problem.contacts());
+    let same = w.snapshot_with_last_impulses(&r).unwrap();
+    assert_eq!(same, w.snapshot(), "bit for bit");
+}
+
+/// Tolerance 10⁻⁹ relative to the largest force of a grain's balance: the re-solved state is
+/// Moreau–Jean's update with the new impulses, so each grain's mean acceleration over the step
+/// is its weight plus the new contact forces over its mass, and its angular acceleration their
+/// torque over its inertia.
+#[test]
+fn a_resolved_snapshot_obeys_newton_s_law_with_the_new_impulses() {
+    let w = loose_box();
+    let (problem, r) = w.last_step_problem().unwrap();
+    let options = FcOptions {
+        tolerance: 1e-10,
+        initial_guess: Some(r.clone()),
+        ..FcOptions::default()
+    };
+    let (sol, _) = solve_by(
+        &problem,
+        &options,
+        SolverMethod::Auto,
+        &NewtonParams::default(),
+    )
+    .unwrap();
+    assert!(sol.converged, "error {:.2e}", sol.error);
+    let change = sol
+        .r
+        .iter()
+        .zip(&r)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let largest = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(change > 1e-4 * largest, "the loose solve was already exact");
+    let snap = w.snapshot_with_last_impulses(&sol.r).unwrap();
+    let g = w.params.gravity;
+    let n = snap.bodies.len();
+    let mut force = vec![Vector2::zeros(); n];
+    let mut torque = vec![0.0; n];
+    let mut scale = vec![0.0f64; n];
+    for c in &snap.contacts {
+        let t = Vector2::new(-c.normal.y, c.normal.x);
+        let f = c.normal * c.force_n + t * c.force_t;
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        force[b] += f;
+        force[a] -= f;
+        torque[b] += c.lever_b.perp(&f);
+        torque[a] -= c.lever_a.perp(&f);
+        scale[a] = scale[a].max(f.norm());
+        scale[b] = scale[b].max(f.norm());
+    }
+    for (i, b) in snap.bodies.iter().enumerate() {
+        if b.kind != BodyKind::Grain {
+            continue;
+        }
+        let s = scale[i].max(b.mass * g.norm());
+        let lin = (b.acceleration * b.mass - (force[i] + g * b.mass)).norm();
+        assert!(lin <= 1e-9 * s, "grain {i}: {lin:.3e} N against {s:.3e} N");
+        let ang = (b.angular_acceleration * b.inertia - torque[i]).abs();
+        assert!(
+            ang <= 1e-9 * s * b.radius,
+            "grain {i}: {ang:.3e} N·m against {:.3e}",
+            s * b.radius
+        );
+    }
+    // The forces are the new impulses over the step, in the cone.
+    for (c, x) in snap.contacts.iter().zip(sol.r.chunks_exact(2)) {
+        assert_eq!(c.force_n, x[0] / w.params.dt);
+        assert!(c.force_t.abs() <= c.mu * c.force_n * (1.0 + 1e-12) + 1e-300);
+    }
+}
+
+#[test]
+fn an_undone_step_has_no_problem_to_resolve() {
+    let mut w = loose_box();
+    let point = w.undo_point();
+    w.step().unwrap();
+    assert!(w.last_step_problem().is_some());
+    w.undo_to(&point);
+    assert!(w.last_step_problem().is_none());
+    let err = w.snapshot_with_last_impulses(&[]).unwrap_err();
+    assert!(err.to_string().contains("not available"), "{err}");
+    w.step().unwrap();
+    let (_, r) = w.last_step_problem().unwrap();
+    let err = w.snapshot_with_last_impulses(&r[1..]).unwrap_err();
+    assert!(err.to_string().contains("two per contact"), "{err}");
+}
