@@ -560,6 +560,11 @@ fn bad_scenarios_in_files_and_overrides() {
             &["key `column_aspect`"],
         ),
         row(
+            "--set too many solver tightenings",
+            &["run", "shear-cell", "--set", "solver_tightenings=5"],
+            &["key `solver_tightenings`", "5"],
+        ),
+        row(
             "--set radius larger than the cell",
             &["run", "shear-cell", "--set", "cell_length_diameters=1"],
             &["key `cell_length_diameters`"],

@@ -38,7 +38,10 @@ use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::{info, warn};
-use crate::verdict::{export_law, max_solid_fraction, Checks, RunVerdict, Verdict, WindowStats};
+use crate::verdict::{
+    export_law, max_solid_fraction, Checks, RunVerdict, Sensitivity, Verdict, WindowStats,
+    SENSITIVITY_MU_SUSPECT, SENSITIVITY_PRESSURE_SUSPECT, SENSITIVITY_TOLERANCE,
+};
 
 /// Averages of one run (sums of finite samples).
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -279,6 +282,16 @@ struct ShearState {
     /// One row per wall-velocity correction: `lead_stages.csv`.
     #[serde(default, with = "crate::floats::table")]
     lead_rows: Vec<Vec<f64>>,
+    /// The current lead stage's solver sensitivity (its second half's samples, re-solved).
+    #[serde(default)]
+    lead_sensitivity: Sensitivity,
+    /// Decades by which the lead stages have tightened the solver tolerance so far
+    /// ([`datasets::config::ShearCellConfig::solver_tightenings`]).
+    #[serde(default)]
+    tightenings: u32,
+    /// Mean sweeps per step of the last phase (the cost of its solves, [`needs_tightening`]).
+    #[serde(default)]
+    lead_sweeps: f64,
 }
 
 /// The correction of the wall velocity after a lead stage whose bulk measurement is `lead`:
@@ -300,6 +313,35 @@ fn velocity_correction(i_target: f64, lead: &LeadAverages, d: f64, rho: f64) -> 
     let (lo, hi) = VELOCITY_CORRECTION_BOUNDS;
     (i_measured, miss.sqrt().clamp(lo, hi))
 }
+
+/// Whether the re-solve of a lead stage's samples calls for a tighter tolerance: on at least
+/// [`TIGHTEN_MIN_SAMPLES`] samples, the upper bound ([`Sensitivity::upper_bounds`],
+/// [`TIGHTEN_Z`] standard errors) of μ's change exceeds
+/// [`crate::verdict::SENSITIVITY_MU_SUSPECT`] or that of the pressure's
+/// [`crate::verdict::SENSITIVITY_PRESSURE_SUSPECT`]: what the window, another set of samples of
+/// the same flow, could show; and only where the stage's solves took at most
+/// [`TIGHTEN_MAX_SWEEPS`] of the sweep cap `max_sweeps` on average (`sweeps`). Where the
+/// solves are loose against the contact forces (a rapid flow) the per-sample changes scatter
+/// widely (±30–80 % of a sample's pressure at I = 0.2, at 13–40 sweeps a step); in the slow
+/// dense shear (I = 0.005: 1.3 % ± 0.6 %, at 2100–2400 sweeps a step against a cap of 5000) a
+/// tenth of the tolerance stalls: the default cell at 10⁻⁵ throughout left 32 of the 1896
+/// window steps at I = 0.005 unconverged and took 12.4 min instead of 3.
+fn needs_tightening(s: &Sensitivity, sweeps: f64, max_sweeps: usize) -> bool {
+    let [mu, p] = s.upper_bounds(TIGHTEN_Z);
+    s.samples >= TIGHTEN_MIN_SAMPLES
+        && sweeps <= TIGHTEN_MAX_SWEEPS * max_sweeps as f64
+        && (mu > SENSITIVITY_MU_SUSPECT || p > SENSITIVITY_PRESSURE_SUSPECT)
+}
+
+/// Largest mean sweeps per step of a lead stage, as a fraction of the sweep cap, after which
+/// [`needs_tightening`] may tighten the tolerance.
+pub const TIGHTEN_MAX_SWEEPS: f64 = 0.2;
+
+/// Standard errors of the mean added to a lead stage's measured changes ([`needs_tightening`]).
+pub const TIGHTEN_Z: f64 = 2.0;
+
+/// Fewest re-solved samples of a lead stage on which [`needs_tightening`] decides.
+pub const TIGHTEN_MIN_SAMPLES: u64 = 4;
 
 /// Which part of which run phase `k ≥ 1` is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -396,6 +438,26 @@ impl PhasedRun for Shear<'_> {
                 );
             }
         }
+        // The solver's accuracy: tightened after a lead stage whose samples' stress moved when
+        // solved again to 1e-8 (`solver_tightenings`).
+        if k >= 2 && self.stage(k - 1).lead.is_some() {
+            let sens = std::mem::take(&mut st.lead_sensitivity);
+            if st.tightenings < c.solver_tightenings
+                && needs_tightening(&sens, st.lead_sweeps, c.solver.max_iterations)
+            {
+                st.tightenings += 1;
+                info(
+                    env.verbosity,
+                    &format!(
+                        "      I={i_target}: the lead's samples move by Δμ = {:.4}, ΔP/P = {:.2} % when solved to {SENSITIVITY_TOLERANCE:.0e}: solver tolerance → {:.0e}",
+                        sens.mu_change(),
+                        100.0 * sens.pressure_change(),
+                        c.solver.tolerance * 0.1f64.powi(st.tightenings as i32)
+                    ),
+                );
+            }
+        }
+        world.params.solver.tolerance = c.solver.tolerance * 0.1f64.powi(st.tightenings as i32);
         let dt = c.dt_max.min(c.travel_per_step * r / v);
         let (strain, name) = match stage.lead {
             Some(j) => (
@@ -429,6 +491,7 @@ impl PhasedRun for Shear<'_> {
         };
         st.acc = RunAverages::default();
         st.lead = LeadAverages::default();
+        st.lead_sensitivity = Sensitivity::default();
         st.window.reset();
         Ok(Some(PhasePlan {
             name,
@@ -460,10 +523,15 @@ impl PhasedRun for Shear<'_> {
                 let resolved = resolved_stress(w, self.c.grain.radius_mean, d)?;
                 st.window.sensitivity.add([sxy, syy], resolved);
             } else {
-                let (gamma_dot, pressure) = bulk_shear(w, self.c.grain.radius_mean, d)?;
+                let (gamma_dot, sym) = bulk_shear(w, self.c.grain.radius_mean, d)?;
                 st.lead.gamma_dot += gamma_dot;
-                st.lead.pressure += pressure;
+                st.lead.pressure += -sym[(1, 1)];
                 st.lead.samples += 1;
+                if self.c.solver_tightenings > 0 {
+                    let resolved = resolved_stress(w, self.c.grain.radius_mean, d)?;
+                    st.lead_sensitivity
+                        .add([sym[(0, 1)], sym[(1, 1)]], resolved);
+                }
             }
         }
         Ok(())
@@ -478,6 +546,7 @@ impl PhasedRun for Shear<'_> {
         stats: &PhaseStats,
     ) -> Result<()> {
         st.all.merge(stats);
+        st.lead_sweeps = stats.mean_sweeps();
         if k == 0 || self.stage(k).lead.is_some() {
             return Ok(());
         }
@@ -527,6 +596,7 @@ impl PhasedRun for Shear<'_> {
             mut_,
             acc.samples as f64,
             v / v_uniform,
+            world.params.solver.tolerance,
         ]);
         st.profiles.push(MeanProfile {
             i: i_meas,
@@ -560,6 +630,9 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             checks: Vec::new(),
             lead: LeadAverages::default(),
             lead_rows: Vec::new(),
+            lead_sensitivity: Sensitivity::default(),
+            tightenings: 0,
+            lead_sweeps: 0.0,
         };
         Ok((world, state))
     };
@@ -611,6 +684,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         "mu_eff_top",
         "samples",
         "wall_velocity_over_uniform",
+        "solver_tolerance",
         "point_verdict",
     ];
     let grain = GrainScale {
@@ -837,13 +911,14 @@ fn bulk_stress(snap: &Snapshot, region: &Region) -> Result<nalgebra::Matrix2<f64
 }
 
 /// The bulk shear rate `γ̇ = ∂v_x/∂y` (1/s, mass-weighted affine fit of the grain velocities)
-/// and pressure `P = −σ_yy` (Pa) of one state: what the wall-velocity correction measures.
-fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, f64)> {
+/// and symmetric stress (Pa) of one state: what the wall-velocity correction measures
+/// (`P = −σ_yy`).
+fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, nalgebra::Matrix2<f64>)> {
     let snap = w.snapshot();
     let region = bulk_region(w, r, d);
     let sym = bulk_stress(&snap, &region)?;
     let g = velocity_gradient(&snap, &region, VelocityWeight::Mass)?.gradient[(0, 1)];
-    Ok((g, -sym[(1, 1)]))
+    Ok((g, sym))
 }
 
 /// The bulk `[σ_xy, σ_yy]` (Pa) of the world with its last step's contact problem solved to
@@ -947,5 +1022,35 @@ mod tests {
         let (i, f) = velocity_correction(0.02, &LeadAverages::default(), 1.0, 1.0);
         assert!(i.is_nan() && f == 1.0);
         assert_eq!(velocity_correction(0.02, &lead_at(0.0, 3), 1.0, 1.0).1, 1.0);
+    }
+
+    /// `n` lead samples at P = 100 Pa, μ = 0.3, whose pressure moves by `mean ± spread` (Pa,
+    /// alternately) when re-solved.
+    fn lead_sensitivity(n: usize, mean: f64, spread: f64) -> Sensitivity {
+        let mut s = Sensitivity::default();
+        for i in 0..n {
+            let d = mean + if i % 2 == 0 { spread } else { -spread };
+            s.add([-30.0, -100.0], Some([-30.0, -100.0 - d]));
+        }
+        s
+    }
+
+    /// The tightening rule: the measured change plus two standard errors against the suspect
+    /// limits, on at least four samples, where the stage's solves take at most a fifth of the
+    /// cap.
+    #[test]
+    fn the_tolerance_is_tightened_where_the_samples_could_move_and_sweeps_are_cheap() {
+        let cheap = (100.0, 5000);
+        let t = |s: &Sensitivity, (sweeps, cap): (f64, usize)| needs_tightening(s, sweeps, cap);
+        // P moves by 3 % on every sample: beyond 2.5 %.
+        assert!(t(&lead_sensitivity(20, 3.0, 0.0), cheap));
+        // ... but not where the stage's solves took 2300 sweeps a step against 5000.
+        assert!(!t(&lead_sensitivity(20, 3.0, 0.0), (2300.0, 5000)));
+        // 1.3 % on average within ±0.3 %: bound 1.3 + 2·0.3·√(20/19)/√20 = 1.44 %, kept.
+        assert!(!t(&lead_sensitivity(20, 1.3, 0.3), cheap));
+        // 1.3 % on average within ±10 % a sample: the bound, 5.9 %, could be suspect.
+        assert!(t(&lead_sensitivity(20, 1.3, 10.0), cheap));
+        // Too few samples to decide.
+        assert!(!t(&lead_sensitivity(3, 30.0, 0.0), cheap));
     }
 }

@@ -42,6 +42,16 @@ pub struct ShearCellConfig {
     /// uniform-shear estimate. Absent from older files: 2.
     #[serde(default = "default_velocity_corrections")]
     pub velocity_corrections: usize,
+    /// Decades by which the lead stages of the runs may tighten `solver.tolerance`: after each
+    /// lead stage whose samples, solved again to 10⁻⁸, could move the bulk μ by more than 0.005
+    /// or its pressure by more than 2.5 % (the verdict's suspect limits of the solver
+    /// sensitivity, against the measured change plus two standard errors) and whose solves
+    /// took at most a fifth of the sweep cap on average, the tolerance of the following stages
+    /// is divided by 10, at most this many times in all (the tightening carries over to the
+    /// next runs, whose I is higher). 0: the tolerance stays as given. Absent from older
+    /// files: 2.
+    #[serde(default = "default_solver_tightenings")]
+    pub solver_tightenings: u32,
     /// Largest time step (s).
     pub dt_max: f64,
     /// Largest travel of the top wall per step, as a fraction of the mean radius (sets dt).
@@ -63,6 +73,17 @@ fn default_velocity_corrections() -> usize {
 
 /// Largest number of wall-velocity corrections a run.
 pub const MAX_VELOCITY_CORRECTIONS: usize = 4;
+
+/// Default of [`ShearCellConfig::solver_tightenings`].
+pub const DEFAULT_SOLVER_TIGHTENINGS: u32 = 2;
+
+fn default_solver_tightenings() -> u32 {
+    DEFAULT_SOLVER_TIGHTENINGS
+}
+
+/// Largest [`ShearCellConfig::solver_tightenings`]: the tolerance of a run stays at or above
+/// 10⁻⁴ of the one given.
+pub const MAX_SOLVER_TIGHTENINGS: u32 = 4;
 
 impl ShearCellConfig {
     /// Checks every value (key named in the error), and that no phase takes more than
@@ -109,6 +130,11 @@ impl ShearCellConfig {
             "velocity_corrections",
             self.velocity_corrections,
             MAX_VELOCITY_CORRECTIONS,
+        )?;
+        limits::at_most(
+            "solver_tightenings",
+            self.solver_tightenings as usize,
+            MAX_SOLVER_TIGHTENINGS as usize,
         )?;
         if self.velocity_corrections > 0 && self.average_strain >= self.strain {
             return Err(DatasetError::invalid(
