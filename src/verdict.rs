@@ -460,28 +460,50 @@ pub struct Sensitivity {
     pub samples: u64,
     /// Samples whose re-solve did not reach it (left out of the sums).
     pub unresolved: u64,
+    /// Samples whose step's problem was not available to re-solve (the step's last attempt
+    /// undone, a resume within the window): left out, not a failure of the solver.
+    #[serde(default)]
+    pub unavailable: u64,
     /// Σ σ_xy, Σ σ_yy of the re-solved samples as run (Pa, tension positive).
+    #[serde(with = "dem::serde_float")]
     pub sxy: f64,
     /// See `sxy`.
+    #[serde(with = "dem::serde_float")]
     pub syy: f64,
     /// The same sums with the re-solved impulses (Pa).
+    #[serde(with = "dem::serde_float")]
     pub sxy_resolved: f64,
     /// See `sxy_resolved`.
+    #[serde(with = "dem::serde_float")]
     pub syy_resolved: f64,
     /// Second moments of the per-sample changes `Δxy = σ_xy' − σ_xy`, `Δyy = σ_yy' − σ_yy`:
     /// `Σ Δxy²`, `Σ Δyy²`, `Σ Δxy Δyy` (Pa²), for the noise of the means
     /// ([`Sensitivity::upper_bounds`]).
-    #[serde(default)]
+    #[serde(default, with = "dem::serde_float")]
     pub dxy2: f64,
     /// See `dxy2`.
-    #[serde(default)]
+    #[serde(default, with = "dem::serde_float")]
     pub dyy2: f64,
     /// See `dxy2`.
-    #[serde(default)]
+    #[serde(default, with = "dem::serde_float")]
     pub dxy_dyy: f64,
 }
 
 impl Sensitivity {
+    /// Adds a sample ([`Sensitivity::add`]), or counts it as unavailable.
+    pub fn record(
+        &mut self,
+        run: [f64; 2],
+        resolved: crate::scenarios::sensitivity::Resolved<[f64; 2]>,
+    ) {
+        use crate::scenarios::sensitivity::Resolved;
+        match resolved {
+            Resolved::Solved(s) => self.add(run, Some(s)),
+            Resolved::Failed => self.add(run, None),
+            Resolved::Unavailable => self.unavailable += 1,
+        }
+    }
+
     /// Adds a sample: its bulk `[σ_xy, σ_yy]` as run and, when the re-solve converged, as
     /// re-solved (`None`: counted as unresolved).
     pub fn add(&mut self, run: [f64; 2], resolved: Option<[f64; 2]>) {
@@ -553,6 +575,7 @@ impl Sensitivity {
     pub fn merge(&mut self, o: &Sensitivity) {
         self.samples += o.samples;
         self.unresolved += o.unresolved;
+        self.unavailable += o.unavailable;
         self.sxy += o.sxy;
         self.syy += o.syy;
         self.sxy_resolved += o.sxy_resolved;
@@ -629,7 +652,8 @@ impl WindowStats {
     /// `PREFIX_worst_error_without_gap_shifts`, `PREFIX_energy_growth_steps`,
     /// `PREFIX_max_overlap_over_radius`; where the solver sensitivity was measured
     /// ([`Sensitivity`]), `PREFIX_resolved_samples`, `PREFIX_unresolved_samples`,
-    /// `PREFIX_resolved_mu_change`, `PREFIX_resolved_pressure_change`.
+    /// `PREFIX_unavailable_samples`, `PREFIX_resolved_mu_change`,
+    /// `PREFIX_resolved_pressure_change`.
     pub fn keys(&self, s: &mut Summary, prefix: &str) {
         s.int(&format!("{prefix}_steps"), self.steps)
             .int(&format!("{prefix}_unconverged_steps"), self.unconverged)
@@ -644,9 +668,10 @@ impl WindowStats {
                 self.max_overlap_ratio,
             );
         let sens = &self.sensitivity;
-        if sens.samples + sens.unresolved > 0 {
+        if sens.samples + sens.unresolved + sens.unavailable > 0 {
             s.int(&format!("{prefix}_resolved_samples"), sens.samples)
                 .int(&format!("{prefix}_unresolved_samples"), sens.unresolved)
+                .int(&format!("{prefix}_unavailable_samples"), sens.unavailable)
                 .num(&format!("{prefix}_resolved_mu_change"), sens.mu_change())
                 .num(
                     &format!("{prefix}_resolved_pressure_change"),
@@ -1048,6 +1073,20 @@ mod tests {
         assert!((bp - 2.0 * 0.05 / 39f64.sqrt()).abs() < 1e-12, "{bp}");
         assert!((bm - 2.0 * 0.005 / 39f64.sqrt()).abs() < 1e-9, "{bm}");
         assert!(Sensitivity::default().upper_bounds(2.0)[0].is_nan());
+        // Both components scaled by 1 ± 5 % in turn: each sample's μ is unchanged, so the
+        // linearised δμ_i = (s Δxy_i + μ Δyy_i)/P vanishes (Δxy and Δyy fully correlated: the
+        // covariance term cancels the variances), while P scatters by ±5 %.
+        let mut s = Sensitivity::default();
+        for i in 0..40 {
+            let e = if i % 2 == 0 { -0.05 } else { 0.05 };
+            s.add(
+                [-10.0, -100.0],
+                Some([-10.0 * (1.0 + e), -100.0 * (1.0 + e)]),
+            );
+        }
+        let [bm, bp] = s.upper_bounds(2.0);
+        assert!(bm.abs() < 1e-12, "{bm}");
+        assert!((bp - 2.0 * 0.05 / 39f64.sqrt()).abs() < 1e-12, "{bp}");
     }
 
     #[test]

@@ -132,12 +132,28 @@ pub struct PhaseStats {
     /// ([`dem::step_control::step_subdivided_checked`]).
     #[serde(default)]
     pub polished_steps: u64,
+    /// Newton iterations of the phase's solves (`auto`'s global stage and active-set solves).
+    #[serde(default)]
+    pub newton_iterations: u64,
+    /// Pivots of Lemke's method over the phase's solves.
+    #[serde(default)]
+    pub pivots: u64,
     /// Whether the rest criterion was met (phases that look for rest).
     pub at_rest: bool,
     /// Translational kinetic energy over `Σ m g d` at the end (1).
     #[serde(with = "dem::serde_float")]
     pub final_energy_ratio: f64,
 }
+
+/// Cost of one Newton iteration (a sparse LU of the step's problem) in sweeps, for
+/// [`PhaseStats::mean_solve_cost`]: about 20 on 700-contact columns
+/// ([`dem::solver::AUTO_HORIZON`]).
+pub const NEWTON_ITERATION_SWEEPS: f64 = 20.0;
+
+/// Cost of one pivot of Lemke's method in sweeps, for [`PhaseStats::mean_solve_cost`]: the
+/// shear cell's hard sub-steps (about 500 contacts) took 0.44–0.78 s for 2000–3250 pivots,
+/// about 0.2 ms a pivot against some 15–20 µs a sweep.
+pub const PIVOT_SWEEPS: f64 = 10.0;
 
 /// The earlier of two optional step indices.
 fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
@@ -177,6 +193,8 @@ impl PhaseStats {
         );
         self.max_sweeps = self.max_sweeps.max(r.solver.iterations);
         self.total_sweeps += r.solver.iterations as u64;
+        self.newton_iterations += r.solver.newton_iterations as u64;
+        self.pivots += r.solver.pivots as u64;
         self.max_penetration = self.max_penetration.max(r.max_penetration);
     }
 
@@ -244,11 +262,26 @@ impl PhaseStats {
         self.discarded_sweeps += o.discarded_sweeps;
         self.paused_steps += o.paused_steps;
         self.polished_steps += o.polished_steps;
+        self.newton_iterations += o.newton_iterations;
+        self.pivots += o.pivots;
         self.max_corrected_overlap_ratio = self
             .max_corrected_overlap_ratio
             .max(o.max_corrected_overlap_ratio);
         self.at_rest = o.at_rest;
         self.final_energy_ratio = o.final_energy_ratio;
+    }
+
+    /// Mean cost of a step's solve in Gauss–Seidel sweeps: sweeps, plus
+    /// [`NEWTON_ITERATION_SWEEPS`] per Newton iteration and [`PIVOT_SWEEPS`] per pivot of
+    /// Lemke's method (a rough model, for decisions that must not hang on wall-clock time).
+    pub fn mean_solve_cost(&self) -> f64 {
+        if self.steps == 0 {
+            return 0.0;
+        }
+        (self.total_sweeps as f64
+            + NEWTON_ITERATION_SWEEPS * self.newton_iterations as f64
+            + PIVOT_SWEEPS * self.pivots as f64)
+            / self.steps as f64
     }
 
     /// Mean sweeps per step.

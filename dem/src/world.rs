@@ -170,7 +170,7 @@ pub struct World {
     pos: Vec<[f64; 2]>,
     layout: BlockLayout,
     colouring: ContactColouring,
-    v_free: Vec<[f64; 3]>,
+    pub(crate) v_free: Vec<[f64; 3]>,
     pub(crate) work: solver::SolverWork,
     displacement: Vec<[f64; 3]>,
     projection: Projection,
@@ -555,7 +555,10 @@ impl World {
     /// ```
     ///
     /// and the contacts' statuses read from `r`. The step's position correction is kept as it
-    /// was made (it depends on the positions only through overlaps, a change of order `θ h Δv`).
+    /// was made (it depends on the positions only through overlaps, a change of order `θ h Δv`),
+    /// and so are the walls' resultant forces and geometry in [`Snapshot::walls`] (those of the
+    /// run's solve). For a step done in sub-steps ([`crate::step_control`]) this is its last
+    /// sub-step's solve.
     /// This is how a measurement tells what the solver's residual does to it: the same step,
     /// solved tighter (`grainlaw`'s solver-sensitivity check).
     ///

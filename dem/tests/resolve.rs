@@ -90,6 +90,33 @@ fn a_resolved_snapshot_obeys_newton_s_law_with_the_new_impulses() {
             s * b.radius
         );
     }
+    // Velocities, positions and angles moved with the accelerations: Δv = h Δa (mean
+    // acceleration over the step), Δq = θ h Δv (θ = 1 here), to rounding.
+    let before = w.snapshot();
+    let h = w.params.dt;
+    let theta = w.params.theta;
+    let mut moved = 0;
+    for (b0, b1) in before.bodies.iter().zip(&snap.bodies) {
+        let dv = b1.velocity - b0.velocity;
+        let da = b1.acceleration - b0.acceleration;
+        let dw = b1.omega - b0.omega;
+        let scale = 1e-12 * (b0.velocity.norm() + dv.norm() + 1e-9);
+        assert!((dv - da * h).norm() <= scale, "{dv:?} vs h·{da:?}");
+        assert!(
+            (dw - (b1.angular_acceleration - b0.angular_acceleration) * h).abs()
+                <= 1e-9 * (b0.omega.abs() + dw.abs() + 1e-9)
+        );
+        let dq = b1.position - b0.position;
+        assert!((dq - dv * (theta * h)).norm() <= 1e-12 * (b0.position.norm() + 1e-9));
+        assert!(((b1.angle - b0.angle) - theta * h * dw).abs() <= 1e-12 * (b0.angle.abs() + 1.0));
+        if b0.kind != BodyKind::Grain {
+            // Walls are fixed: no inverse mass, no change.
+            assert_eq!((dv, dw), (Vector2::zeros(), 0.0));
+        } else if dv.norm() > 0.0 {
+            moved += 1;
+        }
+    }
+    assert!(moved > 10, "{moved} grains moved");
     // The forces are the new impulses over the step, in the cone.
     for (c, x) in snap.contacts.iter().zip(sol.r.chunks_exact(2)) {
         assert_eq!(c.force_n, x[0] / w.params.dt);

@@ -234,6 +234,11 @@ fn energy_check_polishes_a_converged_step_at_a_tenth_of_the_tolerance() {
         d.discarded_sweeps, sweeps,
         "the dropped polish ran to its cap"
     );
+    // The kept first solve's problem stays available after the polish is undone, the same as
+    // the plain step's, with the impulses kept (World::last_step_problem).
+    let (pq, rq) = q.last_step_problem().expect("the first solve's problem");
+    let (pp, rp) = plain.last_step_problem().unwrap();
+    assert_eq!((pq.q(), &rq), (pp.q(), &rp));
 }
 
 /// An undo point ([`World::undo_point`]) holds the state, not the work space: a world returned

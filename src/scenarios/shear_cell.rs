@@ -30,6 +30,7 @@ use super::common::{
     VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
+use super::sensitivity::Resolved;
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -289,7 +290,8 @@ struct ShearState {
     /// ([`datasets::config::ShearCellConfig::solver_tightenings`]).
     #[serde(default)]
     tightenings: u32,
-    /// Mean sweeps per step of the last phase (the cost of its solves, [`needs_tightening`]).
+    /// Mean cost per step of the last phase's solves, in sweeps
+    /// ([`PhaseStats::mean_solve_cost`], [`needs_tightening`]).
     #[serde(default)]
     lead_sweeps: f64,
 }
@@ -320,7 +322,8 @@ fn velocity_correction(i_target: f64, lead: &LeadAverages, d: f64, rho: f64) -> 
 /// [`crate::verdict::SENSITIVITY_MU_SUSPECT`] or that of the pressure's
 /// [`crate::verdict::SENSITIVITY_PRESSURE_SUSPECT`]: what the window, another set of samples of
 /// the same flow, could show; and only where the stage's solves took at most
-/// [`TIGHTEN_MAX_SWEEPS`] of the sweep cap `max_sweeps` on average (`sweeps`). Where the
+/// [`TIGHTEN_MAX_SWEEPS`] of the sweep cap `max_sweeps` on average (`sweeps`, Newton
+/// iterations and Lemke pivots counted in sweeps, [`PhaseStats::mean_solve_cost`]). Where the
 /// solves are loose against the contact forces (a rapid flow) the per-sample changes scatter
 /// widely (±30–80 % of a sample's pressure at I = 0.2, at 13–40 sweeps a step); in the slow
 /// dense shear (I = 0.005: 1.3 % ± 0.6 %, at 2100–2400 sweeps a step against a cap of 5000) a
@@ -446,12 +449,14 @@ impl PhasedRun for Shear<'_> {
                 && needs_tightening(&sens, st.lead_sweeps, c.solver.max_iterations)
             {
                 st.tightenings += 1;
+                let [mu_bound, p_bound] = sens.upper_bounds(TIGHTEN_Z);
                 info(
                     env.verbosity,
                     &format!(
-                        "      I={i_target}: the lead's samples move by Δμ = {:.4}, ΔP/P = {:.2} % when solved to {SENSITIVITY_TOLERANCE:.0e}: solver tolerance → {:.0e}",
+                        "      I={i_target}: the lead's samples move by Δμ = {:.4} (up to {mu_bound:.4}), ΔP/P = {:.2} % (up to {:.2} %) when solved to {SENSITIVITY_TOLERANCE:.0e}: solver tolerance → {:.0e}",
                         sens.mu_change(),
                         100.0 * sens.pressure_change(),
+                        100.0 * p_bound,
                         c.solver.tolerance * 0.1f64.powi(st.tightenings as i32)
                     ),
                 );
@@ -520,17 +525,17 @@ impl PhasedRun for Shear<'_> {
             let d = mean_diameter(w);
             if averaged {
                 let (sxy, syy) = sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
-                let resolved = resolved_stress(w, self.c.grain.radius_mean, d)?;
-                st.window.sensitivity.add([sxy, syy], resolved);
+                let resolved = resolved_stress(w, self.c.grain.radius_mean, d);
+                st.window.sensitivity.record([sxy, syy], resolved);
             } else {
                 let (gamma_dot, sym) = bulk_shear(w, self.c.grain.radius_mean, d)?;
                 st.lead.gamma_dot += gamma_dot;
                 st.lead.pressure += -sym[(1, 1)];
                 st.lead.samples += 1;
-                if self.c.solver_tightenings > 0 {
-                    let resolved = resolved_stress(w, self.c.grain.radius_mean, d)?;
+                if st.tightenings < self.c.solver_tightenings {
+                    let resolved = resolved_stress(w, self.c.grain.radius_mean, d);
                     st.lead_sensitivity
-                        .add([sym[(0, 1)], sym[(1, 1)]], resolved);
+                        .record([sym[(0, 1)], sym[(1, 1)]], resolved);
                 }
             }
         }
@@ -546,7 +551,7 @@ impl PhasedRun for Shear<'_> {
         stats: &PhaseStats,
     ) -> Result<()> {
         st.all.merge(stats);
-        st.lead_sweeps = stats.mean_sweeps();
+        st.lead_sweeps = stats.mean_solve_cost();
         if k == 0 || self.stage(k).lead.is_some() {
             return Ok(());
         }
@@ -923,14 +928,14 @@ fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, nalgebra::Matrix2<
 
 /// The bulk `[σ_xy, σ_yy]` (Pa) of the world with its last step's contact problem solved to
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] (the solver-sensitivity measure,
-/// [`crate::verdict::Sensitivity`]); `None` when that solve did not converge or the problem
-/// is not available.
-fn resolved_stress(w: &dem::World, r: f64, d: f64) -> Result<Option<[f64; 2]>> {
-    let Some(snap) = super::sensitivity::resolved_snapshot(w)? else {
-        return Ok(None);
-    };
-    let sym = bulk_stress(&snap, &bulk_region(w, r, d))?;
-    Ok(Some([sym[(0, 1)], sym[(1, 1)]]))
+/// [`crate::verdict::Sensitivity`]), or why there is none.
+fn resolved_stress(w: &dem::World, r: f64, d: f64) -> Resolved<[f64; 2]> {
+    super::sensitivity::resolved_snapshot(w).and_then(|snap| {
+        match bulk_stress(&snap, &bulk_region(w, r, d)) {
+            Ok(sym) => Resolved::Solved([sym[(0, 1)], sym[(1, 1)]]),
+            Err(_) => Resolved::Failed,
+        }
+    })
 }
 
 /// Adds one sample of the bulk and wall quantities to `acc`; returns its bulk
@@ -1025,14 +1030,24 @@ mod tests {
     }
 
     /// `n` lead samples at P = 100 Pa, μ = 0.3, whose pressure moves by `mean ± spread` (Pa,
-    /// alternately) when re-solved.
-    fn lead_sensitivity(n: usize, mean: f64, spread: f64) -> Sensitivity {
+    /// alternately) when re-solved, σ_xy unchanged (μ moves with P) or, with `keep_mu`, moving
+    /// in proportion (μ unchanged).
+    fn lead_samples(n: usize, mean: f64, spread: f64, keep_mu: bool) -> Sensitivity {
         let mut s = Sensitivity::default();
         for i in 0..n {
             let d = mean + if i % 2 == 0 { spread } else { -spread };
-            s.add([-30.0, -100.0], Some([-30.0, -100.0 - d]));
+            let xy = if keep_mu {
+                -30.0 * (1.0 + d / 100.0)
+            } else {
+                -30.0
+            };
+            s.add([-30.0, -100.0], Some([xy, -100.0 - d]));
         }
         s
+    }
+
+    fn lead_sensitivity(n: usize, mean: f64, spread: f64) -> Sensitivity {
+        lead_samples(n, mean, spread, false)
     }
 
     /// The tightening rule: the measured change plus two standard errors against the suspect
@@ -1052,5 +1067,14 @@ mod tests {
         assert!(t(&lead_sensitivity(20, 1.3, 10.0), cheap));
         // Too few samples to decide.
         assert!(!t(&lead_sensitivity(3, 30.0, 0.0), cheap));
+        // μ unchanged: the pressure alone decides, 3 % beyond its limit, 2 % within it.
+        assert!(t(&lead_samples(20, 3.0, 0.0, true), cheap));
+        assert!(!t(&lead_samples(20, 2.0, 0.0, true), cheap));
+        // μ = 0.3 moving by 0.006 at P unchanged (σ_xy by 0.6 Pa): beyond 0.005.
+        let mut s = Sensitivity::default();
+        for _ in 0..20 {
+            s.add([-30.0, -100.0], Some([-30.6, -100.0]));
+        }
+        assert!(t(&s, cheap));
     }
 }
