@@ -532,7 +532,13 @@ impl PhasedRun for Shear<'_> {
                 st.lead.gamma_dot += gamma_dot;
                 st.lead.pressure += -sym[(1, 1)];
                 st.lead.samples += 1;
-                if st.tightenings < self.c.solver_tightenings {
+                // Only where the rule could tighten: tightenings left, and the stage's solves so
+                // far cheap enough (the slow shear's lead stages would spend some 35 s of the
+                // default run re-solving samples that cannot change its tolerance).
+                if st.tightenings < self.c.solver_tightenings
+                    && p.stats.mean_solve_cost()
+                        <= TIGHTEN_MAX_SWEEPS * self.c.solver.max_iterations as f64
+                {
                     let resolved = resolved_stress(w, self.c.grain.radius_mean, d);
                     st.lead_sensitivity
                         .record([sym[(0, 1)], sym[(1, 1)]], resolved);
