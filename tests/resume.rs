@@ -184,6 +184,61 @@ fn stopped_and_resumed_runs_give_the_same_files() {
     assert_eq!(s["energy_growth_first_step"].is_null(), total == 0);
 }
 
+/// The shear cell's solver tightening resumes exactly: a 60-grain cell whose lead at I = 0.08
+/// tightens the tolerance to 1e-5 (`rheology.csv`), stopped inside that run's lead stages
+/// (step 240: its re-solved samples are in the checkpoint, the decision not yet made) and
+/// again in its window (step 300, after the tightening), resumed twice: the same files, byte
+/// for byte, as the uninterrupted run (sensitivity sums included in `summary.json`).
+#[test]
+fn a_shear_cell_resumed_across_its_solver_tightening_gives_the_same_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    let cell: &[&str] = &[
+        "run",
+        "shear-cell",
+        "-q",
+        "--set",
+        "grains=60",
+        "--set",
+        "cell_length_diameters=10",
+        "--set",
+        "inertial_numbers=[0.04, 0.08, 0.15]",
+        "--set",
+        "strain=0.6",
+        "--set",
+        "average_strain=0.3",
+        "--set",
+        "compression_time=0.05",
+    ];
+    assert_finished(&grainlaw(&[cell, &["--out"]].concat(), &[&a]));
+    let table = std::fs::read_to_string(a.join("rheology.csv")).unwrap();
+    let tolerances: Vec<&str> = table
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').rev().nth(1).unwrap())
+        .collect();
+    assert_eq!(tolerances, ["1e-4", "1e-5", "1e-5"], "{table}");
+    let o = grainlaw(
+        &[cell, &["--stop-after-steps", "240", "--out"]].concat(),
+        &[&b],
+    );
+    assert_stopped(&o, &b);
+    assert!(error_line(&o).contains("I=0.08 lead"), "{}", error_line(&o));
+    let o = grainlaw(
+        &["run", "-q", "--stop-after-steps", "60", "--resume"],
+        &[&b],
+    );
+    assert_stopped(&o, &b);
+    assert!(
+        error_line(&o).contains("phase `I=0.08`"),
+        "{}",
+        error_line(&o)
+    );
+    assert_finished(&grainlaw(&["run", "-q", "--resume"], &[&b]));
+    assert_same_outputs(&a, &b);
+}
+
 /// A real SIGINT (Ctrl-C) while the run steps: a checkpoint, exit 130, no summary.json; the
 /// resumed run gives the uninterrupted run's files.
 #[cfg(unix)]
