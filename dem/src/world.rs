@@ -554,11 +554,11 @@ impl World {
     /// v⁺' = v⁺ + Δv,   a' = a + Δv / h,   q⁺' = q⁺ + θ h Δv,   f' = r / h,
     /// ```
     ///
-    /// and the contacts' statuses read from `r`. The step's position correction is kept as it
-    /// was made (it depends on the positions only through overlaps, a change of order `θ h Δv`),
-    /// and so are the walls' resultant forces and geometry in [`Snapshot::walls`] (those of the
-    /// run's solve). For a step done in sub-steps ([`crate::step_control`]) this is its last
-    /// sub-step's solve.
+    /// the contacts' statuses read from `r`, and the walls' resultant contact forces and torques
+    /// in [`Snapshot::walls`] summed from `r`. The step's position correction is kept as it was
+    /// made (it depends on the positions only through overlaps, a change of order `θ h Δv`), and
+    /// so is the walls' geometry (a wall free to move shifts by `θ h Δv`). For a step done in
+    /// sub-steps ([`crate::step_control`]) this is its last sub-step's solve.
     /// This is how a measurement tells what the solver's residual does to it: the same step,
     /// solved tighter (`grainlaw`'s solver-sensitivity check).
     ///
@@ -585,7 +585,11 @@ impl World {
                 rows.len()
             )));
         }
+        let h = self.impulse_dt();
         let mut dv = vec![[0.0; 3]; self.bodies.len()];
+        // The change of every body's contact force and torque (N, N·m), as
+        // `refresh_body_forces` sums them.
+        let mut df = vec![[0.0; 3]; self.bodies.len()];
         for (c, x) in rows.iter().zip(r.chunks_exact(2)) {
             let d = [x[0] - c.r[0], x[1] - c.r[1]];
             if d != [0.0, 0.0] {
@@ -594,9 +598,16 @@ impl World {
                 c.apply(d, &mut va, &self.inv[a], &mut vb, &self.inv[b]);
                 dv[a] = va;
                 dv[b] = vb;
+                let [nx, ny] = c.n;
+                let (fx, fy) = ((d[0] * nx - d[1] * ny) / h, (d[0] * ny + d[1] * nx) / h);
+                df[b][0] += fx;
+                df[b][1] += fy;
+                df[b][2] += (c.k[2] * d[0] + c.k[3] * d[1]) / h;
+                df[a][0] -= fx;
+                df[a][1] -= fy;
+                df[a][2] -= (c.k[0] * d[0] + c.k[1] * d[1]) / h;
             }
         }
-        let h = self.impulse_dt();
         let theta = self.params.theta;
         let periodic = self.periodic();
         let mut snap = self.snapshot();
@@ -613,6 +624,11 @@ impl World {
             if let (Some(p), BodyKind::Grain) = (periodic, b.kind) {
                 b.position.x = p.wrap(b.position.x);
             }
+        }
+        for wall in &mut snap.walls {
+            let f = df[wall.body as usize];
+            wall.force += Vector2::new(f[0], f[1]);
+            wall.torque += f[2];
         }
         for ((c, row), x) in snap.contacts.iter_mut().zip(rows).zip(r.chunks_exact(2)) {
             c.force_n = x[0] / h;

@@ -117,6 +117,27 @@ fn a_resolved_snapshot_obeys_newton_s_law_with_the_new_impulses() {
         }
     }
     assert!(moved > 10, "{moved} grains moved");
+    // Each wall's resultant is the sum of the new forces of its contacts (it receives −f),
+    // to rounding.
+    for wall in &snap.walls {
+        let mut f = Vector2::zeros();
+        for c in &snap.contacts {
+            let t = Vector2::new(-c.normal.y, c.normal.x);
+            let fc = c.normal * c.force_n + t * c.force_t;
+            if c.body_a == wall.body {
+                f -= fc;
+            }
+            if c.body_b == wall.body {
+                f += fc;
+            }
+        }
+        assert!(
+            (wall.force - f).norm() <= 1e-9 * (f.norm() + 1e-12),
+            "{}: {:?} vs {f:?}",
+            wall.name,
+            wall.force
+        );
+    }
     // The forces are the new impulses over the step, in the cone.
     for (c, x) in snap.contacts.iter().zip(sol.r.chunks_exact(2)) {
         assert_eq!(c.force_n, x[0] / w.params.dt);

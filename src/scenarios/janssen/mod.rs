@@ -30,6 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::sensitivity::{resolved_snapshot, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -38,6 +39,8 @@ use crate::progress::{info, warn};
 use crate::verdict::{export_law, max_solid_fraction, Checks, RunVerdict, Verdict, WindowStats};
 
 mod figures;
+mod solver_sensitivity;
+use solver_sensitivity::JanssenSensitivity;
 pub mod fit;
 pub mod measure;
 
@@ -96,6 +99,15 @@ struct ColumnState {
     /// Most sub-steps of a step of the measurement window (1 unless one was subdivided).
     #[serde(default)]
     measured_substeps: u64,
+    /// The measurement window's sums over its steps solved again to
+    /// [`crate::verdict::SENSITIVITY_TOLERANCE`] (the solver sensitivity of the fit).
+    #[serde(default)]
+    resolved: MeasureWindow,
+    /// Measured steps whose re-solve failed, or whose problem was not available.
+    #[serde(default)]
+    resolve_failed: u64,
+    #[serde(default)]
+    resolve_unavailable: u64,
 }
 
 impl Column<'_> {
@@ -221,6 +233,27 @@ impl PhasedRun for Column<'_> {
             };
             st.window
                 .observe(&w.snapshot(), self.width, self.c.analysis.depth_bins, loads)?;
+            // The same step solved again to 1e-8: what the fit would see of an exact solve.
+            match resolved_snapshot(w) {
+                Resolved::Solved(snap) => {
+                    let fy = |b: usize| {
+                        snap.walls
+                            .iter()
+                            .find(|x| x.body as usize == b)
+                            .map_or(0.0, |x| x.force.y)
+                    };
+                    let loads = ColumnLoads {
+                        floor: -fy(st.bottom),
+                        walls: -(fy(st.left) + fy(st.right)),
+                    };
+                    let bins = self.c.analysis.depth_bins;
+                    if st.resolved.observe(&snap, self.width, bins, loads).is_err() {
+                        st.resolve_failed += 1;
+                    }
+                }
+                Resolved::Failed => st.resolve_failed += 1,
+                Resolved::Unavailable => st.resolve_unavailable += 1,
+            }
         }
         st.last_step_index = r.step;
         let load = Self::floor_load(w, st);
@@ -312,6 +345,9 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             window: MeasureWindow::default(),
             last_step_index: 0,
             measured_substeps: 0,
+            resolved: MeasureWindow::default(),
+            resolve_failed: 0,
+            resolve_unavailable: 0,
         };
         Ok((col.world, state))
     };
@@ -329,6 +365,9 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         measured,
         window: measure_window,
         measured_substeps,
+        resolved,
+        resolve_failed,
+        resolve_unavailable,
         ..
     } = st;
     let final_report = world.last_report();
@@ -400,6 +439,19 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             d * 1e3
         )
     });
+    // The solver's effect on the fit: the measured steps solved again to 1e-8, fitted alike.
+    let sensitivity = JanssenSensitivity {
+        resolved: resolved.samples,
+        failed: resolve_failed,
+        unavailable: resolve_unavailable,
+        fit: (resolved.samples > 0 && resolved.samples == measure_window.samples).then(|| {
+            resolved
+                .profile(c.analysis.depth_bins)
+                .map_err(|e| e.to_string())
+                .and_then(|p| fit_profile(&p, &setup, window).map_err(|e| e.to_string()))
+        }),
+    };
+    sensitivity.check(&mut checks, fitted.as_ref().ok());
     let mut verdict = RunVerdict {
         run: checks.clone(),
         ..Default::default()
@@ -531,6 +583,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .int("measure_steps", measure_window.samples)
         .int("measured_max_substeps", measured_substeps);
     measured.keys(&mut s, "measured");
+    sensitivity.keys(&mut s, fitted.as_ref().ok());
     s.int("vtk_frames", frames as u64);
 
     // CSV: history and the fit-ready profile.
