@@ -532,12 +532,15 @@ impl PhasedRun for Shear<'_> {
                 st.lead.gamma_dot += gamma_dot;
                 st.lead.pressure += -sym[(1, 1)];
                 st.lead.samples += 1;
-                // Only where the rule could tighten: tightenings left, and the stage's solves so
-                // far cheap enough (the slow shear's lead stages would spend some 35 s of the
-                // default run re-solving samples that cannot change its tolerance).
+                // Only where the rule could tighten: tightenings left, and the stage's solves
+                // not already too costly for it, whatever its remaining steps cost (the cost so
+                // far over all the stage's steps is a lower bound of its mean): the slow shear's
+                // lead stages would spend some 35 s of the default run re-solving samples that
+                // cannot change its tolerance.
+                let cost_bound =
+                    p.stats.mean_solve_cost() * p.stats.steps as f64 / st.run.steps.max(1) as f64;
                 if st.tightenings < self.c.solver_tightenings
-                    && p.stats.mean_solve_cost()
-                        <= TIGHTEN_MAX_SWEEPS * self.c.solver.max_iterations as f64
+                    && cost_bound <= TIGHTEN_MAX_SWEEPS * self.c.solver.max_iterations as f64
                 {
                     let resolved = resolved_stress(w, self.c.grain.radius_mean, d);
                     st.lead_sensitivity

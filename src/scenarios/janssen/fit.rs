@@ -14,6 +14,7 @@ use identify::IdentifyError;
 use super::measure::ColumnProfile;
 
 /// The Janssen fit of a column, with how it was obtained.
+#[derive(Debug, Clone)]
 pub struct JanssenOutcome {
     /// The fit.
     pub fit: JanssenFit,
@@ -24,13 +25,12 @@ pub struct JanssenOutcome {
     pub uses_tau_w: bool,
 }
 
-/// Fits Janssen's law (joint; full mobilisation if μ_w reaches the wall friction).
-pub fn fit_profile(
+/// The fit's data and options: σ_v, σ_h, and τ_w when `uses_tau_w`, over the depth `window`.
+fn fit_input(
     p: &ColumnProfile,
-    setup: &JanssenSetup,
     window: (f64, f64),
-) -> std::result::Result<JanssenOutcome, IdentifyError> {
-    let uses_tau_w = p.negative_tau_w(window).is_empty();
+    uses_tau_w: bool,
+) -> (JanssenProfile, JanssenOptions) {
     let profile = JanssenProfile {
         z_m: p.z.clone(),
         sigma_v_pa: p.sigma_v.clone(),
@@ -41,6 +41,39 @@ pub fn fit_profile(
         depth_window: Some(window),
         ..Default::default()
     };
+    (profile, opts)
+}
+
+/// Fits `p` with the data and the mode `like` was fitted with (τ_w in or out, joint or full
+/// mobilisation), whatever `p` itself would select: the solver sensitivity compares two fits
+/// of one model on two solves of the same states.
+pub fn fit_profile_like(
+    p: &ColumnProfile,
+    setup: &JanssenSetup,
+    window: (f64, f64),
+    like: &JanssenOutcome,
+) -> std::result::Result<JanssenOutcome, IdentifyError> {
+    let (profile, opts) = fit_input(p, window, like.uses_tau_w);
+    let fit = if like.mode == "joint" {
+        fit_janssen(&profile, setup, &opts)?
+    } else {
+        fit_janssen_full_mobilisation(&profile, setup, &opts)?
+    };
+    Ok(JanssenOutcome {
+        fit,
+        mode: like.mode,
+        uses_tau_w: like.uses_tau_w,
+    })
+}
+
+/// Fits Janssen's law (joint; full mobilisation if μ_w reaches the wall friction).
+pub fn fit_profile(
+    p: &ColumnProfile,
+    setup: &JanssenSetup,
+    window: (f64, f64),
+) -> std::result::Result<JanssenOutcome, IdentifyError> {
+    let uses_tau_w = p.negative_tau_w(window).is_empty();
+    let (profile, opts) = fit_input(p, window, uses_tau_w);
     match fit_janssen(&profile, setup, &opts) {
         Ok(fit) => Ok(JanssenOutcome {
             fit,

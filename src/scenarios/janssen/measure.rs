@@ -157,8 +157,14 @@ impl MeasureWindow {
         loads: ColumnLoads,
     ) -> Result<()> {
         if self.samples == 0 {
+            let surface = if self.surface > 0.0 {
+                // Set by [`MeasureWindow::empty_like`].
+                self.surface
+            } else {
+                surface_height(snap, width, mean_grain_diameter(snap))
+            };
             *self = MeasureWindow {
-                surface: surface_height(snap, width, mean_grain_diameter(snap)),
+                surface,
                 sigma_v: vec![0.0; bins],
                 sigma_h: vec![0.0; bins],
                 tau_w: vec![0.0; bins],
@@ -184,6 +190,15 @@ impl MeasureWindow {
         }
         self.samples += 1;
         Ok(())
+    }
+
+    /// An empty window whose first sample will be binned below this window's free surface
+    /// instead of its own (two measures of the same states in the same bins).
+    pub fn empty_like(&self) -> MeasureWindow {
+        MeasureWindow {
+            surface: self.surface,
+            ..Default::default()
+        }
     }
 
     fn mean(&self, sum: f64) -> f64 {

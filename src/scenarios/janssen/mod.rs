@@ -44,7 +44,7 @@ use solver_sensitivity::JanssenSensitivity;
 pub mod fit;
 pub mod measure;
 
-pub use fit::{fit_band, fit_profile, JanssenOutcome};
+pub use fit::{fit_band, fit_profile, fit_profile_like, JanssenOutcome};
 pub use measure::{surface_height, ColumnLoads, ColumnProfile, MeasureWindow};
 
 /// Simulated seconds between two VTK frames.
@@ -247,6 +247,10 @@ impl PhasedRun for Column<'_> {
                         walls: -(fy(st.left) + fy(st.right)),
                     };
                     let bins = self.c.analysis.depth_bins;
+                    if st.resolved.samples == 0 {
+                        // The run's depth bins (the re-solved surface moves by θ h Δv).
+                        st.resolved = st.window.empty_like();
+                    }
                     if st.resolved.observe(&snap, self.width, bins, loads).is_err() {
                         st.resolve_failed += 1;
                     }
@@ -440,16 +444,25 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         )
     });
     // The solver's effect on the fit: the measured steps solved again to 1e-8, fitted alike.
+    let complete = resolved.samples > 0 && resolved.samples == measure_window.samples;
+    let resolved_profile = complete
+        .then(|| resolved.profile(c.analysis.depth_bins).ok())
+        .flatten();
     let sensitivity = JanssenSensitivity {
         resolved: resolved.samples,
+        measured: measure_window.samples,
         failed: resolve_failed,
         unavailable: resolve_unavailable,
-        fit: (resolved.samples > 0 && resolved.samples == measure_window.samples).then(|| {
-            resolved
-                .profile(c.analysis.depth_bins)
-                .map_err(|e| e.to_string())
-                .and_then(|p| fit_profile(&p, &setup, window).map_err(|e| e.to_string()))
-        }),
+        fit: match (&fitted, &resolved_profile) {
+            (Ok(run), Some(p)) => {
+                Some(fit_profile_like(p, &setup, window, run).map_err(|e| e.to_string()))
+            }
+            _ => None,
+        },
+        tau_w_flipped: match (&fitted, &resolved_profile) {
+            (Ok(run), Some(p)) => p.negative_tau_w(window).is_empty() != run.uses_tau_w,
+            _ => false,
+        },
     };
     sensitivity.check(&mut checks, fitted.as_ref().ok());
     let mut verdict = RunVerdict {
