@@ -5,6 +5,8 @@
 //! with one line and exit code 2. The numerics keys of `summary.json` are there, and a normal
 //! deposit flags no energy growth.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -193,23 +195,7 @@ fn stopped_and_resumed_runs_give_the_same_files() {
 fn a_shear_cell_resumed_across_its_solver_tightening_gives_the_same_files() {
     let tmp = tempfile::tempdir().unwrap();
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
-    let cell: &[&str] = &[
-        "run",
-        "shear-cell",
-        "-q",
-        "--set",
-        "grains=60",
-        "--set",
-        "cell_length_diameters=10",
-        "--set",
-        "inertial_numbers=[0.04, 0.08, 0.15]",
-        "--set",
-        "strain=0.6",
-        "--set",
-        "average_strain=0.3",
-        "--set",
-        "compression_time=0.05",
-    ];
+    let cell = &common::small_shear_cell("inertial_numbers=[0.04, 0.08, 0.15]", &[])[..];
     assert_finished(&grainlaw(&[cell, &["--out"]].concat(), &[&a]));
     let table = std::fs::read_to_string(a.join("rheology.csv")).unwrap();
     let tolerances: Vec<&str> = table

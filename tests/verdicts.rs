@@ -5,6 +5,8 @@
 //! as such with exit 0, and a resume keeps it; a run whose checks pass exits with 0 and a law
 //! marked `ok`.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -186,23 +188,7 @@ fn cases() -> Vec<Case> {
         Case {
             name: "shear cell whose highest target I is not reached: suspect, exit 3",
             dir: "shear",
-            args: vec![
-                "run",
-                "shear-cell",
-                "-q",
-                "--set",
-                "grains=60",
-                "--set",
-                "cell_length_diameters=10",
-                "--set",
-                "inertial_numbers=[0.1, 0.2, 0.4]",
-                "--set",
-                "strain=0.6",
-                "--set",
-                "average_strain=0.3",
-                "--set",
-                "compression_time=0.05",
-            ],
+            args: common::small_shear_cell("inertial_numbers=[0.1, 0.2, 0.4]", &[]),
             code: 3,
             stderr: "shear_cell.inertial_number_factor (suspect)",
             verdict: Some("refused"),
@@ -216,27 +202,15 @@ fn cases() -> Vec<Case> {
             // (the lead stages' tightening of the tolerance off).
             name: "shear cell solved at 1e-2: the re-solve of its samples refuses it, exit 3",
             dir: "loose-shear",
-            args: vec![
-                "run",
-                "shear-cell",
-                "-q",
-                "--set",
-                "grains=60",
-                "--set",
-                "cell_length_diameters=10",
-                "--set",
+            args: common::small_shear_cell(
                 "inertial_numbers=[0.04, 0.08, 0.15]",
-                "--set",
-                "strain=0.6",
-                "--set",
-                "average_strain=0.3",
-                "--set",
-                "compression_time=0.05",
-                "--set",
-                "solver.tolerance=1e-2",
-                "--set",
-                "solver_tightenings=0",
-            ],
+                &[
+                    "--set",
+                    "solver.tolerance=1e-2",
+                    "--set",
+                    "solver_tightenings=0",
+                ],
+            ),
             code: 3,
             stderr: "solver.sensitivity_pressure (refused)",
             verdict: Some("refused"),
