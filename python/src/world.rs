@@ -10,7 +10,7 @@ use dem::solver::{ErrorScale, SolverMethod};
 use dem::{ContactLaws, SolverParams, WorldParams};
 
 use crate::arrays::{finite1, out1, out2, rows2};
-use crate::errors::{dem_err, input, panic_err};
+use crate::errors::{dem_err, input, one_line, panic_err, SolverError};
 
 /// Largest overlap between two grains, or of a grain behind a wall, accepted when a world is
 /// checked before its first step (m), as for the built-in scenarios.
@@ -449,7 +449,10 @@ impl World {
         d.set_item("active_contacts", r.active_contacts)?;
         d.set_item("iterations", r.solver.iterations)?;
         d.set_item("error", r.solver.error)?;
-        d.set_item("error_without_gap_shifts", r.solver.error_without_gap_shifts)?;
+        d.set_item(
+            "error_without_gap_shifts",
+            r.solver.error_without_gap_shifts,
+        )?;
         d.set_item("converged", r.solver.converged)?;
         d.set_item("max_penetration", r.max_penetration)?;
         Ok(d)
@@ -517,6 +520,58 @@ impl World {
         Snapshot {
             inner: self.world.snapshot(),
         }
+    }
+
+    /// resolved_snapshot(tolerance=1e-8)
+    /// --
+    ///
+    /// The last step solved again, from the same state, to ``tolerance`` (the error measure of
+    /// the step's problem): the Snapshot Moreau–Jean's update gives with those impulses
+    /// (velocities ``v + M⁻¹Hᵀ(r' − r)``, mean accelerations, positions ``+ θ h Δv``, contact
+    /// and wall forces ``r'/h``), the world itself unchanged. Comparing what a measurement
+    /// gives on it and on ``snapshot()`` tells what the solver's residual does to the
+    /// measurement (grainlaw's solver sensitivity). The re-solve is ``auto`` on the assembled
+    /// problem: Gauss–Seidel, the proximal semismooth Newton method, then Lemke's method, exact
+    /// in 2D. Raises InputError before a step or for a non-positive tolerance, SolverError when
+    /// the re-solve does not reach the tolerance.
+    #[pyo3(signature = (tolerance=1e-8))]
+    fn resolved_snapshot(&self, py: Python<'_>, tolerance: f64) -> PyResult<Snapshot> {
+        if !(tolerance > 0.0 && tolerance < 1.0) {
+            return Err(input(format!(
+                "tolerance must lie in (0, 1), got {tolerance}"
+            )));
+        }
+        let Some((problem, r)) = self.world.last_step_problem() else {
+            return Err(input(
+                "no step to solve again: step the world first (the last step's problem is \
+                 not kept across an undo, a resume or a deformable cell)",
+            ));
+        };
+        let options = dem::fc::FcOptions {
+            tolerance,
+            initial_guess: Some(r),
+            ..dem::fc::FcOptions::default()
+        };
+        let solved = py.detach(|| {
+            dem::fc::solve_by(
+                &problem,
+                &options,
+                dem::fc::SolverMethod::Auto,
+                &dem::fc::NewtonParams::default(),
+            )
+        });
+        let (solution, _) = solved.map_err(|e| SolverError::new_err(one_line(&e.to_string())))?;
+        if !solution.converged {
+            return Err(SolverError::new_err(format!(
+                "the re-solve stopped at error {:.2e} above the tolerance {tolerance:.0e}",
+                solution.error
+            )));
+        }
+        let inner = self
+            .world
+            .snapshot_with_last_impulses(&solution.r)
+            .map_err(dem_err)?;
+        Ok(Snapshot { inner })
     }
 
     fn __repr__(&self) -> String {

@@ -59,6 +59,29 @@ def test_disk_resting_on_a_floor_carries_its_weight():
     assert abs(w.velocities[1, 1]) <= 1e-9
 
 
+def test_a_loose_step_solved_again_carries_the_weight_exactly():
+    # three disks stacked on a floor, at rest, their first step solved by one Gauss–Seidel
+    # sweep from zero impulses: the floor then carries less than the weight. Solved again to
+    # 1e-10 (World.resolved_snapshot) it carries 3 m g to 1e-9, every disk is at rest in the
+    # re-solved state (mean acceleration within 1e-9 g), and the world keeps its own step.
+    m, r = 0.2, 0.01
+    w = grainlaw.World(dt=1e-3, tolerance=1e-12, max_iterations=1, method="nlgs")
+    w.add_wall((0.0, 0.0), (0.0, 1.0), name="floor")
+    w.add_disks([[0.0, r], [0.0, 3 * r], [0.0, 5 * r]], [r] * 3, masses=[m] * 3)
+    with pytest.raises(grainlaw.InputError, match="step the world first"):
+        w.resolved_snapshot()
+    report = w.step()
+    assert not report["converged"]
+    floor = w.snapshot().walls["floor"]["force"][1]
+    assert -floor < 3 * m * G * (1 - 1e-3)
+    s = w.resolved_snapshot(tolerance=1e-10)
+    assert abs(s.walls["floor"]["force"][1] + 3 * m * G) <= 1e-9 * m * G
+    assert np.all(np.abs(s.accelerations[1:, 1]) <= 1e-9 * G)
+    assert w.snapshot().walls["floor"]["force"][1] == floor
+    with pytest.raises(grainlaw.InputError, match="tolerance"):
+        w.resolved_snapshot(tolerance=0.0)
+
+
 def test_loaded_error_scale_holds_the_tolerance_on_the_loaded_contacts():
     # the scene of dem/tests/error_scale.rs: 30 disks (radius 1 mm) stacked on a floor, and a
     # disk hanging 2.5e-5 m above it, within the detection gap (1e-4 m): its gap-closing shift
