@@ -460,8 +460,8 @@ pub struct Sensitivity {
     pub samples: u64,
     /// Samples whose re-solve did not reach it (left out of the sums).
     pub unresolved: u64,
-    /// Samples whose step's problem was not available to re-solve (the step's last attempt
-    /// undone, a resume within the window): left out, not a failure of the solver.
+    /// Samples whose step's problem was not available to re-solve (no step since a resume, a
+    /// deformable cell): left out, not a failure of the solver.
     #[serde(default)]
     pub unavailable: u64,
     /// Σ σ_xy, Σ σ_yy of the re-solved samples as run (Pa, tension positive).
@@ -490,20 +490,6 @@ pub struct Sensitivity {
 }
 
 impl Sensitivity {
-    /// Adds a sample ([`Sensitivity::add`]), or counts it as unavailable.
-    pub fn record(
-        &mut self,
-        run: [f64; 2],
-        resolved: crate::scenarios::sensitivity::Resolved<[f64; 2]>,
-    ) {
-        use crate::scenarios::sensitivity::Resolved;
-        match resolved {
-            Resolved::Solved(s) => self.add(run, Some(s)),
-            Resolved::Failed => self.add(run, None),
-            Resolved::Unavailable => self.unavailable += 1,
-        }
-    }
-
     /// Adds a sample: its bulk `[σ_xy, σ_yy]` as run and, when the re-solve converged, as
     /// re-solved (`None`: counted as unresolved).
     pub fn add(&mut self, run: [f64; 2], resolved: Option<[f64; 2]>) {

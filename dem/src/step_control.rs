@@ -215,10 +215,7 @@ pub fn step_subdivided_checked(
     let method = world.params.solver.method;
     let gauss_seidel_attempts = world.params.solver.gauss_seidel_attempts;
     // The first solve of a step whose energy grew, while its polish is tried.
-    // With the free velocities of its last sub-step, which `undo_to` does not keep: the kept
-    // first solve's problem stays available ([`World::last_step_problem`]).
-    #[allow(clippy::type_complexity)]
-    let mut first: Option<(World, Vec<SubStep>, Option<Unconverged>, Vec<[f64; 3]>)> = None;
+    let mut first: Option<(World, Vec<SubStep>, Option<Unconverged>)> = None;
     let max_iterations = world.params.solver.max_iterations;
     let restore = |world: &mut World| {
         world.params.dt = h;
@@ -291,7 +288,7 @@ pub fn step_subdivided_checked(
         }
         let sweeps =
             |subs: &[SubStep]| -> usize { subs.iter().map(|s| s.report.solver.iterations).sum() };
-        if let Some((first_world, first_subs, first_unconverged, first_free)) = first.take() {
+        if let Some((first_world, first_subs, first_unconverged)) = first.take() {
             // The polish: kept if every sub-step converged at the tighter tolerance.
             let kept = !failed;
             if kept {
@@ -302,7 +299,6 @@ pub fn step_subdivided_checked(
             } else {
                 discarded += sweeps(&subs);
                 world.undo_to(&first_world);
-                world.v_free = first_free;
                 subs = first_subs;
                 unconverged = first_unconverged;
             }
@@ -322,7 +318,7 @@ pub fn step_subdivided_checked(
         if let (Some(limit), true, Some(b)) = (energy_limit, all_converged, backup.as_ref()) {
             if energy_residual(&subs) > limit {
                 // Energy grew in a converged step: solve it again, tighter (doc comment).
-                first = Some((world.undo_point(), subs, unconverged, world.v_free.clone()));
+                first = Some((world.undo_point(), subs, unconverged));
                 world.undo_to(b);
                 continue;
             }

@@ -170,7 +170,7 @@ pub struct World {
     pos: Vec<[f64; 2]>,
     layout: BlockLayout,
     colouring: ContactColouring,
-    pub(crate) v_free: Vec<[f64; 3]>,
+    v_free: Vec<[f64; 3]>,
     pub(crate) work: solver::SolverWork,
     displacement: Vec<[f64; 3]>,
     projection: Projection,
@@ -244,8 +244,10 @@ impl World {
     /// A copy of the world to come back to after steps that are undone ([`World::undo_to`];
     /// [`crate::step_control::step_subdivided`]): everything a step reads from the world, but
     /// not the work space that a step fills before reading it (the previous step's contact set,
-    /// detection, solver and projection buffers), which is left empty. Stepping the copy gives
-    /// the same bits as stepping the world; it is cheaper to make than a clone.
+    /// detection, solver and projection buffers), which is left empty; and the free velocities
+    /// of the last step, with which its problem stays available ([`World::last_step_problem`]).
+    /// Stepping the copy gives the same bits as stepping the world; it is cheaper to make than a
+    /// clone.
     pub fn undo_point(&self) -> World {
         // Listed field by field (no `..`): a new field must be sorted into state or work space.
         let World {
@@ -266,7 +268,7 @@ impl World {
             pos: _,
             layout,
             colouring,
-            v_free: _,
+            v_free,
             work,
             displacement: _,
             projection: _,
@@ -292,6 +294,7 @@ impl World {
             body_force: body_force.clone(),
             layout: layout.clone(),
             colouring: colouring.clone(),
+            v_free: v_free.clone(),
             work: work.carried(),
             last: *last,
             record_problems: *record_problems,
@@ -325,7 +328,7 @@ impl World {
             pos: _,
             layout,
             colouring,
-            v_free: _,
+            v_free,
             work,
             displacement: _,
             projection: _,
@@ -352,6 +355,7 @@ impl World {
         self.body_force.clone_from(body_force);
         self.layout.clone_from(layout);
         self.colouring.clone_from(colouring);
+        self.v_free.clone_from(v_free);
         self.work.restore_carried(work);
         self.last = *last;
         self.record_problems = *record_problems;
@@ -359,8 +363,6 @@ impl World {
         self.cell = *cell;
         self.cell_control = *cell_control;
         self.cell_sigma = *cell_sigma;
-        // The free velocities belong to the undone step ([`World::last_step_problem`]).
-        self.v_free.clear();
     }
 
     /// The biperiodic deformable cell, if any.
@@ -531,19 +533,25 @@ impl World {
     /// and free velocities (`u = W r + q`, [`crate::assemble::contact_problem`]; the contacts in
     /// the order of [`World::snapshot`]), with the impulses its solve returned (N·s, interleaved
     /// `(r_n, r_t)`): what [`World::snapshot_with_last_impulses`] takes other impulses for.
-    /// Needs no [`World::record_problems`]. `None` before a step, after [`World::undo_to`] or a
-    /// resume (the free velocities are work space), and in a world with a deformable cell,
-    /// whose step does more than the contact solve (its stress control and wraps).
+    /// Needs no [`World::record_problems`]; after [`World::undo_to`], the problem of the step
+    /// that led to the point returned to. `None` before a step, after a resume (the free
+    /// velocities are not checkpointed), and in a world with a deformable cell, whose step does
+    /// more than the contact solve (its stress control and wraps).
     pub fn last_step_problem(&self) -> Option<(FcProblem, Vec<f64>)> {
-        if self.cell.is_some()
-            || self.v_free.len() != self.bodies.len()
-            || self.inv.len() != self.bodies.len()
-        {
+        if !self.has_last_step_problem() {
             return None;
         }
         let rows = &self.contacts.rows;
         let problem = crate::assemble::contact_problem(rows, &self.v_free, &self.inv);
         Some((problem, rows.iter().flat_map(|c| c.r).collect()))
+    }
+
+    /// Whether [`World::last_step_problem`] can be assembled: the free velocities of a step
+    /// are there, and no deformable cell.
+    fn has_last_step_problem(&self) -> bool {
+        self.cell.is_none()
+            && self.v_free.len() == self.bodies.len()
+            && self.inv.len() == self.bodies.len()
     }
 
     /// The world's [`World::snapshot`] as if the last step's contact solve had returned the
@@ -570,10 +578,10 @@ impl World {
             name: "impulses".into(),
             reason,
         };
-        if self.cell.is_some() || self.v_free.len() != self.bodies.len() {
+        if !self.has_last_step_problem() {
             return Err(bad(
-                "the last step's problem is not available (no step since the last undo or \
-                 resume, or a deformable cell)"
+                "the last step's problem is not available (no step, a resume, or a deformable \
+                 cell)"
                     .into(),
             ));
         }
@@ -586,28 +594,24 @@ impl World {
             )));
         }
         let h = self.impulse_dt();
-        let mut dv = vec![[0.0; 3]; self.bodies.len()];
-        // The change of every body's contact force and torque (N, N·m), as
-        // `refresh_body_forces` sums them.
-        let mut df = vec![[0.0; 3]; self.bodies.len()];
+        // Per body, the change of its generalised impulse `Hᵀ Δr` (N·s, N·m·s): of its
+        // velocity through `M⁻¹`, of its contact force and torque over `h`.
+        let mut dj = vec![[0.0; 3]; self.bodies.len()];
         for (c, x) in rows.iter().zip(r.chunks_exact(2)) {
             let d = [x[0] - c.r[0], x[1] - c.r[1]];
             if d != [0.0, 0.0] {
-                let (a, b) = (c.a as usize, c.b as usize);
-                let (mut va, mut vb) = (dv[a], dv[b]);
-                c.apply(d, &mut va, &self.inv[a], &mut vb, &self.inv[b]);
-                dv[a] = va;
-                dv[b] = vb;
-                let [nx, ny] = c.n;
-                let (fx, fy) = ((d[0] * nx - d[1] * ny) / h, (d[0] * ny + d[1] * nx) / h);
-                df[b][0] += fx;
-                df[b][1] += fy;
-                df[b][2] += (c.k[2] * d[0] + c.k[3] * d[1]) / h;
-                df[a][0] -= fx;
-                df[a][1] -= fy;
-                df[a][2] -= (c.k[0] * d[0] + c.k[1] * d[1]) / h;
+                for (side, body) in [(0, c.a), (1, c.b)] {
+                    let j = c.impulse_on(side, d);
+                    let acc = &mut dj[body as usize];
+                    (0..3).for_each(|k| acc[k] += j[k]);
+                }
             }
         }
+        let dv: Vec<[f64; 3]> = dj
+            .iter()
+            .zip(&self.inv)
+            .map(|(j, i)| [i[0] * j[0], i[1] * j[1], i[2] * j[2]])
+            .collect();
         let theta = self.params.theta;
         let periodic = self.periodic();
         let mut snap = self.snapshot();
@@ -626,9 +630,11 @@ impl World {
             }
         }
         for wall in &mut snap.walls {
-            let f = df[wall.body as usize];
-            wall.force += Vector2::new(f[0], f[1]);
-            wall.torque += f[2];
+            let j = dj[wall.body as usize];
+            if j != [0.0, 0.0, 0.0] {
+                wall.force += Vector2::new(j[0], j[1]) / h;
+                wall.torque += j[2] / h;
+            }
         }
         for ((c, row), x) in snap.contacts.iter_mut().zip(rows).zip(r.chunks_exact(2)) {
             c.force_n = x[0] / h;
@@ -1138,19 +1144,11 @@ impl World {
             if row.r[0] > 0.0 {
                 active += 1;
             }
-            let [nx, ny] = row.n;
-            let fx = (row.r[0] * nx - row.r[1] * ny) / h;
-            let fy = (row.r[0] * ny + row.r[1] * nx) / h;
-            let ta = (row.k[0] * row.r[0] + row.k[1] * row.r[1]) / h;
-            let tb = (row.k[2] * row.r[0] + row.k[3] * row.r[1]) / h;
-            let fb = &mut self.body_force[row.b as usize];
-            fb[0] += fx;
-            fb[1] += fy;
-            fb[2] += tb;
-            let fa = &mut self.body_force[row.a as usize];
-            fa[0] -= fx;
-            fa[1] -= fy;
-            fa[2] -= ta;
+            for (side, body) in [(1, row.b), (0, row.a)] {
+                let j = row.impulse_on(side, row.r);
+                let f = &mut self.body_force[body as usize];
+                (0..3).for_each(|k| f[k] += j[k] / h);
+            }
         }
         active
     }

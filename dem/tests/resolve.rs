@@ -145,18 +145,25 @@ fn a_resolved_snapshot_obeys_newton_s_law_with_the_new_impulses() {
     }
 }
 
+/// Before any step there is no problem; a world returned to an undo point has the problem of
+/// the step that led there (the same `q` and impulses, bit for bit), not that of the step
+/// undone; wrong lengths are typed errors.
 #[test]
-fn an_undone_step_has_no_problem_to_resolve() {
+fn an_undone_step_leaves_the_problem_of_the_point_returned_to() {
+    let fresh = random_box(60, 0.04, 1e-3, 1.5e-3, 0.5, 1.0, 7);
+    assert!(fresh.last_step_problem().is_none());
+    let err = fresh.snapshot_with_last_impulses(&[]).unwrap_err();
+    assert!(err.to_string().contains("not available"), "{err}");
     let mut w = loose_box();
+    let (p0, r0) = w.last_step_problem().unwrap();
     let point = w.undo_point();
     w.step().unwrap();
-    assert!(w.last_step_problem().is_some());
+    let (p1, _) = w.last_step_problem().unwrap();
+    assert_ne!(p1.q(), p0.q(), "the step changed the problem");
     w.undo_to(&point);
-    assert!(w.last_step_problem().is_none());
-    let err = w.snapshot_with_last_impulses(&[]).unwrap_err();
-    assert!(err.to_string().contains("not available"), "{err}");
-    w.step().unwrap();
-    let (_, r) = w.last_step_problem().unwrap();
-    let err = w.snapshot_with_last_impulses(&r[1..]).unwrap_err();
+    let (pu, ru) = w.last_step_problem().unwrap();
+    assert_eq!((pu.q(), &ru), (p0.q(), &r0));
+    assert_eq!(point.last_step_problem().unwrap().0.q(), p0.q());
+    let err = w.snapshot_with_last_impulses(&ru[1..]).unwrap_err();
     assert!(err.to_string().contains("two per contact"), "{err}");
 }

@@ -15,7 +15,7 @@
 use dem::fc::{solve_by, FcOptions, NewtonParams, SolverMethod};
 use dem::{Snapshot, World};
 
-use crate::verdict::SENSITIVITY_TOLERANCE;
+use crate::verdict::{Sensitivity, SENSITIVITY_TOLERANCE};
 
 /// Gauss–Seidel sweeps of a re-solve before its global stages end it.
 pub const SENSITIVITY_SWEEPS: usize = 2000;
@@ -28,7 +28,7 @@ pub enum Resolved<T> {
     /// The re-solve did not reach the tolerance, or failed (a singular factorisation, a
     /// non-finite state): counted as unresolved, left out of the measure.
     Failed,
-    /// The step's problem is not available (the step's last attempt was undone, a resume, a
+    /// The step's problem is not available (no step since a resume, a
     /// deformable cell): no measure, counted apart.
     Unavailable,
 }
@@ -67,5 +67,15 @@ pub fn resolved_snapshot(w: &World) -> Resolved<Snapshot> {
             .snapshot_with_last_impulses(&solution.r)
             .map_or(Resolved::Failed, Resolved::Solved),
         _ => Resolved::Failed,
+    }
+}
+
+/// Adds a sample to `s`: its bulk `[σ_xy, σ_yy]` as run and the outcome of its re-solve
+/// ([`Sensitivity::add`]; an unavailable problem is counted apart).
+pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<[f64; 2]>) {
+    match resolved {
+        Resolved::Solved(r) => s.add(run, Some(r)),
+        Resolved::Failed => s.add(run, None),
+        Resolved::Unavailable => s.unavailable += 1,
     }
 }

@@ -30,7 +30,7 @@ use super::common::{
     VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
-use super::sensitivity::Resolved;
+use super::sensitivity::{record, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -292,8 +292,8 @@ struct ShearState {
     tightenings: u32,
     /// Mean cost per step of the last phase's solves, in sweeps
     /// ([`PhaseStats::mean_solve_cost`], [`needs_tightening`]).
-    #[serde(default)]
-    lead_sweeps: f64,
+    #[serde(default, alias = "lead_sweeps")]
+    phase_cost: f64,
 }
 
 /// The correction of the wall velocity after a lead stage whose bulk measurement is `lead`:
@@ -446,7 +446,7 @@ impl PhasedRun for Shear<'_> {
         if k >= 2 && self.stage(k - 1).lead.is_some() {
             let sens = std::mem::take(&mut st.lead_sensitivity);
             if st.tightenings < c.solver_tightenings
-                && needs_tightening(&sens, st.lead_sweeps, c.solver.max_iterations)
+                && needs_tightening(&sens, st.phase_cost, c.solver.max_iterations)
             {
                 st.tightenings += 1;
                 let [mu_bound, p_bound] = sens.upper_bounds(TIGHTEN_Z);
@@ -526,7 +526,7 @@ impl PhasedRun for Shear<'_> {
             if averaged {
                 let (sxy, syy) = sample(w, &mut st.acc, self.c.grain.radius_mean, d)?;
                 let resolved = resolved_stress(w, self.c.grain.radius_mean, d);
-                st.window.sensitivity.record([sxy, syy], resolved);
+                record(&mut st.window.sensitivity, [sxy, syy], resolved);
             } else {
                 let (gamma_dot, sym) = bulk_shear(w, self.c.grain.radius_mean, d)?;
                 st.lead.gamma_dot += gamma_dot;
@@ -543,8 +543,11 @@ impl PhasedRun for Shear<'_> {
                     && cost_bound <= TIGHTEN_MAX_SWEEPS * self.c.solver.max_iterations as f64
                 {
                     let resolved = resolved_stress(w, self.c.grain.radius_mean, d);
-                    st.lead_sensitivity
-                        .record([sym[(0, 1)], sym[(1, 1)]], resolved);
+                    record(
+                        &mut st.lead_sensitivity,
+                        [sym[(0, 1)], sym[(1, 1)]],
+                        resolved,
+                    );
                 }
             }
         }
@@ -560,7 +563,7 @@ impl PhasedRun for Shear<'_> {
         stats: &PhaseStats,
     ) -> Result<()> {
         st.all.merge(stats);
-        st.lead_sweeps = stats.mean_solve_cost();
+        st.phase_cost = stats.mean_solve_cost();
         if k == 0 || self.stage(k).lead.is_some() {
             return Ok(());
         }
@@ -646,7 +649,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             lead_rows: Vec::new(),
             lead_sensitivity: Sensitivity::default(),
             tightenings: 0,
-            lead_sweeps: 0.0,
+            phase_cost: 0.0,
         };
         Ok((world, state))
     };

@@ -103,9 +103,10 @@ struct ColumnState {
     /// [`crate::verdict::SENSITIVITY_TOLERANCE`] (the solver sensitivity of the fit).
     #[serde(default)]
     resolved: MeasureWindow,
-    /// Measured steps whose re-solve failed, or whose problem was not available.
+    /// Measured steps whose re-solve failed.
     #[serde(default)]
     resolve_failed: u64,
+    /// Measured steps whose problem was not available to re-solve.
     #[serde(default)]
     resolve_unavailable: u64,
 }
@@ -118,6 +119,21 @@ impl Column<'_> {
 
     fn floor_load(world: &dem::World, st: &ColumnState) -> f64 {
         -world.contact_force(st.bottom).0.y / st.weight
+    }
+}
+
+/// The vertical loads of one state on the floor and both side walls, from the walls' contact
+/// forces in `snap` (N per metre, upward on the grains positive).
+fn column_loads(snap: &dem::Snapshot, st: &ColumnState) -> ColumnLoads {
+    let fy = |b: usize| {
+        snap.walls
+            .iter()
+            .find(|x| x.body as usize == b)
+            .map_or(0.0, |x| x.force.y)
+    };
+    ColumnLoads {
+        floor: -fy(st.bottom),
+        walls: -(fy(st.left) + fy(st.right)),
     }
 }
 
@@ -227,30 +243,18 @@ impl PhasedRun for Column<'_> {
             st.measured_substeps = st
                 .measured_substeps
                 .max(r.step.saturating_sub(st.last_step_index));
-            let loads = ColumnLoads {
-                floor: -w.contact_force(st.bottom).0.y,
-                walls: -(w.contact_force(st.left).0.y + w.contact_force(st.right).0.y),
-            };
-            st.window
-                .observe(&w.snapshot(), self.width, self.c.analysis.depth_bins, loads)?;
+            let bins = self.c.analysis.depth_bins;
+            let snap = w.snapshot();
+            let loads = column_loads(&snap, st);
+            st.window.observe(&snap, self.width, bins, loads)?;
             // The same step solved again to 1e-8: what the fit would see of an exact solve.
             match resolved_snapshot(w) {
                 Resolved::Solved(snap) => {
-                    let fy = |b: usize| {
-                        snap.walls
-                            .iter()
-                            .find(|x| x.body as usize == b)
-                            .map_or(0.0, |x| x.force.y)
-                    };
-                    let loads = ColumnLoads {
-                        floor: -fy(st.bottom),
-                        walls: -(fy(st.left) + fy(st.right)),
-                    };
-                    let bins = self.c.analysis.depth_bins;
                     if st.resolved.samples == 0 {
                         // The run's depth bins (the re-solved surface moves by θ h Δv).
                         st.resolved = st.window.empty_like();
                     }
+                    let loads = column_loads(&snap, st);
                     if st.resolved.observe(&snap, self.width, bins, loads).is_err() {
                         st.resolve_failed += 1;
                     }

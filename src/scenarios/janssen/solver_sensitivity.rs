@@ -5,7 +5,7 @@
 
 use super::fit::JanssenOutcome;
 use crate::output::Summary;
-use crate::verdict::{Checks, Verdict, SENSITIVITY_TOLERANCE, SENSITIVITY_UNRESOLVED_SUSPECT};
+use crate::verdict::{Checks, Verdict, SENSITIVITY_TOLERANCE};
 
 /// Change of K or μ_w, over the half-width of the run's 95 % interval, above which the law is
 /// suspect: a solver bias of a quarter of the stated uncertainty widens it by 3 % when added in
@@ -56,28 +56,12 @@ impl JanssenSensitivity {
         Some(([dk, dmu], [f.k.value, f.mu_w.value]))
     }
 
-    /// The checks `solver.sensitivity_unresolved` (a failed re-solve) and
-    /// `solver.sensitivity_janssen` (the larger change over its half-width, against
+    /// The check `solver.sensitivity_janssen`: the larger change over its half-width, against
     /// [`SENSITIVITY_CI_SUSPECT`] and [`SENSITIVITY_CI_REFUSED`], a NaN refused; suspect when
-    /// not every measured step was re-solved, when the re-solved profile cannot be fitted as
-    /// the run's was, or when it would select τ_w otherwise).
+    /// not every measured step was re-solved (failed or unavailable: one reason), when the
+    /// re-solved profile cannot be fitted as the run's was, or when it would select τ_w
+    /// otherwise. Nothing where the run's own fit failed (`janssen.fit` refuses it).
     pub fn check(&self, checks: &mut Checks, run: Option<&JanssenOutcome>) {
-        let tried = self.resolved + self.failed;
-        if tried > 0 {
-            let f = self.failed as f64 / tried as f64;
-            checks.at_most(
-                "solver.sensitivity_unresolved",
-                f,
-                SENSITIVITY_UNRESOLVED_SUSPECT,
-                None,
-                |_| {
-                    format!(
-                        "the re-solve of the measured steps to {SENSITIVITY_TOLERANCE:.0e} failed on {} of {tried}",
-                        self.failed
-                    )
-                },
-            );
-        }
         let Some(run) = run else {
             return;
         };
