@@ -329,6 +329,16 @@ impl Checks {
     /// The numerics of the steps that feed a result: unconverged steps and worst error over the
     /// tolerance, energy growth, largest overlap ([module documentation](self)).
     pub fn window(&mut self, label: &str, w: &WindowStats) {
+        self.window_measured(label, w, false);
+    }
+
+    /// [`Checks::window`] for a window whose result has its own direct measure of the solver's
+    /// effect (`measured_passed`: that measure was made on every step of the window and passed,
+    /// e.g. Janssen's fit solved again, `solver.sensitivity_janssen`): like a passing
+    /// [`Checks::sensitivity`] of the window's samples, it stands in for the suspect limit of
+    /// the loaded contacts' proxy `solver.loaded_error_over_tolerance` (its refusal limit is
+    /// kept). The measure, judged by its own check, must have been made before.
+    pub fn window_measured(&mut self, label: &str, w: &WindowStats, measured_passed: bool) {
         if w.steps == 0 {
             return;
         }
@@ -367,7 +377,7 @@ impl Checks {
         // tolerance only because open pairs' gap-closing shifts inflate the error's scale.
         // Judged where it exceeds the error (not under `error_scale = "loaded"`, whose error
         // already includes it): one cause, one reason.
-        let measured = self.sensitivity(label, &w.sensitivity);
+        let measured = self.sensitivity(label, &w.sensitivity) || measured_passed;
         let loaded = w.worst_error_without_gap_shifts;
         if loaded > w.worst_error || loaded.is_nan() {
             let e0 = loaded / w.tolerance;
@@ -1142,6 +1152,43 @@ mod tests {
         let c = judge(0.2, resolved(40, 0.0, 0.0, 0));
         assert_eq!(c.verdict(), Verdict::Refused);
         assert_eq!(names(&c), ["solver.loaded_error_over_tolerance"]);
+    }
+
+    #[test]
+    fn a_direct_measure_that_passed_stands_in_for_the_proxy() {
+        // Janssen's measurement window of seed 4 (2026-12-03): solved to 1e-6 on the problem's
+        // scale, 2.48e-5 on the loaded contacts' (25× the tolerance, suspect beyond 10×), the
+        // fit solved again moving K and μ_w by 0.05 and 0.08 of their half-widths.
+        let w = WindowStats {
+            steps: 4,
+            worst_error: 1e-6,
+            worst_error_without_gap_shifts: 2.48e-5,
+            tolerance: 1e-6,
+            ..Default::default()
+        };
+        let judged = |passed| {
+            let mut c = Checks::new();
+            c.window_measured("measurement window", &w, passed);
+            c
+        };
+        let c = judged(false);
+        assert_eq!(c.verdict(), Verdict::Suspect);
+        assert_eq!(c.reasons[0].check, "solver.loaded_error_over_tolerance");
+        assert_eq!(c.reasons[0].threshold, SOLVER_ERROR_SUSPECT);
+        assert_eq!(judged(true).verdict(), Verdict::Ok);
+        // `window` is the measure-less form.
+        let mut c = Checks::new();
+        c.window("measurement window", &w);
+        assert_eq!(c.reasons, judged(false).reasons);
+        // Beyond the refusal limit (here 2000×), refused whatever the measure says.
+        let w = WindowStats {
+            worst_error_without_gap_shifts: 2e-3,
+            ..w
+        };
+        let mut c = Checks::new();
+        c.window_measured("measurement window", &w, true);
+        assert_eq!(c.verdict(), Verdict::Refused);
+        assert_eq!(c.reasons[0].threshold, SOLVER_ERROR_REFUSED);
     }
 
     #[test]

@@ -414,39 +414,6 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     let window = (top_skip, profile.surface - bottom_skip);
     let fitted = fit_profile(&profile, &setup, window);
 
-    // 5. Checks (crate::verdict): the measured step's numerics, the force balance of the
-    // column, the solid fraction, the depth bins.
-    let mut checks = Checks::new();
-    checks.window("measurement window", &measured);
-    let wall_load = loads.walls;
-    let balance = (bottom_load + wall_load) / weight - 1.0;
-    checks.at_most(
-        "janssen.force_balance",
-        balance.abs(),
-        FORCE_BALANCE_SUSPECT,
-        Some(FORCE_BALANCE_REFUSED),
-        |t| {
-            format!(
-                "floor and wall vertical loads carry {:.2} % of the weight (the column is not at rest; limit ±{:.0} %)",
-                100.0 * (1.0 + balance),
-                100.0 * t
-            )
-        },
-    );
-    checks.solid_fraction(
-        "janssen.solid_fraction",
-        "the column's solid fraction",
-        phi,
-        max_solid_fraction(c.grain.radius_spread),
-    );
-    let bin = profile.surface / c.analysis.depth_bins as f64;
-    checks.at_most("janssen.bin_thickness", d / bin, 1.0, None, |_| {
-        format!(
-            "depth bins {:.2} mm thick, thinner than a mean diameter ({:.2} mm): lower analysis.depth_bins",
-            bin * 1e3,
-            d * 1e3
-        )
-    });
     // The solver's effect on the fit: the measured steps solved again to 1e-8, fitted alike.
     let complete = resolved.samples > 0 && resolved.samples == measure_window.samples;
     let resolved_profile = complete
@@ -468,7 +435,45 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             _ => false,
         },
     };
-    sensitivity.check(&mut checks, fitted.as_ref().ok());
+
+    // 5. Checks (crate::verdict): the measured step's numerics, the force balance of the
+    // column, the solid fraction, the depth bins.
+    let mut checks = Checks::new();
+    // The fit's solver sensitivity is judged first (its reasons listed after the window's):
+    // when it passes, it stands in for the window's loaded-contacts proxy.
+    let mut sensitivity_checks = Checks::new();
+    let sensitivity_passed = sensitivity.check(&mut sensitivity_checks, fitted.as_ref().ok());
+    checks.window_measured("measurement window", &measured, sensitivity_passed);
+    let wall_load = loads.walls;
+    let balance = (bottom_load + wall_load) / weight - 1.0;
+    checks.at_most(
+        "janssen.force_balance",
+        balance.abs(),
+        FORCE_BALANCE_SUSPECT,
+        Some(FORCE_BALANCE_REFUSED),
+        |t| {
+            format!(
+                "floor and wall vertical loads carry {:.2} % of the weight (the column is accelerating, e.g. a slip event while measured: a longer release.floor_drop may measure it sliding steadily; limit ±{:.0} %)",
+                100.0 * (1.0 + balance),
+                100.0 * t
+            )
+        },
+    );
+    checks.solid_fraction(
+        "janssen.solid_fraction",
+        "the column's solid fraction",
+        phi,
+        max_solid_fraction(c.grain.radius_spread),
+    );
+    let bin = profile.surface / c.analysis.depth_bins as f64;
+    checks.at_most("janssen.bin_thickness", d / bin, 1.0, None, |_| {
+        format!(
+            "depth bins {:.2} mm thick, thinner than a mean diameter ({:.2} mm): lower analysis.depth_bins",
+            bin * 1e3,
+            d * 1e3
+        )
+    });
+    checks.extend(&sensitivity_checks);
     let mut verdict = RunVerdict {
         run: checks.clone(),
         ..Default::default()

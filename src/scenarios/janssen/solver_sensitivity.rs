@@ -61,10 +61,15 @@ impl JanssenSensitivity {
     /// not every measured step was re-solved (failed or unavailable: one reason), when the
     /// re-solved profile cannot be fitted as the run's was, or when it would select τ_w
     /// otherwise. Nothing where the run's own fit failed (`janssen.fit` refuses it).
-    pub fn check(&self, checks: &mut Checks, run: Option<&JanssenOutcome>) {
+    ///
+    /// Returns whether the measure was made on every measured step and passed (no reason
+    /// added): then it stands in for the loaded contacts' proxy of the measurement window
+    /// ([`Checks::window_measured`]).
+    pub fn check(&self, checks: &mut Checks, run: Option<&JanssenOutcome>) -> bool {
         let Some(run) = run else {
-            return;
+            return false;
         };
+        let before = checks.reasons.len();
         if self.resolved < self.measured {
             checks.fail(
                 "solver.sensitivity_janssen",
@@ -76,7 +81,7 @@ impl JanssenSensitivity {
                     self.resolved, self.measured
                 ),
             );
-            return;
+            return false;
         }
         if self.tau_w_flipped {
             checks.fail(
@@ -118,6 +123,7 @@ impl JanssenSensitivity {
             }
             _ => {}
         }
+        self.measured > 0 && self.fit.is_some() && checks.reasons.len() == before
     }
 
     /// Summary keys `resolved_samples`, `resolved_unresolved_samples`,
@@ -208,15 +214,20 @@ mod tests {
         assert_eq!(run.mode, "joint");
         let half = 0.5 * (run.fit.k.ci_high - run.fit.k.ci_low);
         assert!(half > 0.0 && half < 0.1, "K ± {half}");
+        // The reasons, and whether the measure passed (then standing in for the window's
+        // loaded-contacts proxy): exactly when it adds no reason.
         let judge = |s: &JanssenSensitivity| {
             let mut c = Checks::new();
-            s.check(&mut c, Some(&run));
+            let passed = s.check(&mut c, Some(&run));
+            assert_eq!(passed, c.reasons.is_empty(), "{:?}", c.reasons);
             c
         };
         let same = sensitivity(Some(
             fit_profile_like(&p, &SETUP, WINDOW, &run).map_err(|e| e.to_string()),
         ));
         assert!(judge(&same).reasons.is_empty());
+        // Without the run's fit there is nothing to measure: no reason, and no pass.
+        assert!(!same.check(&mut Checks::new(), None));
         let ([dk, dmu], _) = same.changes(&run).unwrap();
         assert!(dk < 1e-9 && dmu < 1e-9, "{dk} {dmu}");
         let moved = profile(0.9, 0.2, 0.01);
