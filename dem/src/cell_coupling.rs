@@ -164,6 +164,27 @@ impl CellCoupling {
         d
     }
 
+    /// The change of `δ` (1/s, as a matrix: zero on the components whose rate is imposed) that
+    /// impulses `r` (N·s, interleaved `(r_n, r_t)` per row of `rows`) give instead of the rows'
+    /// own: `Δδ_κ = m_κ Σ_c B_cκ · (r_c − r_c^rows)` over the coupled rows.
+    pub fn delta_change(&self, rows: &[ContactRow], r: &[f64]) -> Mat {
+        let mut dd = [0.0; 3];
+        for (s, &i) in self.rows.iter().enumerate() {
+            let i = i as usize;
+            let own = rows[i].r;
+            let d = [r[2 * i] - own[0], r[2 * i + 1] - own[1]];
+            for (k, x) in dd.iter_mut().enumerate() {
+                let b = self.coef[s][k];
+                *x += self.compliance[k] * (b[0] * d[0] + b[1] * d[1]);
+            }
+        }
+        let mut m = Mat::zeros();
+        for (k, &ij) in COMPONENTS.iter().enumerate() {
+            m[ij] = dd[k];
+        }
+        m
+    }
+
     /// `Σ_κ B_cκ δ_κ` of slot `s` for the change `delta`.
     #[inline]
     fn affine_of(&self, s: usize, delta: &[f64; 3]) -> [f64; 2] {

@@ -200,6 +200,21 @@ pub struct World {
     /// Whether the last step's implicit cell changed `L` by more than the swept margins
     /// covered ([`crate::detection::Detector::image_rate`]): detect again after it.
     image_outran: bool,
+    /// What a deformable cell's last step adds to its contact problem, when that step can be
+    /// solved again ([`World::last_step_problem`]): state, like the free velocities.
+    last_cell_step: Option<LastCellStep>,
+}
+
+/// The part of a deformable cell's step that depends on the contact impulses, kept after the
+/// step for [`World::last_step_problem`] and [`World::snapshot_with_last_impulses`]: under an
+/// implicit control the coupling of its stress-controlled components to the contacts
+/// ([`crate::cell_coupling`]), whose change `δ` of `L` the grains then follow
+/// (`v ← v + δ (x − c)`); without a control, or one that imposes no stress, nothing (the
+/// cell's motion does not depend on the impulses). An explicit control, whose next `L`
+/// depends on the step's stress through its own law, keeps none (not available).
+#[derive(Debug, Clone, Default)]
+struct LastCellStep {
+    coupling: Option<CellCoupling>,
 }
 
 impl World {
@@ -238,6 +253,7 @@ impl World {
             fluct_displacement: Vec::new(),
             last_wrap_energy: 0.0,
             image_outran: false,
+            last_cell_step: None,
         }
     }
 
@@ -283,6 +299,7 @@ impl World {
             fluct_displacement: _,
             last_wrap_energy: _,
             image_outran: _,
+            last_cell_step,
         } = self;
         World {
             bodies: bodies.clone(),
@@ -302,6 +319,7 @@ impl World {
             cell: *cell,
             cell_control: *cell_control,
             cell_sigma: *cell_sigma,
+            last_cell_step: last_cell_step.clone(),
             ..World::new(*params, laws.clone())
         }
     }
@@ -343,6 +361,7 @@ impl World {
             fluct_displacement: _,
             last_wrap_energy: _,
             image_outran: _,
+            last_cell_step,
         } = point;
         self.params = *params;
         self.bodies.clone_from(bodies);
@@ -363,6 +382,7 @@ impl World {
         self.cell = *cell;
         self.cell_control = *cell_control;
         self.cell_sigma = *cell_sigma;
+        self.last_cell_step.clone_from(last_cell_step);
     }
 
     /// The biperiodic deformable cell, if any.
@@ -380,6 +400,7 @@ impl World {
         }
         self.cell = cell;
         self.cell_sigma = None;
+        self.last_cell_step = None;
         self.wrap_grains();
         Ok(())
     }
@@ -534,22 +555,32 @@ impl World {
     /// the order of [`World::snapshot`]), with the impulses its solve returned (N·s, interleaved
     /// `(r_n, r_t)`): what [`World::snapshot_with_last_impulses`] takes other impulses for.
     /// Needs no [`World::record_problems`]; after [`World::undo_to`], the problem of the step
-    /// that led to the point returned to. `None` before a step, after a resume (the free
-    /// velocities are not checkpointed), and in a world with a deformable cell, whose step does
-    /// more than the contact solve (its stress control and wraps).
+    /// that led to the point returned to. With a deformable cell under an implicit control, the
+    /// problem with the cell's stress-controlled components eliminated
+    /// ([`crate::assemble::contact_problem_with`], [`crate::cell_coupling`]), as the step solved
+    /// it. `None` before a step, after a resume (the free velocities are not checkpointed), and
+    /// with a cell under an explicit control (its next `L` follows the step's stress by its own
+    /// law, outside the problem).
     pub fn last_step_problem(&self) -> Option<(FcProblem, Vec<f64>)> {
         if !self.has_last_step_problem() {
             return None;
         }
         let rows = &self.contacts.rows;
-        let problem = crate::assemble::contact_problem(rows, &self.v_free, &self.inv);
+        let coupling = self.last_coupling();
+        let problem =
+            crate::assemble::contact_problem_with(rows, &self.v_free, &self.inv, coupling);
         Some((problem, rows.iter().flat_map(|c| c.r).collect()))
     }
 
+    /// The coupling of the last step's cell to its contacts, if any.
+    fn last_coupling(&self) -> Option<&CellCoupling> {
+        self.last_cell_step.as_ref()?.coupling.as_ref()
+    }
+
     /// Whether [`World::last_step_problem`] can be assembled: the free velocities of a step
-    /// are there, and no deformable cell.
+    /// are there, and no deformable cell or one whose step was recorded.
     fn has_last_step_problem(&self) -> bool {
-        self.cell.is_none()
+        (self.cell.is_none() || self.last_cell_step.is_some())
             && self.v_free.len() == self.bodies.len()
             && self.inv.len() == self.bodies.len()
     }
@@ -570,6 +601,14 @@ impl World {
     /// This is how a measurement tells what the solver's residual does to it: the same step,
     /// solved tighter (`grainlaw`'s solver-sensitivity check).
     ///
+    /// With a deformable cell under an implicit control, the cell's stress-controlled
+    /// components change with the impulses too ([`crate::cell_coupling`]):
+    /// `Δδ_κ = m_κ Σ_c B_cκ · Δr_c`, so `L' = L + Δδ` and every grain, which followed `δ` at the
+    /// end of the step, gains `Δδ (x − c)` on its free velocity components (no acceleration: the
+    /// step's `a` is that of the solve, before the grains follow the cell). The cell's geometry,
+    /// advanced over the step with `L⁻ + δ`, is kept (a change of order `h Δδ`), as are the
+    /// positions' affine part and the wraps.
+    ///
     /// # Errors
     /// [`DemError::Parameter`] when the last step's problem is not available
     /// ([`World::last_step_problem`]) or `r` does not have two entries per contact.
@@ -580,8 +619,8 @@ impl World {
         };
         if !self.has_last_step_problem() {
             return Err(bad(
-                "the last step's problem is not available (no step, a resume, or a deformable \
-                 cell)"
+                "the last step's problem is not available (no step, a resume, or a cell under \
+                 an explicit control)"
                     .into(),
             ));
         }
@@ -615,6 +654,25 @@ impl World {
         let theta = self.params.theta;
         let periodic = self.periodic();
         let mut snap = self.snapshot();
+        // The cell's change with the impulses, and the grains following it.
+        if let (Some(coupling), Some(cell)) = (self.last_coupling(), snap.cell.as_mut()) {
+            let dl = coupling.delta_change(rows, r);
+            if dl != Mat::zeros() {
+                cell.l += dl;
+                let c = cell.centre();
+                for (b, body) in snap.bodies.iter_mut().zip(&self.bodies) {
+                    if body.kind != BodyKind::Grain {
+                        continue;
+                    }
+                    let dv = dl * (b.position - c);
+                    for d in 0..2 {
+                        if body.dofs[d] == Dof::Free {
+                            b.velocity[d] += dv[d];
+                        }
+                    }
+                }
+            }
+        }
         for (b, d) in snap.bodies.iter_mut().zip(&dv) {
             if *d == [0.0, 0.0, 0.0] {
                 continue;
@@ -1431,6 +1489,13 @@ impl World {
         // L⁺ (4b), the grains follow δ at the end of the step (6.).
         let delta = coupling.as_ref().map_or_else(Mat::zeros, |c| c.delta());
         self.image_outran = delta.abs().sum() > self.detector.image_rate();
+        self.last_cell_step = match (self.cell, self.cell_control) {
+            (Some(_), Some(ctl)) if !ctl.implicit => None,
+            (Some(_), _) => Some(LastCellStep {
+                coupling: coupling.clone(),
+            }),
+            (None, _) => None,
+        };
 
         // 4. Positions, accelerations.
         self.displacement.clear();

@@ -501,3 +501,136 @@ fn implicit_cell_steps_are_not_subdivided() {
         assert_eq!(a.velocity, b.velocity);
     }
 }
+
+/// The last step of a cell under the implicit control solved again
+/// (`World::last_step_problem`, `World::snapshot_with_last_impulses`): a frictional biaxial
+/// compression of 36 disks whose last step is swept 5 times (far from converged) is solved
+/// again to 10⁻¹⁰ with the cell's stress-controlled component eliminated; the state those
+/// impulses give keeps the implicit law, recomputed from the public state as in
+/// `implicit_law_holds_at_every_step_of_a_frictional_compression`, with the new impulses (to
+/// 10⁻⁸ of `ε̇_max`), while the cell's `L_xx` moved by more than 10⁻⁴ of it; the imposed `L_yy`
+/// is unchanged; each grain's velocity changed by the contacts' `h Δa` plus the cell's
+/// `ΔL (x − c)` (10⁻¹² m/s); the run's own impulses give its own snapshot bit for bit. Under an
+/// explicit control the problem is not available.
+#[test]
+fn a_cell_step_solved_again_keeps_the_implicit_law() {
+    use dem::fc::{solve_by, FcOptions, NewtonParams, SolverMethod};
+    let p = 100.0;
+    let mut w = packing(6, 5, 0.5);
+    let (rho, d): (f64, f64) = (2500.0, 2e-3);
+    let rate = 1e-3 * (p / rho).sqrt() / d;
+    let max_rate = 20.0 * rate;
+    let gain = 10.0 * max_rate / p;
+    w.cell_control = Some(CellControl::implicit_law(
+        Imposed::Stress(-p),
+        Imposed::Stress(-p),
+        Imposed::Rate(0.0),
+        gain,
+        max_rate,
+    ));
+    w.params.solver.tolerance = 1e-9;
+    w.params.solver.lemke_max_contacts = 1000;
+    for _ in 0..1500 {
+        w.step().unwrap();
+    }
+    w.cell_control = Some(CellControl::implicit_law(
+        Imposed::Stress(-p),
+        Imposed::Rate(-rate),
+        Imposed::Rate(0.0),
+        gain,
+        max_rate,
+    ));
+    for _ in 0..50 {
+        w.step().unwrap();
+    }
+    // The last step swept 5 times.
+    w.params.solver.method = SolverMethod::Nlgs;
+    w.params.solver.max_iterations = 5;
+    let thickness = w.bodies[0].thickness;
+    let cell0 = *w.cell().unwrap();
+    let grains: Vec<_> = w.bodies.iter().filter(|b| b.mass > 0.0).collect();
+    let c0 = cell0.centre();
+    let mass: f64 = grains.iter().map(|b| b.mass).sum();
+    let mom = grains.iter().fold(Vect::zeros(), |m, b| {
+        m + (b.velocity - cell0.l * (b.position - c0)) * b.mass
+    });
+    let mean_v = mom / mass;
+    let kin_xx: f64 = -grains
+        .iter()
+        .map(|b| {
+            let v = b.velocity - cell0.l * (b.position - c0) - mean_v;
+            b.mass * v.x * v.x
+        })
+        .sum::<f64>()
+        / (cell0.volume() * thickness);
+    let rep = w.step().unwrap();
+    assert!(!rep.solver.converged, "{:?}", rep.solver);
+
+    let (problem, r) = w.last_step_problem().expect("an implicit cell's step");
+    assert_eq!(
+        w.snapshot_with_last_impulses(&r).unwrap(),
+        w.snapshot(),
+        "bit for bit"
+    );
+    let options = FcOptions {
+        tolerance: 1e-10,
+        max_iterations: 100_000,
+        initial_guess: Some(r.clone()),
+        ..FcOptions::default()
+    };
+    let (sol, _) = solve_by(
+        &problem,
+        &options,
+        SolverMethod::Auto,
+        &NewtonParams::default(),
+    )
+    .unwrap();
+    assert!(sol.converged, "error {:.2e}", sol.error);
+    let snap = w.snapshot_with_last_impulses(&sol.r).unwrap();
+
+    // The implicit law with the new impulses.
+    let h = w.params.dt;
+    let c = w.contacts();
+    let boundary: f64 = c
+        .rows
+        .iter()
+        .zip(&c.geometry)
+        .zip(sol.r.chunks_exact(2))
+        .map(|((row, geo), x)| (x[0] * row.n[0] - x[1] * row.n[1]) * geo.image[0])
+        .sum();
+    let sigma = kin_xx - boundary / (h * cell0.volume() * thickness);
+    let want = cell0.l[(0, 0)].clamp(-max_rate, max_rate) + gain * (-p - sigma);
+    let (run_l, new_l) = (w.cell().unwrap().l, snap.cell.unwrap().l);
+    assert!(
+        (new_l[(0, 0)] - want).abs() < 1e-8 * max_rate,
+        "L_xx {:e} vs the law's {want:e}",
+        new_l[(0, 0)]
+    );
+    assert!(
+        (new_l[(0, 0)] - run_l[(0, 0)]).abs() > 1e-4 * max_rate,
+        "the re-solve moved L_xx by {:e} only",
+        new_l[(0, 0)] - run_l[(0, 0)]
+    );
+    assert_eq!(new_l[(1, 1)], -rate);
+    assert_eq!(new_l[(0, 1)], run_l[(0, 1)]);
+
+    // Each grain: the contacts' change of velocity plus the cell's.
+    let dl = new_l - run_l;
+    let centre = snap.cell.unwrap().centre();
+    let before = w.snapshot();
+    for (a, b) in before.bodies.iter().zip(&snap.bodies) {
+        let contact = (b.acceleration - a.acceleration) * h;
+        let cell = dl * (a.position - centre);
+        let err = (b.velocity - a.velocity - contact - cell).norm();
+        assert!(err < 1e-12, "{err:e} m/s");
+    }
+
+    // An explicit control: no problem to solve again.
+    w.cell_control = Some(CellControl {
+        implicit: false,
+        ..w.cell_control.unwrap()
+    });
+    w.step().unwrap();
+    assert!(w.last_step_problem().is_none());
+    assert!(w.snapshot_with_last_impulses(&r).is_err());
+}

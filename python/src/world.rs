@@ -544,7 +544,7 @@ impl World {
         let Some((problem, r)) = self.world.last_step_problem() else {
             return Err(input(
                 "no step to solve again: step the world first (the last step's problem is \
-                 not kept across a resume, nor for a deformable cell)",
+                 not kept across a resume, nor for a cell under an explicit control)",
             ));
         };
         let options = dem::fc::FcOptions {

@@ -53,7 +53,7 @@ pub enum Resolved<T> {
     /// non-finite state): counted as unresolved, left out of the measure.
     Failed,
     /// The step's problem is not available (no step since a resume, a
-    /// deformable cell): no measure, counted apart.
+    /// cell under an explicit control): no measure, counted apart.
     Unavailable,
 }
 
