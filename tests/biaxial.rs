@@ -190,6 +190,23 @@ fn frictional_biaxial_steps_converge_under_the_implicit_control() {
     let end = num(&s, "p1_friction_critical_sin_phi");
     assert!((0.35..=0.6).contains(&peak), "sin φ_peak = {peak}");
     assert!(peak > end, "peak {peak} vs end {end}");
+    // The solver sensitivity: every 25th axial step solved again to 1e-8 with the cell, none
+    // failing; sin φ and p move by less than the suspect limits (0.005, 2.5 %), so the loaded
+    // contacts' proxy is judged against its refusal limit only.
+    let steps = num(&s, "window_steps");
+    let samples = num(&s, "window_resolved_samples");
+    assert_eq!(samples, (steps / 25.0).floor(), "{steps} axial steps");
+    assert_eq!(num(&s, "window_unresolved_samples"), 0.0);
+    let dmu = num(&s, "window_resolved_mu_change");
+    let dp = num(&s, "window_resolved_pressure_change");
+    assert!(dmu > 0.0 && dmu < 0.005, "sin φ moves by {dmu}");
+    assert!(dp > 0.0 && dp < 0.025, "p moves by {dp}");
+    let reasons = s["verdict_reasons"].to_string();
+    assert!(
+        !reasons.contains("solver.loaded_error_over_tolerance")
+            && !reasons.contains("solver.sensitivity"),
+        "{reasons}"
+    );
 }
 
 /// A run stopped inside the axial compression and resumed writes the same files as an

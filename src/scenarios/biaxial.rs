@@ -37,6 +37,7 @@ use super::common::{
     Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
+use super::sensitivity::{record, resolved_snapshot, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -109,6 +110,15 @@ const CONTROL_TOLERANCE: f64 = 0.5;
 const MAX_CORRECTIONS: usize = 8;
 /// Blocks of the block-averaged standard errors (at least).
 const MIN_BLOCKS: usize = 4;
+/// Every this many axial steps, the step is solved again to
+/// [`crate::verdict::SENSITIVITY_TOLERANCE`] and the cell's stress taken both ways: the solver
+/// sensitivity of the axial compression ([`crate::verdict::Sensitivity`] with the axial
+/// deviator `q_a = (Σ_xx − Σ_yy)/2` as the shear stress and the mean stress as the normal one,
+/// so its μ is `sin φ_mob = Σ q_a / Σ p`, the ratio of means the analysis takes, and its
+/// pressure `p`), judged by the window's checks (`solver.sensitivity_mu` on sin φ,
+/// `solver.sensitivity_pressure` on p). 1 step in 25: about 170 samples per pressure at the
+/// defaults.
+const SENSITIVITY_EVERY: u64 = 25;
 /// Fraction of the isotropic compression (its last steps) over which the reached stress is
 /// averaged and compared with −p₀.
 const COMPRESSION_TAIL: f64 = 0.2;
@@ -231,6 +241,13 @@ struct State {
     /// Sums of Σ_xx, Σ_yy (Σ_xx twice in the axial compression) and steps of the current
     /// phase, for the outer correction.
     seg: (f64, f64, u64),
+}
+
+/// `[q_a, −p] = [(Σ_xx − Σ_yy)/2, (Σ_xx + Σ_yy)/2]` of a cell stress (Pa, tension positive):
+/// the pair the solver-sensitivity measure takes as shear and normal stress
+/// ([`SENSITIVITY_EVERY`]).
+fn axial_pair(s: &Mat) -> [f64; 2] {
+    [0.5 * (s[(0, 0)] - s[(1, 1)]), 0.5 * (s[(0, 0)] + s[(1, 1)])]
 }
 
 /// Bins of a history: per bin of `width` in ε_a (the first starting at ε_a = 0, bins with at
@@ -597,6 +614,13 @@ impl PhasedRun for Biaxial<'_> {
         st.seg = (st.seg.0 + s[(0, 0)], st.seg.1 + s[(0, 0)], st.seg.2 + 1);
         st.run.n += 1;
         st.window.step(true, w, r, &p.stats);
+        if st.run.n.is_multiple_of(SENSITIVITY_EVERY) {
+            let resolved = resolved_snapshot(w).and_then(|snap| match cell_state(&snap) {
+                Ok(state) => Resolved::Solved(axial_pair(&state.stress)),
+                Err(_) => Resolved::Failed,
+            });
+            record(&mut st.window.sensitivity, axial_pair(&s), resolved);
+        }
         let Some(cell) = w.cell().copied() else {
             return Ok(());
         };
