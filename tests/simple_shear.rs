@@ -1,6 +1,6 @@
 //! The `simple-shear` scenario (biperiodic cell): its inputs are validated (one line naming
 //! the key, exit code 2), and a run stopped and resumed writes the same files, byte for byte,
-//! as an uninterrupted one.
+//! as an uninterrupted one, its solver-sensitivity samples included.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -104,6 +104,22 @@ fn resume_is_bit_identical() {
         "different files"
     );
     assert!(fa.contains_key(Path::new("history_I1.csv")));
+    // Every tenth step of the averaging window was solved again with the cell
+    // (`dem::World::last_step_problem`): the window's last `window_steps` of the run's steps
+    // (one history row each) hold floor(n/10) − floor((n − w)/10) of them, all available.
+    let summary: serde_json::Value =
+        serde_json::from_slice(&fa[Path::new("summary.json")]).unwrap();
+    let history = String::from_utf8_lossy(&fa[Path::new("history_I1.csv")]).to_string();
+    let n = history
+        .lines()
+        .filter(|l| l.starts_with(|c: char| c.is_ascii_digit()))
+        .count() as u64;
+    let w = summary["window_steps"].as_u64().unwrap();
+    let tried = summary["window_resolved_samples"].as_u64().unwrap()
+        + summary["window_unresolved_samples"].as_u64().unwrap();
+    assert_eq!(tried, n / 10 - (n - w) / 10, "{n} steps, window {w}");
+    assert!(tried >= 1, "{tried} samples");
+    assert_eq!(summary["window_unavailable_samples"].as_u64(), Some(0));
     for (name, bytes) in &fa {
         if name == Path::new("summary.json") {
             let strip = |v: &[u8]| -> serde_json::Map<String, serde_json::Value> {

@@ -25,6 +25,7 @@ use super::common::{
     implicit_cell_control, mean_diameter, solver_keys, strain_bins, Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
+use super::sensitivity::{record, resolved_snapshot, Resolved};
 use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -33,6 +34,13 @@ use crate::output::{CsvTable, OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::verdict::{max_solid_fraction, RunVerdict, WindowStats};
+
+/// Every this many steps of an averaging window, the step is solved again to
+/// [`crate::verdict::SENSITIVITY_TOLERANCE`] with the cell's stress-controlled component
+/// (`dem::World::last_step_problem`) and the cell's stress taken both ways: the window's solver
+/// sensitivity of μ = |Σσ_xy| / (−Σσ_yy) and of σ_yy ([`crate::verdict::Sensitivity`]), judged
+/// by its checks.
+const SENSITIVITY_EVERY: u64 = 10;
 
 /// Columns of `history_I{k}.csv`.
 const HISTORY: [&str; 18] = [
@@ -222,11 +230,18 @@ impl PhasedRun for Shear<'_> {
             return Ok(());
         }
         st.run.n += 1;
-        st.window
-            .step(st.run.n + st.run.avg_steps > st.run.steps, w, r, &p.stats);
+        let averaged = st.run.n + st.run.avg_steps > st.run.steps;
+        st.window.step(averaged, w, r, &p.stats);
         let snap = w.snapshot();
         let cs = cell_state(&snap)?;
         let s = cs.stress;
+        if averaged && st.run.n.is_multiple_of(SENSITIVITY_EVERY) {
+            let resolved = resolved_snapshot(w).and_then(|snap| match cell_state(&snap) {
+                Ok(state) => Resolved::Solved([state.stress[(0, 1)], state.stress[(1, 1)]]),
+                Err(_) => Resolved::Failed,
+            });
+            record(&mut st.window.sensitivity, [s[(0, 1)], s[(1, 1)]], resolved);
+        }
         let d = mean_diameter(w);
         let pn = -s[(1, 1)];
         let i = if pn > 0.0 {
