@@ -190,12 +190,14 @@ fn frictional_biaxial_steps_converge_under_the_implicit_control() {
     let end = num(&s, "p1_friction_critical_sin_phi");
     assert!((0.35..=0.6).contains(&peak), "sin φ_peak = {peak}");
     assert!(peak > end, "peak {peak} vs end {end}");
-    // The solver sensitivity: every 25th axial step solved again to 1e-8 with the cell, none
-    // failing; sin φ and p move by less than the suspect limits (0.005, 2.5 %), so the loaded
-    // contacts' proxy is judged against its refusal limit only.
+    // The solver sensitivity: 20 axial steps evenly spread (every ⌊steps/20⌋-th) solved again
+    // to 1e-8 with the cell, none failing; sin φ and p move by less than the suspect limits
+    // (0.005, 2.5 %), so the loaded contacts' proxy is judged against its refusal limit only.
     let steps = num(&s, "window_steps");
     let samples = num(&s, "window_resolved_samples");
-    assert_eq!(samples, (steps / 25.0).floor(), "{steps} axial steps");
+    let every = (steps / 20.0).floor().max(1.0);
+    assert_eq!(samples, (steps / every).floor(), "{steps} axial steps");
+    assert!(samples >= 20.0, "{samples} samples");
     assert_eq!(num(&s, "window_unresolved_samples"), 0.0);
     let dmu = num(&s, "window_resolved_mu_change");
     let dp = num(&s, "window_resolved_pressure_change");
