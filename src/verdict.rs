@@ -32,9 +32,10 @@
 //! release: 56×). A window must meet both; the second is judged only where it exceeds the
 //! first (under `solver.error_scale = "loaded"` the error already includes it).
 //!
-//! Where a scenario measures it ([`Sensitivity`]: the shear cell), the solver's effect on what
-//! the window reports is measured instead of bounded by a proxy: the step of every sample that
-//! feeds the window's mean stress is solved again from the same state to
+//! Where a scenario measures it ([`Sensitivity`]: the shear cell, simple-shear, the biaxial's
+//! axial compressions; Janssen has its own measure on its fit), the solver's effect on what
+//! the window reports is measured instead of bounded by a proxy: the step of each sampled state
+//! (every averaging sample in the shear cell) is solved again from the same state to
 //! [`SENSITIVITY_TOLERANCE`] (`dem::World::last_step_problem`, `dem::fc::solve_by` with `auto`
 //! and Lemke's method, `dem::World::snapshot_with_last_impulses`), and the window's μ and
 //! pressure are taken both ways. When at least [`SENSITIVITY_MIN_SAMPLES`] samples were
@@ -463,7 +464,8 @@ pub struct WindowStats {
 
 /// The solver's effect on an averaging window's stress (module documentation): the sums of the
 /// bulk stress components of its samples as the run solved them and as re-solved to
-/// [`SENSITIVITY_TOLERANCE`], over the samples whose re-solve converged.
+/// [`SENSITIVITY_TOLERANCE`] (or to a tenth of the run's own error where that is out of reach,
+/// `crate::scenarios::sensitivity::measures_the_run`), over the samples so re-solved.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Sensitivity {
     /// Samples re-solved to the tolerance.
@@ -471,7 +473,7 @@ pub struct Sensitivity {
     /// Samples whose re-solve did not reach it (left out of the sums).
     pub unresolved: u64,
     /// Samples whose step's problem was not available to re-solve (no step since a resume, a
-    /// deformable cell): left out, not a failure of the solver.
+    /// cell under an explicit control): left out, not a failure of the solver.
     #[serde(default)]
     pub unavailable: u64,
     /// Σ σ_xy, Σ σ_yy of the re-solved samples as run (Pa, tension positive).

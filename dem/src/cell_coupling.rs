@@ -149,6 +149,11 @@ impl CellCoupling {
         Some(c)
     }
 
+    /// Number of contacts of the step the coupling was made for (coupled or not).
+    pub fn row_count(&self) -> usize {
+        self.slot.len()
+    }
+
     /// Number of contacts coupled to the cell.
     pub fn coupled_contacts(&self) -> usize {
         self.rows.len()

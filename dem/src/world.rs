@@ -400,7 +400,7 @@ impl World {
         }
         self.cell = cell;
         self.cell_sigma = None;
-        self.last_cell_step = None;
+        self.forget_last_step_problem();
         self.wrap_grains();
         Ok(())
     }
@@ -572,6 +572,13 @@ impl World {
         Some((problem, rows.iter().flat_map(|c| c.r).collect()))
     }
 
+    /// Drops what [`World::last_step_problem`] is assembled from (the free velocities and the
+    /// cell's coupling): done where the contacts or the cell change outside a step's solve.
+    fn forget_last_step_problem(&mut self) {
+        self.v_free.clear();
+        self.last_cell_step = None;
+    }
+
     /// The coupling of the last step's cell to its contacts, if any.
     fn last_coupling(&self) -> Option<&CellCoupling> {
         self.last_cell_step.as_ref()?.coupling.as_ref()
@@ -580,7 +587,15 @@ impl World {
     /// Whether [`World::last_step_problem`] can be assembled: the free velocities of a step
     /// are there, and no deformable cell or one whose step was recorded.
     fn has_last_step_problem(&self) -> bool {
-        (self.cell.is_none() || self.last_cell_step.is_some())
+        let cell_consistent = match (&self.cell, &self.last_cell_step) {
+            (None, None) => true,
+            (Some(_), Some(step)) => step
+                .coupling
+                .as_ref()
+                .is_none_or(|c| c.row_count() == self.contacts.rows.len()),
+            _ => false,
+        };
+        cell_consistent
             && self.v_free.len() == self.bodies.len()
             && self.inv.len() == self.bodies.len()
     }
@@ -1112,6 +1127,8 @@ impl World {
     /// checkpoints show until the next step (contact forces on bodies are not refreshed). Called
     /// in the middle of a run it discards the warm start of the previous step.
     pub fn prime_with_weight(&mut self) -> Result<(), DemError> {
+        // The last step's contacts are replaced: its problem goes with them.
+        self.forget_last_step_problem();
         self.refresh_inverse_mass();
         self.detect_step_contacts(self.implicit_free_change())?;
         let (h, g) = (self.params.dt, self.params.gravity);
@@ -1335,6 +1352,9 @@ impl World {
         let g = self.params.gravity;
         let periodic = self.periodic();
         self.refresh_inverse_mass();
+        // The contacts are about to change: a step that fails before its solve leaves no
+        // problem behind.
+        self.forget_last_step_problem();
 
         // 1. Detection at q⁻, warm start from the previous step.
         std::mem::swap(&mut self.contacts, &mut self.previous);

@@ -167,3 +167,19 @@ fn an_undone_step_leaves_the_problem_of_the_point_returned_to() {
     let err = w.snapshot_with_last_impulses(&ru[1..]).unwrap_err();
     assert!(err.to_string().contains("two per contact"), "{err}");
 }
+
+/// The problem goes with the contacts it was assembled from: priming the contacts again
+/// (`World::prime_with_weight`) or giving the world a cell drops it (no problem rather than one
+/// whose rows are not the step's), and the next step brings one back.
+#[test]
+fn the_problem_is_dropped_when_the_contacts_change_outside_a_step() {
+    let mut w = loose_box();
+    assert!(w.last_step_problem().is_some());
+    w.prime_with_weight().unwrap();
+    assert!(w.last_step_problem().is_none());
+    assert!(w.snapshot_with_last_impulses(&[]).is_err());
+    w.step().unwrap();
+    let (problem, r) = w.last_step_problem().expect("a step was made");
+    assert_eq!(problem.contacts() * 2, r.len());
+    assert_eq!(problem.contacts(), w.contacts().len());
+}

@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
-use super::sensitivity::{resolved_snapshot, Resolved};
+use super::sensitivity::{resolve_last_step, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -109,6 +109,10 @@ struct ColumnState {
     /// Measured steps whose problem was not available to re-solve.
     #[serde(default)]
     resolve_unavailable: u64,
+    /// Measured steps whose re-solve stopped short of the tolerance but within a tenth of the
+    /// run's own error ([`super::sensitivity::measures_the_run`]).
+    #[serde(default)]
+    resolve_near: u64,
 }
 
 impl Column<'_> {
@@ -248,8 +252,9 @@ impl PhasedRun for Column<'_> {
             let loads = column_loads(&snap, st);
             st.window.observe(&snap, self.width, bins, loads)?;
             // The same step solved again to 1e-8: what the fit would see of an exact solve.
-            match resolved_snapshot(w) {
-                Resolved::Solved(snap) => {
+            match resolve_last_step(w) {
+                Resolved::Solved((snap, exact)) => {
+                    st.resolve_near += u64::from(!exact);
                     if st.resolved.samples == 0 {
                         // The run's depth bins (the re-solved surface moves by θ h Δv).
                         st.resolved = st.window.empty_like();
@@ -356,6 +361,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             resolved: MeasureWindow::default(),
             resolve_failed: 0,
             resolve_unavailable: 0,
+            resolve_near: 0,
         };
         Ok((col.world, state))
     };
@@ -376,6 +382,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         resolved,
         resolve_failed,
         resolve_unavailable,
+        resolve_near,
         ..
     } = st;
     let final_report = world.last_report();
@@ -424,6 +431,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         measured: measure_window.samples,
         failed: resolve_failed,
         unavailable: resolve_unavailable,
+        near: resolve_near,
         fit: match (&fitted, &resolved_profile) {
             (Ok(run), Some(p)) => {
                 Some(fit_profile_like(p, &setup, window, run).map_err(|e| e.to_string()))
