@@ -2,6 +2,8 @@
 //! minimum image against a brute-force search, contacts across the corner of the cell, the
 //! basis change, the energy balance and the mixed stress control.
 
+mod common;
+
 use dem::cell::{Cell, CellControl, Imposed, Mat, Shift, Vect};
 use dem::{ContactLaws, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
@@ -371,15 +373,10 @@ fn implicit_control_holds_a_rigid_lattice_at_its_stress() {
     }
 }
 
-/// The implicit law holds at every step of a frictional biaxial compression of 36 disks
-/// (σ_xx = −P, L_yy = −ε̇ imposed, μ = 0.5), recomputed from the public state alone: after each
-/// converged step, `L⁺_xx = clamp(L⁻_xx, ±ε̇_max) + g (σ* − σ⁺)` with
-/// `σ⁺ = σ^kin − (1/(hV)) Σ R_x (h k)_x` over the step's image contacts and `σ^kin` the kinetic
-/// stress at its start, to 10⁻⁸ of `ε̇_max`; every step converges, and the measured lateral
-/// stress (`World::cell_stress`) averages −P within 10 % over the compression.
-#[test]
-fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
-    let p = 100.0;
+/// The frictional packing of 36 disks (μ = 0.5) compressed isotropically to `p` under the
+/// implicit control for 1500 exact steps (Lemke's method where the sweeps stall), with the
+/// control's axial rate `ε̇`, rate cap and gain: `(world, ε̇, ε̇_max, g)`.
+fn compressed_frictional_cell(p: f64) -> (World, f64, f64, f64) {
     let mut w = packing(6, 5, 0.5);
     let (rho, d): (f64, f64) = (2500.0, 2e-3);
     let rate = 1e-3 * (p / rho).sqrt() / d;
@@ -394,11 +391,45 @@ fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
         max_rate,
     ));
     w.params.solver.tolerance = 1e-9;
-    // Exact steps (Lemke's method where the sweeps stall).
     w.params.solver.lemke_max_contacts = 1000;
     for _ in 0..1500 {
         w.step().unwrap();
     }
+    (w, rate, max_rate, gain)
+}
+
+/// The kinetic stress `σ^kin_xx` of the grains' velocity fluctuations (Pa), as the implicit
+/// law takes it at the start of a step (module documentation of `dem::cell_coupling`).
+fn kinetic_xx(w: &World) -> f64 {
+    let cell = *w.cell().unwrap();
+    let thickness = w.bodies[0].thickness;
+    let grains: Vec<_> = w.bodies.iter().filter(|b| b.mass > 0.0).collect();
+    let c0 = cell.centre();
+    let mass: f64 = grains.iter().map(|b| b.mass).sum();
+    let mom = grains.iter().fold(Vect::zeros(), |m, b| {
+        m + (b.velocity - cell.l * (b.position - c0)) * b.mass
+    });
+    let mean_v = mom / mass;
+    -grains
+        .iter()
+        .map(|b| {
+            let v = b.velocity - cell.l * (b.position - c0) - mean_v;
+            b.mass * v.x * v.x
+        })
+        .sum::<f64>()
+        / (cell.volume() * thickness)
+}
+
+/// The implicit law holds at every step of a frictional biaxial compression of 36 disks
+/// (σ_xx = −P, L_yy = −ε̇ imposed, μ = 0.5), recomputed from the public state alone: after each
+/// converged step, `L⁺_xx = clamp(L⁻_xx, ±ε̇_max) + g (σ* − σ⁺)` with
+/// `σ⁺ = σ^kin − (1/(hV)) Σ R_x (h k)_x` over the step's image contacts and `σ^kin` the kinetic
+/// stress at its start, to 10⁻⁸ of `ε̇_max`; every step converges, and the measured lateral
+/// stress (`World::cell_stress`) averages −P within 10 % over the compression.
+#[test]
+fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
+    let p = 100.0;
+    let (mut w, rate, max_rate, gain) = compressed_frictional_cell(p);
     let s = w.cell_stress().unwrap();
     assert!(
         (s[(0, 0)] + p).abs() < 0.2 * p && (s[(1, 1)] + p).abs() < 0.2 * p,
@@ -416,22 +447,7 @@ fn implicit_law_holds_at_every_step_of_a_frictional_compression() {
     let (mut mean, mut n) = (0.0, 0);
     for _ in 0..400 {
         let cell0 = *w.cell().unwrap();
-        // Kinetic stress at the start of the step (module documentation of dem::cell_coupling).
-        let grains: Vec<_> = w.bodies.iter().filter(|b| b.mass > 0.0).collect();
-        let c0 = cell0.centre();
-        let mass: f64 = grains.iter().map(|b| b.mass).sum();
-        let mom = grains.iter().fold(Vect::zeros(), |m, b| {
-            m + (b.velocity - cell0.l * (b.position - c0)) * b.mass
-        });
-        let mean_v = mom / mass;
-        let kin_xx: f64 = -grains
-            .iter()
-            .map(|b| {
-                let v = b.velocity - cell0.l * (b.position - c0) - mean_v;
-                b.mass * v.x * v.x
-            })
-            .sum::<f64>()
-            / (cell0.volume() * thickness);
+        let kin_xx = kinetic_xx(&w);
         let rep = w.step().unwrap();
         assert!(rep.solver.converged, "{:?}", rep.solver);
         let h = w.params.dt;
@@ -515,25 +531,9 @@ fn implicit_cell_steps_are_not_subdivided() {
 /// available.
 #[test]
 fn a_cell_step_solved_again_keeps_the_implicit_law() {
-    use dem::fc::{solve_by, FcOptions, NewtonParams, SolverMethod};
+    use dem::fc::SolverMethod;
     let p = 100.0;
-    let mut w = packing(6, 5, 0.5);
-    let (rho, d): (f64, f64) = (2500.0, 2e-3);
-    let rate = 1e-3 * (p / rho).sqrt() / d;
-    let max_rate = 20.0 * rate;
-    let gain = 10.0 * max_rate / p;
-    w.cell_control = Some(CellControl::implicit_law(
-        Imposed::Stress(-p),
-        Imposed::Stress(-p),
-        Imposed::Rate(0.0),
-        gain,
-        max_rate,
-    ));
-    w.params.solver.tolerance = 1e-9;
-    w.params.solver.lemke_max_contacts = 1000;
-    for _ in 0..1500 {
-        w.step().unwrap();
-    }
+    let (mut w, rate, max_rate, gain) = compressed_frictional_cell(p);
     w.cell_control = Some(CellControl::implicit_law(
         Imposed::Stress(-p),
         Imposed::Rate(-rate),
@@ -549,21 +549,7 @@ fn a_cell_step_solved_again_keeps_the_implicit_law() {
     w.params.solver.max_iterations = 5;
     let thickness = w.bodies[0].thickness;
     let cell0 = *w.cell().unwrap();
-    let grains: Vec<_> = w.bodies.iter().filter(|b| b.mass > 0.0).collect();
-    let c0 = cell0.centre();
-    let mass: f64 = grains.iter().map(|b| b.mass).sum();
-    let mom = grains.iter().fold(Vect::zeros(), |m, b| {
-        m + (b.velocity - cell0.l * (b.position - c0)) * b.mass
-    });
-    let mean_v = mom / mass;
-    let kin_xx: f64 = -grains
-        .iter()
-        .map(|b| {
-            let v = b.velocity - cell0.l * (b.position - c0) - mean_v;
-            b.mass * v.x * v.x
-        })
-        .sum::<f64>()
-        / (cell0.volume() * thickness);
+    let kin_xx = kinetic_xx(&w);
     let point = w.undo_point();
     let rep = w.step().unwrap();
     assert!(!rep.solver.converged, "{:?}", rep.solver);
@@ -574,20 +560,7 @@ fn a_cell_step_solved_again_keeps_the_implicit_law() {
         w.snapshot(),
         "bit for bit"
     );
-    let options = FcOptions {
-        tolerance: 1e-10,
-        max_iterations: 100_000,
-        initial_guess: Some(r.clone()),
-        ..FcOptions::default()
-    };
-    let (sol, _) = solve_by(
-        &problem,
-        &options,
-        SolverMethod::Auto,
-        &NewtonParams::default(),
-    )
-    .unwrap();
-    assert!(sol.converged, "error {:.2e}", sol.error);
+    let sol = common::solve_tightly(&problem, &r, 1e-10);
     let snap = w.snapshot_with_last_impulses(&sol.r).unwrap();
 
     // The implicit law with the new impulses.

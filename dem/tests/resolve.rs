@@ -5,7 +5,7 @@
 mod common;
 
 use common::random_box;
-use dem::fc::{solve_by, FcOptions, NewtonParams, SolverMethod};
+use dem::fc::SolverMethod;
 use dem::snapshot::BodyKind;
 use nalgebra::Vector2;
 
@@ -38,19 +38,7 @@ fn the_run_s_own_impulses_give_its_own_snapshot() {
 fn a_resolved_snapshot_obeys_newton_s_law_with_the_new_impulses() {
     let w = loose_box();
     let (problem, r) = w.last_step_problem().unwrap();
-    let options = FcOptions {
-        tolerance: 1e-10,
-        initial_guess: Some(r.clone()),
-        ..FcOptions::default()
-    };
-    let (sol, _) = solve_by(
-        &problem,
-        &options,
-        SolverMethod::Auto,
-        &NewtonParams::default(),
-    )
-    .unwrap();
-    assert!(sol.converged, "error {:.2e}", sol.error);
+    let sol = common::solve_tightly(&problem, &r, 1e-10);
     let change = sol
         .r
         .iter()

@@ -141,3 +141,26 @@ pub fn nlgs(tolerance: f64, sweeps: usize) -> SolverParams {
         ..Default::default()
     }
 }
+
+/// `problem` solved from the impulses `r` to `tolerance` by `auto` (Gauss–Seidel, Newton, the
+/// exact finish), which must converge: the re-solve of the solver-sensitivity tests.
+pub fn solve_tightly(
+    problem: &dem::fc::FcProblem,
+    r: &[f64],
+    tolerance: f64,
+) -> dem::fc::FcSolution {
+    let options = dem::fc::FcOptions {
+        tolerance,
+        initial_guess: Some(r.to_vec()),
+        ..dem::fc::FcOptions::default()
+    };
+    let (sol, _) = dem::fc::solve_by(
+        problem,
+        &options,
+        SolverMethod::Auto,
+        &dem::fc::NewtonParams::default(),
+    )
+    .unwrap();
+    assert!(sol.converged, "error {:.2e}", sol.error);
+    sol
+}
