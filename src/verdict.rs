@@ -468,9 +468,9 @@ pub struct WindowStats {
 /// `crate::scenarios::sensitivity::measures_the_run`), over the samples so re-solved.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Sensitivity {
-    /// Samples re-solved to the tolerance.
+    /// Samples re-solved (to the tolerance, or to a tenth of the run's own error).
     pub samples: u64,
-    /// Samples whose re-solve did not reach it (left out of the sums).
+    /// Samples whose re-solve reached neither (left out of the sums).
     pub unresolved: u64,
     /// Samples whose step's problem was not available to re-solve (no step since a resume, a
     /// cell under an explicit control): left out, not a failure of the solver.
