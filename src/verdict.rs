@@ -324,7 +324,7 @@ impl Checks {
                 },
             );
         }
-        self.reasons.len() == before && s.samples >= SENSITIVITY_MIN_SAMPLES
+        self.reasons.len() == before && s.samples >= SENSITIVITY_MIN_SAMPLES && s.near == 0
     }
 
     /// The numerics of the steps that feed a result: unconverged steps and worst error over the
@@ -472,6 +472,11 @@ pub struct Sensitivity {
     pub samples: u64,
     /// Samples whose re-solve reached neither (left out of the sums).
     pub unresolved: u64,
+    /// Of `samples`, those re-solved short of the tolerance, within a tenth of the run's own
+    /// error: they measure the stress, but a measure with any of them does not stand in for
+    /// the loaded contacts' proxy, whose scale they were not judged on.
+    #[serde(default)]
+    pub near: u64,
     /// Samples whose step's problem was not available to re-solve (no step since a resume, a
     /// cell under an explicit control): left out, not a failure of the solver.
     #[serde(default)]
@@ -573,6 +578,7 @@ impl Sensitivity {
     pub fn merge(&mut self, o: &Sensitivity) {
         self.samples += o.samples;
         self.unresolved += o.unresolved;
+        self.near += o.near;
         self.unavailable += o.unavailable;
         self.sxy += o.sxy;
         self.syy += o.syy;
@@ -668,6 +674,7 @@ impl WindowStats {
         let sens = &self.sensitivity;
         if sens.samples + sens.unresolved + sens.unavailable > 0 {
             s.int(&format!("{prefix}_resolved_samples"), sens.samples)
+                .int(&format!("{prefix}_resolved_near_samples"), sens.near)
                 .int(&format!("{prefix}_unresolved_samples"), sens.unresolved)
                 .int(&format!("{prefix}_unavailable_samples"), sens.unavailable)
                 .num(&format!("{prefix}_resolved_mu_change"), sens.mu_change())
@@ -1118,6 +1125,16 @@ mod tests {
         assert_eq!(c.verdict(), Verdict::Ok, "{:?}", c.reasons);
         // Too few samples to stand in: the proxy judges.
         let c = judge(2e-3, resolved(5, 4e-5, 0.003, 0));
+        assert_eq!(names(&c), ["solver.loaded_error_over_tolerance"]);
+        // One of the 40 re-solved short of 1e-8 (within a tenth of the run's own error): the
+        // measure passes but does not stand in, the proxy judges.
+        let c = judge(
+            2e-3,
+            Sensitivity {
+                near: 1,
+                ..resolved(40, 4e-5, 0.003, 0)
+            },
+        );
         assert_eq!(names(&c), ["solver.loaded_error_over_tolerance"]);
         // μ moves by 0.01 (suspect) or 0.03 (refused); the proxy's suspect stays.
         let c = judge(2e-3, resolved(40, 0.01, 0.0, 0));

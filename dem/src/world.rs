@@ -913,6 +913,9 @@ impl World {
     /// Check every parameter, body, collider and contact law, and that no two grains overlap
     /// and no grain lies behind a line wall by more than `tolerance` (m).
     pub fn validate(&mut self, tolerance: f64) -> Result<(), DemError> {
+        // The inverse masses are refreshed from the bodies (which may have been changed): the
+        // last step's problem, assembled with them, is no longer the step's.
+        self.forget_last_step_problem();
         let p = &self.params;
         let perr = |name: &str, reason: String| DemError::Parameter {
             name: name.into(),

@@ -617,6 +617,16 @@ fn a_cell_step_solved_again_keeps_the_implicit_law() {
         "{miss:e} of {change:e} m/s"
     );
 
+    // Priming the contacts again, or removing the cell, drops the coupled step's problem (a
+    // primed coupled world used to assemble it with the new rows and panic).
+    let mut primed = w.undo_point();
+    primed.prime_with_weight().unwrap();
+    assert!(primed.last_step_problem().is_none());
+    assert!(primed.snapshot_with_last_impulses(&r).is_err());
+    let mut cellless = w.undo_point();
+    cellless.set_cell(None).unwrap();
+    assert!(cellless.last_step_problem().is_none());
+
     // An explicit control: no problem to solve again.
     w.cell_control = Some(CellControl {
         implicit: false,

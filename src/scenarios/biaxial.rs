@@ -37,7 +37,7 @@ use super::common::{
     Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
-use super::sensitivity::{record, resolved_snapshot, Resolved};
+use super::sensitivity::{record, resolve_last_step, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -622,8 +622,8 @@ impl PhasedRun for Biaxial<'_> {
             .n
             .is_multiple_of((st.run.steps / SENSITIVITY_SAMPLES).max(1))
         {
-            let resolved = resolved_snapshot(w).and_then(|snap| match cell_state(&snap) {
-                Ok(state) => Resolved::Solved(axial_pair(&state.stress)),
+            let resolved = resolve_last_step(w).and_then(|(snap, exact)| match cell_state(&snap) {
+                Ok(state) => Resolved::Solved((axial_pair(&state.stress), exact)),
                 Err(_) => Resolved::Failed,
             });
             record(&mut st.window.sensitivity, axial_pair(&s), resolved);

@@ -103,16 +103,16 @@ pub fn resolve_last_step(w: &World) -> Resolved<(Snapshot, bool)> {
     }
 }
 
-/// [`resolve_last_step`]'s snapshot.
-pub fn resolved_snapshot(w: &World) -> Resolved<Snapshot> {
-    resolve_last_step(w).and_then(|(snap, _)| Resolved::Solved(snap))
-}
-
 /// Adds a sample to `s`: its bulk `[σ_xy, σ_yy]` as run and the outcome of its re-solve
-/// ([`Sensitivity::add`]; an unavailable problem is counted apart).
-pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<[f64; 2]>) {
+/// (with whether it reached the tolerance, [`resolve_last_step`]; [`Sensitivity::add`], a
+/// re-solve short of it counted in [`Sensitivity::near`] too; an unavailable problem is
+/// counted apart).
+pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<([f64; 2], bool)>) {
     match resolved {
-        Resolved::Solved(r) => s.add(run, Some(r)),
+        Resolved::Solved((r, exact)) => {
+            s.add(run, Some(r));
+            s.near += u64::from(!exact);
+        }
         Resolved::Failed => s.add(run, None),
         Resolved::Unavailable => s.unavailable += 1,
     }

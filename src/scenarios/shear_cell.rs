@@ -941,10 +941,10 @@ fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, nalgebra::Matrix2<
 /// The bulk `[σ_xy, σ_yy]` (Pa) of the world with its last step's contact problem solved to
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] (the solver-sensitivity measure,
 /// [`crate::verdict::Sensitivity`]), or why there is none.
-fn resolved_stress(w: &dem::World, r: f64, d: f64) -> Resolved<[f64; 2]> {
-    super::sensitivity::resolved_snapshot(w).and_then(|snap| {
+fn resolved_stress(w: &dem::World, r: f64, d: f64) -> Resolved<([f64; 2], bool)> {
+    super::sensitivity::resolve_last_step(w).and_then(|(snap, exact)| {
         match bulk_stress(&snap, &bulk_region(w, r, d)) {
-            Ok(sym) => Resolved::Solved([sym[(0, 1)], sym[(1, 1)]]),
+            Ok(sym) => Resolved::Solved(([sym[(0, 1)], sym[(1, 1)]], exact)),
             Err(_) => Resolved::Failed,
         }
     })

@@ -254,7 +254,6 @@ impl PhasedRun for Column<'_> {
             // The same step solved again to 1e-8: what the fit would see of an exact solve.
             match resolve_last_step(w) {
                 Resolved::Solved((snap, exact)) => {
-                    st.resolve_near += u64::from(!exact);
                     if st.resolved.samples == 0 {
                         // The run's depth bins (the re-solved surface moves by θ h Δv).
                         st.resolved = st.window.empty_like();
@@ -262,6 +261,8 @@ impl PhasedRun for Column<'_> {
                     let loads = column_loads(&snap, st);
                     if st.resolved.observe(&snap, self.width, bins, loads).is_err() {
                         st.resolve_failed += 1;
+                    } else {
+                        st.resolve_near += u64::from(!exact);
                     }
                 }
                 Resolved::Failed => st.resolve_failed += 1,

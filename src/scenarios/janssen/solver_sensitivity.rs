@@ -131,7 +131,7 @@ impl JanssenSensitivity {
         self.measured > 0 && self.fit.is_some() && self.near == 0 && checks.reasons.len() == before
     }
 
-    /// Summary keys `resolved_samples`, `resolved_unresolved_samples`,
+    /// Summary keys `resolved_samples`, `resolved_near_samples`, `resolved_unresolved_samples`,
     /// `resolved_unavailable_samples`, `resolved_janssen_K`, `resolved_janssen_mu_w`,
     /// `resolved_K_change_over_half_width`, `resolved_mu_w_change_over_half_width` (NaN where
     /// there is nothing to compare).
