@@ -1426,7 +1426,7 @@ impl World {
             _ => None,
         };
         let approach_limit = self.approach_limit();
-        self.v_free.clear();
+        // Emptied at the start of the step (`forget_last_step_problem`).
         self.v_free.extend_from_slice(&self.vel);
         self.last_problem = self.record_problems.then(|| {
             crate::assemble::contact_problem_with(
@@ -1515,7 +1515,7 @@ impl World {
         self.last_cell_step = match (self.cell, self.cell_control) {
             (Some(_), Some(ctl)) if !ctl.implicit => None,
             (Some(_), _) => Some(LastCellStep {
-                coupling: coupling.clone(),
+                coupling: coupling.take(),
             }),
             (None, _) => None,
         };

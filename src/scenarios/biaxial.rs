@@ -37,7 +37,7 @@ use super::common::{
     Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
-use super::sensitivity::{record, resolve_last_step, Resolved};
+use super::sensitivity::{record, resolved_pair};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -116,10 +116,10 @@ const MIN_BLOCKS: usize = 4;
 /// deviator `q_a = (Σ_xx − Σ_yy)/2` as the shear stress and the mean stress as the normal one,
 /// so its μ is `sin φ_mob = Σ q_a / Σ p`, the ratio of means the analysis takes, and its
 /// pressure `p`), judged by the window's checks (`solver.sensitivity_mu` on sin φ,
-/// `solver.sensitivity_pressure` on p). A re-solve of these quasi-static steps takes about a
-/// to two seconds at 200 grains (the default run with one step in 25, 581 samples: 914 s; with
-/// 40 per pressure, 160 samples: 557 s; about 310 s without), so their number is fixed rather
-/// than their rate: every `⌊steps / SENSITIVITY_SAMPLES⌋`-th axial step (at least every
+/// `solver.sensitivity_pressure` on p). A re-solve of these quasi-static steps takes one to
+/// two seconds at 200 grains (the default run, 2026-12-03: 479 s with 80 samples, 390 s
+/// without, both alone; 914 s with one step in 25, 581 samples, beside other work), so their
+/// number is fixed rather than their rate: every `⌊steps / SENSITIVITY_SAMPLES⌋`-th axial step (at least every
 /// step), 20 samples per pressure, twice the verdict's minimum.
 const SENSITIVITY_SAMPLES: u64 = 20;
 /// Fraction of the isotropic compression (its last steps) over which the reached stress is
@@ -622,10 +622,8 @@ impl PhasedRun for Biaxial<'_> {
             .n
             .is_multiple_of((st.run.steps / SENSITIVITY_SAMPLES).max(1))
         {
-            let resolved = resolve_last_step(w).and_then(|(snap, exact)| match cell_state(&snap) {
-                Ok(state) => Resolved::Solved((axial_pair(&state.stress), exact)),
-                Err(_) => Resolved::Failed,
-            });
+            let resolved =
+                resolved_pair(w, |snap| Some(axial_pair(&cell_state(snap).ok()?.stress)));
             record(&mut st.window.sensitivity, axial_pair(&s), resolved);
         }
         let Some(cell) = w.cell().copied() else {

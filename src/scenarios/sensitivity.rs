@@ -20,9 +20,9 @@
 //! ([`RESOLVE_MARGIN`], `dem::fc::fc_error` of the run's impulses) is taken as the measure all
 //! the same: its residual is then a tenth of the run's. (A residual bounds the distance to a
 //! solution only where the solution is unique: in a hyperstatic packing the impulses are not,
-//! and both solves pick one; the measure is of the stresses each gives.) The Janssen check
-//! counts such re-solves apart: they measure its fit but do not stand in for the loaded
-//! contacts' proxy, whose scale they were not judged on.
+//! and both solves pick one; the measure is of the stresses each gives.) Such re-solves are
+//! counted apart (`Sensitivity::near`, Janssen's own count): they measure the stress but do not
+//! stand in for the loaded contacts' proxy, whose scale they were not judged on.
 
 use dem::fc::{fc_error, solve_by, FcOptions, NewtonParams, SolverMethod};
 use dem::{Snapshot, World};
@@ -52,8 +52,9 @@ pub enum Resolved<T> {
     /// Solved to the tolerance, or to a tenth of the run's ([`measures_the_run`]): what the
     /// measure gives on the re-solved state.
     Solved(T),
-    /// The re-solve did not reach the tolerance, or failed (a singular factorisation, a
-    /// non-finite state): counted as unresolved, left out of the measure.
+    /// The re-solve reached neither the tolerance nor a tenth of the run's own error, or failed
+    /// (a singular factorisation, a non-finite state): counted as unresolved, left out of the
+    /// measure.
     Failed,
     /// The step's problem is not available (no step since a resume, a
     /// cell under an explicit control): no measure, counted apart.
@@ -101,6 +102,20 @@ pub fn resolve_last_step(w: &World) -> Resolved<(Snapshot, bool)> {
             }),
         _ => Resolved::Failed,
     }
+}
+
+/// The stress pair `[shear, normal]` (Pa) that `pair` takes from the last step's state
+/// re-solved ([`resolve_last_step`]), with whether the re-solve reached the tolerance; `pair`
+/// returning `None` (the state cannot be measured) is a failed sample. The one form of every
+/// stress-window measure ([`record`]).
+pub fn resolved_pair(
+    w: &World,
+    pair: impl FnOnce(&Snapshot) -> Option<[f64; 2]>,
+) -> Resolved<([f64; 2], bool)> {
+    resolve_last_step(w).and_then(|(snap, exact)| match pair(&snap) {
+        Some(p) => Resolved::Solved((p, exact)),
+        None => Resolved::Failed,
+    })
 }
 
 /// Adds a sample to `s`: its bulk `[σ_xy, σ_yy]` as run and the outcome of its re-solve

@@ -942,11 +942,9 @@ fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, nalgebra::Matrix2<
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] (the solver-sensitivity measure,
 /// [`crate::verdict::Sensitivity`]), or why there is none.
 fn resolved_stress(w: &dem::World, r: f64, d: f64) -> Resolved<([f64; 2], bool)> {
-    super::sensitivity::resolve_last_step(w).and_then(|(snap, exact)| {
-        match bulk_stress(&snap, &bulk_region(w, r, d)) {
-            Ok(sym) => Resolved::Solved(([sym[(0, 1)], sym[(1, 1)]], exact)),
-            Err(_) => Resolved::Failed,
-        }
+    super::sensitivity::resolved_pair(w, |snap| {
+        let sym = bulk_stress(snap, &bulk_region(w, r, d)).ok()?;
+        Some([sym[(0, 1)], sym[(1, 1)]])
     })
 }
 

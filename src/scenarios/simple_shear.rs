@@ -25,7 +25,7 @@ use super::common::{
     implicit_cell_control, mean_diameter, solver_keys, strain_bins, Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
-use super::sensitivity::{record, resolve_last_step, Resolved};
+use super::sensitivity::{record, resolved_pair};
 use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -236,11 +236,9 @@ impl PhasedRun for Shear<'_> {
         let cs = cell_state(&snap)?;
         let s = cs.stress;
         if averaged && st.run.n.is_multiple_of(SENSITIVITY_EVERY) {
-            let resolved = resolve_last_step(w).and_then(|(snap, exact)| match cell_state(&snap) {
-                Ok(state) => {
-                    Resolved::Solved(([state.stress[(0, 1)], state.stress[(1, 1)]], exact))
-                }
-                Err(_) => Resolved::Failed,
+            let resolved = resolved_pair(w, |snap| {
+                let s = cell_state(snap).ok()?.stress;
+                Some([s[(0, 1)], s[(1, 1)]])
             });
             record(&mut st.window.sensitivity, [s[(0, 1)], s[(1, 1)]], resolved);
         }
