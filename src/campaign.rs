@@ -895,11 +895,21 @@ fn metadata_line(line: &str) -> Option<(String, String)> {
 /// material and the merge is refused.
 pub const MERGE_METADATA_SPREAD: f64 = 0.05;
 
-/// Concatenates per-run CSV tables written by grainlaw (same header) and adds a `run` column.
-/// Their `# key = value` metadata must agree: a text value exactly, a number within
-/// [`MERGE_METADATA_SPREAD`] of the mean over the runs, which the merged table carries (a fit
-/// over grains of different sizes would mix scales).
+/// Concatenates per-run CSV tables written by grainlaw (same header) and adds a `run` column
+/// ([`merged_table`]), into `merged`.
 fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
+    let (text, _) = merged_table(files, &merged.display().to_string(), "grainlaw campaign")?;
+    write_atomic(merged, text.as_bytes())
+}
+
+/// The text of per-run CSV tables written by grainlaw (same header) concatenated, with a `run`
+/// column (each file's index), and how many rows were left out: a table with a `point_verdict`
+/// column keeps only its rows whose verdict is 0. Their `# key = value` metadata must agree: a
+/// text value exactly, a number within [`MERGE_METADATA_SPREAD`] of the mean over the runs,
+/// which the merged table carries (a fit over grains of different sizes would mix scales).
+/// `name` names the merged table in messages, `by` the command merging (its first comment).
+/// The merge of `campaign --collect` and of `grainlaw fit LAW A.csv B.csv ...`.
+pub fn merged_table(files: &[(usize, PathBuf)], name: &str, by: &str) -> Result<(String, usize)> {
     let mut metas: Vec<(PathBuf, Vec<(String, String)>)> = Vec::new();
     let mut header: Option<String> = None;
     let mut rows = Vec::new();
@@ -976,7 +986,7 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
                 let spread = xs.iter().map(|x| (x - mean).abs()).fold(0.0, f64::max);
                 if spread > MERGE_METADATA_SPREAD * mean.abs() {
                     return Err(CliError::Input {
-                        path: merged.display().to_string(),
+                        path: name.to_string(),
                         reason: format!(
                             "metadata `{k}` differs by {:.1} % between runs (more than {:.0} %): they are not one material and are not merged",
                             100.0 * spread / mean.abs(),
@@ -998,7 +1008,7 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
         }
     }
     let mut text = format!(
-        "# merged by grainlaw campaign: the rows that passed their checks ({dropped} left out); column `run` is the run's index; numeric metadata are the means over the runs\n"
+        "# merged by {by}: the rows that passed their checks ({dropped} left out); column `run` is the run's index; numeric metadata are the means over the runs\n"
     );
     for m in merged_meta {
         text.push_str(&m);
@@ -1010,7 +1020,7 @@ fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
         text.push_str(&r);
         text.push('\n');
     }
-    write_atomic(merged, text.as_bytes())
+    Ok((text, dropped))
 }
 
 #[cfg(test)]

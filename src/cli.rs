@@ -5,7 +5,7 @@
 //!          [--checkpoint-every STEPS] [--checkpoint-seconds S]
 //! grainlaw run --resume DIR [--checkpoint-every STEPS] [--checkpoint-seconds S] [--quiet]
 //! grainlaw scenarios [--show NAME]
-//! grainlaw fit LAW DATA.csv [--out law.json]
+//! grainlaw fit LAW DATA.csv [MORE.csv ...] [--out law.json]
 //! grainlaw solve-fc PROBLEM.json [--tol T] [--method nlgs|newton|auto|lemke] [--out SOLUTION.json]
 //! grainlaw bench [--dir DIR] [--engine-grains N ...]
 //! ```
@@ -62,8 +62,10 @@ pub enum Command {
     Fit {
         /// Law name.
         law: String,
-        /// CSV file (units in the headers, `# key = value` constants).
-        data: PathBuf,
+        /// CSV file (units in the headers, `# key = value` constants); several files of the
+        /// same columns are merged as `campaign --collect` merges its runs' tables.
+        #[arg(required = true, num_args = 1..)]
+        data: Vec<PathBuf>,
         /// Write the calibrated law here (JSON); without it the JSON goes to stdout.
         #[arg(long, value_name = "LAW.json")]
         out: Option<PathBuf>,
@@ -276,6 +278,10 @@ pub struct HomogeniseArgs {
     /// Friction coefficient of the contacts, for the mobilisation |f_t|/(μ f_n).
     #[arg(long)]
     pub mu: Option<f64>,
+    /// Friction coefficient of the wall contacts when the walls have their own (default:
+    /// --mu); written as the wall friction of the Janssen table.
+    #[arg(long)]
+    pub wall_mu: Option<f64>,
     /// Time step (s): times of LAMMPS dumps without ITEM: TIME are step × dt.
     #[arg(long)]
     pub dt: Option<f64>,
@@ -320,6 +326,7 @@ fn homogenise_cmd(a: HomogeniseArgs) -> Result<()> {
         options: crate::readers::ReadOptions {
             gravity: [g[0], g[1]],
             mu: a.mu,
+            wall_mu: a.wall_mu,
             dt: a.dt,
             inertia_factor: a.inertia_factor,
             density: a.density,
@@ -341,7 +348,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
         Command::Run(args) => run(args),
         Command::Homogenise(args) => homogenise_cmd(args),
         Command::Scenarios { show } => scenarios_cmd(show.as_deref()),
-        Command::Fit { law, data, out } => crate::fit_cmd::fit(&law, &data, out.as_deref()),
+        Command::Fit { law, data, out } => crate::fit_cmd::fit_files(&law, &data, out.as_deref()),
         Command::Campaign {
             plan,
             out,

@@ -1,4 +1,5 @@
-//! `grainlaw fit LAW DATA.csv [--out law.json]`: fits a law to a user's CSV.
+//! `grainlaw fit LAW DATA.csv [MORE.csv ...] [--out law.json]`: fits a law to a user's CSV, or
+//! to several tables of the same columns merged ([`fit_files`]).
 //!
 //! Exit status: 0 when the law passed every check of `identify::accept` and was written; 2 for
 //! bad input (unreadable or malformed file, missing column or metadata, unknown metadata key,
@@ -25,9 +26,47 @@ use crate::output::dir::write_atomic;
 pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
     let cal =
         fit_csv_file(law, data, &CsvFitOptions::default()).map_err(|e| naming_file(data, e))?;
-    let json = cal.to_json_string()? + "\n";
-    let mut lines = report_lines(&cal, data);
     let left_out = left_out_points(data);
+    report(&cal, data, left_out, out)
+}
+
+/// [`fit`] on several tables of the same columns (e.g. the `rheology.csv` of one run per
+/// inertial number, grainlaw's or another code's read by `grainlaw homogenise`), merged as
+/// `grainlaw campaign --collect` merges its runs' ([`crate::campaign::merged_table`]: the rows
+/// whose `point_verdict` is 0, a `run` column numbering the files from 0, metadata that must
+/// agree within 5 %); the provenance records every file with its SHA-256. One file is [`fit`].
+pub fn fit_files(law: &str, data: &[std::path::PathBuf], out: Option<&Path>) -> Result<()> {
+    match data {
+        [] => Err(CliError::Usage("fit: no data file".into())),
+        [one] => fit(law, one, out),
+        _ => {
+            let name = format!(
+                "merged({})",
+                data.iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            let indexed: Vec<(usize, std::path::PathBuf)> =
+                data.iter().cloned().enumerate().collect();
+            let (text, left_out) = crate::campaign::merged_table(&indexed, &name, "grainlaw fit")?;
+            let label = Path::new(&name);
+            let mut cal =
+                identify::user_fit::fit_csv_text(law, &text, &name, &CsvFitOptions::default())
+                    .map_err(|e| naming_file(label, e))?;
+            for p in data {
+                let bytes = std::fs::read(p).map_err(|e| CliError::io(p, e))?;
+                cal.provenance = cal.provenance.with_input(&p.display().to_string(), &bytes);
+            }
+            report(&cal, label, left_out, out)
+        }
+    }
+}
+
+/// Prints the report of a fitted law and writes it (see [`fit`]).
+fn report(cal: &CalibratedLaw, data: &Path, left_out: usize, out: Option<&Path>) -> Result<()> {
+    let json = cal.to_json_string()? + "\n";
+    let mut lines = report_lines(cal, data);
     if left_out > 0 {
         lines.insert(
             1,

@@ -111,6 +111,13 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
             )));
         }
     }
+    if let Some(mu) = plan.options.wall_mu {
+        if !(mu.is_finite() && mu >= 0.0) {
+            return Err(CliError::Usage(format!(
+                "--wall-mu must be finite and ≥ 0, got {mu}"
+            )));
+        }
+    }
     if !(plan.options.inertia_factor.is_finite() && plan.options.inertia_factor > 0.0) {
         return Err(CliError::Usage(
             "--inertia-factor must be finite and > 0".into(),
@@ -196,6 +203,16 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
                 .collect::<Vec<_>>()
                 .into(),
         );
+    if snaps.iter().any(|s| s.velocity_gradient.is_some()) {
+        summary.set(
+            "velocity_gradients",
+            snaps
+                .iter()
+                .map(|s| s.velocity_gradient.map_or("none", |g| g.name()))
+                .collect::<Vec<_>>()
+                .into(),
+        );
+    }
     for ext in &snaps {
         let s = &ext.snapshot;
         let (row, grains) = snapshot_row(ext)?;
@@ -248,7 +265,7 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
                 s.step, s.time, grains.len(), s.contacts.len(), phi, z, ext.accelerations.name()
             ),
             format!(
-                "mean stress (Pa, tension > 0): σxx = {:.4e}, σyy = {:.4e}, σxy = {:.4e}; P = {:.4e}, τ/P = {}",
+                "mean stress (Pa, tension > 0): σxx = {:.4e}, σyy = {:.4e}, σxy = {:.4e}; p = {:.4e}, q/p = {}",
                 whole_total[(0, 0)], whole_total[(1, 1)], 0.5 * (whole_total[(0, 1)] + whole_total[(1, 0)]),
                 inv.pressure, inv.friction.map_or("-".into(), |f| format!("{f:.4}"))
             ),
@@ -263,7 +280,21 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
         .last()
         .ok_or_else(|| CliError::Usage("homogenise: no snapshot read".into()))?;
     last_outputs(&mut out, last, &mut summary)?;
+    janssen_table(&mut out, &snaps, &plan.options, &mut summary)?;
     summary.set("walls", wall_names.clone().into());
+    if let Some(c) = last.snapshot.cell {
+        summary
+            .set(
+                "cell_matrix_m",
+                vec![c.h[(0, 0)], c.h[(0, 1)], c.h[(1, 0)], c.h[(1, 1)]].into(),
+            )
+            .num("cell_area_m2", c.volume());
+    }
+    let rve = crate::rve::rve_point(&snaps)?;
+    if let Some(p) = &rve {
+        p.write(&mut out)?;
+        p.keys(&mut summary);
+    }
     let s = &last.snapshot;
     for w in &s.walls {
         summary
@@ -279,6 +310,23 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
             "wall {}: force ({:.6e}, {:.6e}) N",
             w.name, w.force.x, w.force.y
         ));
+    }
+    if let Some(p) = &rve {
+        lines.extend(p.lines());
+        if p.verdict == crate::verdict::Verdict::Refused {
+            return Err(CliError::Verdict {
+                dir: plan.out.display().to_string(),
+                reason: format!(
+                    "the simple-shear point is refused (rheology.csv, point_verdict 2): {}",
+                    p.checks
+                        .reasons
+                        .iter()
+                        .map(|r| r.message.as_str())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ),
+            });
+        }
     }
     Ok(HomogeniseOutcome {
         lines,
@@ -516,7 +564,7 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
                     "mean_mobilisation",
                 ]);
                 t.comments.push(format!(
-                    "wall `{}`, step {}, bins of {width:e} m along gravity",
+                    "wall `{}`, step {}, bins of {width:e} m along gravity; one wall's stresses, tension positive: the table a Janssen fit reads is janssen.csv (grainlaw fit janssen janssen.csv)",
                     w.name, s.step
                 ));
                 for b in &p {
@@ -615,6 +663,158 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
             width_px: 900,
         },
     )?;
+    Ok(())
+}
+
+/// The two side walls of a column: the vertical line walls whose normals point to +x (left)
+/// and to −x (right), when there is exactly one of each.
+fn side_walls(s: &Snapshot) -> Option<(String, String)> {
+    let side = |sign: f64| -> Vec<&str> {
+        s.walls
+            .iter()
+            .filter(|w| {
+                matches!(w.geometry, WallGeometry::Line { normal, .. }
+                    if sign * normal.x > 1.0 - 1e-6)
+            })
+            .map(|w| w.name.as_str())
+            .collect()
+    };
+    match (side(1.0).as_slice(), side(-1.0).as_slice()) {
+        ([l], [r]) => Some((l.to_string(), r.to_string())),
+        _ => None,
+    }
+}
+
+/// `janssen.csv`, the table `grainlaw fit janssen` reads (`identify::user_fit`), of a column
+/// between two vertical walls under gravity along −y ([`side_walls`]): per depth bin of two
+/// mean diameters below the free surface, `z_m`, `sigma_v_Pa` (across horizontal planes),
+/// `sigma_h_Pa` and `tau_w_Pa` (the two walls' mean), compressive positive
+/// ([`homogenise::column::column_profile`]), averaged over the snapshots (the series is the
+/// measurement window, as the `janssen` scenario averages its last steps); metadata `width_m`
+/// (between the walls), `bulk_density_kg_m3` (φ ρ of the column), `gravity_m_s2`, the fitted
+/// depths (one mean diameter below the surface to one above the lowest grain) and
+/// `wall_friction` (`--wall-mu`, else `--mu`; without either the table fits `janssen-kmu`).
+/// As in the `janssen` scenario, τ_w is named `tau_w_Pa` (a datum of the fit) only when it is
+/// nowhere negative in the fitted depths, `tau_w_measured_Pa` otherwise. Nothing is written
+/// for a sample that is not such a column.
+fn janssen_table(
+    out: &mut OutputDir,
+    snaps: &[ExternalSnapshot],
+    opts: &ReadOptions,
+    summary: &mut Summary,
+) -> Result<()> {
+    let Some(last) = snaps.last().map(|e| &e.snapshot) else {
+        return Ok(());
+    };
+    let g = last.gravity;
+    let d = mean_diameter(last);
+    let Some((left, right)) = side_walls(last) else {
+        return Ok(());
+    };
+    if !(g.y < 0.0 && g.x.abs() <= 1e-12 * g.y.abs() && d > 0.0) {
+        return Ok(());
+    }
+    let spec = homogenise::column::ColumnSpec {
+        left,
+        right,
+        bin_width: 2.0 * d,
+    };
+    let mut profiles = Vec::with_capacity(snaps.len());
+    for e in snaps {
+        if side_walls(&e.snapshot).as_ref() != Some(&(spec.left.clone(), spec.right.clone())) {
+            continue;
+        }
+        match homogenise::column::column_profile(&e.snapshot, &spec) {
+            Ok(p) => profiles.push(p),
+            Err(err) => {
+                summary.text(
+                    "janssen_table",
+                    &format!("not written: step {}: {err}", e.snapshot.step),
+                );
+                return Ok(());
+            }
+        }
+    }
+    // the depths common to every snapshot's profile
+    let bins = profiles.iter().map(|p| p.depth.len()).min().unwrap_or(0);
+    if bins == 0 {
+        return Ok(());
+    }
+    let m = profiles.len() as f64;
+    let mean = |f: &dyn Fn(&homogenise::column::ColumnProfile) -> f64| {
+        profiles.iter().map(f).sum::<f64>() / m
+    };
+    let at = |f: fn(&homogenise::column::ColumnProfile) -> &Vec<f64>| -> Vec<f64> {
+        (0..bins)
+            .map(|k| profiles.iter().map(|p| f(p)[k]).sum::<f64>() / m)
+            .collect()
+    };
+    let z = profiles[profiles.len() - 1].depth[..bins].to_vec();
+    let (sv, sh, tw, svm, phi) = (
+        at(|p| &p.sigma_v),
+        at(|p| &p.sigma_h),
+        at(|p| &p.tau_w),
+        at(|p| &p.sigma_v_mean),
+        at(|p| &p.solid_fraction),
+    );
+    let height = grain_extent(last).map_or(0.0, |e| e.3 - e.2);
+    let window = (d, (height - d).max(d));
+    let uses_tau = z
+        .iter()
+        .zip(&tw)
+        .all(|(z, t)| *z < window.0 || *z > window.1 || *t >= 0.0);
+    let mut t = CsvTable::new(&[
+        "z_m",
+        "sigma_v_Pa",
+        "sigma_h_Pa",
+        if uses_tau {
+            "tau_w_Pa"
+        } else {
+            "tau_w_measured_Pa"
+        },
+        "sigma_v_mean_Pa",
+        "solid_fraction",
+    ]);
+    t.comments.push(format!(
+        "Janssen column between the walls `{}` and `{}`, mean of {} snapshots: depth below the free surface, vertical stress across planes, wall normal and shear stress (mean of both walls; shear positive when the grains drag the walls down), compressive positive; sigma_v_mean_Pa is -sigma_yy of the bin's mean stress. Fit with: grainlaw fit janssen janssen.csv",
+        spec.left,
+        spec.right,
+        profiles.len()
+    ));
+    if !uses_tau {
+        t.comments.push("the wall shear stress is negative at some fitted depth: named tau_w_measured_Pa, it is not a datum of the fit".into());
+    }
+    let width = mean(&|p| p.width);
+    let bulk = mean(&|p| p.bulk_density);
+    t.metadata = vec![
+        ("width_m".into(), width),
+        ("bulk_density_kg_m3".into(), bulk),
+        ("gravity_m_s2".into(), g.norm()),
+        ("depth_min_m".into(), window.0),
+        ("depth_max_m".into(), window.1),
+    ];
+    match opts.wall_mu.or(opts.mu) {
+        Some(mu) => t.metadata.push(("wall_friction".into(), mu)),
+        None => t.comments.push(
+            "no wall friction given (--wall-mu or --mu): fit janssen-kmu, or add `# wall_friction = MU`"
+                .into(),
+        ),
+    }
+    for k in 0..bins {
+        t.push(vec![z[k], sv[k], sh[k], tw[k], svm[k], phi[k]]);
+    }
+    t.write(out, "janssen.csv")?;
+    summary
+        .num("janssen_width_m", width)
+        .num("janssen_bulk_density_kg_m3", bulk)
+        .num(
+            "janssen_bottom_load_over_weight",
+            mean(&|p| p.bottom_load_over_weight),
+        )
+        .num(
+            "janssen_side_wall_load_over_weight",
+            mean(&|p| p.side_wall_load_over_weight),
+        );
     Ok(())
 }
 

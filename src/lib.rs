@@ -21,6 +21,7 @@ pub mod plot;
 pub mod progress;
 pub mod provenance;
 pub mod readers;
+pub mod rve;
 pub mod scenarios;
 pub mod siconos_peer;
 pub mod verdict;

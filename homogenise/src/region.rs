@@ -8,6 +8,11 @@
 //! area-weighted means over a partition of a region give the mean over the whole region.
 //! With a periodic x direction the disk's images at `x ± L` are counted too, and a region
 //! spanning the whole cell width covers every x.
+//!
+//! **Biperiodic cells** (`dem::cell`): the whole sample is the cell, of area `det h`; every
+//! grain lies in it once (its images are the same grain) and counts whole, `w_p = 1`. A
+//! rectangle or slice of a cell whose first edge lies along x (`a₁ = (l_x, 0)`, as in LAMMPS'
+//! boxes and the engine's cells) is periodic along x with the period `l_x`.
 
 use dem::snapshot::{BodyKind, Snapshot};
 use nalgebra::Vector2;
@@ -35,7 +40,8 @@ pub enum Region {
         y_max: f64,
     },
     /// The whole sample: the bounding box of the grains' disks (x: the periodic cell when x is
-    /// periodic). In a box whose walls all touch grains this is the box itself.
+    /// periodic). In a box whose walls all touch grains this is the box itself. In a
+    /// biperiodic cell, the cell (module documentation).
     Whole,
 }
 
@@ -48,6 +54,9 @@ pub struct Rect {
     pub max: Vector2<f64>,
     /// Periodic cell along x, `[x_min, x_max)` (m), if any.
     pub periodic_x: Option<[f64; 2]>,
+    /// The whole biperiodic cell: its area `det h` (m²). Every grain counts whole in it;
+    /// `min`, `max` are then the cell's bounding box.
+    pub cell_area: Option<f64>,
 }
 
 /// Extent `[min, max]` of the grains' disks along x and y: `(x_lo, x_hi, y_lo, y_hi)`.
@@ -68,7 +77,26 @@ impl Region {
     /// Resolves the region against a snapshot into a rectangle (m). Fails on non-finite or
     /// inverted bounds, or when `Whole`/`Slice` need grains and there are none.
     pub fn resolve(&self, snapshot: &Snapshot) -> Result<Rect> {
-        let periodic_x = snapshot.periodic_x;
+        if let (Region::Whole, Some(cell)) = (self, &snapshot.cell) {
+            let h = cell.h;
+            let xs = [0.0, h[(0, 0)], h[(0, 1)], h[(0, 0)] + h[(0, 1)]];
+            let ys = [0.0, h[(1, 0)], h[(1, 1)], h[(1, 0)] + h[(1, 1)]];
+            let lo = |v: &[f64; 4]| v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = |v: &[f64; 4]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            return Ok(Rect {
+                min: Vector2::new(lo(&xs), lo(&ys)),
+                max: Vector2::new(hi(&xs), hi(&ys)),
+                periodic_x: None,
+                cell_area: Some(cell.volume()),
+            });
+        }
+        // a cell whose first edge lies along x is periodic along x with its length
+        let periodic_x = snapshot.periodic_x.or_else(|| {
+            snapshot
+                .cell
+                .filter(|c| c.h[(1, 0)] == 0.0)
+                .map(|c| [0.0, c.h[(0, 0)]])
+        });
         let x_range = || -> Result<(f64, f64)> {
             if let Some([a, b]) = periodic_x {
                 return Ok((a, b));
@@ -113,6 +141,7 @@ impl Region {
             min,
             max,
             periodic_x,
+            cell_area: None,
         })
     }
 }
@@ -120,7 +149,8 @@ impl Region {
 impl Rect {
     /// Area of the region (m²), voids included.
     pub fn area(&self) -> f64 {
-        (self.max.x - self.min.x) * (self.max.y - self.min.y)
+        self.cell_area
+            .unwrap_or((self.max.x - self.min.x) * (self.max.y - self.min.y))
     }
 
     /// Whether the rectangle covers the whole periodic cell width (then every x is inside).
@@ -141,6 +171,9 @@ impl Rect {
 
     /// Whether the point lies in the region (closed rectangle; periodic in x when the cell is).
     pub fn contains(&self, p: &Vector2<f64>) -> bool {
+        if self.cell_area.is_some() {
+            return true;
+        }
         if p.y < self.min.y || p.y > self.max.y {
             return false;
         }
@@ -167,6 +200,9 @@ impl Rect {
     /// Fraction `w ∈ [0, 1]` of the disk of the given centre and radius inside the region:
     /// `|D ∩ R| / (π R²)`, exact, summed over periodic images.
     pub fn disk_fraction(&self, centre: &Vector2<f64>, radius: f64) -> f64 {
+        if self.cell_area.is_some() {
+            return 1.0;
+        }
         if radius <= 0.0 {
             return if self.contains(centre) { 1.0 } else { 0.0 };
         }

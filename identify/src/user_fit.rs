@@ -114,20 +114,32 @@ pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<C
             "stream did not contain valid UTF-8",
         ),
     })?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    let table = Table::parse_csv(text, &source)?;
+    let mut law = fit_csv_text(law, &text, &source, options)?;
+    law.provenance = law.provenance.with_input(&source, &bytes);
+    Ok(law)
+}
+
+/// [`fit_csv_file`] on the text of a table (`source` names it in messages and in the
+/// provenance's `source`; the caller records the input files): e.g. several tables merged.
+pub fn fit_csv_text(
+    law: &str,
+    text: &str,
+    source: &str,
+    options: &CsvFitOptions,
+) -> Result<CalibratedLaw> {
+    check_law_name(law)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let table = Table::parse_csv(text, source)?;
     let header = header_line(text);
     check_unique_headers(&table, header)?;
     if table.rows() == 0 {
         return Err(IdentifyError::Csv {
-            file: source,
+            file: source.to_string(),
             line: header,
             message: "no data rows after the header".into(),
         });
     }
-    let mut law = fit_table(law, &table, options)?;
-    law.provenance = law.provenance.with_input(&source, &bytes);
-    Ok(law)
+    fit_table(law, &table, options)
 }
 
 /// Name of the column in which grainlaw's scenarios judge each point of a table (0 passed its

@@ -14,10 +14,12 @@ use pyo3::types::{PyDict, PyList};
 use crate::errors::{cli_err, input, panic_err, OutputError};
 use crate::world::Snapshot;
 
-/// The reader options of `grainlaw homogenise`'s flags (`--mu`, `--dt`, `--gravity`,
-/// `--inertia-factor`, `--density`, `--column`).
+/// The reader options of `grainlaw homogenise`'s flags (`--mu`, `--wall-mu`, `--dt`,
+/// `--gravity`, `--inertia-factor`, `--density`, `--column`).
+#[allow(clippy::too_many_arguments)]
 fn read_options(
     mu: Option<f64>,
+    wall_mu: Option<f64>,
     dt: Option<f64>,
     gravity: (f64, f64),
     inertia_factor: f64,
@@ -27,6 +29,7 @@ fn read_options(
     grainlaw::readers::ReadOptions {
         gravity: [gravity.0, gravity.1],
         mu,
+        wall_mu,
         dt,
         inertia_factor,
         density,
@@ -35,23 +38,31 @@ fn read_options(
 }
 
 /// read_snapshots(format, files, mu=None, dt=None, gravity=(0.0, -9.81), inertia_factor=0.5,
-/// density=None, columns=None)
+/// density=None, columns=None, wall_mu=None)
 ///
 /// Reads the snapshots of another DEM code, as ``grainlaw homogenise --from FORMAT FILES``
 /// does. ``format``: ``"lammps"`` (or ``"liggghts"``), ``"lmgc90"`` or ``"plain"``; ``files``:
 /// paths (plain or gzip). ``mu``: friction coefficient given to every contact (for the
-/// mobilisation); ``dt`` (s): time step when the files do not give times; ``gravity`` (m/s²);
+/// mobilisation); ``wall_mu``: that of the wall contacts when the walls have their own
+/// (default ``mu``); ``dt`` (s): time step when the files do not give times; ``gravity`` (m/s²);
 /// ``inertia_factor``: ``k`` in ``I = k m R²`` for codes that do not write ``I`` (1/2 disks,
 /// 2/5 spheres); ``density`` (kg/m³): LMGC90's grain density; ``columns``: dict ``{key:
 /// header}`` of LAMMPS local-dump column names.
 ///
+/// LAMMPS cells are read from the dump headers (orthogonal or triclinic, periodic or not per
+/// axis, docs/formats.md §7.1): pairs take the minimum image of the cell; a biperiodic cell is
+/// the snapshot's ``cell`` (positions relative to its corner), over which the whole-sample
+/// functions (``mean_stress``, ``solid_fraction`` without a region) average.
+///
 /// Returns a list, one dict per snapshot in time order: ``snapshot`` (a ``Snapshot``),
 /// ``grain_ids`` (int64 array, the other code's ids, in the order of the snapshot's grains),
 /// ``accelerations`` (``"file"``, ``"backward_difference"``, ``"forward_difference"`` or
-/// ``"zero"``: where the inertia part of the stress takes ``ω̇`` from) and ``source`` (the
-/// file). Raises ``InputError`` naming the file and line of what cannot be read.
+/// ``"zero"``: where the inertia part of the stress takes ``ω̇`` from), ``velocity_gradient``
+/// (``"cell_deformation"``, ``"velocity_profile"`` or None: where the velocity gradient of a
+/// biperiodic cell comes from) and ``source`` (the file). Raises ``InputError`` naming the file
+/// and line of what cannot be read.
 #[pyfunction]
-#[pyo3(signature = (format, files, mu=None, dt=None, gravity=(0.0, -9.81), inertia_factor=0.5, density=None, columns=None))]
+#[pyo3(signature = (format, files, mu=None, dt=None, gravity=(0.0, -9.81), inertia_factor=0.5, density=None, columns=None, wall_mu=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn read_snapshots<'py>(
     py: Python<'py>,
@@ -63,9 +74,10 @@ pub fn read_snapshots<'py>(
     inertia_factor: f64,
     density: Option<f64>,
     columns: Option<std::collections::BTreeMap<String, String>>,
+    wall_mu: Option<f64>,
 ) -> PyResult<Bound<'py, PyList>> {
     let format: grainlaw::readers::Format = format.parse().map_err(input)?;
-    let opts = read_options(mu, dt, gravity, inertia_factor, density, columns);
+    let opts = read_options(mu, wall_mu, dt, gravity, inertia_factor, density, columns);
     let snaps = py
         .detach(|| grainlaw::readers::read(format, &files, &opts))
         .map_err(|e| input(e.to_string()))?;
@@ -77,6 +89,7 @@ pub fn read_snapshots<'py>(
             PyArray1::from_vec(py, s.grain_ids.iter().map(|&i| i as i64).collect()),
         )?;
         d.set_item("accelerations", s.accelerations.name())?;
+        d.set_item("velocity_gradient", s.velocity_gradient.map(|g| g.name()))?;
         d.set_item("source", s.source)?;
         d.set_item("snapshot", Snapshot { inner: s.snapshot })?;
         list.append(d)?;
@@ -85,7 +98,7 @@ pub fn read_snapshots<'py>(
 }
 
 /// homogenise(format, files, out, mu=None, dt=None, gravity=(0.0, -9.81), inertia_factor=0.5,
-/// density=None, columns=None)
+/// density=None, columns=None, wall_mu=None)
 /// --
 ///
 /// Homogenises the snapshots of another DEM code and writes every output of
@@ -93,8 +106,10 @@ pub fn read_snapshots<'py>(
 /// snapshot ``grains_STEP.csv``, a row of ``snapshots.csv``, a row per wall of ``walls.csv``
 /// and a VTK frame (``vtk/*.vtp``, ``grains.pvd``, ``contacts.pvd``, ``walls.pvd``); for the
 /// last snapshot ``stress_profile.csv`` and ``.png``, ``wall_profile_WALL.csv``,
-/// ``mobilisation.csv`` (with ``mu``), ``coarse.csv``, ``grains.png``; ``summary.json`` last
-/// (files and keys in docs/outputs.md §4). Stresses in Pa, tension positive.
+/// ``mobilisation.csv`` (with ``mu``), ``coarse.csv``, ``grains.png``; ``janssen.csv`` for a
+/// column between two vertical walls; ``rheology.csv`` (the point of μ(I), φ(I)) for a series
+/// of a sheared biperiodic cell; ``summary.json`` last (files and keys in docs/outputs.md §4).
+/// Stresses in Pa, tension positive.
 ///
 /// ``format``, ``files`` and the options as in ``read_snapshots``; ``out``: the output
 /// directory (str or os.PathLike; created if needed).
@@ -105,9 +120,11 @@ pub fn read_snapshots<'py>(
 /// The GIL is released while it runs.
 ///
 /// Raises ``InputError`` (a file that cannot be read, naming file and line; an option out of
-/// its domain; ``out`` a file) or ``OutputError`` (a file that cannot be written).
+/// its domain; ``out`` a file), ``OutputError`` (a file that cannot be written), or the
+/// ``GrainlawError`` (a refused result) when the simple-shear point is refused, every
+/// file written.
 #[pyfunction]
-#[pyo3(signature = (format, files, out, mu=None, dt=None, gravity=(0.0, -9.81), inertia_factor=0.5, density=None, columns=None))]
+#[pyo3(signature = (format, files, out, mu=None, dt=None, gravity=(0.0, -9.81), inertia_factor=0.5, density=None, columns=None, wall_mu=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn homogenise<'py>(
     py: Python<'py>,
@@ -120,13 +137,14 @@ pub fn homogenise<'py>(
     inertia_factor: f64,
     density: Option<f64>,
     columns: Option<std::collections::BTreeMap<String, String>>,
+    wall_mu: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let format: grainlaw::readers::Format = format.parse().map_err(input)?;
     let plan = grainlaw::homogenise_cmd::HomogenisePlan {
         format,
         files,
         out: out.clone(),
-        options: read_options(mu, dt, gravity, inertia_factor, density, columns),
+        options: read_options(mu, wall_mu, dt, gravity, inertia_factor, density, columns),
         quiet: true,
     };
     let outcome = py

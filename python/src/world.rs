@@ -627,6 +627,25 @@ impl Snapshot {
     fn gravity(&self) -> (f64, f64) {
         (self.inner.gravity.x, self.inner.gravity.y)
     }
+    /// Periodic cell along x ``(x_min, x_max)`` (m), or None.
+    #[getter]
+    fn periodic_x(&self) -> Option<(f64, f64)> {
+        self.inner.periodic_x.map(|[a, b]| (a, b))
+    }
+    /// The biperiodic cell, or None: a dict with ``h`` (2, 2), the cell matrix whose columns
+    /// are the cell's edges (m, corner at the origin), ``velocity_gradient`` (2, 2) L (1/s), and
+    /// ``area`` det h (m²).
+    #[getter]
+    fn cell<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(c) = self.inner.cell else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("h", crate::arrays::out_tensor(py, &c.h)?)?;
+        d.set_item("velocity_gradient", crate::arrays::out_tensor(py, &c.l)?)?;
+        d.set_item("area", c.volume())?;
+        Ok(Some(d))
+    }
     /// Number of bodies.
     fn __len__(&self) -> usize {
         self.inner.bodies.len()

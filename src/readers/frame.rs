@@ -12,14 +12,30 @@
 //!   where codes such as LAMMPS apply the torque).
 //!
 //! `f_n = F·n`, `f_t = F·t` with `t = (−n_y, n_x)` ([`dem::snapshot::ContactState`]).
+//!
+//! **Periodic cells** ([`FrameCell`], a LAMMPS box): "nearest periodic image" is the minimum
+//! image of the cell's lattice. A cell periodic along both edges (biperiodic, possibly tilted)
+//! becomes the snapshot's [`dem::cell::Cell`] (`h = [a₁ a₂]`, corner at the origin: positions
+//! are taken relative to the file's corner and wrapped into the cell), its images those of
+//! [`dem::cell::Cell::min_image`]; its velocity gradient `L` is the cell's own rate of
+//! deformation `L = ḣ h⁻¹` between consecutive snapshots (`h` of the later one and the earlier
+//! one with its tilt unwrapped by whole periods, `ḣ = Δh/Δt`, `h` at the middle: exact for a
+//! tilt growing linearly, `L_xy = Δxy/(l_y Δt)`), the first snapshot taking the interval with
+//! the second; for a single snapshot, or snapshots without times, the mass-weighted affine fit
+//! of the grain velocities over the cell ([`homogenise::kinematics::velocity_gradient`]).
+//! [`GradientSource`] says which. A cell periodic along one edge only gives the images along
+//! that edge (`x ± l_x`; `x ± a₂`).
 
 use std::collections::HashMap;
 
+use dem::cell::{Cell, Mat};
 use dem::local::ContactStatus;
 use dem::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
+use homogenise::kinematics::{velocity_gradient, VelocityWeight};
+use homogenise::Region;
 use nalgebra::Vector2;
 
-use super::{AccelerationSource, ExternalSnapshot, ReadError, ReadOptions};
+use super::{AccelerationSource, ExternalSnapshot, GradientSource, ReadError, ReadOptions};
 
 /// One grain as a file describes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +98,35 @@ pub struct ContactRecord {
     pub normal: Option<Vector2<f64>>,
 }
 
+/// The periodic cell of a frame, as LAMMPS describes its box: the parallelogram with corner
+/// `origin` and edges `a₁ = (l_x, 0)`, `a₂ = (xy, l_y)` (m), periodic along `a₁` when
+/// `periodic[0]` and along `a₂` when `periodic[1]` (a non-periodic edge only bounds the box).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameCell {
+    /// Corner `(x_lo, y_lo)` (m).
+    pub origin: Vector2<f64>,
+    /// Length along x `l_x = x_hi − x_lo` (m).
+    pub lx: f64,
+    /// Height `l_y = y_hi − y_lo` (m).
+    pub ly: f64,
+    /// Tilt `xy` (m): the x offset of the top edge from the bottom one.
+    pub xy: f64,
+    /// Periodic along `a₁` (x) and along `a₂`.
+    pub periodic: [bool; 2],
+}
+
+impl FrameCell {
+    /// The cell matrix `h = [a₁ a₂] = [[l_x, xy], [0, l_y]]` (m).
+    pub fn matrix(&self) -> Mat {
+        Mat::new(self.lx, self.xy, 0.0, self.ly)
+    }
+
+    /// Whether the cell is periodic along both edges.
+    pub fn biperiodic(&self) -> bool {
+        self.periodic == [true, true]
+    }
+}
+
 /// One snapshot as a reader found it.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Frame {
@@ -89,8 +134,10 @@ pub struct Frame {
     pub step: u64,
     /// Time (s) when known.
     pub time: Option<f64>,
-    /// Periodic cell along x, if any.
+    /// Periodic cell along x, if any (when [`Frame::cell`] is `None`).
     pub periodic_x: Option<[f64; 2]>,
+    /// The periodic cell (LAMMPS' box), if the file describes one; it overrides `periodic_x`.
+    pub cell: Option<FrameCell>,
     /// The grains.
     pub grains: Vec<GrainRecord>,
     /// The walls.
@@ -108,13 +155,46 @@ fn content(source: &str, reason: String) -> ReadError {
     }
 }
 
-/// `d` mapped to the nearest periodic image along x.
-fn min_image(mut d: Vector2<f64>, periodic_x: Option<[f64; 2]>) -> Vector2<f64> {
-    if let Some([a, b]) = periodic_x {
-        let l = b - a;
-        d.x -= l * (d.x / l).round();
+/// The periodic images of a frame.
+enum Images {
+    None,
+    /// Along x with this period (m).
+    X(f64),
+    /// Along the edge `a₂` (m) alone.
+    Edge(Vector2<f64>),
+    /// Biperiodic cell.
+    Cell(Cell),
+}
+
+impl Images {
+    fn of(f: &Frame) -> Result<Self, ReadError> {
+        Ok(match (f.cell, f.periodic_x) {
+            (Some(c), _) if c.biperiodic() => Images::Cell(cell_of(f, &c, Mat::zeros())?),
+            (Some(c), _) if c.periodic[0] => Images::X(c.lx),
+            (Some(c), _) if c.periodic[1] => Images::Edge(Vector2::new(c.xy, c.ly)),
+            (Some(_), _) => Images::None,
+            (None, Some([a, b])) => Images::X(b - a),
+            (None, None) => Images::None,
+        })
     }
-    d
+
+    /// `d` mapped to its shortest periodic image.
+    fn min(&self, mut d: Vector2<f64>) -> Vector2<f64> {
+        match self {
+            Images::None => d,
+            Images::X(l) => {
+                d.x -= l * (d.x / l).round();
+                d
+            }
+            Images::Edge(a2) => d - a2 * (d.y / a2.y).round(),
+            Images::Cell(c) => c.min_image(&d).0,
+        }
+    }
+}
+
+/// The [`Cell`] of a frame's biperiodic cell with the velocity gradient `l` (1/s).
+fn cell_of(f: &Frame, c: &FrameCell, l: Mat) -> Result<Cell, ReadError> {
+    Cell::new(c.matrix(), l).map_err(|e| content(&f.source, format!("the periodic cell: {e}")))
 }
 
 /// Per grain, the acceleration (m/s²) and angular acceleration (rad/s²).
@@ -226,22 +306,102 @@ pub fn build_snapshots(
             })
             .flatten()
     });
+    let gradients = cell_gradients(&frames, &times);
     frames
         .into_iter()
         .zip(acc)
         .zip(times)
-        .map(|((f, (a, src)), t)| build_one(f, a, src, t, dt_all, opts))
+        .zip(gradients)
+        .map(|(((f, (a, src)), t), l)| build_one(f, a, src, t, dt_all, l, opts))
         .collect()
 }
 
+/// The velocity gradient `L = ḣ h⁻¹` (1/s) of each frame's biperiodic cell from the cell's
+/// deformation between consecutive frames (module documentation): the interval ending at the
+/// frame, the first frame taking the one after it; `None` for a frame without a biperiodic
+/// cell, and for every frame when there is a single frame or a time is unknown (the velocity
+/// profile then gives `L`, [`build_one`]).
+fn cell_gradients(frames: &[Frame], times: &[Option<f64>]) -> Vec<Option<Mat>> {
+    let n = frames.len();
+    let cells: Vec<Option<FrameCell>> = frames
+        .iter()
+        .map(|f| f.cell.filter(FrameCell::biperiodic))
+        .collect();
+    if n < 2 || times.iter().any(Option::is_none) {
+        return vec![None; n];
+    }
+    let rate = |j0: usize, j1: usize| -> Option<Mat> {
+        let (c0, c1) = (cells[j0]?, cells[j1]?);
+        let (t0, t1) = (times[j0]?, times[j1]?);
+        let dt = t1 - t0;
+        if !(dt > 0.0 && dt.is_finite()) {
+            return None;
+        }
+        // a flip of the tilt between the two (LAMMPS' `fix deform ... flip yes`) moves a₂ by a
+        // whole a₁: undone on the earlier cell
+        let mut h0 = c0.matrix();
+        let h1 = c1.matrix();
+        let m = ((h1[(0, 1)] - h0[(0, 1)]) / c0.lx).round();
+        h0[(0, 1)] += m * c0.lx;
+        let mid = (h0 + h1) * 0.5;
+        let inv = mid.try_inverse()?;
+        let l = (h1 - h0) / dt * inv;
+        l.iter().all(|v| v.is_finite()).then_some(l)
+    };
+    (0..n)
+        .map(|k| {
+            cells[k]?;
+            if k == 0 {
+                rate(0, 1)
+            } else {
+                rate(k - 1, k)
+            }
+        })
+        .collect()
+}
+
+/// Moves a frame with a biperiodic cell to the cell's frame: every position relative to the
+/// cell's corner, grain centres wrapped into the cell (their velocities unchanged: LAMMPS'
+/// `remap v` velocities are those of the wrapped atom).
+fn to_cell_frame(f: &mut Frame, c: &FrameCell) -> Result<(), ReadError> {
+    let cell = cell_of(f, c, Mat::zeros())?;
+    let o = c.origin;
+    for g in &mut f.grains {
+        g.position = cell.wrap(&(g.position - o)).0;
+    }
+    for w in &mut f.walls {
+        w.position -= o;
+        match &mut w.geometry {
+            WallGeometry::Line { point, .. } => *point -= o,
+            WallGeometry::Segment { a, b } => {
+                *a -= o;
+                *b -= o;
+            }
+            WallGeometry::Clump { centres, .. } => centres.iter_mut().for_each(|p| *p -= o),
+        }
+    }
+    for ct in &mut f.contacts {
+        if let Some(p) = &mut ct.point {
+            *p -= o;
+        }
+    }
+    Ok(())
+}
+
 fn build_one(
-    f: Frame,
+    mut f: Frame,
     acc: Vec<(Vector2<f64>, f64)>,
     src: AccelerationSource,
     time: Option<f64>,
     dt: Option<f64>,
+    gradient: Option<Mat>,
     opts: &ReadOptions,
 ) -> Result<ExternalSnapshot, ReadError> {
+    let biperiodic = f.cell.filter(FrameCell::biperiodic);
+    if let Some(c) = &biperiodic {
+        to_cell_frame(&mut f, c)?;
+    }
+    let images = Images::of(&f)?;
     let mut index: HashMap<u64, u32> = HashMap::with_capacity(f.grains.len());
     let mut bodies = Vec::with_capacity(f.grains.len() + f.walls.len());
     for (g, (a, w)) in f.grains.iter().zip(&acc) {
@@ -299,6 +459,7 @@ fn build_one(
         });
     }
     let mu = opts.mu.unwrap_or(0.0);
+    let wall_mu = opts.wall_mu.or(opts.mu).unwrap_or(0.0);
     let mut contacts = Vec::with_capacity(f.contacts.len());
     let mut wall_force = vec![(Vector2::zeros(), 0.0); f.walls.len()];
     for c in &f.contacts {
@@ -328,7 +489,7 @@ fn build_one(
                     ));
                 }
                 let ga = &bodies[ia as usize];
-                let d = min_image(cb - ga.position, f.periodic_x);
+                let d = images.min(cb - ga.position);
                 let dist = d.norm();
                 let n = match c.normal {
                     Some(n) => n,
@@ -390,8 +551,12 @@ fn build_one(
         let t = Vector2::new(-normal.y, normal.x);
         let (fn_, ft) = (c.force.dot(&normal), c.force.dot(&t));
         let ca = bodies[ia as usize].position;
-        let lever_a = min_image(point - ca, f.periodic_x);
-        let lever_b = min_image(point - cb, f.periodic_x);
+        let lever_a = images.min(point - ca);
+        let lever_b = images.min(point - cb);
+        let mu = match c.a {
+            Other::Grain(_) => mu,
+            Other::Wall(_) => wall_mu,
+        };
         let status = if fn_ == 0.0 && ft == 0.0 {
             ContactStatus::Open
         } else if mu > 0.0 && ft.abs() >= 0.999 * mu * fn_ {
@@ -430,20 +595,48 @@ fn build_one(
         })
         .collect();
     let grain_ids = f.grains.iter().map(|g| g.id).collect();
+    let periodic_x = match f.cell {
+        Some(c) if c.periodic == [true, false] => Some([c.origin.x, c.origin.x + c.lx]),
+        Some(_) => None,
+        None => f.periodic_x,
+    };
+    let cell = match &biperiodic {
+        Some(c) => Some(cell_of(&f, c, gradient.unwrap_or_else(Mat::zeros))?),
+        None => None,
+    };
+    let mut snapshot = Snapshot {
+        step: f.step,
+        time: time.unwrap_or(f.step as f64),
+        dt: dt.filter(|d| *d > 0.0 && d.is_finite()).unwrap_or(1.0),
+        gravity: Vector2::new(opts.gravity[0], opts.gravity[1]),
+        periodic_x,
+        cell,
+        bodies,
+        contacts,
+        walls,
+    };
+    let velocity_gradient = match (&biperiodic, gradient) {
+        (None, _) => None,
+        (Some(_), Some(_)) => Some(GradientSource::CellDeformation),
+        (Some(c), None) => {
+            // the mass-weighted affine fit of the grain velocities over the cell
+            let fit = velocity_gradient(&snapshot, &Region::Whole, VelocityWeight::Mass).map_err(
+                |e| {
+                    content(
+                        &f.source,
+                        format!("the velocity gradient of the cell from the grain velocities: {e}"),
+                    )
+                },
+            )?;
+            snapshot.cell = Some(cell_of(&f, c, fit.gradient)?);
+            Some(GradientSource::VelocityProfile)
+        }
+    };
     Ok(ExternalSnapshot {
-        snapshot: Snapshot {
-            step: f.step,
-            time: time.unwrap_or(f.step as f64),
-            dt: dt.filter(|d| *d > 0.0 && d.is_finite()).unwrap_or(1.0),
-            gravity: Vector2::new(opts.gravity[0], opts.gravity[1]),
-            periodic_x: f.periodic_x,
-            cell: None,
-            bodies,
-            contacts,
-            walls,
-        },
+        snapshot,
         grain_ids,
         accelerations: src,
+        velocity_gradient,
         source: f.source,
     })
 }

@@ -19,7 +19,15 @@
 //!
 //! The moment of inertia is `I = k m R²` with `k` = [`ReadOptions::inertia_factor`] (1/2 for
 //! disks, `fix nve/sphere disc`). A dump file may hold several snapshots; per-atom and local
-//! blocks are matched by their `TIMESTEP`. Periodic x (`BOX BOUNDS pp ..`) sets the cell.
+//! blocks are matched by their `TIMESTEP`.
+//!
+//! The cell is the box of the per-atom block's header, as LAMMPS writes it: orthogonal
+//! (`ITEM: BOX BOUNDS pp ff pp`, lines `lo hi`) or triclinic (`ITEM: BOX BOUNDS xy xz yz pp pp
+//! pp`, lines `lo_bound hi_bound tilt`, turned into the box's edges by the conversion of the
+//! LAMMPS documentation, [`parse_box`]), periodic or not along x and y by its flags; every pair
+//! takes the minimum image of that cell (`frame` module). Refused: a periodic cell tilted
+//! beyond [`MAX_TILT_RATIO`], a 3D dump (z not periodic, z tilts, atoms off the plane z = 0),
+//! and a series whose atom count or kind of box changes ([`check_series`]).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -27,7 +35,7 @@ use std::path::{Path, PathBuf};
 use dem::snapshot::WallGeometry;
 use nalgebra::Vector2;
 
-use super::frame::{ContactRecord, Frame, GrainRecord, Other, WallRecord};
+use super::frame::{ContactRecord, Frame, FrameCell, GrainRecord, Other, WallRecord};
 use super::{build_snapshots, number, read_text, ExternalSnapshot, ReadError, ReadOptions};
 
 /// Keys of the local (pair) columns and their default header names.
@@ -59,18 +67,152 @@ enum Kind {
     Entries,
 }
 
+/// Largest tilt of a periodic LAMMPS cell over its x length, `|xy| / l_x` (LAMMPS refuses a
+/// box beyond one half, "Triclinic box skew is too large"); the 10⁻³ above it allows the step
+/// at which `fix deform` has passed the half and flips the cell at the next one.
+pub const MAX_TILT_RATIO: f64 = 0.5 + 1e-3;
+
+/// The box of a dump block (`ITEM: BOX BOUNDS`), converted to a [`FrameCell`].
+#[derive(Debug, Clone, Copy)]
+struct DumpBox {
+    cell: FrameCell,
+    /// `ITEM: BOX BOUNDS xy xz yz ...` (a triclinic box).
+    triclinic: bool,
+    /// Line of the `ITEM: BOX BOUNDS` header (1-based).
+    line: usize,
+}
+
+impl DumpBox {
+    /// How the box reads in a message: `orthogonal pp ff` or `triclinic pp pp`.
+    fn describe(&self) -> String {
+        let f = |p: bool| if p { "periodic" } else { "not periodic" };
+        format!(
+            "{} box, x {}, y {}",
+            if self.triclinic {
+                "triclinic"
+            } else {
+                "orthogonal"
+            },
+            f(self.cell.periodic[0]),
+            f(self.cell.periodic[1])
+        )
+    }
+}
+
 /// One block of a dump file.
 #[derive(Debug)]
 struct Block {
     kind: Kind,
     step: u64,
     time: Option<f64>,
-    periodic_x: Option<[f64; 2]>,
+    /// The box, when the block has one.
+    cell: Option<DumpBox>,
     header: Vec<String>,
     /// Line number of the first row.
     first_line: usize,
+    /// Line of the count (`ITEM: NUMBER OF ...` value), 1-based.
+    count_line: usize,
     cols: usize,
     values: Vec<f64>,
+}
+
+/// Reads the three lines of `ITEM: BOX BOUNDS [xy xz yz] FLAGS` (the header at 0-based line
+/// `ln`, `rest` what follows `BOX BOUNDS`): bounds `lo hi` per axis, with the tilt factors as
+/// third numbers when the box is triclinic. The triclinic bounds are those of the box's
+/// bounding box, turned into its edges as the LAMMPS documentation ("Triclinic (non-orthogonal)
+/// simulation boxes") gives: `x_lo = x_lo,bound − min(0, xy, xz, xy + xz)`,
+/// `x_hi = x_hi,bound − max(0, xy, xz, xy + xz)`, `y_lo = y_lo,bound − min(0, yz)`,
+/// `y_hi = y_hi,bound − max(0, yz)`. A 2D run's box is periodic in z without z tilts: anything
+/// else is a 3D dump, refused.
+fn parse_box<'a>(
+    path: &Path,
+    ln: usize,
+    rest: &str,
+    lines: &mut impl Iterator<Item = (usize, &'a str)>,
+) -> Result<DumpBox, ReadError> {
+    let tokens: Vec<&str> = rest.split_whitespace().collect();
+    let triclinic = tokens.contains(&"xy");
+    let flags: Vec<&str> = tokens
+        .iter()
+        .copied()
+        .filter(|f| f.len() == 2 && f.chars().all(|c| "pfsm".contains(c)))
+        .collect();
+    let header_line = ln + 1;
+    if flags.len() == 3 && flags[2] != "pp" {
+        return Err(ReadError::parse(
+            path,
+            header_line,
+            format!(
+                "a 3D dump (the z boundary is `{}`; LAMMPS' 2D runs are periodic in z): 3D is not supported yet, grainlaw reads 2D dumps",
+                flags[2]
+            ),
+        ));
+    }
+    let mut axes = [[0.0; 3]; 3];
+    for (a, name) in ["x", "y", "z"].iter().enumerate() {
+        let (l, t) = lines.next().ok_or_else(|| {
+            ReadError::parse(path, header_line, "the file ends within the box bounds")
+        })?;
+        let xs: Vec<&str> = t.split_whitespace().collect();
+        let need = if triclinic { 3 } else { 2 };
+        if xs.len() < need {
+            return Err(ReadError::parse(
+                path,
+                l + 1,
+                format!(
+                    "the {name} bounds of a {} box need {need} numbers, got {}",
+                    if triclinic { "triclinic" } else { "orthogonal" },
+                    xs.len()
+                ),
+            ));
+        }
+        for k in 0..need {
+            axes[a][k] = number(path, l + 1, &format!("{name} bound"), xs[k])?;
+        }
+    }
+    let [[xlb, xhb, xy], [ylb, yhb, xz], [_, _, yz]] = axes;
+    if xz != 0.0 || yz != 0.0 {
+        return Err(ReadError::parse(
+            path,
+            header_line,
+            format!("a 3D dump (tilt factors xz = {xz}, yz = {yz}; a 2D box has none): 3D is not supported yet, grainlaw reads 2D dumps"),
+        ));
+    }
+    let (xlo, xhi) = (
+        xlb - 0f64.min(xy).min(xz).min(xy + xz),
+        xhb - 0f64.max(xy).max(xz).max(xy + xz),
+    );
+    let (ylo, yhi) = (ylb - 0f64.min(yz), yhb - 0f64.max(yz));
+    let (lx, ly) = (xhi - xlo, yhi - ylo);
+    if !(lx > 0.0 && ly > 0.0) {
+        return Err(ReadError::parse(
+            path,
+            header_line,
+            format!("the box has no area: x from {xlo} to {xhi}, y from {ylo} to {yhi}"),
+        ));
+    }
+    let periodic = [flags.first() == Some(&"pp"), flags.get(1) == Some(&"pp")];
+    if periodic[0] && xy.abs() > MAX_TILT_RATIO * lx {
+        return Err(ReadError::parse(
+            path,
+            header_line,
+            format!(
+                "the cell's tilt xy = {xy:e} m is {:.3} of its x length {lx:e} m: beyond LAMMPS' own limit of one half (a box read wrong, or a run with `box tilt large`, which grainlaw does not read)",
+                xy.abs() / lx
+            ),
+        ));
+    }
+    Ok(DumpBox {
+        cell: FrameCell {
+            origin: Vector2::new(xlo, ylo),
+            lx,
+            ly,
+            xy,
+            periodic,
+        },
+        triclinic,
+        line: header_line,
+    })
 }
 
 impl Block {
@@ -89,8 +231,8 @@ fn parse_blocks(path: &Path, text: &str) -> Result<Vec<Block>, ReadError> {
     let mut lines = text.lines().enumerate().peekable();
     let mut time = None;
     let mut step: Option<u64> = None;
-    let mut count: Option<usize> = None;
-    let mut periodic_x = None;
+    let mut count: Option<(usize, usize)> = None;
+    let mut cell = None;
     let err = |l: usize, r: String| ReadError::parse(path, l + 1, r);
     while let Some((ln, line)) = lines.next() {
         let line = line.trim();
@@ -121,28 +263,14 @@ fn parse_blocks(path: &Path, text: &str) -> Result<Vec<Block>, ReadError> {
             time = Some(number(path, l + 1, "time", t)?);
         } else if item.starts_with("NUMBER OF") {
             let (l, t) = next_line("count")?;
-            count = Some(
+            count = Some((
                 t.trim()
                     .parse()
                     .map_err(|_| err(l, format!("count `{}` is not an integer", short(t))))?,
-            );
-        } else if let Some(flags) = item.strip_prefix("BOX BOUNDS") {
-            let flags: Vec<&str> = flags
-                .split_whitespace()
-                .filter(|f| f.len() == 2 && f.chars().all(|c| "pfsm".contains(c)))
-                .collect();
-            let (l, t) = next_line("box bounds")?;
-            let xs: Vec<&str> = t.split_whitespace().collect();
-            if xs.len() < 2 {
-                return Err(err(l, "box bounds need two numbers".into()));
-            }
-            let (lo, hi) = (
-                number(path, l + 1, "xlo", xs[0])?,
-                number(path, l + 1, "xhi", xs[1])?,
-            );
-            periodic_x = (flags.first() == Some(&"pp")).then_some([lo, hi]);
-            next_line("box bounds")?;
-            next_line("box bounds")?;
+                l + 1,
+            ));
+        } else if let Some(rest) = item.strip_prefix("BOX BOUNDS") {
+            cell = Some(parse_box(path, ln, rest, &mut lines)?);
         } else if let Some(cols) = item
             .strip_prefix("ATOMS")
             .or_else(|| item.strip_prefix("ENTRIES"))
@@ -154,7 +282,7 @@ fn parse_blocks(path: &Path, text: &str) -> Result<Vec<Block>, ReadError> {
             };
             let header: Vec<String> = cols.split_whitespace().map(String::from).collect();
             let s = step.ok_or_else(|| err(ln, "no `ITEM: TIMESTEP` before the data".into()))?;
-            let n =
+            let (n, count_line) =
                 count.ok_or_else(|| err(ln, "no `ITEM: NUMBER OF ...` before the data".into()))?;
             let ncols = header.len();
             let mut values = Vec::with_capacity(n * ncols);
@@ -183,9 +311,10 @@ fn parse_blocks(path: &Path, text: &str) -> Result<Vec<Block>, ReadError> {
                 kind,
                 step: s,
                 time: time.take(),
-                periodic_x,
+                cell: cell.take(),
                 header,
                 first_line: ln + 2,
+                count_line,
                 cols: ncols,
                 values,
             });
@@ -262,11 +391,25 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
         _ => None,
     };
     let walls = wall_columns(b);
+    // a 2D run keeps every atom in the plane z = 0 (`fix enforce2d`): z that differ are 3D
+    if let Some(z) = b.col(&["z", "zu", "zs"]) {
+        let z0 = b.values.get(z).copied().unwrap_or(0.0);
+        if let Some(row) = (0..b.rows()).find(|&r| b.values[r * b.cols + z] != z0) {
+            return Err(ReadError::parse(
+                path,
+                b.first_line + row,
+                format!(
+                    "a 3D dump (atom z = {} where the first atom's is {z0}): 3D is not supported yet, grainlaw reads 2D dumps",
+                    b.values[row * b.cols + z]
+                ),
+            ));
+        }
+    }
     let k = opts.inertia_factor;
     let mut frame = Frame {
         step: b.step,
         time: b.time,
-        periodic_x: b.periodic_x,
+        cell: b.cell.map(|c| c.cell),
         source: path.display().to_string(),
         ..Default::default()
     };
@@ -569,6 +712,45 @@ fn add_walls(
     Ok(())
 }
 
+/// One series is one sample: every per-atom snapshot has as many atoms as the first, and a box
+/// of the same kind (orthogonal or triclinic, the same periodic axes; its size and tilt may
+/// change). The first snapshot that differs is named by its file and line.
+fn check_series(
+    series: &BTreeMap<u64, (PathBuf, Option<DumpBox>, usize, usize)>,
+) -> Result<(), ReadError> {
+    let mut it = series.iter();
+    let Some((s0, (p0, b0, _, n0))) = it.next() else {
+        return Ok(());
+    };
+    for (s, (p, b, count_line, n)) in it {
+        if n != n0 {
+            return Err(ReadError::parse(
+                p,
+                *count_line,
+                format!(
+                    "step {s} has {n} atoms where step {s0} ({}) has {n0}: a series must keep its grains (homogenise snapshots of another sample separately)",
+                    p0.display()
+                ),
+            ));
+        }
+        let kind = |b: &Option<DumpBox>| b.map(|b| (b.triclinic, b.cell.periodic));
+        if kind(b) != kind(b0) {
+            let describe = |b: &Option<DumpBox>| b.map_or("no box".to_string(), |b| b.describe());
+            return Err(ReadError::parse(
+                p,
+                b.map_or(*count_line, |b| b.line),
+                format!(
+                    "the cell changes within the series: step {s} has a {} where step {s0} ({}) has a {}",
+                    describe(b),
+                    p0.display(),
+                    describe(b0)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads LAMMPS/LIGGGHTS dumps: per-atom files and pair-force local files in any order (the
 /// kind of each block is told by its `ITEM: ATOMS` or `ITEM: ENTRIES` line), gzip or plain.
 /// One snapshot per per-atom block, with the local block of the same time step.
@@ -577,6 +759,8 @@ pub fn read_lammps(
     opts: &ReadOptions,
 ) -> Result<Vec<ExternalSnapshot>, ReadError> {
     let mut frames: BTreeMap<u64, Frame> = BTreeMap::new();
+    // per step: the file, its box and the line of its atom count (the series checks)
+    let mut series: BTreeMap<u64, (PathBuf, Option<DumpBox>, usize, usize)> = BTreeMap::new();
     let mut locals: Vec<(PathBuf, Block)> = Vec::new();
     for path in files {
         let text = read_text(path)?;
@@ -591,6 +775,7 @@ pub fn read_lammps(
             match b.kind {
                 Kind::Atoms => {
                     let f = atoms_frame(path, &b, opts)?;
+                    series.insert(b.step, (path.clone(), b.cell, b.count_line, b.rows()));
                     if frames.insert(b.step, f).is_some() {
                         return Err(ReadError::content(
                             path,
@@ -612,6 +797,7 @@ pub fn read_lammps(
             reason: "no per-atom dump (`ITEM: ATOMS`): the grains are needed".into(),
         });
     }
+    check_series(&series)?;
     let mut seen = std::collections::HashSet::new();
     for (path, b) in &locals {
         let f = frames.get_mut(&b.step).ok_or_else(|| {

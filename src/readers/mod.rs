@@ -24,7 +24,7 @@ pub mod plain;
 
 use std::path::Path;
 
-pub use frame::{build_snapshots, ContactRecord, Frame, GrainRecord, Other, WallRecord};
+pub use frame::{build_snapshots, ContactRecord, Frame, FrameCell, GrainRecord, Other, WallRecord};
 pub use lammps::read_lammps;
 pub use lmgc90::read_lmgc90;
 pub use plain::read_plain;
@@ -109,6 +109,30 @@ impl AccelerationSource {
     }
 }
 
+/// Where the velocity gradient `L` of a biperiodic cell comes from (the affine field that the
+/// kinetic stress and the shear rate of a representative volume refer to; `frame` module
+/// documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GradientSource {
+    /// The cell's own rate of deformation between consecutive snapshots, `L = ḣ h⁻¹` (for
+    /// simple shear the tilt rate over the height, `γ̇ = ẋy / l_y`).
+    CellDeformation,
+    /// The mass-weighted affine fit of the grain velocities over the cell (a single snapshot,
+    /// or snapshots without times).
+    VelocityProfile,
+}
+
+impl GradientSource {
+    /// The name written in outputs: `cell_deformation` or `velocity_profile`.
+    pub fn name(self) -> &'static str {
+        match self {
+            GradientSource::CellDeformation => "cell_deformation",
+            GradientSource::VelocityProfile => "velocity_profile",
+        }
+    }
+}
+
 /// A snapshot read from another code, with what the reader had to supply.
 #[derive(Debug, Clone)]
 pub struct ExternalSnapshot {
@@ -118,6 +142,9 @@ pub struct ExternalSnapshot {
     pub grain_ids: Vec<u64>,
     /// Where the accelerations come from.
     pub accelerations: AccelerationSource,
+    /// Where the velocity gradient of the snapshot's biperiodic cell comes from (`None`
+    /// without such a cell).
+    pub velocity_gradient: Option<GradientSource>,
     /// The file(s) it was read from.
     pub source: String,
 }
@@ -130,6 +157,9 @@ pub struct ReadOptions {
     /// Friction coefficient given to every contact, for the mobilisation `|f_t|/(μ f_n)`
     /// (default none: contacts count as frictionless, no mobilisation).
     pub mu: Option<f64>,
+    /// Friction coefficient of the wall contacts, when the walls have their own (default:
+    /// [`ReadOptions::mu`]).
+    pub wall_mu: Option<f64>,
     /// Time step (s) of the simulation: times of LAMMPS dumps without `ITEM: TIME` are
     /// `step · dt`. Default: from the files when they tell it.
     pub dt: Option<f64>,
@@ -149,6 +179,7 @@ impl Default for ReadOptions {
         Self {
             gravity: [0.0, -9.81],
             mu: None,
+            wall_mu: None,
             dt: None,
             inertia_factor: 0.5,
             density: None,

@@ -92,7 +92,8 @@ pub(crate) struct PointJudgement {
     pub(crate) windows: WindowStats,
 }
 
-/// Judges every point of a rheology ([`PointJudgement`]).
+/// Judges every point of a rheology ([`PointJudgement`]). A point whose `i_target` is not finite
+/// (another code's run, which has none) skips the check of `I` against its target.
 pub(crate) fn judge_points(run_checks: &[RunCheckData], phi_bound: f64) -> PointJudgement {
     let mut j = PointJudgement {
         common: Checks::new(),
@@ -102,24 +103,32 @@ pub(crate) fn judge_points(run_checks: &[RunCheckData], phi_bound: f64) -> Point
         windows: WindowStats::default(),
     };
     for rc in run_checks {
-        let label = format!("I = {}", rc.i_target);
+        // a run without a target (another code's run read by `grainlaw homogenise`: NaN) is
+        // named by its measured I and has no target to miss
+        let label = if rc.i_target.is_finite() {
+            format!("I = {}", rc.i_target)
+        } else {
+            format!("I = {:.4e} (measured)", rc.i_measured)
+        };
         let (mut pc, mut pm, mut pp) = (Checks::new(), Checks::new(), Checks::new());
         pc.window(&format!("{label}, averaging window"), &rc.window);
         j.windows.merge(&rc.window);
-        let ratio = rc.i_measured / rc.i_target;
-        let factor = if ratio >= 1.0 { ratio } else { 1.0 / ratio };
-        pc.at_most(
-            "shear_cell.inertial_number_factor",
-            factor,
-            I_FACTOR_SUSPECT,
-            Some(I_FACTOR_REFUSED),
-            |t| {
-                format!(
-                    "{label}: measured I = {:.3e} is {factor:.2} times off its target (limit {t}×)",
-                    rc.i_measured
-                )
-            },
-        );
+        if rc.i_target.is_finite() {
+            let ratio = rc.i_measured / rc.i_target;
+            let factor = if ratio >= 1.0 { ratio } else { 1.0 / ratio };
+            pc.at_most(
+                "shear_cell.inertial_number_factor",
+                factor,
+                I_FACTOR_SUSPECT,
+                Some(I_FACTOR_REFUSED),
+                |t| {
+                    format!(
+                        "{label}: measured I = {:.3e} is {factor:.2} times off its target (limit {t}×)",
+                        rc.i_measured
+                    )
+                },
+            );
+        }
         pm.steady(
             "shear_cell.steady_mu",
             &format!("{label}: μ"),

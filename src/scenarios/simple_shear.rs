@@ -71,7 +71,142 @@ const CONTROL_TOLERANCE: f64 = 0.5;
 /// Re-solves of a step at most by the implicit correction.
 const MAX_CORRECTIONS: usize = 8;
 /// Blocks of the block-averaged standard errors (at least).
-const MIN_BLOCKS: usize = 4;
+pub(crate) const MIN_BLOCKS: usize = 4;
+
+/// The samples of a biperiodic cell's state over an averaging window, one per step (this
+/// scenario) or per snapshot (another code's run, `grainlaw homogenise`): `−Σ_yy` and
+/// μ = |Σ_xy|/(−Σ_yy) of the symmetric mean stress, solid fraction φ, mean pressure `−tr Σ/2`,
+/// coordination Z.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct CellSamples {
+    pub(crate) normal_stress: Vec<f64>,
+    pub(crate) mu: Vec<f64>,
+    pub(crate) phi: Vec<f64>,
+    pub(crate) pressure: Vec<f64>,
+    pub(crate) coordination: Vec<f64>,
+}
+
+impl CellSamples {
+    /// Adds the state of one step or snapshot.
+    pub(crate) fn push(&mut self, cs: &homogenise::cell::CellState) {
+        let s = cs.stress;
+        let pn = -s[(1, 1)];
+        self.normal_stress.push(pn);
+        self.mu.push(if pn > 0.0 {
+            s[(0, 1)].abs() / pn
+        } else {
+            f64::NAN
+        });
+        self.phi.push(cs.solid_fraction);
+        self.pressure.push(cs.pressure);
+        self.coordination.push(cs.coordination);
+    }
+}
+
+/// One point of μ(I), φ(I): means over the window with their block-averaged standard errors
+/// ([`block_average`], at least [`MIN_BLOCKS`] blocks; NaN with fewer than `2 · MIN_BLOCKS`
+/// samples), `P = ⟨−Σ_yy⟩` and `I = |γ̇| d / √(P/ρ)` with `SE_I = I SE_P / (2P)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RheologyPoint {
+    pub(crate) i: f64,
+    pub(crate) i_se: f64,
+    pub(crate) mu: f64,
+    pub(crate) mu_se: f64,
+    pub(crate) phi: f64,
+    pub(crate) phi_se: f64,
+    pub(crate) pn: f64,
+    pub(crate) pn_se: f64,
+    pub(crate) p: f64,
+    pub(crate) z: f64,
+}
+
+impl RheologyPoint {
+    /// The point of the samples at the shear rate `gamma_dot` (1/s), mean diameter `d` (m) and
+    /// grain density `rho` (kg/m³). Errors: a non-finite sample (a tensile `Σ_yy` makes μ NaN).
+    pub(crate) fn of(s: &CellSamples, gamma_dot: f64, d: f64, rho: f64) -> Result<Self> {
+        let avg = |v: &[f64]| -> Result<(f64, f64)> {
+            if v.len() < 2 * MIN_BLOCKS {
+                if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(homogenise::HomogeniseError::InvalidParameter {
+                        name: "series",
+                        reason: format!("sample {i} is not finite"),
+                    }
+                    .into());
+                }
+                return Ok((v.iter().sum::<f64>() / v.len().max(1) as f64, f64::NAN));
+            }
+            let a = block_average(v, MIN_BLOCKS)?;
+            Ok((a.mean, a.std_error))
+        };
+        let (pn, pn_se) = avg(&s.normal_stress)?;
+        let (mu, mu_se) = avg(&s.mu)?;
+        let (phi, phi_se) = avg(&s.phi)?;
+        let (p, _) = avg(&s.pressure)?;
+        let (z, _) = avg(&s.coordination)?;
+        let i = gamma_dot.abs() * d / (pn / rho).sqrt();
+        Ok(RheologyPoint {
+            i,
+            i_se: 0.5 * i * pn_se / pn,
+            mu,
+            mu_se,
+            phi,
+            phi_se,
+            pn,
+            pn_se,
+            p,
+            z,
+        })
+    }
+
+    /// The row of `rheology.csv` ([`RHEOLOGY_HEADERS`] but `point_verdict`).
+    pub(crate) fn row(
+        &self,
+        i_target: f64,
+        gamma_dot: f64,
+        dt: f64,
+        samples: usize,
+        corrections_per_step: f64,
+    ) -> Vec<f64> {
+        vec![
+            i_target,
+            self.i,
+            self.i_se,
+            self.mu,
+            self.mu_se,
+            self.phi,
+            self.phi_se,
+            self.pn,
+            self.pn_se,
+            self.p,
+            self.z,
+            gamma_dot,
+            dt,
+            samples as f64,
+            corrections_per_step,
+        ]
+    }
+}
+
+/// Columns of the `rheology.csv` of a biperiodic cell ([`RheologyPoint::row`], then the
+/// point's verdict).
+pub(crate) const RHEOLOGY_HEADERS: [&str; 16] = [
+    "I_target",
+    "I",
+    "I_std_error",
+    "mu",
+    "mu_std_error",
+    "phi",
+    "phi_std_error",
+    "P_Pa",
+    "P_std_error_Pa",
+    "p_mean_Pa",
+    "Z",
+    "shear_rate_1_s",
+    "dt_s",
+    "samples",
+    "cell_corrections_per_step",
+    "point_verdict",
+];
 
 /// The plan of the current shear run.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
@@ -301,48 +436,34 @@ impl PhasedRun for Shear<'_> {
         let tail =
             &st.history[st.history.len() - (st.run.avg_steps as usize).min(st.history.len())..];
         let col = |j: usize| -> Vec<f64> { tail.iter().map(|r| r[j]).collect() };
-        let avg = |j: usize| -> Result<(f64, f64)> {
-            let a = block_average(&col(j), MIN_BLOCKS)?;
-            Ok((a.mean, a.std_error))
+        let samples = CellSamples {
+            normal_stress: col(3).iter().map(|s| -s).collect(),
+            mu: col(16),
+            phi: col(10),
+            pressure: col(8),
+            coordination: col(11),
         };
-        let (syy, syy_se) = avg(3)?;
-        let (mu, mu_se) = avg(16)?;
-        let (phi, phi_se) = avg(10)?;
-        let (p, _) = avg(8)?;
-        let (z, _) = avg(11)?;
-        let pn = -syy;
         let d = mean_diameter(world);
         let gd = st.run.gamma_dot;
-        let i = gd * d / (pn / self.c.grain.density).sqrt();
-        let i_se = 0.5 * i * syy_se / pn;
+        let point = RheologyPoint::of(&samples, gd, d, self.c.grain.density)?;
         let corrections: f64 = col(17).iter().sum();
         st.checks.push(RunCheckData {
             i_target: target,
-            i_measured: i,
+            i_measured: point.i,
             window: st.window,
-            mu: col(16),
-            phi: col(10),
+            mu: samples.mu,
+            phi: samples.phi,
         });
-        st.rows.push(vec![
+        st.rows.push(point.row(
             target,
-            i,
-            i_se,
-            mu,
-            mu_se,
-            phi,
-            phi_se,
-            pn,
-            syy_se,
-            p,
-            z,
             gd,
             st.run.dt,
-            tail.len() as f64,
+            tail.len(),
             corrections / tail.len().max(1) as f64,
-        ]);
+        ));
         st.peaks.push(peak_mu(&st.history, 1, 16));
         st.curves.push((
-            i,
+            point.i,
             st.history
                 .iter()
                 .step_by((st.history.len() / 200).max(1))
@@ -426,24 +547,7 @@ pub fn run(
     verdict.run.extend(&phi_checks);
     frames.finish(&mut ctx.out, &world)?;
     let d = mean_diameter(&world);
-    let headers = [
-        "I_target",
-        "I",
-        "I_std_error",
-        "mu",
-        "mu_std_error",
-        "phi",
-        "phi_std_error",
-        "P_Pa",
-        "P_std_error_Pa",
-        "p_mean_Pa",
-        "Z",
-        "shear_rate_1_s",
-        "dt_s",
-        "samples",
-        "cell_corrections_per_step",
-        "point_verdict",
-    ];
+    let headers = RHEOLOGY_HEADERS;
     let grain = GrainScale {
         diameter_m: d,
         density_kg_m3: c.grain.density,
