@@ -806,15 +806,7 @@ fn janssen_table(
     t.write(out, "janssen.csv")?;
     summary
         .num("janssen_width_m", width)
-        .num("janssen_bulk_density_kg_m3", bulk)
-        .num(
-            "janssen_bottom_load_over_weight",
-            mean(&|p| p.bottom_load_over_weight),
-        )
-        .num(
-            "janssen_side_wall_load_over_weight",
-            mean(&|p| p.side_wall_load_over_weight),
-        );
+        .num("janssen_bulk_density_kg_m3", bulk);
     Ok(())
 }
 

@@ -159,7 +159,7 @@ impl RvePoint {
                 self.samples,
                 match self.source {
                     GradientSource::CellDeformation => "cell's tilt rate",
-                    GradientSource::VelocityProfile => "grain velocities (affine fit)",
+                    _ => "grain velocities (affine fit)",
                 }
             ),
             self.grain,
@@ -212,7 +212,7 @@ impl RvePoint {
             self.shear_rate,
             match self.source {
                 GradientSource::CellDeformation => "cell's tilt rate",
-                GradientSource::VelocityProfile => "grain velocities",
+                _ => "grain velocities",
             },
             self.shear_rate_velocity_profile,
             self.value("I"),

@@ -652,3 +652,126 @@ fn liggghts_wall_contacts_from_wall_gran_local() {
         other => panic!("{other:?}"),
     }
 }
+
+/// Runs the grainlaw executable: (exit code, stdout, stderr).
+fn grainlaw_exe(args: &[&str]) -> (Option<i32>, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout).to_string(),
+        String::from_utf8_lossy(&o.stderr).to_string(),
+    )
+}
+
+#[test]
+fn walls_take_their_own_friction() {
+    // the example's walls are at 0.3, its grains at 0.5 (in.settle2d)
+    let opts = ReadOptions {
+        mu: Some(0.5),
+        wall_mu: Some(0.3),
+        ..Default::default()
+    };
+    let snaps = readers::read_lammps(&lammps_files(), &opts).unwrap();
+    let s = &snaps[2].snapshot;
+    let (mut walls, mut pairs) = (0, 0);
+    for c in &s.contacts {
+        let wall = s.bodies[c.body_a as usize].kind == BodyKind::Wall;
+        assert_eq!(c.mu, if wall { 0.3 } else { 0.5 });
+        if wall {
+            walls += 1;
+        } else {
+            pairs += 1;
+        }
+    }
+    assert!(
+        walls > 10 && pairs > 100,
+        "{walls} wall, {pairs} pair contacts"
+    );
+    // without --wall-mu the walls take --mu
+    let one = readers::read_lammps(
+        &lammps_files(),
+        &ReadOptions {
+            mu: Some(0.5),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(one[2].snapshot.contacts.iter().all(|c| c.mu == 0.5));
+}
+
+#[test]
+fn dumps_of_a_column_to_a_janssen_law_in_two_commands() {
+    // datasets/external/lammps/column: 228 disks between walls 30 mm apart, the floor sinking
+    // (its README). `homogenise` writes janssen.csv in the form `fit janssen` reads; the
+    // released column's wall friction is mobilised, and the law comes out.
+    let d = data("lammps/column");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("h");
+    let (code, stdout, stderr) = grainlaw_exe(&[
+        "homogenise",
+        "--from",
+        "lammps",
+        "--mu",
+        "0.5",
+        "--wall-mu",
+        "0.3",
+        "--out",
+        out.to_str().unwrap(),
+        d.join("atoms.450000.dump.gz").to_str().unwrap(),
+        d.join("pairs.450000.dump.gz").to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    // the report names the stress ratio it prints: q/p, the invariants' ratio
+    assert!(
+        stdout.contains("q/p = ") && !stdout.contains("τ/P"),
+        "{stdout}"
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let ratio = s["stress_ratio"].as_f64().unwrap();
+    let q_over_p = s["shear_stress_Pa"].as_f64().unwrap() / s["pressure_Pa"].as_f64().unwrap();
+    assert!((ratio - q_over_p).abs() < 1e-12);
+    assert!(stdout.contains(&format!("q/p = {ratio:.4}")), "{stdout}");
+    let table = out.join("janssen.csv");
+    let text = std::fs::read_to_string(&table).unwrap();
+    for key in [
+        "width_m = 3",
+        "wall_friction = 3e-1",
+        "bulk_density_kg_m3 = ",
+    ] {
+        assert!(text.contains(key), "{key}: {text}");
+    }
+    let law = dir.path().join("janssen_law.json");
+    let (code, stdout, stderr) = grainlaw_exe(&[
+        "fit",
+        "janssen",
+        table.to_str().unwrap(),
+        "--out",
+        law.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&law).unwrap()).unwrap();
+    let param = |n: &str| {
+        json["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == n)
+            .unwrap()["value"]
+            .as_f64()
+            .unwrap()
+    };
+    // a Janssen column: K of order 1, the wall friction mobilised below its 0.3
+    let (k, mu_w) = (param("K"), param("mu_w"));
+    assert!(
+        k > 0.3 && k < 3.0 && mu_w > 0.0 && mu_w < 0.3,
+        "K = {k}, mu_w = {mu_w}"
+    );
+    // the per-wall profiles say which table a fit reads
+    let w = std::fs::read_to_string(out.join("wall_profile_left.csv")).unwrap();
+    assert!(w.contains("grainlaw fit janssen janssen.csv"));
+}

@@ -22,8 +22,8 @@
 //! one with its tilt unwrapped by whole periods, `ḣ = Δh/Δt`, `h` at the middle: exact for a
 //! tilt growing linearly, `L_xy = Δxy/(l_y Δt)`), the first snapshot taking the interval with
 //! the second; for a single snapshot, or snapshots without times, the mass-weighted affine fit
-//! of the grain velocities over the cell ([`homogenise::kinematics::velocity_gradient`]).
-//! [`GradientSource`] says which. A cell periodic along one edge only gives the images along
+//! of the grain velocities over the cell ([`homogenise::kinematics::velocity_gradient`]), or
+//! zero when the grains are too few or aligned for that fit. [`GradientSource`] says which. A cell periodic along one edge only gives the images along
 //! that edge (`x ± l_x`; `x ± a₂`).
 
 use std::collections::HashMap;
@@ -619,17 +619,15 @@ fn build_one(
         (None, _) => None,
         (Some(_), Some(_)) => Some(GradientSource::CellDeformation),
         (Some(c), None) => {
-            // the mass-weighted affine fit of the grain velocities over the cell
-            let fit = velocity_gradient(&snapshot, &Region::Whole, VelocityWeight::Mass).map_err(
-                |e| {
-                    content(
-                        &f.source,
-                        format!("the velocity gradient of the cell from the grain velocities: {e}"),
-                    )
-                },
-            )?;
-            snapshot.cell = Some(cell_of(&f, c, fit.gradient)?);
-            Some(GradientSource::VelocityProfile)
+            // the mass-weighted affine fit of the grain velocities over the cell, when the
+            // grains determine it
+            match velocity_gradient(&snapshot, &Region::Whole, VelocityWeight::Mass) {
+                Ok(fit) => {
+                    snapshot.cell = Some(cell_of(&f, c, fit.gradient)?);
+                    Some(GradientSource::VelocityProfile)
+                }
+                Err(_) => Some(GradientSource::Zero),
+            }
         }
     };
     Ok(ExternalSnapshot {

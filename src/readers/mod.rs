@@ -121,14 +121,17 @@ pub enum GradientSource {
     /// The mass-weighted affine fit of the grain velocities over the cell (a single snapshot,
     /// or snapshots without times).
     VelocityProfile,
+    /// Neither (a single snapshot whose grains are too few or aligned for the fit): `L = 0`.
+    Zero,
 }
 
 impl GradientSource {
-    /// The name written in outputs: `cell_deformation` or `velocity_profile`.
+    /// The name written in outputs: `cell_deformation`, `velocity_profile` or `zero`.
     pub fn name(self) -> &'static str {
         match self {
             GradientSource::CellDeformation => "cell_deformation",
             GradientSource::VelocityProfile => "velocity_profile",
+            GradientSource::Zero => "zero",
         }
     }
 }
