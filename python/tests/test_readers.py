@@ -141,3 +141,55 @@ def test_homogenise_a_real_lmgc90_run(tmp_path):
     weight = 9.81 * (2500.0 * np.pi * radii**2).sum()
     carried = -sum(s[f"wall_{w}_force_y_N"] for w in s["walls"])
     assert abs(carried - weight) < 1e-5 * weight, (carried, weight)
+
+
+RVE = LAMMPS.parent / "lammps-rve"
+
+
+def test_a_tilted_biperiodic_lammps_cell_is_read_as_lammps_computes_it():
+    """A snapshot of the LAMMPS simple shear (datasets/external/lammps-rve/exact, a tilted
+    triclinic cell periodic in x and y, written at the setup of a `run 0`): the cell from the
+    dump header, the pairs' minimum images across the tilt, and the whole-sample means over
+    the cell's area, as `compute stress/atom NULL pair` and the cell's volume say."""
+    files = sorted(str(p) for p in (RVE / "exact").glob("*.I0.003.*.dump.gz"))
+    (s,) = grainlaw.read_snapshots("lammps", files)
+    snap = s["snapshot"]
+    cell = snap.cell
+    assert cell is not None and snap.periodic_x is None
+    step, time, sxx, syy, sxy, lx, ly, xy, area = np.loadtxt(RVE / "exact" / "thermo_I0.003.txt", skiprows=1)
+    np.testing.assert_allclose(cell["h"], [[lx, xy], [0.0, ly]], rtol=0, atol=1e-15)
+    assert abs(cell["area"] - area) <= 1e-12 * area
+    assert abs(xy) > 0.1 * lx
+    # contact part of the whole-cell mean stress = LAMMPS' Σ_i S_i / area (its xy is grainlaw's yx)
+    m = grainlaw.mean_stress(snap)
+    c = m["contact"]
+    scale = np.sqrt(sxx**2 + syy**2 + sxy**2) / area
+    for ours, lammps in ((c[0, 0], sxx), (c[1, 1], syy), (c[1, 0], sxy)):
+        assert abs(ours - lammps / area) <= 1e-6 * scale
+    assert c[1, 1] < 0.0
+    disks = np.pi * (snap.radii[snap.is_grain] ** 2).sum()
+    assert abs(grainlaw.solid_fraction(snap) - disks / area) <= 1e-12
+    # a single snapshot: the cell's velocity gradient from the grain velocities
+    assert s["velocity_gradient"] == "velocity_profile"
+
+
+def test_homogenise_a_lammps_shear_series_writes_its_rheology_point(tmp_path):
+    d = RVE / "I0.01"
+    r = grainlaw.homogenise("lammps", [str(d / "atoms.dump.gz"), str(d / "pairs.dump.gz")], out=tmp_path / "o", mu=0.5)
+    s = r["summary"]
+    assert "rheology.csv" in r["files"]
+    assert s["rve_samples"] == 16 and s["rve_point_verdict"] == "ok"
+    assert s["rve_shear_rate_source"] == "cell_deformation"
+    assert s["velocity_gradients"] == ["cell_deformation"] * 16
+    th = np.loadtxt(d / "thermo.txt", skiprows=1)
+    mu_lammps = np.mean(np.abs(th[:, 4]) / th[:, 3])
+    assert abs(s["rve_mu"] - mu_lammps) <= s["rve_mu_std_error"]
+
+
+def test_walls_have_their_own_friction(tmp_path):
+    snap = grainlaw.read_snapshots("lammps", lammps_files(), mu=0.5, wall_mu=0.3)[-1]["snapshot"]
+    walls = ~snap.is_grain[snap.contact_a]
+    assert walls.any() and (~walls).any()
+    assert np.all(snap.contact_mu[walls] == 0.3) and np.all(snap.contact_mu[~walls] == 0.5)
+    r = grainlaw.homogenise("lammps", lammps_files(), out=tmp_path / "o", mu=0.5, wall_mu=0.3)
+    assert "# wall_friction = 3e-1" in (tmp_path / "o" / "janssen.csv").read_text()
