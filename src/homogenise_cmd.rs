@@ -3,7 +3,10 @@
 //! `docs/outputs.md` § "homogenise"): per-grain and whole-sample mean stress with its contact
 //! (Love–Weber) and inertia parts (`docs/physics.md` §2.1–2.2), solid fraction, coordination,
 //! fabric, wall loads and wall stress profiles, the vertical stress by slices, force
-//! polarisation (friction mobilisation), Gaussian coarse-grained fields, figures, VTK.
+//! polarisation (friction mobilisation), Gaussian coarse-grained fields, figures, VTK; for a
+//! column between two vertical walls the table `grainlaw fit janssen` reads (`janssen.csv`),
+//! and for a series of a sheared biperiodic cell the point of μ(I), φ(I) (`rheology.csv`,
+//! [`crate::rve`]).
 
 use std::path::PathBuf;
 

@@ -324,3 +324,41 @@ fn periodic_images_are_counted() {
     );
     assert!((fa - fb).abs() < 1e-14 && (fa - std::f64::consts::PI * r * r / 0.04).abs() < 1e-13);
 }
+
+#[test]
+fn the_whole_of_a_biperiodic_cell_is_the_cell() {
+    // A tilted cell h = [[10, 4], [0, 8]] (area 80) holding three disks of radius 1, one of
+    // them across its top edge and one past its bounding box's left side: the whole sample is
+    // the cell, each disk counted whole once (φ = 3π/80), not the disks' bounding box; a
+    // slice across the cell is periodic along x with the period 10.
+    let mut b = Builder::new(v(0.0, 0.0));
+    for p in [v(5.0, 4.0), v(7.0, 7.6), v(0.9, 0.5)] {
+        b.grain(p, 1.0, 1.0, 1.0);
+    }
+    let mut snap = b.finish();
+    let h = Matrix2::new(10.0, 4.0, 0.0, 8.0);
+    snap.cell = Some(dem::cell::Cell::new(h, Matrix2::zeros()).unwrap());
+    let phi = solid_fraction(&snap, &Region::Whole).unwrap();
+    assert!(
+        (phi - 3.0 * std::f64::consts::PI / 80.0).abs() < 1e-15,
+        "{phi}"
+    );
+    let rect = Region::Whole.resolve(&snap).unwrap();
+    assert_eq!(rect.area(), 80.0);
+    // the slice 0 ≤ y ≤ 2 across the cell: the disk at (0.9, 0.5) wholly inside but for its
+    // part below y = 0 (x wrapped by the period, so its left part at x < 0 counts too)
+    let slice = Region::Slice {
+        y_min: 0.0,
+        y_max: 2.0,
+    }
+    .resolve(&snap)
+    .unwrap();
+    assert_eq!(slice.periodic_x, Some([0.0, 10.0]));
+    let w = slice.disk_fraction(&v(0.9, 0.5), 1.0);
+    // the circular segment below y = 0 at distance 0.5 from the centre: r² acos(d) − d√(1−d²)
+    let seg = 0.5f64.acos() - 0.5 * (1.0f64 - 0.25).sqrt();
+    assert!(
+        (w - (1.0 - seg / std::f64::consts::PI)).abs() < 1e-12,
+        "{w}"
+    );
+}
