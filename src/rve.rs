@@ -79,12 +79,13 @@ pub fn rve_point(snaps: &[ExternalSnapshot]) -> Result<Option<RvePoint>> {
     if !(shear_rate.is_finite() && shear_rate != 0.0) {
         return Ok(None);
     }
+    // the grain velocities' affine fit (NaN where the grains are too few or aligned for it)
     let mut fitted = 0.0;
     let mut samples = CellSamples::default();
     for e in snaps {
         samples.push(&cell_state(&e.snapshot)?);
-        fitted +=
-            velocity_gradient(&e.snapshot, &Region::Whole, VelocityWeight::Mass)?.gradient[(0, 1)];
+        fitted += velocity_gradient(&e.snapshot, &Region::Whole, VelocityWeight::Mass)
+            .map_or(f64::NAN, |f| f.gradient[(0, 1)]);
     }
     let first = &snaps[0].snapshot;
     let grains: Vec<_> = first

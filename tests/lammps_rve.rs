@@ -589,3 +589,45 @@ fn dumps_grainlaw_cannot_read_are_refused_naming_file_and_line() {
     );
     assert!(one_line(&err), "{err}");
 }
+
+#[test]
+fn a_refused_point_exits_with_code_3_after_writing_everything() {
+    // 16 snapshots of a 2 × 2 mm cell sheared at 5 1/s holding two overlapping disks of
+    // radius 0.8 mm: φ = 2π 0.64/4 = 1.005, above the densest packing of equal disks
+    let dir = tempfile::tempdir().unwrap();
+    let (r, m) = (8e-4, 2500.0 * std::f64::consts::PI * 8e-4 * 8e-4);
+    let (mut atoms, mut pairs) = (String::new(), String::new());
+    for k in 0..16u64 {
+        let xy = 1e-5 * k as f64;
+        let bounds = format!(
+            "ITEM: BOX BOUNDS xy xz yz pp pp pp\n0 {} {xy}\n0 0.002 0\n-0.0005 0.0005 0",
+            0.002 + xy
+        );
+        atoms += &format!(
+            "ITEM: TIME\n{}\nITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n2\n{bounds}\nITEM: ATOMS id x y vx vy omegaz radius mass fx fy tqz\n1 0.0005 0.0005 0 0 0 {r} {m} 0 0 0\n2 0.0012 0.0013 0 0 0 {r} {m} 0 0 0\n",
+            1e-3 * k as f64,
+            1000 * k
+        );
+        pairs += &format!(
+            "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ENTRIES\n1\n{bounds}\nITEM: ENTRIES c_ids[1] c_ids[2] c_pf[1] c_pf[2] c_pf[3] c_pf[4] c_pf[5] c_pf[6]\n1 2 0 -0.7 -0.8 0 0 0\n",
+            1000 * k
+        );
+    }
+    let (a, p) = (dir.path().join("atoms.dump"), dir.path().join("pairs.dump"));
+    std::fs::write(&a, atoms).unwrap();
+    std::fs::write(&p, pairs).unwrap();
+    let out = dir.path().join("out");
+    let (code, err) = homogenise_files(&[a, p], &out);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(
+        err.contains("the simple-shear point is refused") && err.contains("densest packing"),
+        "{err}"
+    );
+    let table = std::fs::read_to_string(out.join("rheology.csv")).unwrap();
+    assert!(table.trim_end().ends_with(",2e0"), "{table}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["rve_point_verdict"], "refused");
+    // the cell's rate: Δxy / (l_y Δt) = 1e-5 / (2e-3 · 1e-3) = 5 1/s
+    assert!((s["rve_shear_rate_1_s"].as_f64().unwrap() - 5.0).abs() < 1e-9);
+}
