@@ -341,7 +341,9 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
         Command::Run(args) => run(args),
         Command::Homogenise(args) => homogenise_cmd(args),
         Command::Scenarios { show } => scenarios_cmd(show.as_deref()),
-        Command::Fit { law, data, out } => crate::fit_cmd::fit(&law, &data, out.as_deref()),
+        Command::Fit { law, data, out } => {
+            crate::fit_cmd::fit(&law, &data, out.as_deref()).map(|_| ())
+        }
         Command::Campaign {
             plan,
             out,

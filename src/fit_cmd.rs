@@ -22,7 +22,8 @@ use crate::output::dir::write_atomic;
 /// bound is printed as such, not as an estimate; angles also in degrees), then the derived
 /// quantities, and writes the calibrated-law JSON to `out`. With `out` the lines go to stdout;
 /// without it the JSON goes to stdout (so that it can be piped) and the lines to stderr.
-pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
+/// Returns the law written.
+pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<CalibratedLaw> {
     let cal =
         fit_csv_file(law, data, &CsvFitOptions::default()).map_err(|e| naming_file(data, e))?;
     let json = cal.to_json_string()? + "\n";
@@ -52,7 +53,7 @@ pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
             print!("{json}");
         }
     }
-    Ok(())
+    Ok(cal)
 }
 
 /// Rows of `data` that the fit left out for their `point_verdict` (0 when the file has no such

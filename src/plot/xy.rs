@@ -231,9 +231,9 @@ impl XyPlot {
             return r;
         }
         let bar_ends = self.series.iter().flat_map(|s| {
-            s.error_bars().into_iter().flat_map(|(x, y, ex, ey)| {
-                [(x - ex, y - ey), (x + ex, y + ey)]
-            })
+            s.error_bars()
+                .into_iter()
+                .flat_map(|(x, y, ex, ey)| [(x - ex, y - ey), (x + ex, y + ey)])
         });
         let vals = self
             .series
@@ -310,12 +310,8 @@ impl XyPlot {
         let yr = if self.y.reversed { (y1, y0) } else { (y0, y1) };
         match (self.x.log, self.y.log) {
             (false, false) => self.draw_generic(area, ranges, xr.0..xr.1, yr.0..yr.1),
-            (true, false) => {
-                self.draw_generic(area, ranges, (xr.0..xr.1).log_scale(), yr.0..yr.1)
-            }
-            (false, true) => {
-                self.draw_generic(area, ranges, xr.0..xr.1, (yr.0..yr.1).log_scale())
-            }
+            (true, false) => self.draw_generic(area, ranges, (xr.0..xr.1).log_scale(), yr.0..yr.1),
+            (false, true) => self.draw_generic(area, ranges, xr.0..xr.1, (yr.0..yr.1).log_scale()),
             (true, true) => self.draw_generic(
                 area,
                 ranges,
