@@ -207,7 +207,7 @@ pub struct XyPlot {
     /// Extra text lines in the upper left of the plotting area.
     pub notes: Vec<String>,
     /// One unit of x as long on the screen as one unit of y (circles drawn round): the
-    /// shorter range is widened about its middle to the plotting area's aspect ratio.
+    /// shorter range is widened above its high end to the plotting area's aspect ratio.
     pub equal_aspect: bool,
 }
 
@@ -292,10 +292,8 @@ impl XyPlot {
             let (pw, ph) = self.plotting_pixels(area);
             // metres (or pascals) per pixel along each axis; the larger one wins
             let per_px = ((x1 - x0) / pw).max((y1 - y0) / ph);
-            let widen = |lo: f64, hi: f64, px: f64| {
-                let mid = 0.5 * (lo + hi);
-                (mid - 0.5 * per_px * px, mid + 0.5 * per_px * px)
-            };
+            // the shorter range grows upwards from its low end (e.g. a τ axis from 0)
+            let widen = |lo: f64, _hi: f64, px: f64| (lo, lo + per_px * px);
             (x0, x1) = widen(x0, x1, pw);
             (y0, y1) = widen(y0, y1, ph);
         }
@@ -462,9 +460,14 @@ impl XyPlot {
             }
         }
         if labelled {
+            // a legend in the upper left goes below the notes drawn there
+            let position = match (&self.legend, self.notes.len()) {
+                (LegendAt::UpperLeft, n) if n > 0 => LegendAt::Coordinate(5, 10 + 22 * n as i32),
+                (l, _) => l.clone(),
+            };
             chart
                 .configure_series_labels()
-                .position(self.legend.clone())
+                .position(position)
                 .background_style(WHITE.mix(0.85))
                 .border_style(RGBColor(150, 150, 150))
                 .label_font(font(16.0))
@@ -598,3 +601,64 @@ pub fn draw_column(
 
 #[allow(dead_code)]
 type Lin = RangedCoordf64;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// With equal scales, the plotting area's size computed from the layout is the one the
+    /// chart gets (to a pixel), and one unit of x spans as many pixels as one unit of y (to
+    /// 1 %), the shorter range grown from its low end; the data stay inside the ranges.
+    #[test]
+    fn equal_aspect_draws_equal_scales() {
+        crate::plot::init_font();
+        let (w, h) = (650u32, 650u32);
+        let mut buf = vec![0u8; (w * h * 3) as usize];
+        let area = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        let mut plot = XyPlot::new("Mohr", Axis::new("σ (Pa)"), Axis::new("τ (Pa)"));
+        plot.series.push(Series::new(
+            "",
+            Style::Line,
+            RGBColor(0, 0, 0),
+            vec![(0.0, 0.0), (10_000.0, 0.0), (6000.0, 3000.0)],
+        ));
+        plot.equal_aspect = true;
+        let (pw, ph) = plot.plotting_pixels(&area);
+        let ((x0, x1), (y0, y1)) = plot.ranges(&area);
+        let chart = ChartBuilder::on(&area)
+            .margin(MARGIN)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .caption("Mohr", font(TITLE_SIZE))
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .unwrap();
+        let (aw, ah) = chart.plotting_area().dim_in_pixel();
+        assert!((aw as f64 - pw).abs() <= 1.0 && (ah as f64 - ph).abs() <= 1.0);
+        let (sx, sy) = ((x1 - x0) / aw as f64, (y1 - y0) / ah as f64);
+        assert!((sx / sy - 1.0).abs() < 0.01, "{sx} {sy}");
+        // x is the longer range (padded 5 %); y grew upwards from its padded low end
+        assert!(x0 < 0.0 && x1 > 10_000.0 && (y0 - (-150.0)).abs() < 1e-9 && y1 > 3000.0);
+    }
+
+    /// Error bars: a point with a finite positive standard error has a bar, one with NaN or
+    /// zero has none, and points dropped for a non-finite coordinate drop their errors.
+    #[test]
+    fn error_bars_follow_their_points() {
+        let s = Series::with_errors(
+            "",
+            Style::Points,
+            RGBColor(0, 0, 0),
+            vec![
+                (1.0, 2.0, f64::NAN, 0.1),
+                (f64::NAN, 3.0, 0.5, 0.5),
+                (2.0, 4.0, 0.0, f64::NAN),
+                (3.0, 5.0, 0.2, 0.0),
+            ],
+        );
+        assert_eq!(s.xy, vec![(1.0, 2.0), (2.0, 4.0), (3.0, 5.0)]);
+        assert_eq!(
+            s.error_bars(),
+            vec![(1.0, 2.0, 0.0, 0.1), (3.0, 5.0, 0.2, 0.0)]
+        );
+    }
+}

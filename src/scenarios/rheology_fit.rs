@@ -388,14 +388,20 @@ pub(crate) fn fit_mu_phi(
             })
             .collect()
     };
-    let marked_label = "failed its own checks (fitted; the law is not calibrated)";
+    let marked_label = |fitted: bool| {
+        if fitted {
+            "failed its own checks (fitted: the law is not calibrated)"
+        } else {
+            "failed its own checks"
+        }
+    };
     let mu_points = points(series.mu.as_deref(), inp.std_errors.mu.as_deref());
     let pmu = rheology_plot(&RheologyFigure {
         title: format!("Friction law μ(I){}", inp.title_suffix),
         y_label: "μ = |σ_xy| / P",
         colour: PALETTE[0],
         passed_label: inp.dem_label.to_string(),
-        marked_label,
+        marked_label: marked_label(mu_curve.is_some()),
         points: &mu_points,
         curve: mu_curve,
         notes: mu_notes,
@@ -406,7 +412,7 @@ pub(crate) fn fit_mu_phi(
         y_label: "solid fraction φ",
         colour: PALETTE[2],
         passed_label: inp.dem_label.to_string(),
-        marked_label,
+        marked_label: marked_label(phi_curve.is_some()),
         points: &phi_points,
         curve: phi_curve,
         notes: phi_notes,
