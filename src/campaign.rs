@@ -25,7 +25,8 @@
 //! and every numeric `summary.json` key), `campaign_stats.csv` (per combination of the swept
 //! keys other than `seed`: mean and standard error over the seeds of every numeric key), and
 //! merges the per-run tables a law can be fitted to (`rheology.csv` → μ(I), φ(I)) over the runs
-//! whose exit status is 0, then fits them with the same code as `grainlaw fit`.
+//! whose exit status is 0, then fits them with the same code as `grainlaw fit`, and draws
+//! `rheology.png` (μ(I), φ(I) over every point, with the merged laws and their bands).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};

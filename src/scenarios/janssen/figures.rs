@@ -81,8 +81,9 @@ pub(super) fn draw(ctx: &mut RunContext, f: &Inputs) -> Result<()> {
         "force_chains.png",
         &ParticleView {
             snap: f.snap,
+            // the last state: the last measured step after the release
             title: format!(
-                "Column after the release (its last measured state), {} grains: normal contact forces",
+                "Column after the release, {} grains: normal forces",
                 f.grains
             ),
             fill: GrainFill::Plain,
