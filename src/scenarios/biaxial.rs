@@ -1135,6 +1135,10 @@ fn analyse(
             vec![(lo, a + b * lo), (hi, a + b * hi)],
         ));
     }
+    if sd_line.is_none() {
+        psd.notes
+            .push("no stress–dilatancy relation fitted (stress_dilatancy_fit_error)".into());
+    }
     psd.legend = LegendAt::UpperLeft;
     draw_row(out, "biaxial.png", &[pq, pv], (1300, 650))?;
     draw_row(out, "biaxial_fits.png", &[pmc, psd], (1300, 650))?;
