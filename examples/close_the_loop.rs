@@ -198,7 +198,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             for r in v["verdict_reasons"].as_array().into_iter().flatten() {
                 println!("  {}: {}", r["verdict"], r["message"]);
             }
-            println!("(more seeds and a longer averaging window narrow the intervals: see `grainlaw campaign` in the README)");
+            println!("(more seeds and a longer averaging window narrow the intervals: see `grainlaw campaign`, docs/cli.md §9)");
             return Ok(());
         }
     }

@@ -25,7 +25,8 @@
 //! and every numeric `summary.json` key), `campaign_stats.csv` (per combination of the swept
 //! keys other than `seed`: mean and standard error over the seeds of every numeric key), and
 //! merges the per-run tables a law can be fitted to (`rheology.csv` → μ(I), φ(I)) over the runs
-//! whose exit status is 0, then fits them with the same code as `grainlaw fit`.
+//! whose exit status is 0, then fits them with the same code as `grainlaw fit`, and draws
+//! `rheology.png` (μ(I), φ(I) over every point, with the merged laws and their bands).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -38,6 +39,7 @@ use toml::{Table, Value};
 
 use crate::error::{CliError, Result};
 use crate::output::dir::write_atomic;
+use crate::scenarios::rheology_fit::{FittedCurve, MeasuredPoint, RheologyFigure};
 
 /// A parsed campaign plan.
 #[derive(Debug, Clone, PartialEq)]
@@ -732,6 +734,7 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
             files.len(),
             merged.display()
         );
+        let mut fitted_laws = Vec::new();
         for (law, simpler) in *laws {
             let mut tried = vec![*law];
             tried.extend(simpler.iter());
@@ -739,7 +742,8 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
             for l in tried {
                 let law_out = out.join(format!("{}_law.json", l.replace('-', "_")));
                 match crate::fit_cmd::fit(l, &merged, Some(&law_out)) {
-                    Ok(()) => {
+                    Ok(cal) => {
+                        fitted_laws.push(cal);
                         fitted = true;
                         break;
                     }
@@ -756,6 +760,10 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
                 refused.push(law.to_string());
             }
         }
+        if *table == "rheology.csv" {
+            let figure = write_rheology_figure(out, &files, &fitted_laws)?;
+            println!("figure of the merged points and laws: {}", figure.display());
+        }
     }
     if !refused.is_empty() {
         return Err(CliError::FitRefused {
@@ -764,6 +772,143 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// The points of the runs' `rheology.csv` tables, for the campaign's figure: `(μ points,
+/// φ points)`, each point with its standard errors when the table has them and whether it
+/// passed its own checks (`point_verdict` 0; a table without that column passes whole).
+fn rheology_points(files: &[(usize, PathBuf)]) -> Result<(Vec<MeasuredPoint>, Vec<MeasuredPoint>)> {
+    let (mut mu, mut phi) = (Vec::new(), Vec::new());
+    for (_, path) in files {
+        let text = std::fs::read_to_string(path).map_err(|e| CliError::io(path, e))?;
+        let table = identify::data::Table::parse_csv(&text, &path.display().to_string())?;
+        let column = |name: &str| table.optional_column(name);
+        let i = table.column("I")?;
+        let nan = vec![f64::NAN; i.len()];
+        let i_se = column("I_std_error")?.unwrap_or_else(|| nan.clone());
+        let passed: Vec<bool> = column(identify::user_fit::POINT_VERDICT)?
+            .map(|v| v.iter().map(|v| *v == 0.0).collect())
+            .unwrap_or_else(|| vec![true; i.len()]);
+        for (name, into) in [("mu", &mut mu), ("phi", &mut phi)] {
+            let Some(values) = column(name)? else {
+                continue;
+            };
+            let se = column(&format!("{name}_std_error"))?.unwrap_or_else(|| nan.clone());
+            for k in 0..i.len() {
+                into.push(MeasuredPoint {
+                    i: i[k],
+                    i_std_error: i_se[k],
+                    value: values[k],
+                    std_error: se[k],
+                    passed: passed[k],
+                });
+            }
+        }
+    }
+    Ok((mu, phi))
+}
+
+/// The fitted curve of a calibrated law over `[lo, hi]`, with its pointwise 95 % band by the
+/// delta method on the law's covariance ([`crate::scenarios::common::delta_band`], with the
+/// law's `t` quantile at its confidence and degrees of freedom); `linear` when the law is
+/// linear in `I` (`mu-i-linear`, `phi-i`, `phi-i-linear`).
+fn law_curve(cal: &identify::CalibratedLaw, (lo, hi): (f64, f64)) -> Result<FittedCurve> {
+    let linear = cal.law != "mu-i";
+    let order: Vec<String> = match &cal.covariance {
+        Some(c) => c.order.clone(),
+        None => Vec::new(),
+    };
+    let cov = cal
+        .covariance
+        .as_ref()
+        .map(|c| c.matrix.clone())
+        .unwrap_or_default();
+    let p: Vec<f64> = order
+        .iter()
+        .map(|n| cal.parameter(n))
+        .collect::<identify::Result<_>>()?;
+    // the law with the parameters `q` (in the covariance's order) at `x`
+    let eval = |q: &[f64], x: f64| -> f64 {
+        let mut c = cal.clone();
+        for (name, v) in order.iter().zip(q) {
+            if let Some(par) = c.parameters.iter_mut().find(|par| &par.name == name) {
+                par.estimate.value = *v;
+            }
+        }
+        c.to_law().map_or(f64::NAN, |l| l.evaluate(x))
+    };
+    cal.to_law()?;
+    let t = identify::stats::t_critical(cal.fit.confidence, cal.fit.dof.max(1));
+    let xs = crate::scenarios::rheology_fit::curve_abscissae(lo, hi, !linear);
+    Ok(FittedCurve {
+        label: format!("{}: {}", cal.law, cal.expression.formula),
+        linear,
+        band: crate::scenarios::common::delta_band(&p, &cov, t, &xs, eval),
+    })
+}
+
+/// Draws `rheology.png` in the campaign directory: μ(I) and φ(I) over every point of the
+/// merged runs (those that failed their own checks hollow, as left out of the fits), with the
+/// laws fitted to the merged table (`laws`) and their 95 % bands over the fitted points' range
+/// ([`crate::scenarios::rheology_fit::rheology_plot`], the figure of a single run). Returns the
+/// file's path.
+fn write_rheology_figure(
+    out: &Path,
+    files: &[(usize, PathBuf)],
+    laws: &[identify::CalibratedLaw],
+) -> Result<PathBuf> {
+    let (mu, phi) = rheology_points(files)?;
+    let fitted_range = |pts: &[MeasuredPoint]| {
+        crate::scenarios::rheology_fit::finite_range(pts.iter().filter(|p| p.passed).map(|p| p.i))
+    };
+    let curve = |names: &[&str], pts: &[MeasuredPoint]| -> Result<Option<FittedCurve>> {
+        match (
+            laws.iter().find(|l| names.contains(&l.law.as_str())),
+            fitted_range(pts),
+        ) {
+            (Some(cal), Some(range)) => law_curve(cal, range).map(Some),
+            _ => Ok(None),
+        }
+    };
+    let runs = files.len();
+    let plot = |title: &str, y_label: &str, colour, pts: &[MeasuredPoint], names: &[&str]| {
+        let curve = curve(names, pts)?;
+        let notes = if curve.is_none() {
+            vec!["no law fitted to these points (refused: see the printed reason)".to_string()]
+        } else {
+            Vec::new()
+        };
+        Ok::<_, CliError>(crate::scenarios::rheology_fit::rheology_plot(
+            &RheologyFigure {
+                title: title.to_string(),
+                y_label,
+                colour,
+                passed_label: format!("DEM, {runs} runs"),
+                marked_label: "left out: failed its own checks",
+                points: pts,
+                curve,
+                notes,
+            },
+        ))
+    };
+    let pmu = plot(
+        "Friction law μ(I), the campaign's points",
+        "μ = |σ_xy| / P",
+        crate::plot::PALETTE[0],
+        &mu,
+        &["mu-i", "mu-i-linear"],
+    )?;
+    let mut pphi = plot(
+        "Solid fraction φ(I), the campaign's points",
+        "solid fraction φ",
+        crate::plot::PALETTE[2],
+        &phi,
+        &["phi-i", "phi-i-linear"],
+    )?;
+    pphi.legend = crate::plot::xy::LegendAt::UpperRight;
+    let mut dir = crate::output::OutputDir::open(out)?;
+    crate::plot::xy::draw_row(&mut dir, "rheology.png", &[pmu, pphi], (1500, 650))?;
+    Ok(out.join("rheology.png"))
 }
 
 fn abbreviate(list: &[String]) -> String {
@@ -1026,6 +1171,82 @@ pub fn merged_table(files: &[(usize, PathBuf)], name: &str, by: &str) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Per-run `rheology.csv` tables as `simple-shear` writes them, three runs, points on
+    /// μ = 0.28 + I and φ = 0.80 − 0.25 I (within ±0.004 in a fixed pattern), with standard
+    /// errors 0.01 (μ) and 0.001 (φ); run k's point k + 1 failed its own checks (and lies
+    /// off the law: μ + 0.1).
+    fn run_tables(dir: &Path) -> Vec<(usize, PathBuf)> {
+        let is = [0.04, 0.07, 0.1, 0.15, 0.25];
+        let wobble = [0.004, -0.003, 0.001, -0.004, 0.002, 0.003, -0.001];
+        (0..3)
+            .map(|k| {
+                let mut t = String::from(
+                    "# grain_diameter_m = 3e-3\n# grain_density_kg_m3 = 2.5e3\nI,I_std_error,mu,mu_std_error,phi,phi_std_error,P_Pa,point_verdict\n",
+                );
+                for (j, &i) in is.iter().enumerate() {
+                    let w = wobble[(j + 2 * k) % wobble.len()];
+                    let failed = j == k + 1;
+                    let mu = 0.28 + i + w + if failed { 0.1 } else { 0.0 };
+                    let phi = 0.80 - 0.25 * i - 0.5 * w;
+                    t.push_str(&format!(
+                        "{i},{},{mu},0.01,{phi},0.001,1000,{}\n",
+                        0.01 * i,
+                        u8::from(failed)
+                    ));
+                }
+                let path = dir.join(format!("r{k}.csv"));
+                std::fs::write(&path, t).unwrap();
+                (k, path)
+            })
+            .collect()
+    }
+
+    /// The campaign's figure data: every point of every run, with its standard errors, those
+    /// that failed their own checks marked; a law fitted to the merged table is drawn over
+    /// the passed points' I range only, as a straight line (linear law, linear axis: evenly
+    /// spaced abscissae, the values on μ_s + b I to 1e-12) with a band holding the line; and
+    /// the figure file is written.
+    #[test]
+    fn the_figure_shows_all_points_and_the_merged_laws_over_their_range() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = run_tables(dir.path());
+        let (mu, phi) = rheology_points(&files).unwrap();
+        assert_eq!((mu.len(), phi.len()), (15, 15));
+        assert_eq!(mu.iter().filter(|p| !p.passed).count(), 3);
+        assert!(mu
+            .iter()
+            .all(|p| p.std_error == 0.01 && p.i_std_error == 0.01 * p.i));
+        assert!(phi.iter().all(|p| p.std_error == 0.001));
+        let merged = dir.path().join("rheology.csv");
+        merge_tables(&files, &merged).unwrap();
+        let cal =
+            crate::fit_cmd::fit("mu-i-linear", &merged, Some(&dir.path().join("l.json"))).unwrap();
+        let range = crate::scenarios::rheology_fit::finite_range(
+            mu.iter().filter(|p| p.passed).map(|p| p.i),
+        )
+        .unwrap();
+        assert_eq!(range, (0.04, 0.25));
+        let c = law_curve(&cal, range).unwrap();
+        assert!(c.linear);
+        let (mu_s, b) = (cal.parameter("mu_s").unwrap(), cal.parameter("b").unwrap());
+        assert!(
+            (mu_s - 0.28).abs() < 0.01 && (b - 1.0).abs() < 0.1,
+            "{mu_s} {b}"
+        );
+        assert_eq!(c.band.first().unwrap().0, 0.04);
+        assert!((c.band.last().unwrap().0 - 0.25).abs() < 1e-15);
+        for w in c.band.windows(2) {
+            assert!((w[1].0 - w[0].0 - 0.21 / 80.0).abs() < 1e-12);
+        }
+        for &(x, f, lo, hi) in &c.band {
+            assert!((f - (mu_s + b * x)).abs() < 1e-12);
+            assert!(lo < f && f < hi, "{lo} {f} {hi}");
+        }
+        let figure = write_rheology_figure(dir.path(), &files, &[cal]).unwrap();
+        let png = std::fs::read(figure).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    }
 
     fn plan(text: &str) -> Result<Plan> {
         parse_plan(text, Path::new("plan.toml"))

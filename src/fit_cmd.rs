@@ -23,7 +23,8 @@ use crate::output::dir::write_atomic;
 /// bound is printed as such, not as an estimate; angles also in degrees), then the derived
 /// quantities, and writes the calibrated-law JSON to `out`. With `out` the lines go to stdout;
 /// without it the JSON goes to stdout (so that it can be piped) and the lines to stderr.
-pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
+/// Returns the law written.
+pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<CalibratedLaw> {
     let cal =
         fit_csv_file(law, data, &CsvFitOptions::default()).map_err(|e| naming_file(data, e))?;
     let left_out = left_out_points(data);
@@ -38,7 +39,7 @@ pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<()> {
 pub fn fit_files(law: &str, data: &[std::path::PathBuf], out: Option<&Path>) -> Result<()> {
     match data {
         [] => Err(CliError::Usage("fit: no data file".into())),
-        [one] => fit(law, one, out),
+        [one] => fit(law, one, out).map(|_| ()),
         _ => {
             let name = format!(
                 "merged({})",
@@ -91,7 +92,7 @@ fn report(cal: &CalibratedLaw, data: &Path, left_out: usize, out: Option<&Path>)
             print!("{json}");
         }
     }
-    Ok(())
+    Ok(cal)
 }
 
 /// Rows of `data` that the fit left out for their `point_verdict` (0 when the file has no such

@@ -109,6 +109,7 @@ pub fn rve_point(snaps: &[ExternalSnapshot]) -> Result<Option<RvePoint>> {
         _ => f64::NAN,
     };
     let judged = judge_points(
+        "simple_shear",
         &[RunCheckData {
             i_target: f64::NAN,
             i_measured: point.i,

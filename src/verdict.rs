@@ -895,20 +895,53 @@ impl RunVerdict {
     }
 }
 
+/// How a law was exported ([`export_law`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Exported {
+    /// `NAME_law.json`, verdict ok: a calibrated law.
+    Calibrated,
+    /// `NAME_law.json` marked suspect (`--allow-suspect`).
+    MarkedSuspect,
+    /// `NAME_law.rejected.json`: not a calibrated law.
+    Rejected,
+}
+
+impl Exported {
+    /// The printed line that goes before a law's coefficients, so that a reader of the run's
+    /// report meets the verdict on them before the numbers (None for a calibrated law).
+    pub fn heading(self, law: &str) -> Option<String> {
+        match self {
+            Exported::Calibrated => None,
+            Exported::MarkedSuspect => Some(format!(
+                "law {law}: SUSPECT (exported marked, --allow-suspect); its coefficients, for inspection (reasons under the verdict below):"
+            )),
+            Exported::Rejected => Some(format!(
+                "law {law}: REJECTED, not a calibrated law; its coefficients, for inspection only (reasons under the verdict below):"
+            )),
+        }
+    }
+}
+
 /// Writes the calibrated law `law` (named `name`, e.g. `janssen`) with the verdict of
 /// `checks` and records it in `verdict`: `NAME_law.json` when ok, or when suspect with
 /// `verdict.allow_suspect` (marked `"verdict": "suspect"` with its reasons); otherwise
 /// `NAME_law.rejected.json` (same schema, with the verdict and reasons), and a stale file of the
-/// other name from an earlier run in the directory is removed.
+/// other name from an earlier run in the directory is removed. Returns which of these it was,
+/// for the printed report ([`Exported::heading`]).
 pub fn export_law(
     out: &mut OutputDir,
     verdict: &mut RunVerdict,
     name: &str,
     law: &identify::CalibratedLaw,
     checks: Checks,
-) -> Result<()> {
+) -> Result<Exported> {
     let v = checks.verdict();
     let accepted = v == Verdict::Ok || (v == Verdict::Suspect && verdict.allow_suspect);
+    let exported = match (accepted, v) {
+        (false, _) => Exported::Rejected,
+        (true, Verdict::Ok) => Exported::Calibrated,
+        (true, _) => Exported::MarkedSuspect,
+    };
     let (file, stale) = if accepted {
         (
             format!("{name}_law.json"),
@@ -935,7 +968,7 @@ pub fn export_law(
         file: Some(file),
         checks,
     });
-    Ok(())
+    Ok(exported)
 }
 
 /// Removes `NAME_law.json` and `NAME_law.rejected.json` left in the directory by an earlier

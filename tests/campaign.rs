@@ -251,3 +251,50 @@ fn shear_cell_seeds_are_merged_and_fitted() {
         "{t}"
     );
 }
+
+/// `--collect` of a finished simple-shear campaign writes its figure, `rheology.png` (μ(I) and
+/// φ(I) over every point with the merged laws), beside the merged table and the laws. The runs'
+/// outputs are written here (three seeds, points on μ = 0.28 + I and φ = 0.80 − 0.25 I, one
+/// point per run failed its own checks), so that only the collection runs.
+#[test]
+fn collect_writes_the_campaign_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("plan.toml"),
+        "scenario = \"simple-shear\"\n[sweep]\nseed = [1, 2, 3]\n",
+    )
+    .unwrap();
+    let c = dir.path().join("c");
+    for k in 0..3usize {
+        let run = c.join(format!("runs/{k:04}"));
+        std::fs::create_dir_all(&run).unwrap();
+        std::fs::write(c.join(format!("runs/{k:04}.exit")), "0\n").unwrap();
+        std::fs::write(run.join("summary.json"), "{\"verdict\": \"ok\"}\n").unwrap();
+        let mut t = String::from(
+            "# grain_diameter_m = 3e-3\n# grain_density_kg_m3 = 2.5e3\nI,I_std_error,mu,mu_std_error,phi,phi_std_error,P_Pa,point_verdict\n",
+        );
+        for (j, i) in [0.04, 0.07, 0.1, 0.15, 0.25].into_iter().enumerate() {
+            let w = [0.004, -0.003, 0.001, -0.004, 0.002, 0.003, -0.001][(j + 2 * k) % 7];
+            t.push_str(&format!(
+                "{i},{},{},0.01,{},0.001,1000,{}\n",
+                0.01 * i,
+                0.28 + i + w,
+                0.80 - 0.25 * i - 0.5 * w,
+                u8::from(j == k + 1)
+            ));
+        }
+        std::fs::write(run.join("rheology.csv"), t).unwrap();
+    }
+    assert!(!c.join("rheology.png").exists());
+    let o = campaign(dir.path(), &["plan.toml", "--out", "c", "--collect"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    let png = std::fs::read(c.join("rheology.png")).unwrap_or_else(|e| panic!("{e}: {t}"));
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert!(t.contains("rheology.png"), "{t}");
+    assert!(c.join("rheology.csv").is_file());
+    assert!(
+        c.join("mu_i_law.json").is_file() || c.join("mu_i_linear_law.json").is_file(),
+        "{t}"
+    );
+}

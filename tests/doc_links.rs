@@ -180,3 +180,36 @@ fn anchors_follow_github() {
     );
     assert_eq!(slug("μ(I) and φ(I)"), "μi-and-φi");
 }
+
+/// The README is a front page: under 200 lines; its first code block, before any section, is
+/// the two commands a newcomer types on a fresh machine, the main job and all the tests; it
+/// names its prerequisites; and it links every page of `docs/` (whose links the test above
+/// resolves), so that what was moved there from the README stays reachable.
+#[test]
+fn the_readme_is_a_front_page() {
+    let text = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let n = text.lines().count();
+    assert!(n < 200, "README.md has {n} lines");
+    let first_section = text.find("\n## ").expect("a section");
+    let start = text.find("```sh\n").expect("a shell block") + 6;
+    assert!(
+        start < first_section,
+        "the commands come before any section"
+    );
+    let end = start + text[start..].find("```").unwrap();
+    let commands: Vec<&str> = text[start..end]
+        .lines()
+        .map(|l| l.split('#').next().unwrap().trim())
+        .collect();
+    assert_eq!(commands, ["cargo run --release", "scripts/test-all.sh"]);
+    assert!(text.contains("\n## Prerequisites\n"));
+    for page in std::fs::read_dir(root().join("docs")).unwrap() {
+        let name = page.unwrap().file_name().to_string_lossy().to_string();
+        if name.ends_with(".md") {
+            assert!(
+                text.contains(&format!("](docs/{name}")),
+                "README.md does not link docs/{name}"
+            );
+        }
+    }
+}

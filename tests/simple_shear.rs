@@ -1,6 +1,7 @@
 //! The `simple-shear` scenario (biperiodic cell): its inputs are validated (one line naming
 //! the key, exit code 2), and a run stopped and resumed writes the same files, byte for byte,
-//! as an uninterrupted one, its solver-sensitivity samples included.
+//! as an uninterrupted one, its solver-sensitivity samples included, and its checks are named
+//! `simple_shear.*`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -120,6 +121,23 @@ fn resume_is_bit_identical() {
     assert_eq!(tried, n / 10 - (n - w) / 10, "{n} steps, window {w}");
     assert!(tried >= 1, "{tried} samples");
     assert_eq!(summary["window_unavailable_samples"].as_u64(), Some(0));
+    // The point's checks are named after the scenario that measured it (the tiny window is
+    // too short to test steadiness: simple_shear.steady_mu and .steady_phi are suspect), never
+    // after the shear cell.
+    let checks: Vec<&str> = summary["verdict_reasons"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["check"].as_str().unwrap())
+        .collect();
+    assert!(
+        checks.contains(&"simple_shear.steady_mu") && checks.contains(&"simple_shear.steady_phi"),
+        "{checks:?}"
+    );
+    assert!(
+        !checks.iter().any(|c| c.starts_with("shear_cell.")),
+        "{checks:?}"
+    );
     for (name, bytes) in &fa {
         if name == Path::new("summary.json") {
             let strip = |v: &[u8]| -> serde_json::Map<String, serde_json::Value> {

@@ -325,3 +325,36 @@ fn resume_keeps_allow_suspect() {
     assert_eq!(json(&out.join("janssen_law.json"))["verdict"], "suspect");
     assert!(!out.join("janssen_law.rejected.json").exists());
 }
+
+/// A rejected law's coefficients are printed under a line that says it is rejected, before
+/// them: the loose column of `cases` (its Janssen law suspect, written as
+/// `janssen_law.rejected.json`) prints `law janssen: REJECTED …` above `K = …`; with
+/// `--allow-suspect`, `law janssen: SUSPECT …` instead. A law that passes prints no such line
+/// (the `column` case's report is checked in `cases`; here the stdout of the two loose runs).
+#[test]
+fn rejected_coefficients_are_marked_before_they_are_printed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let args: Vec<&str> = ["run", "janssen", "--set", "grains=100"]
+        .into_iter()
+        .chain(LOOSE.iter().copied())
+        .collect();
+    for (extra, mark) in [
+        (None, "law janssen: REJECTED, not a calibrated law"),
+        (
+            Some("--allow-suspect"),
+            "law janssen: SUSPECT (exported marked",
+        ),
+    ] {
+        let mut a = args.clone();
+        a.extend(extra);
+        let o = grainlaw(&a, &tmp.path().join("loose"));
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        let lines: Vec<&str> = stdout.lines().collect();
+        let at = |p: &str| lines.iter().position(|l| l.starts_with(p));
+        let (m, k) = (at(mark), at("K    ="));
+        assert!(
+            matches!((m, k), (Some(m), Some(k)) if m + 1 == k),
+            "the mark must head the coefficients: {stdout}"
+        );
+    }
+}

@@ -29,6 +29,21 @@ impl OutputDir {
         })
     }
 
+    /// An existing directory that is not a run's (e.g. a campaign's), to add files to: nothing
+    /// in it is removed.
+    pub fn open(root: &Path) -> Result<Self> {
+        if !root.is_dir() {
+            return Err(CliError::io(
+                root,
+                std::io::Error::new(std::io::ErrorKind::NotFound, "not a directory"),
+            ));
+        }
+        Ok(Self {
+            root: root.to_path_buf(),
+            written: Vec::new(),
+        })
+    }
+
     /// The directory.
     pub fn path(&self) -> &Path {
         &self.root

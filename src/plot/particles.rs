@@ -195,7 +195,7 @@ pub fn draw_particles(out: &mut OutputDir, name: &str, view: &ParticleView) -> R
                 let (_, py) = chart.plotting_area().get_pixel_range();
                 let px0 = chart.plotting_area().get_base_pixel().0;
                 main.draw(&Text::new(
-                    format!("line width ∝ normal force, max {:.3e} N", fmax),
+                    format!("line width ∝ normal force, max {:.3e} N/m", fmax),
                     (px0 + 5, py.end + 2 - 22),
                     font(14.0),
                 ))?;

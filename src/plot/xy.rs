@@ -1,4 +1,5 @@
-//! Curves, points and confidence bands on linear or logarithmic axes, with a legend.
+//! Curves, points with error bars, and confidence bands on linear or logarithmic axes, with a
+//! legend.
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
@@ -38,6 +39,10 @@ pub struct Series {
     pub color: RGBColor,
     /// Points `(x, y)`; non-finite points are skipped.
     pub xy: Vec<(f64, f64)>,
+    /// Error bars: one `(x_error, y_error)` half-width per point of `xy` (a standard error,
+    /// drawn as `x ± x_error`, `y ± y_error`; a non-finite or non-positive half-width draws no
+    /// bar), or empty for a series without error bars.
+    pub errors: Vec<(f64, f64)>,
 }
 
 impl Series {
@@ -51,7 +56,42 @@ impl Series {
                 .into_iter()
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
                 .collect(),
+            errors: Vec::new(),
         }
+    }
+
+    /// A series of points with error bars: `(x, y, x_error, y_error)`, the errors half-widths
+    /// (e.g. standard errors; NaN where a point has none). Points with a non-finite `x` or `y`
+    /// are skipped with their errors.
+    pub fn with_errors(
+        label: &str,
+        style: Style,
+        color: RGBColor,
+        pts: Vec<(f64, f64, f64, f64)>,
+    ) -> Self {
+        let kept: Vec<_> = pts
+            .into_iter()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect();
+        Self {
+            label: label.to_string(),
+            style,
+            color,
+            xy: kept.iter().map(|p| (p.0, p.1)).collect(),
+            errors: kept.iter().map(|p| (p.2, p.3)).collect(),
+        }
+    }
+
+    /// The error bars drawn: `(x, y, x_error, y_error)` for each point with at least one usable
+    /// half-width (finite and positive; the other one is then 0).
+    pub fn error_bars(&self) -> Vec<(f64, f64, f64, f64)> {
+        let usable = |e: f64| if e.is_finite() && e > 0.0 { e } else { 0.0 };
+        self.xy
+            .iter()
+            .zip(&self.errors)
+            .map(|(&(x, y), &(ex, ey))| (x, y, usable(ex), usable(ey)))
+            .filter(|b| b.2 > 0.0 || b.3 > 0.0)
+            .collect()
     }
 }
 
@@ -137,6 +177,15 @@ impl Axis {
     }
 }
 
+/// Margin of a chart around its title, labels and plotting area (px).
+const MARGIN: u32 = 18;
+/// Height of the x tick labels and axis description below the plotting area (px).
+const X_LABEL_AREA: u32 = 55;
+/// Width of the y tick labels and axis description left of the plotting area (px).
+const Y_LABEL_AREA: u32 = 85;
+/// Font size of a chart's title.
+const TITLE_SIZE: f64 = 22.0;
+
 /// Where the legend goes.
 pub use plotters::chart::SeriesLabelPosition as LegendAt;
 
@@ -157,6 +206,9 @@ pub struct XyPlot {
     pub legend: LegendAt,
     /// Extra text lines in the upper left of the plotting area.
     pub notes: Vec<String>,
+    /// One unit of x as long on the screen as one unit of y (circles drawn round): the
+    /// shorter range is widened above its high end to the plotting area's aspect ratio.
+    pub equal_aspect: bool,
 }
 
 impl XyPlot {
@@ -170,6 +222,7 @@ impl XyPlot {
             bands: Vec::new(),
             legend: LegendAt::UpperRight,
             notes: Vec::new(),
+            equal_aspect: false,
         }
     }
 
@@ -177,12 +230,18 @@ impl XyPlot {
         if let Some(r) = axis.range {
             return r;
         }
+        let bar_ends = self.series.iter().flat_map(|s| {
+            s.error_bars()
+                .into_iter()
+                .flat_map(|(x, y, ex, ey)| [(x - ex, y - ey), (x + ex, y + ey)])
+        });
         let vals = self
             .series
             .iter()
-            .flat_map(|s| s.xy.iter())
-            .chain(self.bands.iter().flat_map(|b| b.outline.iter()))
-            .map(|&(x, y)| if xs { x } else { y })
+            .flat_map(|s| s.xy.iter().copied())
+            .chain(self.bands.iter().flat_map(|b| b.outline.iter().copied()))
+            .chain(bar_ends)
+            .map(|(x, y)| if xs { x } else { y })
             .filter(|v| !axis.log || *v > 0.0);
         if axis.log {
             let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -203,25 +262,67 @@ impl XyPlot {
         }
     }
 
+    /// The plotting area's size in pixels when the figure is drawn into `area` (the chart's
+    /// layout: its margins, the title, the label areas).
+    pub fn plotting_pixels(&self, area: &DrawingArea<BitMapBackend, Shift>) -> (f64, f64) {
+        let (w, h) = area.dim_in_pixel();
+        let title_h = if self.title.is_empty() {
+            0
+        } else {
+            // `DrawingArea::titled`: the text's height and a padding of min(h/2, 5) above and
+            // below it
+            let th = area
+                .estimate_text_size(&self.title, &font(TITLE_SIZE))
+                .map(|s| s.1)
+                .unwrap_or(0);
+            th + 2 * (th / 2).min(5)
+        };
+        (
+            (w as f64 - 2.0 * MARGIN as f64 - Y_LABEL_AREA as f64).max(1.0),
+            (h as f64 - 2.0 * MARGIN as f64 - title_h as f64 - X_LABEL_AREA as f64).max(1.0),
+        )
+    }
+
+    /// The ranges drawn into `area`: each axis's fixed range or the data's, widened to equal
+    /// scales when [`XyPlot::equal_aspect`] (linear axes only).
+    pub fn ranges(&self, area: &DrawingArea<BitMapBackend, Shift>) -> ((f64, f64), (f64, f64)) {
+        let (mut x0, mut x1) = self.data_range(true, &self.x);
+        let (mut y0, mut y1) = self.data_range(false, &self.y);
+        if self.equal_aspect && !self.x.log && !self.y.log {
+            let (pw, ph) = self.plotting_pixels(area);
+            // metres (or pascals) per pixel along each axis; the larger one wins
+            let per_px = ((x1 - x0) / pw).max((y1 - y0) / ph);
+            // the shorter range grows upwards from its low end (e.g. a τ axis from 0)
+            let widen = |lo: f64, _hi: f64, px: f64| (lo, lo + per_px * px);
+            (x0, x1) = widen(x0, x1, pw);
+            (y0, y1) = widen(y0, y1, ph);
+        }
+        ((x0, x1), (y0, y1))
+    }
+
     /// Draws the figure into `area`.
     pub fn draw_on(&self, area: &DrawingArea<BitMapBackend, Shift>) -> DrawResult {
-        let (x0, x1) = self.data_range(true, &self.x);
-        let (y0, y1) = self.data_range(false, &self.y);
+        let ranges = self.ranges(area);
+        let ((x0, x1), (y0, y1)) = ranges;
         let xr = if self.x.reversed { (x1, x0) } else { (x0, x1) };
         let yr = if self.y.reversed { (y1, y0) } else { (y0, y1) };
         match (self.x.log, self.y.log) {
-            (false, false) => self.draw_generic(area, xr.0..xr.1, yr.0..yr.1),
-            (true, false) => self.draw_generic(area, (xr.0..xr.1).log_scale(), yr.0..yr.1),
-            (false, true) => self.draw_generic(area, xr.0..xr.1, (yr.0..yr.1).log_scale()),
-            (true, true) => {
-                self.draw_generic(area, (xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
-            }
+            (false, false) => self.draw_generic(area, ranges, xr.0..xr.1, yr.0..yr.1),
+            (true, false) => self.draw_generic(area, ranges, (xr.0..xr.1).log_scale(), yr.0..yr.1),
+            (false, true) => self.draw_generic(area, ranges, xr.0..xr.1, (yr.0..yr.1).log_scale()),
+            (true, true) => self.draw_generic(
+                area,
+                ranges,
+                (xr.0..xr.1).log_scale(),
+                (yr.0..yr.1).log_scale(),
+            ),
         }
     }
 
     fn draw_generic<XR, YR>(
         &self,
         area: &DrawingArea<BitMapBackend, Shift>,
+        ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
         xr: XR,
         yr: YR,
     ) -> DrawResult
@@ -233,16 +334,25 @@ impl XyPlot {
     {
         let mut builder = ChartBuilder::on(area);
         builder
-            .margin(18)
-            .x_label_area_size(55)
-            .y_label_area_size(85);
+            .margin(MARGIN)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA);
         if !self.title.is_empty() {
-            builder.caption(&self.title, font(22.0));
+            builder.caption(&self.title, font(TITLE_SIZE));
         }
         let mut chart = builder.build_cartesian_2d(xr, yr)?;
         let (xlog, ylog) = (self.x.log, self.y.log);
-        let xf = move |v: &f64| if xlog { fmt_log_tick(*v) } else { fmt_tick(*v) };
-        let yf = move |v: &f64| if ylog { fmt_log_tick(*v) } else { fmt_tick(*v) };
+        // a logarithmic axis spanning less than a decade labels every tick
+        let within_decade = |a: f64, b: f64| a.max(b) < 10.0 * a.min(b);
+        let (xall, yall) = (within_decade(x0, x1), within_decade(y0, y1));
+        let xf = move |v: &f64| match (xlog, xall) {
+            (true, false) => fmt_log_tick(*v),
+            _ => fmt_tick(*v),
+        };
+        let yf = move |v: &f64| match (ylog, yall) {
+            (true, false) => fmt_log_tick(*v),
+            _ => fmt_tick(*v),
+        };
         chart
             .configure_mesh()
             .max_light_lines(if xlog || ylog { 0 } else { 5 })
@@ -271,6 +381,37 @@ impl XyPlot {
         }
         for s in &self.series {
             let c = s.color;
+            let (xlo, ylo) = (x0.min(x1), y0.min(y1));
+            for (x, y, ex, ey) in s.error_bars() {
+                // on a logarithmic axis a bar reaching zero or below is cut at the axis
+                let low = |v: f64, e: f64, log: bool, floor: f64| {
+                    if log && v - e <= 0.0 {
+                        floor
+                    } else {
+                        v - e
+                    }
+                };
+                if ey > 0.0 {
+                    chart.draw_series(std::iter::once(ErrorBar::new_vertical(
+                        x,
+                        low(y, ey, ylog, ylo),
+                        y,
+                        y + ey,
+                        c.stroke_width(2),
+                        10,
+                    )))?;
+                }
+                if ex > 0.0 {
+                    chart.draw_series(std::iter::once(ErrorBar::new_horizontal(
+                        y,
+                        low(x, ex, xlog, xlo),
+                        x,
+                        x + ex,
+                        c.stroke_width(2),
+                        10,
+                    )))?;
+                }
+            }
             let anno = match s.style {
                 Style::Line | Style::Thin | Style::LinePoints => {
                     let w = if s.style == Style::Thin { 1 } else { 3 };
@@ -319,9 +460,14 @@ impl XyPlot {
             }
         }
         if labelled {
+            // a legend in the upper left goes below the notes drawn there
+            let position = match (&self.legend, self.notes.len()) {
+                (LegendAt::UpperLeft, n) if n > 0 => LegendAt::Coordinate(5, 10 + 22 * n as i32),
+                (l, _) => l.clone(),
+            };
             chart
                 .configure_series_labels()
-                .position(self.legend.clone())
+                .position(position)
                 .background_style(WHITE.mix(0.85))
                 .border_style(RGBColor(150, 150, 150))
                 .label_font(font(16.0))
@@ -455,3 +601,64 @@ pub fn draw_column(
 
 #[allow(dead_code)]
 type Lin = RangedCoordf64;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// With equal scales, the plotting area's size computed from the layout is the one the
+    /// chart gets (to a pixel), and one unit of x spans as many pixels as one unit of y (to
+    /// 1 %), the shorter range grown from its low end; the data stay inside the ranges.
+    #[test]
+    fn equal_aspect_draws_equal_scales() {
+        crate::plot::init_font();
+        let (w, h) = (650u32, 650u32);
+        let mut buf = vec![0u8; (w * h * 3) as usize];
+        let area = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        let mut plot = XyPlot::new("Mohr", Axis::new("σ (Pa)"), Axis::new("τ (Pa)"));
+        plot.series.push(Series::new(
+            "",
+            Style::Line,
+            RGBColor(0, 0, 0),
+            vec![(0.0, 0.0), (10_000.0, 0.0), (6000.0, 3000.0)],
+        ));
+        plot.equal_aspect = true;
+        let (pw, ph) = plot.plotting_pixels(&area);
+        let ((x0, x1), (y0, y1)) = plot.ranges(&area);
+        let chart = ChartBuilder::on(&area)
+            .margin(MARGIN)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .caption("Mohr", font(TITLE_SIZE))
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .unwrap();
+        let (aw, ah) = chart.plotting_area().dim_in_pixel();
+        assert!((aw as f64 - pw).abs() <= 1.0 && (ah as f64 - ph).abs() <= 1.0);
+        let (sx, sy) = ((x1 - x0) / aw as f64, (y1 - y0) / ah as f64);
+        assert!((sx / sy - 1.0).abs() < 0.01, "{sx} {sy}");
+        // x is the longer range (padded 5 %); y grew upwards from its padded low end
+        assert!(x0 < 0.0 && x1 > 10_000.0 && (y0 - (-150.0)).abs() < 1e-9 && y1 > 3000.0);
+    }
+
+    /// Error bars: a point with a finite positive standard error has a bar, one with NaN or
+    /// zero has none, and points dropped for a non-finite coordinate drop their errors.
+    #[test]
+    fn error_bars_follow_their_points() {
+        let s = Series::with_errors(
+            "",
+            Style::Points,
+            RGBColor(0, 0, 0),
+            vec![
+                (1.0, 2.0, f64::NAN, 0.1),
+                (f64::NAN, 3.0, 0.5, 0.5),
+                (2.0, 4.0, 0.0, f64::NAN),
+                (3.0, 5.0, 0.2, 0.0),
+            ],
+        );
+        assert_eq!(s.xy, vec![(1.0, 2.0), (2.0, 4.0), (3.0, 5.0)]);
+        assert_eq!(
+            s.error_bars(),
+            vec![(1.0, 2.0, 0.0, 0.1), (3.0, 5.0, 0.2, 0.0)]
+        );
+    }
+}

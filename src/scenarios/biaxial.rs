@@ -947,22 +947,15 @@ fn analyse(
             );
             s.num("friction_peak_r_squared", f.report.r_squared)
                 .flag("friction_peak_cohesion_fixed_zero", cohesion_fixed_zero);
+            mc_line = Some((f.law.friction_angle_rad, f.law.cohesion_pa));
+            let law = CalibratedLaw::from_mohr_coulomb(&f, provenance.clone());
+            let exported = export_law(out, &mut verdict, "mohr_coulomb", &law, common.clone())?;
+            headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "Mohr–Coulomb over the peaks, q = p sin φ + c cos φ",
                 f.report.r_squared,
                 &[f.friction_angle_deg.clone(), f.cohesion.clone()],
             ));
-            mc_line = Some((
-                f.law.friction_angle_rad.sin(),
-                f.law.cohesion_pa * f.law.friction_angle_rad.cos(),
-            ));
-            export_law(
-                out,
-                &mut verdict,
-                "mohr_coulomb",
-                &CalibratedLaw::from_mohr_coulomb(&f, provenance.clone()),
-                common.clone(),
-            )?;
         }
         Err(e) => {
             warn(&format!("Mohr–Coulomb fit over the peaks refused: {e}"));
@@ -1008,6 +1001,9 @@ fn analyse(
             );
             s.num("friction_critical_sin_phi_value", f.sin_phi.value)
                 .num("solid_fraction_critical", f.solid_fraction.value);
+            let law = CalibratedLaw::from_critical_state(&f, provenance.clone());
+            let exported = export_law(out, &mut verdict, "critical_state", &law, critical.clone())?;
+            headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "critical state (plateau means over the pressures)",
                 f.report.r_squared,
@@ -1017,13 +1013,6 @@ fn analyse(
                     f.solid_fraction.clone(),
                 ],
             ));
-            export_law(
-                out,
-                &mut verdict,
-                "critical_state",
-                &CalibratedLaw::from_critical_state(&f, provenance.clone()),
-                critical.clone(),
-            )?;
         }
         Err(e) => {
             warn(&format!("critical state refused: {e}"));
@@ -1054,19 +1043,15 @@ fn analyse(
             fit_keys(&mut s, "stress_dilatancy", &f.report.parameters);
             s.num("stress_dilatancy_r_squared", f.report.r_squared)
                 .int("stress_dilatancy_points", f.report.n as u64);
+            sd_line = Some((f.law.sin_phi_c, f.law.beta));
+            let law = CalibratedLaw::from_stress_dilatancy(&f, provenance.clone());
+            let exported = export_law(out, &mut verdict, "stress_dilatancy", &law, common.clone())?;
+            headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "stress–dilatancy over the hardening phases, sin φ = sin φ_cv + β sin ψ",
                 f.report.r_squared,
                 &f.report.parameters,
             ));
-            sd_line = Some((f.law.sin_phi_c, f.law.beta));
-            export_law(
-                out,
-                &mut verdict,
-                "stress_dilatancy",
-                &CalibratedLaw::from_stress_dilatancy(&f, provenance.clone()),
-                common.clone(),
-            )?;
         }
         Err(e) => {
             warn(&format!("stress–dilatancy fit refused: {e}"));
@@ -1116,32 +1101,12 @@ fn analyse(
     }
     pq.legend = LegendAt::LowerRight;
     pv.legend = LegendAt::UpperLeft;
-    let mut pmc = XyPlot::new(
-        "Peak Mohr circles (compression positive)",
-        Axis::new("p = (σ₁ + σ₃)/2 (Pa)"),
-        Axis::new("q = (σ₁ − σ₃)/2 (Pa)"),
-    );
-    pmc.series.push(Series::new(
-        "peaks",
-        Style::Points,
-        PALETTE[0],
-        rows.iter().map(|r| (r[3], r[4])).collect(),
-    ));
-    if let Some((a, b)) = mc_line {
-        let pmax = rows.iter().map(|r| r[3]).fold(0.0, f64::max) * 1.1;
-        pmc.series.push(Series::new(
-            "q = p sin φ + c cos φ",
-            Style::Line,
-            PALETTE[1],
-            (0..=20)
-                .map(|j| {
-                    let x = pmax * j as f64 / 20.0;
-                    (x, a * x + b)
-                })
-                .collect(),
-        ));
-    }
-    pmc.legend = LegendAt::UpperLeft;
+    let circles: Vec<(f64, f64, f64)> = pressures
+        .iter()
+        .zip(rows.iter())
+        .map(|(p0, r)| (*p0, r[3], r[4]))
+        .collect();
+    let pmc = mohr_plot(&circles, mc_line);
     let mut psd = XyPlot::new(
         "Stress–dilatancy (hardening phases)",
         Axis::new("sin ψ = −ε̇_v / ε̇_γ"),
@@ -1169,6 +1134,10 @@ fn analyse(
             PALETTE[1],
             vec![(lo, a + b * lo), (hi, a + b * hi)],
         ));
+    }
+    if sd_line.is_none() {
+        psd.notes
+            .push("no stress–dilatancy relation fitted (stress_dilatancy_fit_error)".into());
     }
     psd.legend = LegendAt::UpperLeft;
     draw_row(out, "biaxial.png", &[pq, pv], (1300, 650))?;
@@ -1272,4 +1241,117 @@ pub fn bench_rve(grains: usize, compress_steps: usize, axial_steps: usize) -> Re
         corrections: corrections as f64 / k,
         unconverged,
     })
+}
+
+/// Points per drawn half circle.
+const CIRCLE_SEGMENTS: usize = 90;
+
+/// The figure of the peak Mohr circles: for each pressure `(p₀, p, q)` the upper half of the
+/// circle of centre `σ = p` and radius `q` in the plane of normal stress `σ` (compression
+/// positive) and shear stress `τ`, drawn at equal scales so that circles look round; with
+/// `envelope = (φ, c)`, the Mohr–Coulomb line `τ = c + σ tan φ`, tangent to the circle
+/// `(p, q)` at `σ_t = p − q sin φ`, `τ_t = q cos φ` when `q = p sin φ + c cos φ`: solid between
+/// the circles' tangent points (the data), dashed from `σ = 0` (its cohesion intercept, an
+/// extrapolation) to the first of them.
+pub(crate) fn mohr_plot(circles: &[(f64, f64, f64)], envelope: Option<(f64, f64)>) -> XyPlot {
+    let mut plot = XyPlot::new(
+        "Peak Mohr circles (compression positive)",
+        Axis::new("normal stress σ (Pa)"),
+        Axis::new("shear stress τ (Pa)"),
+    );
+    plot.equal_aspect = true;
+    for (k, &(p0, p, q)) in circles.iter().enumerate() {
+        plot.series.push(Series::new(
+            &format!("peak at p₀ = {p0} Pa"),
+            Style::Line,
+            PALETTE[k % PALETTE.len()],
+            (0..=CIRCLE_SEGMENTS)
+                .map(|j| {
+                    let a = std::f64::consts::PI * j as f64 / CIRCLE_SEGMENTS as f64;
+                    (p + q * a.cos(), q * a.sin())
+                })
+                .collect(),
+        ));
+    }
+    if let Some((phi, c)) = envelope {
+        let tangents: Vec<f64> = circles
+            .iter()
+            .map(|&(_, p, q)| p - q * phi.sin())
+            .filter(|x| x.is_finite())
+            .collect();
+        let lo = tangents.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = tangents.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if lo.is_finite() {
+            let tau = |x: f64| c + x * phi.tan();
+            plot.series.push(Series::new(
+                &format!(
+                    "Mohr–Coulomb τ = c + σ tan φ (φ = {:.1}°, c = {c:.0} Pa)",
+                    phi.to_degrees()
+                ),
+                Style::Line,
+                PALETTE[6],
+                vec![(lo, tau(lo)), (hi, tau(hi))],
+            ));
+            if lo > 0.0 {
+                plot.series.push(Series::new(
+                    "the same, extrapolated to σ = 0",
+                    Style::Dashed,
+                    PALETTE[6],
+                    vec![(0.0, tau(0.0)), (lo, tau(lo))],
+                ));
+            }
+        }
+    }
+    plot.legend = LegendAt::UpperLeft;
+    plot
+}
+
+#[cfg(test)]
+mod figure_tests {
+    use super::*;
+
+    /// The circles are circles: every drawn point of the circle `(p, q)` is at distance `q`
+    /// from `(p, 0)` (to 1e-9 relative), with τ ≥ 0, at equal scales; the envelope is the
+    /// line τ = c + σ tan φ, solid only between the tangent points `p − q sin φ` of the
+    /// circles (the smallest and the largest), dashed below, and tangent to a circle that
+    /// satisfies `q = p sin φ + c cos φ` (its distance to the centre equals the radius).
+    #[test]
+    fn mohr_circles_are_circles_and_the_envelope_spans_its_data() {
+        let (phi, c) = (26.5f64.to_radians(), 50.0);
+        let circles: Vec<(f64, f64, f64)> = [1000.0, 2000.0, 4000.0]
+            .iter()
+            .map(|&p| (p, 1.8 * p, 1.8 * p * phi.sin() + c * phi.cos()))
+            .collect();
+        let plot = mohr_plot(&circles, Some((phi, c)));
+        assert!(plot.equal_aspect);
+        for (k, &(_, p, q)) in circles.iter().enumerate() {
+            let s = &plot.series[k];
+            assert_eq!(s.xy.len(), CIRCLE_SEGMENTS + 1);
+            for &(x, y) in &s.xy {
+                let r = ((x - p).powi(2) + y * y).sqrt();
+                assert!((r - q).abs() <= 1e-9 * q, "radius {r} vs {q}");
+                assert!(y >= -1e-9 * q);
+            }
+        }
+        let line = &plot.series[3];
+        assert_eq!(line.style, Style::Line);
+        let (lo, hi) = (line.xy[0].0, line.xy[1].0);
+        let t = |k: usize| circles[k].1 - circles[k].2 * phi.sin();
+        assert!(
+            (lo - t(0)).abs() < 1e-9 && (hi - t(2)).abs() < 1e-9,
+            "{lo} {hi}"
+        );
+        for &(x, y) in &line.xy {
+            assert!((y - (c + x * phi.tan())).abs() < 1e-9);
+        }
+        // tangent: distance from each centre to the line equals its radius
+        for &(_, p, q) in &circles {
+            let d = (p * phi.tan() + c) / (1.0 + phi.tan().powi(2)).sqrt();
+            assert!((d - q).abs() <= 1e-9 * q, "{d} vs {q}");
+        }
+        let ext = &plot.series[4];
+        assert_eq!(ext.style, Style::Dashed);
+        assert_eq!(ext.xy[0].0, 0.0);
+        assert!((ext.xy[1].0 - lo).abs() < 1e-12);
+    }
 }

@@ -2,16 +2,17 @@
 //! fits (the full law, then its linear form when the data do not support it), their curves
 //! and 95 % bands on the figures, the summary keys, the printed parameters with their
 //! intervals, and the laws exported under their verdicts ([`crate::verdict::export_law`]).
-//! One implementation for every scenario that measures μ(I) and φ(I).
+//! One implementation for every scenario that measures μ(I) and φ(I); the figures
+//! ([`rheology_plot`]) are also those of a campaign's merged points (`crate::campaign`).
 
 use identify::law::{GrainScale, Provenance};
 use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use identify::{CalibratedLaw, FitOptions};
 
-use super::common::{add_fitted_curve, delta_band, fit_keys, parameter_lines};
+use super::common::{delta_band, fit_keys, parameter_lines};
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
-use crate::plot::xy::{Axis, LegendAt, Series, Style, XyPlot};
+use crate::plot::xy::{Axis, Band, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::warn;
 use crate::verdict::{export_law, Checks, RunVerdict, Verdict};
@@ -32,54 +33,216 @@ pub(crate) struct RheologyFit<'a> {
     pub(crate) mu_checks: Checks,
     /// The checks the φ(I) law depends on.
     pub(crate) phi_checks: Checks,
+    /// Standard errors of the points as `rheology.csv` holds them (drawn as error bars; None
+    /// where the scenario measures none), whatever the fits weigh by.
+    pub(crate) std_errors: PointStdErrors,
+    /// Each point's own verdict (`point_verdict` of `rheology.csv`): a point not ok is drawn
+    /// marked.
+    pub(crate) point_verdicts: &'a [Verdict],
+}
+
+/// Standard errors of a rheology's points, one per point, each optional.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct PointStdErrors {
+    /// Of `I`.
+    pub(crate) i: Option<Vec<f64>>,
+    /// Of `μ`.
+    pub(crate) mu: Option<Vec<f64>>,
+    /// Of `φ`.
+    pub(crate) phi: Option<Vec<f64>>,
+}
+
+/// One measured point of a rheology figure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MeasuredPoint {
+    /// Inertial number and its standard error (NaN: none).
+    pub(crate) i: f64,
+    pub(crate) i_std_error: f64,
+    /// The measured value (μ or φ) and its standard error (NaN: none).
+    pub(crate) value: f64,
+    pub(crate) std_error: f64,
+    /// Whether the point passed its own checks.
+    pub(crate) passed: bool,
+}
+
+/// A fitted law drawn over its data: the legend's formula, whether the law is linear in `I`
+/// (then drawn on a linear `I` axis, where it is a straight line; the full μ(I) on a
+/// logarithmic one), and its delta-method band `(I, f, lo, hi)` ([`delta_band`]) over the
+/// inertial numbers of the points it was fitted to ([`curve_abscissae`]).
+#[derive(Debug, Clone)]
+pub(crate) struct FittedCurve {
+    pub(crate) label: String,
+    pub(crate) linear: bool,
+    pub(crate) band: Vec<(f64, f64, f64, f64)>,
+}
+
+/// A rheology figure: `μ(I)` or `φ(I)`.
+pub(crate) struct RheologyFigure<'a> {
+    /// Title.
+    pub(crate) title: String,
+    /// The quantity with its definition, e.g. `μ = |σ_xy| / P`.
+    pub(crate) y_label: &'a str,
+    /// Colour of the points and of the band.
+    pub(crate) colour: plotters::style::RGBColor,
+    /// Legend of the points that passed their own checks.
+    pub(crate) passed_label: String,
+    /// Legend of the others (drawn hollow).
+    pub(crate) marked_label: &'a str,
+    /// The points.
+    pub(crate) points: &'a [MeasuredPoint],
+    /// The fitted law, or None when none was fitted.
+    pub(crate) curve: Option<FittedCurve>,
+    /// Text lines in the plotting area (e.g. why no law is drawn).
+    pub(crate) notes: Vec<String>,
+}
+
+/// Number of intervals of a drawn curve.
+const CURVE_INTERVALS: usize = 80;
+
+/// Abscissae of a fitted curve over the data it was fitted to, `lo ≤ I ≤ hi`: evenly spaced,
+/// or geometrically on a logarithmic axis; the curve is not drawn beyond its data.
+pub(crate) fn curve_abscissae(lo: f64, hi: f64, log: bool) -> Vec<f64> {
+    (0..=CURVE_INTERVALS)
+        .map(|k| {
+            let t = k as f64 / CURVE_INTERVALS as f64;
+            if log {
+                lo * (hi / lo).powf(t)
+            } else {
+                lo + (hi - lo) * t
+            }
+        })
+        .collect()
+}
+
+/// The range `[min, max]` of the finite values.
+pub(crate) fn finite_range(xs: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
+    xs.into_iter()
+        .filter(|x| x.is_finite())
+        .fold(None, |r, x| match r {
+            None => Some((x, x)),
+            Some((lo, hi)) => Some((lo.min(x), hi.max(x))),
+        })
+}
+
+/// The figure of a rheology: the points that passed their own checks (filled, with error
+/// bars of ± one standard error where one is known), the others hollow under their own
+/// legend, the fitted law over its data with its 95 % band; `I` on a linear axis unless the
+/// law drawn is not linear in `I` (the full μ(I)).
+pub(crate) fn rheology_plot(f: &RheologyFigure<'_>) -> XyPlot {
+    let log = f.curve.as_ref().is_some_and(|c| !c.linear);
+    let mut x = Axis::new("inertial number I");
+    if log {
+        x = x.log();
+    }
+    let mut plot = XyPlot::new(&f.title, x, Axis::new(f.y_label));
+    if let Some(c) = &f.curve {
+        plot.bands.push(Band::between(
+            "95 % confidence band",
+            f.colour,
+            &c.band.iter().map(|b| (b.0, b.2, b.3)).collect::<Vec<_>>(),
+        ));
+        plot.series.push(Series::new(
+            &c.label,
+            Style::Line,
+            PALETTE[1],
+            c.band.iter().map(|b| (b.0, b.1)).collect(),
+        ));
+    }
+    let pts = |passed: bool| -> Vec<(f64, f64, f64, f64)> {
+        f.points
+            .iter()
+            .filter(|p| p.passed == passed)
+            .map(|p| (p.i, p.value, p.i_std_error, p.std_error))
+            .collect()
+    };
+    let with_errors = f
+        .points
+        .iter()
+        .any(|p| p.std_error.is_finite() && p.std_error > 0.0);
+    let passed_label = if with_errors {
+        format!("{}, ± 1 standard error", f.passed_label)
+    } else {
+        f.passed_label.clone()
+    };
+    plot.series.push(Series::with_errors(
+        &passed_label,
+        Style::Points,
+        f.colour,
+        pts(true),
+    ));
+    let marked = pts(false);
+    if !marked.is_empty() {
+        plot.series.push(Series::with_errors(
+            f.marked_label,
+            Style::Circles,
+            PALETTE[6],
+            marked,
+        ));
+    }
+    plot.notes = f.notes.clone();
+    plot.legend = LegendAt::UpperLeft;
+    plot
 }
 
 /// How an accepted fit is shown: its summary-key prefix, the form recorded under
-/// `{key}_form` (with `{key}_r_squared`), the formula (legend), the printed title and colour.
+/// `{key}_form` (with `{key}_r_squared`), the formula (legend), the printed title, whether the
+/// law is linear in `I`, and the name of its law JSON.
 struct Shown {
     key: &'static str,
     form: Option<&'static str>,
     formula: &'static str,
     title: &'static str,
-    colour: plotters::style::RGBColor,
+    linear: bool,
+    file: &'static str,
 }
 
 impl Shown {
-    /// The fitted curve with its 95 % band on `plot`, the summary keys, and the printed
-    /// parameters with their intervals.
+    /// Exports `law` under `checks`, records the summary keys and the printed parameters
+    /// (after the line saying the law is rejected, when it is), and returns the fitted curve
+    /// with its 95 % band over `[lo, hi]`, the range of the fitted points.
+    #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
-        plot: &mut XyPlot,
-        xs: &[f64],
+        out: &mut OutputDir,
+        verdict: &mut RunVerdict,
+        law: &CalibratedLaw,
+        checks: Checks,
+        (lo, hi): (f64, f64),
         report: &identify::FitReport,
         s: &mut Summary,
         headline: &mut Vec<String>,
         model: impl Fn(&[f64], f64) -> f64,
-    ) {
-        let band = delta_band(
-            &report.values(),
-            &report.covariance,
-            report.t_critical,
-            xs,
-            model,
-        );
-        add_fitted_curve(plot, self.formula, self.colour, PALETTE[1], &band);
+    ) -> Result<FittedCurve> {
+        let exported = export_law(out, verdict, self.file, law, checks)?;
         fit_keys(s, self.key, &report.parameters);
         if let Some(form) = self.form {
             s.text(&format!("{}_form", self.key), form)
                 .num(&format!("{}_r_squared", self.key), report.r_squared);
         }
+        headline.extend(exported.heading(&law.law));
         headline.extend(parameter_lines(
             self.title,
             report.r_squared,
             &report.parameters,
         ));
+        let band = delta_band(
+            &report.values(),
+            &report.covariance,
+            report.t_critical,
+            &curve_abscissae(lo, hi, !self.linear),
+            model,
+        );
+        Ok(FittedCurve {
+            label: self.formula.to_string(),
+            linear: self.linear,
+            band,
+        })
     }
 }
 
 /// Fits μ(I) and φ(I) to `series`, writes the laws that pass (or their `.rejected.json`),
 /// records refusals in `verdict`, the keys in `s`, the printed lines in `headline`; returns
-/// the μ(I) and φ(I) figures.
+/// the μ(I) and φ(I) figures ([`rheology_plot`]).
 pub(crate) fn fit_mu_phi(
     out: &mut OutputDir,
     series: &RheologySeries,
@@ -90,52 +253,38 @@ pub(crate) fn fit_mu_phi(
 ) -> Result<(XyPlot, XyPlot)> {
     let opts = FitOptions::default();
     let is = &series.inertial_number;
-    let points = |ys: Option<&[f64]>| -> Vec<(f64, f64)> {
-        ys.map(|ys| is.iter().copied().zip(ys.iter().copied()).collect())
-            .unwrap_or_default()
-    };
-    let (imin, imax) = (
-        is.iter().cloned().fold(f64::MAX, f64::min),
-        is.iter().cloned().fold(f64::MIN, f64::max),
-    );
-    let xs: Vec<f64> = (0..=80)
-        .map(|k| imin * 0.7 * (imax * 1.4 / (imin * 0.7)).powf(k as f64 / 80.0))
-        .collect();
-    let mut pmu = XyPlot::new(
-        &format!("Friction law μ(I){}", inp.title_suffix),
-        Axis::new("inertial number I").log(),
-        Axis::new("μ = |σ_xy| / P"),
-    );
-    pmu.series.push(Series::new(
-        inp.dem_label,
-        Style::Points,
-        PALETTE[0],
-        points(series.mu.as_deref()),
-    ));
-    match fit_mu_i(series, &opts) {
+    // every point enters the fits (a point failing its own checks makes the laws fail theirs)
+    let range = finite_range(is.iter().copied()).unwrap_or((0.0, 0.0));
+    let mut mu_notes = Vec::new();
+    let mu_curve = match fit_mu_i(series, &opts) {
         Ok(f) => {
             let shown = Shown {
                 key: "mu_i",
                 form: Some("mu-i"),
                 formula: "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
                 title: "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                colour: PALETTE[0],
+                linear: false,
+                file: "mu_i",
             };
-            shown.record(&mut pmu, &xs, &f.report, s, headline, |p, i| {
-                identify::laws::mu_i::MuILaw {
-                    mu_s: p[0],
-                    mu_2: p[1],
-                    i0: p[2],
-                }
-                .mu(i)
-            });
-            export_law(
+            let law = CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone());
+            Some(shown.record(
                 out,
                 verdict,
-                "mu_i",
-                &CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone()),
+                &law,
                 inp.mu_checks.clone(),
-            )?;
+                range,
+                &f.report,
+                s,
+                headline,
+                |p, i| {
+                    identify::laws::mu_i::MuILaw {
+                        mu_s: p[0],
+                        mu_2: p[1],
+                        i0: p[2],
+                    }
+                    .mu(i)
+                },
+            )?)
         }
         Err(e) => {
             warn(&format!(
@@ -147,20 +296,24 @@ pub(crate) fn fit_mu_phi(
                     let shown = Shown {
                         key: "mu_i",
                         form: Some("mu-i-linear"),
-                        formula: "μ_s + b I",
+                        formula: "μ_s + b I (the full μ(I) refused)",
                         title: "μ(I) = μ_s + b I (linear form)",
-                        colour: PALETTE[0],
+                        linear: true,
+                        file: "mu_i",
                     };
-                    shown.record(&mut pmu, &xs, &f.report, s, headline, |p, i| {
-                        p[0] + p[1] * i
-                    });
-                    export_law(
+                    let law =
+                        CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone());
+                    Some(shown.record(
                         out,
                         verdict,
-                        "mu_i",
-                        &CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone()),
+                        &law,
                         inp.mu_checks.clone(),
-                    )?;
+                        range,
+                        &f.report,
+                        s,
+                        headline,
+                        |p, i| p[0] + p[1] * i,
+                    )?)
                 }
                 Err(e2) => {
                     warn(&format!("linear μ(I) fit failed too: {e2}"));
@@ -173,41 +326,35 @@ pub(crate) fn fit_mu_phi(
                         f64::NAN,
                         format!("no μ(I) law could be fitted: {e2}"),
                     );
+                    mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
+                    None
                 }
             }
         }
-    }
-    pmu.legend = LegendAt::UpperLeft;
-    let mut pphi = XyPlot::new(
-        &format!("Solid fraction φ(I){}", inp.title_suffix),
-        Axis::new("inertial number I").log(),
-        Axis::new("solid fraction φ"),
-    );
-    pphi.series.push(Series::new(
-        inp.dem_label,
-        Style::Points,
-        PALETTE[2],
-        points(series.phi.as_deref()),
-    ));
-    match fit_phi_i(series, &opts) {
+    };
+    let mut phi_notes = Vec::new();
+    let phi_curve = match fit_phi_i(series, &opts) {
         Ok(f) => {
             let shown = Shown {
                 key: "phi_i",
                 form: None,
                 formula: "φ_max − (φ_max − φ_min) I",
                 title: "φ(I) = φ_max − (φ_max − φ_min) I",
-                colour: PALETTE[2],
+                linear: true,
+                file: "phi_i",
             };
-            shown.record(&mut pphi, &xs, &f.report, s, headline, |p, i| {
-                p[0] - (p[0] - p[1]) * i
-            });
-            export_law(
+            let law = CalibratedLaw::from_phi_i(&f, inp.grain, inp.provenance.clone());
+            Some(shown.record(
                 out,
                 verdict,
-                "phi_i",
-                &CalibratedLaw::from_phi_i(&f, inp.grain, inp.provenance.clone()),
+                &law,
                 inp.phi_checks.clone(),
-            )?;
+                range,
+                &f.report,
+                s,
+                headline,
+                |p, i| p[0] - (p[0] - p[1]) * i,
+            )?)
         }
         Err(e) => {
             warn(&format!("φ(I) fit failed: {e}"));
@@ -220,8 +367,156 @@ pub(crate) fn fit_mu_phi(
                 f64::NAN,
                 format!("the φ(I) fit failed: {e}"),
             );
+            phi_notes.push("no φ(I) law fitted (phi_i_fit_error)".into());
+            None
         }
-    }
+    };
+    let points = |values: Option<&[f64]>, se: Option<&[f64]>| -> Vec<MeasuredPoint> {
+        let Some(values) = values else {
+            return Vec::new();
+        };
+        let at = |v: Option<&[f64]>, k: usize| v.and_then(|v| v.get(k)).copied();
+        is.iter()
+            .zip(values)
+            .enumerate()
+            .map(|(k, (&i, &value))| MeasuredPoint {
+                i,
+                i_std_error: at(inp.std_errors.i.as_deref(), k).unwrap_or(f64::NAN),
+                value,
+                std_error: at(se, k).unwrap_or(f64::NAN),
+                passed: inp.point_verdicts.get(k) == Some(&Verdict::Ok),
+            })
+            .collect()
+    };
+    let marked_label = |fitted: bool| {
+        if fitted {
+            "failed its own checks (fitted: the law is not calibrated)"
+        } else {
+            "failed its own checks"
+        }
+    };
+    let mu_points = points(series.mu.as_deref(), inp.std_errors.mu.as_deref());
+    let pmu = rheology_plot(&RheologyFigure {
+        title: format!("Friction law μ(I){}", inp.title_suffix),
+        y_label: "μ = |σ_xy| / P",
+        colour: PALETTE[0],
+        passed_label: inp.dem_label.to_string(),
+        marked_label: marked_label(mu_curve.is_some()),
+        points: &mu_points,
+        curve: mu_curve,
+        notes: mu_notes,
+    });
+    let phi_points = points(series.phi.as_deref(), inp.std_errors.phi.as_deref());
+    let mut pphi = rheology_plot(&RheologyFigure {
+        title: format!("Solid fraction φ(I){}", inp.title_suffix),
+        y_label: "solid fraction φ",
+        colour: PALETTE[2],
+        passed_label: inp.dem_label.to_string(),
+        marked_label: marked_label(phi_curve.is_some()),
+        points: &phi_points,
+        curve: phi_curve,
+        notes: phi_notes,
+    });
     pphi.legend = LegendAt::UpperRight;
     Ok((pmu, pphi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(i: f64, value: f64, se: f64, passed: bool) -> MeasuredPoint {
+        MeasuredPoint {
+            i,
+            i_std_error: f64::NAN,
+            value,
+            std_error: se,
+            passed,
+        }
+    }
+
+    /// The figure's data: the points that passed carry error bars of their standard errors
+    /// (the one without a standard error none), the failed point is in its own hollow series,
+    /// a linear law is drawn on a linear I axis over exactly the fitted points' I range, and
+    /// the full μ(I) on a logarithmic one.
+    #[test]
+    fn points_carry_their_errors_and_laws_their_range_and_axis() {
+        let pts = [
+            point(0.04, 0.33, 0.009, true),
+            point(0.1, 0.40, f64::NAN, true),
+            point(0.25, 0.53, 0.015, true),
+            point(0.07, 0.45, 0.017, false),
+        ];
+        let (lo, hi) = (0.04, 0.25);
+        let law = |linear: bool| FittedCurve {
+            label: "law".into(),
+            linear,
+            band: curve_abscissae(lo, hi, !linear)
+                .into_iter()
+                .map(|i| (i, 0.3 + i, 0.29 + i, 0.31 + i))
+                .collect(),
+        };
+        let fig = |curve| {
+            rheology_plot(&RheologyFigure {
+                title: "μ(I)".into(),
+                y_label: "μ",
+                colour: PALETTE[0],
+                passed_label: "DEM".into(),
+                marked_label: "failed",
+                points: &pts,
+                curve: Some(curve),
+                notes: Vec::new(),
+            })
+        };
+        let p = fig(law(true));
+        assert!(!p.x.log, "a linear law on a linear axis");
+        let dem = p
+            .series
+            .iter()
+            .find(|s| s.label.starts_with("DEM"))
+            .unwrap();
+        assert_eq!(dem.label, "DEM, ± 1 standard error");
+        assert_eq!(
+            dem.error_bars(),
+            vec![(0.04, 0.33, 0.0, 0.009), (0.25, 0.53, 0.0, 0.015)]
+        );
+        let failed = p.series.iter().find(|s| s.label == "failed").unwrap();
+        assert_eq!(failed.style, Style::Circles);
+        assert_eq!(failed.xy, vec![(0.07, 0.45)]);
+        assert_eq!(failed.error_bars(), vec![(0.07, 0.45, 0.0, 0.017)]);
+        let curve = p.series.iter().find(|s| s.label == "law").unwrap();
+        let xs: Vec<f64> = curve.xy.iter().map(|q| q.0).collect();
+        assert_eq!(xs.first(), Some(&lo));
+        assert!((xs.last().unwrap() - hi).abs() <= 1e-15 * hi, "{xs:?}");
+        assert!(xs.iter().all(|&x| (lo..=hi * (1.0 + 1e-15)).contains(&x)));
+        // evenly spaced on the linear axis: a straight law is drawn straight
+        assert!((xs[1] - xs[0] - (hi - lo) / 80.0).abs() < 1e-15);
+        let band_x = p.bands[0].outline.iter().map(|q| q.0);
+        assert!(band_x.clone().all(|x| x >= lo && x <= hi * (1.0 + 1e-15)));
+        let p = fig(law(false));
+        assert!(p.x.log, "the full μ(I) on a logarithmic axis");
+    }
+
+    /// Without any standard error the legend claims no error bars, and no bar is drawn.
+    #[test]
+    fn no_error_bars_without_standard_errors() {
+        let pts = [
+            point(0.01, 0.3, f64::NAN, true),
+            point(0.1, 0.4, f64::NAN, true),
+        ];
+        let p = rheology_plot(&RheologyFigure {
+            title: "μ(I)".into(),
+            y_label: "μ",
+            colour: PALETTE[0],
+            passed_label: "DEM".into(),
+            marked_label: "failed",
+            points: &pts,
+            curve: None,
+            notes: Vec::new(),
+        });
+        assert_eq!(p.series.len(), 1);
+        assert_eq!(p.series[0].label, "DEM");
+        assert!(p.series[0].error_bars().is_empty());
+        assert!(!p.x.log);
+    }
 }

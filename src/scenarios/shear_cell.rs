@@ -83,7 +83,8 @@ pub(crate) struct RunCheckData {
 
 /// The checks of the points of a rheology: those common to both laws (window numerics, `I`
 /// against its target), those of μ(I) (steady μ) and of φ(I) (steady φ, φ below `phi_bound`),
-/// each point's own verdict, and the merged window statistics.
+/// each point's own verdict, and the merged window statistics. The checks are named after the
+/// scenario that measured the points (`scenario` = `shear_cell`, `simple_shear`).
 pub(crate) struct PointJudgement {
     pub(crate) common: Checks,
     pub(crate) mu: Checks,
@@ -92,9 +93,14 @@ pub(crate) struct PointJudgement {
     pub(crate) windows: WindowStats,
 }
 
-/// Judges every point of a rheology ([`PointJudgement`]). A point whose `i_target` is not finite
-/// (another code's run, which has none) skips the check of `I` against its target.
-pub(crate) fn judge_points(run_checks: &[RunCheckData], phi_bound: f64) -> PointJudgement {
+/// Judges every point of a rheology ([`PointJudgement`]), its checks named after `scenario`. A
+/// point whose `i_target` is not finite (another code's run, which has none) skips the check of
+/// `I` against its target.
+pub(crate) fn judge_points(
+    scenario: &str,
+    run_checks: &[RunCheckData],
+    phi_bound: f64,
+) -> PointJudgement {
     let mut j = PointJudgement {
         common: Checks::new(),
         mu: Checks::new(),
@@ -117,7 +123,7 @@ pub(crate) fn judge_points(run_checks: &[RunCheckData], phi_bound: f64) -> Point
             let ratio = rc.i_measured / rc.i_target;
             let factor = if ratio >= 1.0 { ratio } else { 1.0 / ratio };
             pc.at_most(
-                "shear_cell.inertial_number_factor",
+                &format!("{scenario}.inertial_number_factor"),
                 factor,
                 I_FACTOR_SUSPECT,
                 Some(I_FACTOR_REFUSED),
@@ -130,20 +136,20 @@ pub(crate) fn judge_points(run_checks: &[RunCheckData], phi_bound: f64) -> Point
             );
         }
         pm.steady(
-            "shear_cell.steady_mu",
+            &format!("{scenario}.steady_mu"),
             &format!("{label}: μ"),
             &rc.mu,
             STEADY_MU_TOLERANCE,
         );
         pp.steady(
-            "shear_cell.steady_phi",
+            &format!("{scenario}.steady_phi"),
             &format!("{label}: φ"),
             &rc.phi,
             STEADY_PHI_TOLERANCE,
         );
         let phi = rc.phi.iter().sum::<f64>() / rc.phi.len().max(1) as f64;
         pp.solid_fraction(
-            "shear_cell.solid_fraction",
+            &format!("{scenario}.solid_fraction"),
             &format!("{label}: the bulk"),
             phi,
             phi_bound,
@@ -682,7 +688,11 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         phi: mut phi_checks,
         points: point_verdicts,
         windows,
-    } = judge_points(&run_checks, max_solid_fraction(c.grain.radius_spread));
+    } = judge_points(
+        "shear_cell",
+        &run_checks,
+        max_solid_fraction(c.grain.radius_spread),
+    );
     mu_checks.extend(&common);
     phi_checks.extend(&common);
     let mut verdict = RunVerdict {
@@ -773,6 +783,9 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             provenance: prov(),
             mu_checks: mu_checks.clone(),
             phi_checks: phi_checks.clone(),
+            // the wall-bounded cell measures no standard error per point
+            std_errors: Default::default(),
+            point_verdicts: &point_verdicts,
         },
         &mut verdict,
         &mut s,
@@ -805,8 +818,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     match select_wall_law(&ws, &opts) {
         Ok(sel) => {
             let best = sel.best();
-            let vmax = vs.iter().cloned().fold(0.0, f64::max) / scale;
-            let vx: Vec<f64> = (0..=80).map(|k| vmax * 1.05 * k as f64 / 80.0).collect();
+            // over the measured slips only: the law is not drawn beyond its data
+            let (vmin, vmax) = super::rheology_fit::finite_range(vs.iter().map(|v| v / scale))
+                .unwrap_or((0.0, 0.0));
+            let vx = super::rheology_fit::curve_abscissae(vmin, vmax, false);
             let p = best.report.values();
             let form = best.form;
             let band = delta_band(
@@ -845,18 +860,15 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             );
             s.text("wall_law_form", form.law_name());
             fit_keys(&mut s, "wall_law", &best.report.parameters);
+            let law =
+                CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov());
+            let exported = export_law(&mut ctx.out, &mut verdict, "wall", &law, common.clone())?;
+            headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 &format!("wall law: {} chosen by AIC", form.law_name()),
                 best.report.r_squared,
                 &best.report.parameters,
             ));
-            export_law(
-                &mut ctx.out,
-                &mut verdict,
-                "wall",
-                &CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov()),
-                common.clone(),
-            )?;
         }
         Err(e) => {
             warn(&format!("wall-law fit failed: {e}"));

@@ -527,7 +527,11 @@ pub fn run(
         phi: phi_checks,
         points: point_verdicts,
         windows,
-    } = judge_points(&run_checks, max_solid_fraction(c.grain.radius_spread));
+    } = judge_points(
+        "simple_shear",
+        &run_checks,
+        max_solid_fraction(c.grain.radius_spread),
+    );
     let mu_checks = {
         let mut m = mu_checks;
         m.extend(&common);
@@ -619,6 +623,12 @@ pub fn run(
             provenance: prov(),
             mu_checks: mu_checks.clone(),
             phi_checks: phi_checks.clone(),
+            std_errors: super::rheology_fit::PointStdErrors {
+                i: Some(rows.iter().map(|r| r[2]).collect()),
+                mu: Some(rows.iter().map(|r| r[4]).collect()),
+                phi: Some(rows.iter().map(|r| r[6]).collect()),
+            },
+            point_verdicts: &point_verdicts,
         },
         &mut verdict,
         &mut s,

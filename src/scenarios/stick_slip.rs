@@ -260,7 +260,7 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 friction.grain_wall
             ),
             Axis::new("time since the start of the push t (s)"),
-            Axis::new("force on the moving wall (N)"),
+            Axis::new("force on the moving wall (N/m)"),
         );
         p.series.push(Series::new(
             "weight",

@@ -81,7 +81,11 @@ pub(super) fn draw(ctx: &mut RunContext, f: &Inputs) -> Result<()> {
         "force_chains.png",
         &ParticleView {
             snap: f.snap,
-            title: format!("Relaxed column, {} grains: normal contact forces", f.grains),
+            // the last state: the last measured step after the release
+            title: format!(
+                "Column after the release, {} grains: normal forces",
+                f.grains
+            ),
             fill: GrainFill::Plain,
             forces: true,
             axis_labels: ("x (m)".into(), "y (m)".into()),
@@ -93,7 +97,7 @@ pub(super) fn draw(ctx: &mut RunContext, f: &Inputs) -> Result<()> {
     let mut ke = XyPlot::new(
         "Kinetic energy",
         Axis::new("time t (s)"),
-        Axis::new("kinetic energy (J)").log(),
+        Axis::new("kinetic energy (J/m)").log(),
     );
     ke.series.push(Series::new(
         "",
@@ -152,22 +156,44 @@ fn figure_profile(
     window: (f64, f64),
     mu_wall: f64,
 ) -> Result<()> {
+    let plot = profile_plot(p, fitted.as_ref().ok(), rho_b, g, window, mu_wall);
+    draw_xy(&mut ctx.out, "wall_stress_profile.png", &plot)
+}
+
+/// Number of intervals of the drawn law.
+const PROFILE_INTERVALS: usize = 120;
+
+/// The stress profile: the measured σ_v, σ_h and τ_w per depth bin, the hydrostatic line, and
+/// the fitted law with the 95 % bands of σ_v and of σ_h, each under its own legend, drawn over
+/// the fit's depth window only (the law is not extrapolated to the surface or the floor).
+/// When τ_w was left out of the fit, its curve is the law's prediction `μ_w σ_h` and says so.
+pub(super) fn profile_plot(
+    p: &ColumnProfile,
+    fitted: Option<&JanssenOutcome>,
+    rho_b: f64,
+    g: f64,
+    window: (f64, f64),
+    mu_wall: f64,
+) -> XyPlot {
     let mut plot = XyPlot::new(
-        "Stresses in the column vs depth",
+        "Stresses in the column vs depth, after the release",
         Axis::new("stress (Pa)"),
         Axis::new("depth below the free surface z (m)").reversed(),
     );
     let zmax = p.surface;
-    let zs: Vec<f64> = (0..=120).map(|k| zmax * k as f64 / 120.0).collect();
-    if let Ok(o) = fitted {
+    let (z0, z1) = (window.0.max(0.0), window.1.min(zmax));
+    let zs: Vec<f64> = (0..=PROFILE_INTERVALS)
+        .map(|k| z0 + (z1 - z0) * k as f64 / PROFILE_INTERVALS as f64)
+        .collect();
+    if let Some(o) = fitted {
         let band = fit_band(&o.fit, &zs);
         plot.bands.push(Band::between_x(
-            "",
+            "95 % band of σ_v",
             PALETTE[0],
             &band.iter().map(|r| (r[0], r[2], r[3])).collect::<Vec<_>>(),
         ));
         plot.bands.push(Band::between_x(
-            "95 % confidence band",
+            "95 % band of σ_h",
             PALETTE[1],
             &band.iter().map(|r| (r[0], r[5], r[6])).collect::<Vec<_>>(),
         ));
@@ -178,7 +204,7 @@ fn figure_profile(
         PALETTE[6],
         vec![(0.0, 0.0), (rho_b * g * zmax, zmax)],
     ));
-    if let Ok(o) = fitted {
+    if let Some(o) = fitted {
         let f = &o.fit;
         plot.series.push(Series::new(
             "Janssen σ_v",
@@ -193,7 +219,11 @@ fn figure_profile(
             zs.iter().map(|&z| (f.law.sigma_h(z), z)).collect(),
         ));
         plot.series.push(Series::new(
-            "Janssen τ_w = μ_w σ_h",
+            if o.uses_tau_w {
+                "Janssen τ_w = μ_w σ_h"
+            } else {
+                "Janssen τ_w = μ_w σ_h (τ_w not fitted)"
+            },
             Style::Line,
             PALETTE[2],
             zs.iter().map(|&z| (f.law.tau_w(z), z)).collect(),
@@ -214,10 +244,8 @@ fn figure_profile(
             )
         };
         plot.notes.push(kmu);
-        plot.notes.push(format!(
-            "fitted over z ∈ [{:.3}, {:.3}] m",
-            window.0, window.1
-        ));
+        plot.notes
+            .push(format!("fitted over z ∈ [{z0:.3}, {z1:.3}] m"));
     }
     plot.series.push(Series::new(
         "DEM σ_v (planes)",
@@ -238,6 +266,76 @@ fn figure_profile(
         p.z.iter().zip(&p.tau_w).map(|(z, s)| (*s, *z)).collect(),
     ));
     plot.legend = LegendAt::UpperRight;
-    let _ = &plot;
-    draw_xy(&mut ctx.out, "wall_stress_profile.png", &plot)
+    plot
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use identify::janssen::JanssenSetup;
+    use identify::laws::janssen::JanssenLaw;
+
+    /// A column drawn from Janssen's law (K = 0.8, μ_w = 0.2, eight bins of a 12 cm column),
+    /// fitted over z ∈ [0.02, 0.1] m: both bands are in the legend, each of its own curve; the
+    /// law's curves and bands lie within the fit's window (not extrapolated to the surface
+    /// or the floor); the measured points are all drawn.
+    #[test]
+    fn the_profile_shows_both_bands_and_the_law_over_its_window_only() {
+        let law = JanssenLaw {
+            k: 0.8,
+            mu_w: 0.2,
+            width_m: 0.03,
+            bulk_density_kg_m3: 2000.0,
+            gravity_m_s2: 9.81,
+        };
+        let z: Vec<f64> = (0..8).map(|i| 0.12 * (i as f64 + 0.5) / 8.0).collect();
+        let wobble = |k: usize| 1.0 + 0.03 * [0.6, -1.0, 0.3, 0.9, -0.7, -0.2, 1.0, -0.8][k % 8];
+        let p = ColumnProfile {
+            sigma_v: z
+                .iter()
+                .enumerate()
+                .map(|(k, &z)| law.sigma_v(z) * wobble(k))
+                .collect(),
+            sigma_h: z
+                .iter()
+                .enumerate()
+                .map(|(k, &z)| law.sigma_h(z) * wobble(k + 3))
+                .collect(),
+            tau_w: z
+                .iter()
+                .enumerate()
+                .map(|(k, &z)| law.tau_w(z) * wobble(k + 5))
+                .collect(),
+            z,
+            surface: 0.12,
+        };
+        let setup = JanssenSetup {
+            width_m: 0.03,
+            bulk_density_kg_m3: 2000.0,
+            gravity_m_s2: 9.81,
+            wall_friction: 0.25,
+        };
+        let window = (0.02, 0.1);
+        let o = super::super::fit_profile(&p, &setup, window).unwrap();
+        let plot = profile_plot(&p, Some(&o), 2000.0, 9.81, window, 0.25);
+        let labels: Vec<&str> = plot.bands.iter().map(|b| b.label.as_str()).collect();
+        assert_eq!(labels, ["95 % band of σ_v", "95 % band of σ_h"]);
+        let inside = |z: f64| (window.0 - 1e-15..=window.1 + 1e-15).contains(&z);
+        for b in &plot.bands {
+            assert!(b.outline.iter().all(|q| inside(q.1)), "{}", b.label);
+        }
+        for s in plot
+            .series
+            .iter()
+            .filter(|s| s.label.starts_with("Janssen"))
+        {
+            let zs: Vec<f64> = s.xy.iter().map(|q| q.1).collect();
+            assert!(zs.iter().all(|&z| inside(z)), "{}", s.label);
+            assert_eq!(zs.first(), Some(&window.0), "{}", s.label);
+            assert!((zs.last().unwrap() - window.1).abs() < 1e-15, "{}", s.label);
+        }
+        let dem = plot.series.iter().filter(|s| s.label.starts_with("DEM"));
+        assert!(dem.clone().all(|s| s.xy.len() == 8));
+        assert_eq!(dem.count(), 3);
+    }
 }

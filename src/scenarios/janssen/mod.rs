@@ -523,7 +523,8 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 f,
                 crate::provenance::of_run(ctx, ctl, "janssen", c.seed),
             );
-            export_law(&mut ctx.out, &mut verdict, "janssen", &law, checks.clone())?;
+            let exported = export_law(&mut ctx.out, &mut verdict, "janssen", &law, checks.clone())?;
+            headline.extend(exported.heading("janssen"));
             headline.push(format!(
                 "K    = {:.3}  (95 % CI {:.3} … {:.3})",
                 f.k.value, f.k.ci_low, f.k.ci_high
