@@ -460,6 +460,7 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
                     confidence: options.fit.confidence,
                     cohesion_fixed_zero,
                     min_r_squared: options.fit.min_r_squared,
+                    ..MohrCoulombOptions::default()
                 },
             )?;
             Ok(CalibratedLaw::from_mohr_coulomb(&fit, provenance))
