@@ -1280,8 +1280,16 @@ mod tests {
         assert_eq!(c.reasons.len(), 1, "{:?}", c.reasons);
         assert_eq!(c.reasons[0].check, "energy.worst_step_growth");
         assert_eq!(c.reasons[0].value, 0.22);
-        assert!(c.reasons[0].message.contains("step 4711"), "{}", c.reasons[0].message);
-        assert!(c.reasons[0].message.contains("22.0 %"), "{}", c.reasons[0].message);
+        assert!(
+            c.reasons[0].message.contains("step 4711"),
+            "{}",
+            c.reasons[0].message
+        );
+        assert!(
+            c.reasons[0].message.contains("22.0 %"),
+            "{}",
+            c.reasons[0].message
+        );
         assert_eq!(judge(1.5).verdict(), Verdict::Refused);
         assert_eq!(judge(0.005).verdict(), Verdict::Ok);
         // Merged windows keep the largest step and its index.

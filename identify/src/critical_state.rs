@@ -9,7 +9,16 @@
 //! propagated one `√(Σ s_k²)/n` and, with two pressures or more, the scatter between them
 //! `sd(x_k)/√n` (a pressure dependence, or plateaus not reached, then shows as a wide
 //! interval). The interval is `x̄ ∓ t s` with Student's `t` at `Σ (b_k − 1)` degrees of
-//! freedom (`b_k` blocks per plateau) for the propagated error, `n − 1` for the scatter. The
+//! freedom (`b_k` blocks per plateau) for the propagated error, `n − 1` for the scatter.
+//!
+//! Which kind each interval is ([`IntervalKind`]) is part of the fit: the block average of one
+//! plateau measures the noise of that sample's time series only, and understates the scatter
+//! between independent samples (the biaxial's critical solid fraction at 1 and 4 kPa, statistical
+//! replicas for rigid grains, differed by 10 of its block standard errors), so an interval is
+//! stated from the replicas whenever there are two or more. The fit also gives the standard
+//! deviation between the replicas, `sd(x_k)`: the standard error of *one* sample's value, whose
+//! interval `x_k ∓ t_{n−1} sd` ([`CriticalStateFit::sample_interval`]) is the one to put on a
+//! single pressure's (or seed's) plateau value. The
 //! angle is `φ_c = asin(sin φ_c)` with `s_φ = s / cos φ_c` (delta method). A constant explains
 //! none of the variance of its data: the report's `R²` is 0 by definition and no `R²`
 //! threshold applies; refusals: a standard error above its value, an interval of `φ_c` outside
@@ -49,6 +58,46 @@ pub struct PlateauMeasure {
     pub blocks: usize,
 }
 
+/// What an interval of the critical state is made of (module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntervalKind {
+    /// The scatter between independent samples (pressures or seeds as replicas), `sd/√n` at
+    /// `n − 1` degrees of freedom: it was the larger error.
+    Replicas,
+    /// The plateaus' block averages propagated, `√(Σ s_k²)/n`: larger than the scatter between
+    /// the replicas, which it therefore covers.
+    BlockAverages,
+    /// One sample's block average: nothing measures the scatter between samples, which it
+    /// understates.
+    OneSample,
+}
+
+impl IntervalKind {
+    /// `replicas`, `block-averages` or `one-sample`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            IntervalKind::Replicas => "replicas",
+            IntervalKind::BlockAverages => "block-averages",
+            IntervalKind::OneSample => "one-sample",
+        }
+    }
+
+    /// One phrase for a report, with `n` the replicas.
+    pub fn describe(self, n: usize) -> String {
+        match self {
+            IntervalKind::Replicas => format!("the scatter between the {n} replicas"),
+            IntervalKind::BlockAverages => format!(
+                "the block averages of the plateaus, wider than the scatter between the {n} replicas"
+            ),
+            IntervalKind::OneSample => {
+                "the block average of one sample, which understates the scatter between samples"
+                    .into()
+            }
+        }
+    }
+}
+
 /// Result of [`fit_critical_state`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CriticalStateFit {
@@ -65,22 +114,56 @@ pub struct CriticalStateFit {
     /// Parameters `friction_angle_c`, `solid_fraction_c` (observations: the `sin φ` of each
     /// plateau).
     pub report: FitReport,
+    /// Plateaus (independent samples: pressures or seeds).
+    pub replicas: usize,
+    /// What the intervals of `sin φ_c` (and `φ_c`) are made of.
+    pub sin_phi_interval: IntervalKind,
+    /// What the interval of the solid fraction is made of.
+    pub solid_fraction_interval: IntervalKind,
+    /// Standard deviation of the plateaus' `sin φ` between the replicas (NaN with one): the
+    /// standard error of one sample's value.
+    pub sin_phi_replica_sd: f64,
+    /// The same for the solid fraction.
+    pub solid_fraction_replica_sd: f64,
+    /// Student's `t` at `n − 1` degrees of freedom and the fit's confidence (NaN with one
+    /// replica), for [`CriticalStateFit::sample_interval`].
+    pub replica_t: f64,
 }
 
-/// Mean, standard error and degrees of freedom of the module documentation.
-fn pooled(x: &[f64], se: &[f64], blocks: &[usize]) -> (f64, f64, usize) {
+impl CriticalStateFit {
+    /// The interval of one sample's plateau value `x` whose standard deviation between the
+    /// replicas is `sd` (`sin_phi_replica_sd` or `solid_fraction_replica_sd`): `x ∓ t_{n−1} sd`,
+    /// the interval that covers the scatter between samples (NaN bounds with one replica).
+    pub fn sample_interval(&self, x: f64, sd: f64) -> (f64, f64) {
+        (x - self.replica_t * sd, x + self.replica_t * sd)
+    }
+}
+
+/// Standard deviation of `x` (NaN with fewer than two values).
+fn replica_sd(x: &[f64]) -> f64 {
+    if x.len() < 2 {
+        return f64::NAN;
+    }
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+/// Mean, standard error, degrees of freedom and the kind of the interval (module
+/// documentation).
+fn pooled(x: &[f64], se: &[f64], blocks: &[usize]) -> (f64, f64, usize, IntervalKind) {
     let n = x.len() as f64;
     let mean = x.iter().sum::<f64>() / n;
     let prop = se.iter().map(|s| s * s).sum::<f64>().sqrt() / n;
     let dof_prop: usize = blocks.iter().map(|b| b.saturating_sub(1).max(1)).sum();
     if x.len() >= 2 {
-        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        let scatter = (var / n).sqrt();
+        let scatter = replica_sd(x) / n.sqrt();
         if scatter > prop {
-            return (mean, scatter, x.len() - 1);
+            return (mean, scatter, x.len() - 1, IntervalKind::Replicas);
         }
+        return (mean, prop, dof_prop, IntervalKind::BlockAverages);
     }
-    (mean, prop, dof_prop)
+    (mean, prop, dof_prop, IntervalKind::OneSample)
 }
 
 /// The critical state from the plateaus of one or more tests (module documentation).
@@ -116,8 +199,8 @@ pub fn fit_critical_state(
         check_finite(name, v)?;
     }
     let blocks: Vec<usize> = plateaus.iter().map(|m| m.blocks).collect();
-    let (sm, sse, sdof) = pooled(&s, &s_se, &blocks);
-    let (fm, fse, fdof) = pooled(&f, &f_se, &blocks);
+    let (sm, sse, sdof, s_kind) = pooled(&s, &s_se, &blocks);
+    let (fm, fse, fdof, f_kind) = pooled(&f, &f_se, &blocks);
     let ts = stats::t_critical(confidence, sdof);
     let tf = stats::t_critical(confidence, fdof);
     let sin_phi = Estimate::new("sin_phi_c", "1", sm, sse, ts);
@@ -184,6 +267,16 @@ pub fn fit_critical_state(
         sin_phi,
         solid_fraction,
         report,
+        replicas: n,
+        sin_phi_interval: s_kind,
+        solid_fraction_interval: f_kind,
+        sin_phi_replica_sd: replica_sd(&s),
+        solid_fraction_replica_sd: replica_sd(&f),
+        replica_t: if n >= 2 {
+            stats::t_critical(confidence, n - 1)
+        } else {
+            f64::NAN
+        },
     })
 }
 
@@ -296,6 +389,47 @@ mod tests {
         assert!((g.report.t_critical - 3.182).abs() < 1e-3);
         // an error above its value is refused
         assert!(fit_critical_state(&[plateau(0.01, 0.05, 0.82)], 0.95).is_err());
+    }
+
+    /// Two pressures, statistical replicas for rigid grains, whose critical solid fractions
+    /// differ by 10 of their block standard errors (the biaxial at 1 and 4 kPa): the block
+    /// interval of one sample misses the other sample's value, the replica intervals cover
+    /// both, and the fit says which kind each interval is.
+    #[test]
+    fn replica_intervals_cover_the_scatter_between_samples() {
+        let se = 2e-4;
+        let (a, b) = (0.8200, 0.8200 + 10.0 * se);
+        let mut p1 = plateau(0.28, 1e-3, a);
+        let mut p2 = plateau(0.28, 1e-3, b);
+        p1.solid_fraction_std_error = se;
+        p2.solid_fraction_std_error = se;
+        p2.pressure_pa = 4000.0;
+        let f = fit_critical_state(&[p1, p2], 0.95).unwrap();
+        // the block interval of one sample (t at its 3 degrees of freedom) misses the other
+        let t_block = stats::t_critical(0.95, 3);
+        assert!(a + t_block * se < b);
+        // the law's interval is the replicas': mean ∓ t₁ sd/√2 (sd = 10 se/√2), both inside
+        assert_eq!(f.solid_fraction_interval, IntervalKind::Replicas);
+        assert_eq!(f.replicas, 2);
+        let sd = 10.0 * se / 2f64.sqrt();
+        assert!((f.solid_fraction_replica_sd - sd).abs() < 1e-12);
+        assert!((f.solid_fraction.std_error - sd / 2f64.sqrt()).abs() < 1e-12);
+        assert!(
+            f.solid_fraction.covers(a) && f.solid_fraction.covers(b),
+            "{:?}",
+            f.solid_fraction
+        );
+        // each sample's replica interval x_k ∓ t₁ sd covers the other sample
+        for (x, other) in [(a, b), (b, a)] {
+            let (lo, hi) = f.sample_interval(x, f.solid_fraction_replica_sd);
+            assert!(lo <= other && other <= hi, "[{lo}, {hi}] misses {other}");
+        }
+        // equal sin φ: their scatter (0) is below the block errors, which are then the interval
+        assert_eq!(f.sin_phi_interval, IntervalKind::BlockAverages);
+        // one sample: said so, no replica interval
+        let g = fit_critical_state(&[p1], 0.95).unwrap();
+        assert_eq!(g.solid_fraction_interval, IntervalKind::OneSample);
+        assert!(g.solid_fraction_replica_sd.is_nan() && g.replica_t.is_nan());
     }
 
     #[test]

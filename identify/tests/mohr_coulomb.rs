@@ -221,7 +221,11 @@ fn unsupported_cohesion_falls_back_to_the_cohesionless_envelope() {
     let c = &fit.cohesion;
     assert!(c.at_bound && c.ci_low == 0.0, "{c:?}");
     assert!(c.ci_high > 0.0 && c.std_error > 0.0, "{c:?}");
-    assert!((c.ci_high - high).abs() < 1e-6 * high, "{} vs {high}", c.ci_high);
+    assert!(
+        (c.ci_high - high).abs() < 1e-6 * high,
+        "{} vs {high}",
+        c.ci_high
+    );
     assert!((c.std_error - se / cos).abs() < 1e-6 * se, "{c:?}");
     // Three pressures (the free form is not tried): the same one-sided interval, at 1 degree of
     // freedom.
@@ -235,8 +239,15 @@ fn unsupported_cohesion_falls_back_to_the_cohesionless_envelope() {
     let high3 = (b3.max(0.0) + identify::stats::t_critical(0.95, 1) * se3)
         / fit3.friction_angle.value.cos();
     let c3 = &fit3.cohesion;
-    assert!(c3.at_bound && c3.ci_low == 0.0 && c3.std_error > 0.0, "{c3:?}");
-    assert!((c3.ci_high - high3).abs() < 1e-6 * high3, "{} vs {high3}", c3.ci_high);
+    assert!(
+        c3.at_bound && c3.ci_low == 0.0 && c3.std_error > 0.0,
+        "{c3:?}"
+    );
+    assert!(
+        (c3.ci_high - high3).abs() < 1e-6 * high3,
+        "{} vs {high3}",
+        c3.ci_high
+    );
     // Fixed by the user (`# cohesion = 0`), it is a constant: [0, 0].
     let user = identify::mohr_coulomb::fit_mohr_coulomb_with(
         &three,
@@ -244,7 +255,11 @@ fn unsupported_cohesion_falls_back_to_the_cohesionless_envelope() {
     )
     .unwrap();
     assert_eq!(
-        (user.cohesion.ci_low, user.cohesion.ci_high, user.cohesion.std_error),
+        (
+            user.cohesion.ci_low,
+            user.cohesion.ci_high,
+            user.cohesion.std_error
+        ),
         (0.0, 0.0, 0.0)
     );
     // Exact cohesive data keep their free fit.
@@ -263,7 +278,12 @@ fn ols_intercept(x: &[f64], y: &[f64]) -> (f64, f64) {
     let mx = x.iter().sum::<f64>() / n;
     let my = y.iter().sum::<f64>() / n;
     let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
-    let a = x.iter().zip(y).map(|(u, v)| (u - mx) * (v - my)).sum::<f64>() / sxx;
+    let a = x
+        .iter()
+        .zip(y)
+        .map(|(u, v)| (u - mx) * (v - my))
+        .sum::<f64>()
+        / sxx;
     let b = my - a * mx;
     let rss: f64 = x.iter().zip(y).map(|(u, v)| (v - a * u - b).powi(2)).sum();
     let s2 = rss / (n - 2.0);
