@@ -68,7 +68,7 @@ fn left_out_points(data: &Path) -> usize {
 }
 
 /// The printed report: a title line, one line per parameter (in the registry's order), one per
-/// derived quantity.
+/// derived quantity, and the verdict.
 fn report_lines(cal: &CalibratedLaw, data: &Path) -> Vec<String> {
     let mut lines = vec![format!(
         "{} fitted to {} ({} points, R² = {:.4})",
@@ -83,6 +83,10 @@ fn report_lines(cal: &CalibratedLaw, data: &Path) -> Vec<String> {
     for d in &cal.derived {
         lines.push(derived_line(d));
     }
+    lines.push(format!(
+        "verdict: {} (every check of the fit passed; the law's `verdict` key)",
+        cal.verdict.as_deref().unwrap_or("ok")
+    ));
     lines
 }
 

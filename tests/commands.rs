@@ -71,7 +71,8 @@ fn solve_fc_one_contact() {
     assert!(v["error"].as_f64().unwrap() <= 1e-10);
 }
 
-/// `grainlaw fit janssen` recovers K and μ_w from an exact Janssen profile (within 1e-3).
+/// `grainlaw fit janssen` recovers K and μ_w from an exact Janssen profile (within 1e-3), and
+/// the law it writes has a verdict (`ok`) like the laws of a run.
 #[test]
 fn fit_janssen_from_csv() {
     let (k, mu, w, rho_b, g) = (0.8, 0.2, 0.03, 1600.0, 9.81);
@@ -115,8 +116,11 @@ fn fit_janssen_from_csv() {
         "mu_w = {}",
         p("mu_w")
     );
+    // A fitted law carries its verdict as a run's laws do: it passed every check, `ok`.
+    assert_eq!(v["verdict"], "ok", "{v}");
     // Without --out the law JSON goes to stdout.
     let o = grainlaw(&["fit", "janssen", data.to_str().unwrap()]);
     assert!(o.status.success());
-    serde_json::from_slice::<Value>(&o.stdout).expect("law JSON on stdout");
+    let v = serde_json::from_slice::<Value>(&o.stdout).expect("law JSON on stdout");
+    assert_eq!(v["verdict"], "ok");
 }

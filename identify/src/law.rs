@@ -755,8 +755,10 @@ pub struct CalibratedLaw {
     pub model_selection: Option<ModelComparison>,
     /// Provenance.
     pub provenance: Provenance,
-    /// Verdict of the `grainlaw run` that produced the law (`ok`, `suspect`, `refused`;
-    /// `docs/outputs.md` §2.1); absent from laws of `grainlaw fit`.
+    /// Verdict of the law (`ok`, `suspect`, `refused`; `docs/outputs.md` §2.1): the `grainlaw
+    /// run` that produced it judged it, or it was fitted by `grainlaw fit` or Python
+    /// (`crate::user_fit`), which return only laws that passed every check: `ok`. Absent only
+    /// from files written before verdicts existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub verdict: Option<String>,
     /// The checks that failed for that verdict (`check`, `verdict`, `value`, `threshold`,

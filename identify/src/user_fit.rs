@@ -130,6 +130,11 @@ pub fn fit_csv_file(law: &str, path: &Path, options: &CsvFitOptions) -> Result<C
     Ok(law)
 }
 
+/// The verdict of a law this module returns (`verdict` of the law JSON, as a `grainlaw run`
+/// writes it, `docs/outputs.md` §2.1): `ok`, since every returned fit passed the checks of
+/// [`crate::accept`]; a fit that does not is refused with an error, not returned.
+pub const FIT_VERDICT: &str = "ok";
+
 /// Name of the column in which grainlaw's scenarios judge each point of a table (0 passed its
 /// checks, 1 suspect, 2 refused; `docs/outputs.md` §2.1).
 pub const POINT_VERDICT: &str = "point_verdict";
@@ -269,17 +274,24 @@ pub fn fit_table(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Ca
     check_law_name(law)?;
     check_metadata(law, table, options)?;
     let (passed, left_out) = passed_points(table)?;
-    fit_rows(law, &passed, options).map_err(|e| match e {
-        IdentifyError::TooFewPoints { law, needed, got } if left_out > 0 => {
-            IdentifyError::NotIdentifiable {
-                reason: format!(
-                    "{law}: {got} points passed their run's checks ({left_out} left out for \
+    fit_rows(law, &passed, options)
+        .map(|mut law| {
+            // it passed every check of `crate::accept` (a refused fit returns no law): `ok`, as
+            // a run marks the laws it exports
+            law.verdict = Some(FIT_VERDICT.into());
+            law
+        })
+        .map_err(|e| match e {
+            IdentifyError::TooFewPoints { law, needed, got } if left_out > 0 => {
+                IdentifyError::NotIdentifiable {
+                    reason: format!(
+                        "{law}: {got} points passed their run's checks ({left_out} left out for \
                      {POINT_VERDICT} ≠ 0), at least {needed} needed"
-                ),
+                    ),
+                }
             }
-        }
-        e => e,
-    })
+            e => e,
+        })
 }
 
 /// [`fit_table`] on rows that may all be fitted.
