@@ -4,8 +4,11 @@ Python bindings of the grainlaw Rust toolkit (PyO3 + numpy). Units are SI; 2D qu
 per metre of thickness; stress tensors are tension positive, while the fits take
 compressive-positive magnitudes (as ``grainlaw fit`` does).
 
-- ``run(scenario, overrides, out, progress)``: a scenario end to end (simulation,
-  homogenisation, fits), as ``grainlaw run``; returns the summary and the tables as arrays.
+- ``run(scenario, overrides, out, progress, allow_suspect)``: a scenario end to end
+  (simulation, homogenisation, fits), as ``grainlaw run``; returns the summary, the tables as
+  arrays, the laws and the verdict. A run judged ``refused`` raises ``ResultRefused``; one
+  judged ``suspect`` raises ``ResultSuspect`` unless ``allow_suspect=True``: as loud as the
+  command line's exit status 3.
 - ``World`` / ``Snapshot``: the contact-dynamics engine (Moreau–Jean, Coulomb friction).
 - ``grain_stresses``, ``mean_stress``, ``solid_fraction``, ``coordination``, ``fabric``:
   homogenisation of a snapshot.
@@ -20,7 +23,9 @@ compressive-positive magnitudes (as ``grainlaw fit`` does).
 
 Errors: every exception raised is a ``GrainlawError``: ``InputError`` (bad input),
 ``FitRefused`` (valid data that do not support the law; ``reason``, ``suggestion``),
-``SolverError`` (a step failed), ``OutputError`` (a file could not be written or read).
+``SolverError`` (a step failed), ``OutputError`` (a file could not be written or read),
+``ResultRefused`` / ``ResultSuspect`` (a run's verdict; ``verdict``, ``reasons``, ``result``).
+Every ``Law`` has a ``verdict`` (``ok`` for a fit that passed its checks).
 A run stopped by Ctrl-C raises ``KeyboardInterrupt``.
 """
 
@@ -34,6 +39,8 @@ from ._grainlaw import (
     InputError,
     Law,
     OutputError,
+    ResultRefused,
+    ResultSuspect,
     Snapshot,
     SolverError,
     World,
@@ -58,6 +65,8 @@ __all__ = [
     "FitRefused",
     "SolverError",
     "OutputError",
+    "ResultRefused",
+    "ResultSuspect",
     "Law",
     "Snapshot",
     "World",
