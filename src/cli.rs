@@ -566,6 +566,12 @@ fn scenarios_cmd(show: Option<&str>) -> Result<()> {
                 })
             })?;
             print!("{}", b.toml);
+            // the laws it fits and the data each needs, from the same table the load checks
+            let loaded = datasets::load(name, &[])?;
+            let needs = datasets::config::laws::describe(&loaded.scenario.law_needs());
+            if !needs.is_empty() {
+                println!("\n{}", needs.join("\n"));
+            }
         }
         None => {
             for b in datasets::BUILTINS.iter() {

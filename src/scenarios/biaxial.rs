@@ -1123,6 +1123,7 @@ fn analyse(
     };
     // A free cohesion with 4 pressures or more, else (or when the data do not identify it:
     // rigid cohesionless grains have none) the envelope through the origin.
+    let left = |law: &str| c.leave_out.iter().any(|l| l == law);
     let fitted = fit_mohr_coulomb_supported(&peaks, 0.95).map(|(f, fixed, refusal)| {
         if let Some(e) = refusal {
             warn(&format!(
@@ -1133,8 +1134,10 @@ fn analyse(
         (f, fixed)
     });
     let mut mc_line = None;
-    match fitted {
-        Ok((f, cohesion_fixed_zero)) => {
+    match (!left("mohr-coulomb")).then_some(fitted) {
+        // left out by the plan (said at the start)
+        None => remove_stale_law(out, "mohr_coulomb")?,
+        Some(Ok((f, cohesion_fixed_zero))) => {
             fit_keys(&mut s, "friction_peak", &f.report.parameters);
             fit_keys(
                 &mut s,
@@ -1162,7 +1165,7 @@ fn analyse(
                 common.clone(),
             )?;
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("Mohr–Coulomb fit over the peaks refused: {e}"));
             s.text("friction_peak_fit_error", &e.to_string());
             remove_stale_law(out, "mohr_coulomb")?;
@@ -1188,8 +1191,9 @@ fn analyse(
             blocks: MIN_BLOCKS,
         })
         .collect();
-    match fit_critical_state(&plateaus, 0.95) {
-        Ok(f) => {
+    match (!left("critical-state")).then(|| fit_critical_state(&plateaus, 0.95)) {
+        None => remove_stale_law(out, "critical_state")?,
+        Some(Ok(f)) => {
             fit_keys(
                 &mut s,
                 "friction_critical",
@@ -1268,7 +1272,7 @@ fn analyse(
                 critical.clone(),
             )?;
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("critical state refused: {e}"));
             s.text("friction_critical_fit_error", &e.to_string());
             remove_stale_law(out, "critical_state")?;
@@ -1293,8 +1297,11 @@ fn analyse(
         sin_phi: hard.iter().map(|w| w[2]).collect(),
     };
     let mut sd_line = None;
-    match fit_stress_dilatancy(&sd_data, &identify::FitOptions::default()) {
-        Ok(f) => {
+    match (!left("stress-dilatancy"))
+        .then(|| fit_stress_dilatancy(&sd_data, &identify::FitOptions::default()))
+    {
+        None => remove_stale_law(out, "stress_dilatancy")?,
+        Some(Ok(f)) => {
             fit_keys(&mut s, "stress_dilatancy", &f.report.parameters);
             s.num("stress_dilatancy_r_squared", f.report.r_squared)
                 .int("stress_dilatancy_points", f.report.n as u64)
@@ -1314,7 +1321,7 @@ fn analyse(
                 dilat.clone(),
             )?;
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("stress–dilatancy fit refused: {e}"));
             s.text("stress_dilatancy_fit_error", &e.to_string());
             remove_stale_law(out, "stress_dilatancy")?;
@@ -1465,6 +1472,8 @@ pub fn bench_rve(grains: usize, compress_steps: usize, axial_steps: usize) -> Re
         &[
             format!("grains={grains}"),
             "confining_pressures=[1000.0]".to_string(),
+            // a benchmark of the engine: nothing is fitted
+            r#"leave_out=["mohr-coulomb", "critical-state", "stress-dilatancy"]"#.to_string(),
         ],
     )?;
     let datasets::Scenario::Biaxial(c) = loaded.scenario else {

@@ -32,6 +32,8 @@ pub(crate) struct RheologyFit<'a> {
     pub(crate) mu_checks: Checks,
     /// The checks the φ(I) law depends on.
     pub(crate) phi_checks: Checks,
+    /// The laws the plan leaves out (`mu-i`, `mu-i-linear`, `phi-i`): not fitted.
+    pub(crate) leave_out: &'a [String],
 }
 
 /// How an accepted fit is shown: its summary-key prefix, the form recorded under
@@ -77,9 +79,9 @@ impl Shown {
     }
 }
 
-/// Fits μ(I) and φ(I) to `series`, writes the laws that pass (or their `.rejected.json`),
-/// records refusals in `verdict`, the keys in `s`, the printed lines in `headline`; returns
-/// the μ(I) and φ(I) figures.
+/// Fits μ(I) and φ(I) to `series` (those the plan does not leave out), writes the laws that
+/// pass (or their `.rejected.json`), records refusals in `verdict`, the keys in `s`, the printed
+/// lines in `headline`; returns the μ(I) and φ(I) figures.
 pub(crate) fn fit_mu_phi(
     out: &mut OutputDir,
     series: &RheologySeries,
@@ -112,8 +114,15 @@ pub(crate) fn fit_mu_phi(
         PALETTE[0],
         points(series.mu.as_deref()),
     ));
-    match fit_mu_i(series, &opts) {
-        Ok(f) => {
+    let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
+    // μ(I), or its linear form when μ(I) is refused or left out (`leave_out`)
+    let full = if left("mu-i") {
+        None
+    } else {
+        Some(fit_mu_i(series, &opts))
+    };
+    let linear_reason = match full {
+        Some(Ok(f)) => {
             let shown = Shown {
                 key: "mu_i",
                 form: Some("mu-i"),
@@ -136,44 +145,67 @@ pub(crate) fn fit_mu_phi(
                 &CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone()),
                 inp.mu_checks.clone(),
             )?;
+            None
         }
-        Err(e) => {
+        Some(Err(e)) => {
+            s.text("mu_i_fit_error", &e.to_string());
+            Some(e.to_string())
+        }
+        None => None,
+    };
+    let try_linear = linear_reason.is_some() || left("mu-i");
+    if try_linear && left("mu-i-linear") {
+        // neither form is fitted: the plan said so at the start
+        crate::verdict::remove_stale_law(out, "mu_i")?;
+        if let Some(e) = linear_reason {
+            warn(&format!(
+                "μ(I) fit failed ({e}); its linear form is left out (leave_out)"
+            ));
+            verdict.run.fail(
+                &format!("{}.mu_i_fit", inp.check_prefix),
+                Verdict::Refused,
+                f64::NAN,
+                f64::NAN,
+                format!("no μ(I) law could be fitted: {e}"),
+            );
+        }
+    } else if try_linear {
+        if let Some(e) = &linear_reason {
             warn(&format!(
                 "μ(I) fit failed ({e}); fitting the linear form μ_s + b I"
             ));
-            s.text("mu_i_fit_error", &e.to_string());
-            match fit_mu_i_linear(series, &opts) {
-                Ok(f) => {
-                    let shown = Shown {
-                        key: "mu_i",
-                        form: Some("mu-i-linear"),
-                        formula: "μ_s + b I",
-                        title: "μ(I) = μ_s + b I (linear form)",
-                        colour: PALETTE[0],
-                    };
-                    shown.record(&mut pmu, &xs, &f.report, s, headline, |p, i| {
-                        p[0] + p[1] * i
-                    });
-                    export_law(
-                        out,
-                        verdict,
-                        "mu_i",
-                        &CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone()),
-                        inp.mu_checks.clone(),
-                    )?;
-                }
-                Err(e2) => {
-                    warn(&format!("linear μ(I) fit failed too: {e2}"));
-                    s.text("mu_i_linear_fit_error", &e2.to_string());
-                    crate::verdict::remove_stale_law(out, "mu_i")?;
-                    verdict.run.fail(
-                        &format!("{}.mu_i_fit", inp.check_prefix),
-                        Verdict::Refused,
-                        f64::NAN,
-                        f64::NAN,
-                        format!("no μ(I) law could be fitted: {e2}"),
-                    );
-                }
+        }
+        match fit_mu_i_linear(series, &opts) {
+            Ok(f) => {
+                let shown = Shown {
+                    key: "mu_i",
+                    form: Some("mu-i-linear"),
+                    formula: "μ_s + b I",
+                    title: "μ(I) = μ_s + b I (linear form)",
+                    colour: PALETTE[0],
+                };
+                shown.record(&mut pmu, &xs, &f.report, s, headline, |p, i| {
+                    p[0] + p[1] * i
+                });
+                export_law(
+                    out,
+                    verdict,
+                    "mu_i",
+                    &CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone()),
+                    inp.mu_checks.clone(),
+                )?;
+            }
+            Err(e2) => {
+                warn(&format!("linear μ(I) fit failed too: {e2}"));
+                s.text("mu_i_linear_fit_error", &e2.to_string());
+                crate::verdict::remove_stale_law(out, "mu_i")?;
+                verdict.run.fail(
+                    &format!("{}.mu_i_fit", inp.check_prefix),
+                    Verdict::Refused,
+                    f64::NAN,
+                    f64::NAN,
+                    format!("no μ(I) law could be fitted: {e2}"),
+                );
             }
         }
     }
@@ -189,8 +221,10 @@ pub(crate) fn fit_mu_phi(
         PALETTE[2],
         points(series.phi.as_deref()),
     ));
-    match fit_phi_i(series, &opts) {
-        Ok(f) => {
+    match (!left("phi-i")).then(|| fit_phi_i(series, &opts)) {
+        // left out by the plan (said at the start)
+        None => crate::verdict::remove_stale_law(out, "phi_i")?,
+        Some(Ok(f)) => {
             let shown = Shown {
                 key: "phi_i",
                 form: None,
@@ -209,7 +243,7 @@ pub(crate) fn fit_mu_phi(
                 inp.phi_checks.clone(),
             )?;
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("φ(I) fit failed: {e}"));
             s.text("phi_i_fit_error", &e.to_string());
             crate::verdict::remove_stale_law(out, "phi_i")?;

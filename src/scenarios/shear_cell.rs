@@ -764,6 +764,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             provenance: prov(),
             mu_checks: mu_checks.clone(),
             phi_checks: phi_checks.clone(),
+            leave_out: &c.leave_out,
         },
         &mut verdict,
         &mut s,
@@ -793,8 +794,11 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         PALETTE[3],
         vs.iter().zip(&mus).map(|(v, m)| (v / scale, *m)).collect(),
     ));
-    match select_wall_law(&ws, &opts) {
-        Ok(sel) => {
+    let wall_left_out = c.leave_out.iter().any(|l| l == "wall-law");
+    match (!wall_left_out).then(|| select_wall_law(&ws, &opts)) {
+        // left out by the plan (said at the start)
+        None => crate::verdict::remove_stale_law(&ctx.out, "wall")?,
+        Some(Ok(sel)) => {
             let best = sel.best();
             let vmax = vs.iter().cloned().fold(0.0, f64::max) / scale;
             let vx: Vec<f64> = (0..=80).map(|k| vmax * 1.05 * k as f64 / 80.0).collect();
@@ -849,7 +853,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 common.clone(),
             )?;
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("wall-law fit failed: {e}"));
             s.text("wall_law_fit_error", &e.to_string());
             headline.push(format!("wall law not identified: {e}"));

@@ -515,6 +515,7 @@ pub fn run(
             provenance: prov(),
             mu_checks: mu_checks.clone(),
             phi_checks: phi_checks.clone(),
+            leave_out: &c.leave_out,
         },
         &mut verdict,
         &mut s,
