@@ -632,7 +632,7 @@ const MERGED: &[(&str, &[LawWithFallback])] = &[(
     "rheology.csv",
     &[
         ("mu-i", Some("mu-i-linear")),
-        ("phi-i", Some("phi-i-linear")),
+        ("phi-i", None),
     ],
 )];
 

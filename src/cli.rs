@@ -58,7 +58,7 @@ pub enum Command {
         show: Option<String>,
     },
     /// Fit a law to your own data: janssen, janssen-kmu, wall-law, mu-i, mu-i-linear, phi-i,
-    /// phi-i-linear, mohr-coulomb. Exit code 2 for bad input, 3 when the fit is refused.
+    /// mohr-coulomb. Exit code 2 for bad input, 3 when the fit is refused.
     Fit {
         /// Law name.
         law: String,

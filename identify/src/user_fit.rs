@@ -11,7 +11,7 @@
 //! | `janssen-kmu` | `z_m`, `sigma_v_Pa` | | `width_m`, `bulk_density_kg_m3`; optional `gravity_m_s2`, `depth_min_m`, `depth_max_m`; `wall_friction`, `full_mobilisation` accepted (a `janssen` file) and not used |
 //! | `wall-law` | `slip_velocity_m_s` and either `mu_eff` or both `tau_w_Pa`, `sigma_w_Pa` | | `grain_diameter_m`; optional `gravity_m_s2` |
 //! | `mu-i`, `mu-i-linear` | `I`, `mu` | `P_Pa`, `mu_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` (the law's `d`, `rho_s`) |
-//! | `phi-i`, `phi-i-linear` | `I`, `phi` | `P_Pa`, `phi_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` |
+//! | `phi-i` | `I`, `phi` | `P_Pa`, `phi_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` |
 //! | `mohr-coulomb` | one of: `p_Pa`, `q_Pa` (Mohr circles) · `sigma_xx_Pa`, `sigma_yy_Pa`, `sigma_xy_Pa` (2D tensors, **tension positive**) · `sigma_n_Pa`, `tau_Pa` (failure plane) | | optional `cohesion` (only `0`: fixes `c = 0`, and 3 states suffice) |
 //!
 //! `z` is the depth below the free surface, `I` the inertial number, `mu = τ/P`, `phi` the solid
@@ -35,18 +35,17 @@ use crate::janssen::{
 use crate::law::{CalibratedLaw, GrainScale, Provenance};
 use crate::laws::STANDARD_GRAVITY;
 use crate::mohr_coulomb::{fit_mohr_coulomb_with, MohrCoulombOptions, YieldData};
-use crate::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, fit_phi_i_linear, RheologySeries};
+use crate::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use crate::wall_law::{select_wall_law, WallSlipSeries};
 
 /// Law names accepted by [`fit_csv_file`].
-pub const LAW_NAMES: [&str; 8] = [
+pub const LAW_NAMES: [&str; 7] = [
     "janssen",
     "janssen-kmu",
     "wall-law",
     "mu-i",
     "mu-i-linear",
     "phi-i",
-    "phi-i-linear",
     "mohr-coulomb",
 ];
 
@@ -64,9 +63,7 @@ pub fn metadata_keys(law: &str) -> &'static [&'static str] {
     match law {
         "janssen" | "janssen-kmu" => JANSSEN,
         "wall-law" => &["grain_diameter_m", "gravity_m_s2"],
-        "mu-i" | "mu-i-linear" | "phi-i" | "phi-i-linear" => {
-            &["grain_diameter_m", "grain_density_kg_m3"]
-        }
+        "mu-i" | "mu-i-linear" | "phi-i" => &["grain_diameter_m", "grain_density_kg_m3"],
         "mohr-coulomb" => &["cohesion"],
         _ => &[],
     }
@@ -199,6 +196,15 @@ fn check_unique_headers(table: &Table, line: u64) -> Result<()> {
 }
 
 fn check_law_name(law: &str) -> Result<()> {
+    if law == "phi-i-linear" {
+        return Err(IdentifyError::UnknownLaw {
+            name: law.to_string(),
+            known: format!(
+                "{}; phi-i-linear was merged into phi-i, the same line φ_max − a I",
+                LAW_NAMES.join(", ")
+            ),
+        });
+    }
     if !LAW_NAMES.contains(&law) {
         return Err(IdentifyError::UnknownLaw {
             name: law.to_string(),
@@ -398,7 +404,7 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
                 provenance,
             ))
         }
-        "mu-i" | "mu-i-linear" | "phi-i" | "phi-i-linear" => {
+        "mu-i" | "mu-i-linear" | "phi-i" => {
             let mut series = RheologySeries {
                 inertial_number: table.column("I")?,
                 pressure_pa: table.optional_column("P_Pa")?,
@@ -423,13 +429,9 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
                     let fit = fit_mu_i_linear(&series, o)?;
                     CalibratedLaw::from_mu_i_linear(&fit, grain_scale(&table)?, provenance)
                 }
-                "phi-i" => {
+                _ => {
                     let fit = fit_phi_i(&series, o)?;
                     CalibratedLaw::from_phi_i(&fit, grain_scale(&table)?, provenance)
-                }
-                _ => {
-                    let fit = fit_phi_i_linear(&series, o)?;
-                    CalibratedLaw::from_phi_i_linear(&fit, grain_scale(&table)?, provenance)
                 }
             })
         }

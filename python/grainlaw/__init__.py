@@ -18,7 +18,7 @@ compressive-positive magnitudes (as ``grainlaw fit`` does).
 - ``homogenise(format, files, out, ...)``: ``grainlaw homogenise --from FORMAT FILES --out
   OUT`` itself (CSV tables, figures, VTK, summary.json); returns the summary and the paths.
 - ``fit_janssen``, ``fit_janssen_kmu``, ``fit_wall_law``, ``fit_mu_i``, ``fit_mu_i_linear``,
-  ``fit_phi_i``, ``fit_phi_i_linear``, ``fit_mohr_coulomb`` (and the generic ``fit``): laws
+  ``fit_phi_i``, ``fit_mohr_coulomb`` (and the generic ``fit``): laws
   with confidence intervals, as ``Law`` objects; ``load_law`` reads a calibrated-law JSON.
 
 Errors: every exception raised is a ``GrainlawError``: ``InputError`` (bad input),
@@ -81,7 +81,6 @@ __all__ = [
     "fit_mu_i",
     "fit_mu_i_linear",
     "fit_phi_i",
-    "fit_phi_i_linear",
     "fit_wall_law",
     "grain_stresses",
     "homogenise",
@@ -226,20 +225,13 @@ def fit_mu_i_linear(I, mu, *, grain_diameter: float, grain_density: float, press
 
 
 def fit_phi_i(I, phi, *, grain_diameter: float, grain_density: float, pressure=None, confidence: float = 0.95) -> Law:
-    """φ(I) = φ_max − (φ_max − φ_min) I (da Cruz et al. 2005; docs/physics.md §3.3).
+    """φ(I) = φ_max − a I (da Cruz et al. 2005; docs/physics.md §3.3), valid over the I of the data.
 
     I: inertial number; phi: solid fraction; other arguments as ``fit_mu_i``. Parameters
-    ``phi_max``, ``phi_min``.
+    ``phi_max`` and ``a`` (the slope −dφ/dI). The former ``fit_phi_i_linear`` fitted the same
+    line: the two are merged into this one.
     """
     return _rheology("phi-i", I, phi, "phi", grain_diameter, grain_density, pressure, confidence)
-
-
-def fit_phi_i_linear(I, phi, *, grain_diameter: float, grain_density: float, pressure=None, confidence: float = 0.95) -> Law:
-    """φ(I) = φ_max − a I, the same line with the slope as parameter.
-
-    Arguments as ``fit_phi_i``; parameters ``phi_max``, ``a``.
-    """
-    return _rheology("phi-i-linear", I, phi, "phi", grain_diameter, grain_density, pressure, confidence)
 
 
 def fit_mohr_coulomb(

@@ -25,7 +25,7 @@ use crate::errors::{identify_err, input};
 /// --
 ///
 /// Fits `law` ("janssen", "janssen-kmu", "wall-law", "mu-i", "mu-i-linear", "phi-i",
-/// "phi-i-linear", "mohr-coulomb"; "_" may stand for "-") to `columns`, a dict
+/// "mohr-coulomb"; "_" may stand for "-") to `columns`, a dict
 /// ``{header: 1-D array}`` with the headers and units of ``grainlaw fit`` (``z_m``,
 /// ``sigma_v_Pa``, ``I``, ``mu``, ...; identify/README.md), and `metadata`, the ``# key =
 /// value`` constants of that file (``width_m``, ``grain_diameter_m``, ...). Stresses are

@@ -228,12 +228,12 @@ pub(crate) fn fit_mu_phi(
             let shown = Shown {
                 key: "phi_i",
                 form: None,
-                formula: "φ_max − (φ_max − φ_min) I",
-                title: "φ(I) = φ_max − (φ_max − φ_min) I",
+                formula: "φ_max − a I",
+                title: "φ(I) = φ_max − a I",
                 colour: PALETTE[2],
             };
             shown.record(&mut pphi, &xs, &f.report, s, headline, |p, i| {
-                p[0] - (p[0] - p[1]) * i
+                p[0] - p[1] * i
             });
             export_law(
                 out,
