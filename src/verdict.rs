@@ -47,7 +47,22 @@
 //! move by `θ h Δv` only); the trajectory's drift is what the overlap and energy checks bound.
 //!
 //! and the scenario's own checks (force balance, inertial number against its target, steady
-//! state), documented where they are made.
+//! state, the biaxial's dilatancy), documented where they are made.
+//!
+//! The verdict is as loud wherever a result leaves grainlaw: `grainlaw run` exits with 3 for a
+//! refused run, or a suspect one without `--allow-suspect` ([`RunVerdict::passes`]); Python's
+//! `grainlaw.run` raises `ResultRefused` / `ResultSuspect` (unless `allow_suspect=True`) with the
+//! verdict, its reasons and the result; every law JSON carries its `verdict`, `ok` for a law of
+//! `grainlaw fit` or a Python fit, which return only laws that passed every check
+//! (`identify::user_fit::FIT_VERDICT`). What a plan cannot identify is not left to a verdict
+//! at the end: a plan short of the data a law needs is refused before the run
+//! (`datasets::config::laws`), unless it leaves that law out.
+//!
+//! An interval says which kind it is: the block averages of one sample's window
+//! (`homogenise::averaging`) measure that sample's noise and understate the scatter between
+//! independent samples; where there are replicas (seeds, or pressures for rigid grains) the
+//! interval comes from their scatter (`identify::critical_state::IntervalKind`,
+//! `docs/outputs.md` §2.1).
 
 use std::fmt;
 

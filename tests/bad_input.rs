@@ -1056,7 +1056,10 @@ fn fits_do_not_print_numbers_that_are_not_estimates() {
     // one-sided: [0, t se(b)] with the unconstrained intercept's standard error, never [0, 0]
     // (b < 0 here: the upper end does not fall below t se, what the data resolve)
     assert_eq!(c["ci_low"], 0.0, "{c}");
-    let (se, high) = (c["std_error"].as_f64().unwrap(), c["ci_high"].as_f64().unwrap());
+    let (se, high) = (
+        c["std_error"].as_f64().unwrap(),
+        c["ci_high"].as_f64().unwrap(),
+    );
     assert!(se > 0.0 && high > se, "{c}");
     assert!(stdout.contains("(the data allow up to "), "{stdout}");
 

@@ -21,7 +21,22 @@ fn scenarios_lists_and_shows_every_builtin() {
         let o = grainlaw(&["scenarios", "--show", b.name]);
         assert!(o.status.success());
         let shown = String::from_utf8(o.stdout).unwrap();
-        assert_eq!(shown, b.toml);
+        // the built-in TOML, then (for a scenario that fits laws) the data each law needs, as
+        // comments
+        let rest = shown.strip_prefix(b.toml).expect("the built-in TOML first");
+        assert!(
+            rest.lines().all(|l| l.is_empty() || l.starts_with('#')),
+            "{rest}"
+        );
+        let fits = datasets::load(b.name, &[]).unwrap().scenario.law_needs();
+        for need in &fits {
+            assert!(
+                rest.contains(&format!("#   {} (", need.law)),
+                "{}: {rest}",
+                b.name
+            );
+        }
+        assert_eq!(rest.is_empty(), fits.is_empty(), "{}: {rest}", b.name);
         // The TOML shown is a complete scenario: it loads as a file.
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("s.toml");

@@ -1167,8 +1167,7 @@ impl CalibratedLaw {
                 .map_err(format_error)?
                 .upgrade()?,
             2 => {
-                let mut law: CalibratedLaw =
-                    serde_json::from_value(value).map_err(format_error)?;
+                let mut law: CalibratedLaw = serde_json::from_value(value).map_err(format_error)?;
                 // `phi-i-linear` was merged into `phi-i` (the same line, same parameters)
                 if law.law == "phi-i-linear" {
                     law.law = "phi-i".into();

@@ -487,9 +487,14 @@ fn phi_i_linear_is_merged_into_phi_i() {
     assert_ne!(old, text);
     let read = CalibratedLaw::from_json_str(&old).unwrap();
     assert_eq!(read.law, "phi-i");
-    assert_eq!(read.evaluate(&[0.1]).unwrap(), law.evaluate(&[0.1]).unwrap());
+    assert_eq!(
+        read.evaluate(&[0.1]).unwrap(),
+        law.evaluate(&[0.1]).unwrap()
+    );
     let former = text.replace("\"a\"", "\"phi_min\"");
-    let e = CalibratedLaw::from_json_str(&former).unwrap_err().to_string();
+    let e = CalibratedLaw::from_json_str(&former)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("phi_min") && e.contains("fit it again"), "{e}");
     let e = identify::user_fit::fit_csv_file(
         "phi-i-linear",
