@@ -285,7 +285,7 @@ pub fn run<'py>(
         );
         let reasons = result
             .get_item("verdict_reasons")?
-            .map_or_else(|| PyList::empty(py).into_any(), |r| r);
+            .unwrap_or_else(|| PyList::empty(py).into_any());
         return Err(verdict_err(py, verdict, line, reasons, result.into_any()));
     }
     Ok(result)

@@ -488,7 +488,7 @@ impl Biaxial<'_> {
             if dl.ratio.is_finite() && dl.sin_psi.is_nan() {
                 undefined += 1;
             }
-            if dl.sin_psi.is_finite() && !(dl.sin_psi <= psi_max.0) {
+            if dl.sin_psi.is_finite() && (psi_max.0.is_nan() || dl.sin_psi > psi_max.0) {
                 psi_max = (dl.sin_psi, *x, dl.std_error);
             }
             // the hardening phase: windows whose centre comes before the peak
