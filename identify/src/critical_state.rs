@@ -25,10 +25,13 @@
 //! `[0, π/2]` or of the solid fraction outside `[0, 1]`.
 //!
 //! **Stress–dilatancy** ([`fit_stress_dilatancy`]): `sin φ_mob = sin φ_cv + β sin ψ` by least
-//! squares ([`crate::fit`]) over binned points of the hardening phase, with the checks of
+//! squares ([`crate::fit`]) over binned points of the hardening phase (with the samples of the
+//! points given, intervals that cover the scatter between them: [`fit_stress_dilatancy`]), with
+//! the checks of
 //! [`crate::accept`]: `sin φ_cv` inside `[0, 1]`, `β ≥ 0`, standard errors below the values,
 //! `R²` above the threshold.
 
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use crate::accept::{Acceptance, PhysicalRange};
@@ -211,7 +214,7 @@ pub fn fit_critical_state(
     let friction_angle_deg =
         Estimate::new("friction_angle_c_deg", "deg", angle * k, angle_se * k, ts);
     let solid_fraction = Estimate::new("solid_fraction_c", "1", fm, fse, tf);
-    let cov = nalgebra::DMatrix::from_row_slice(2, 2, &[angle_se * angle_se, 0.0, 0.0, fse * fse]);
+    let cov = DMatrix::from_row_slice(2, 2, &[angle_se * angle_se, 0.0, 0.0, fse * fse]);
     let n = s.len();
     let residuals: Vec<f64> = s.iter().map(|v| v - sm).collect();
     let rss: f64 = residuals.iter().map(|r| r * r).sum();
@@ -287,6 +290,11 @@ pub struct StressDilatancyData {
     pub sin_psi: Vec<f64>,
     /// `sin φ_mob = q/p` (1).
     pub sin_phi: Vec<f64>,
+    /// The independent sample (a pressure's test, a seed) each point comes from, when known:
+    /// points of one sample are correlated, and the intervals then cover the scatter between
+    /// the samples ([`fit_stress_dilatancy`]).
+    #[serde(default)]
+    pub sample: Option<Vec<usize>>,
 }
 
 /// Result of [`fit_stress_dilatancy`].
@@ -296,9 +304,45 @@ pub struct StressDilatancyFit {
     pub law: StressDilatancyLaw,
     /// Parameters `sin_phi_c`, `beta`.
     pub report: FitReport,
+    /// Independent samples the points come from (0 when not given).
+    pub samples: usize,
+    /// Whether the intervals are the cluster-robust ones over the samples (they were wider
+    /// than the least-squares ones, which take every point as independent).
+    pub clustered: bool,
 }
 
-/// Fits `sin φ_mob = sin φ_cv + β sin ψ` (module documentation).
+/// Cluster-robust covariance of the least-squares line `y = a + b x` over the samples
+/// `sample` (Liang & Zeger, Biometrika 73, 1986; the small-sample factor
+/// `G/(G − 1) · (n − 1)/(n − 2)` of Cameron & Miller, J. Human Resources 50, 2015):
+/// `(XᵀX)⁻¹ Σ_g (X_gᵀ e_g)(X_gᵀ e_g)ᵀ (XᵀX)⁻¹`, `e` the residuals; with `G` samples.
+fn cluster_covariance(x: &[f64], residuals: &[f64], sample: &[usize]) -> (DMatrix<f64>, usize) {
+    let n = x.len();
+    let xm = DMatrix::from_fn(n, 2, |k, j| if j == 0 { 1.0 } else { x[k] });
+    let bread = (xm.transpose() * &xm)
+        .try_inverse()
+        .unwrap_or_else(|| DMatrix::from_element(2, 2, f64::NAN));
+    let mut groups: Vec<usize> = sample.to_vec();
+    groups.sort_unstable();
+    groups.dedup();
+    let mut meat = DMatrix::<f64>::zeros(2, 2);
+    for g in &groups {
+        let mut s = nalgebra::Vector2::zeros();
+        for k in (0..n).filter(|&k| sample[k] == *g) {
+            s += nalgebra::Vector2::new(residuals[k], residuals[k] * x[k]);
+        }
+        meat += s * s.transpose();
+    }
+    let gn = groups.len() as f64;
+    let factor = gn / (gn - 1.0).max(1.0) * (n as f64 - 1.0) / (n as f64 - 2.0).max(1.0);
+    (&bread * meat * &bread * factor, groups.len())
+}
+
+/// Fits `sin φ_mob = sin φ_cv + β sin ψ` (module documentation). With the samples of the points
+/// given (`data.sample`, two or more) and a cluster-robust variance over the samples
+/// ([`cluster_covariance`]) larger than the least-squares one for either parameter, each
+/// standard error is the larger of the two, with the cluster-robust correlation and Student's
+/// `t` at `G − 1` degrees of freedom: the points of one sample are correlated (consecutive windows of
+/// one test), and least squares alone takes them as independent.
 ///
 /// Errors: [`IdentifyError::TooFewPoints`] (< 4), [`IdentifyError::NonFinite`],
 /// [`IdentifyError::ZeroVariance`] (no spread of `sin ψ`), and the refusals of
@@ -327,7 +371,7 @@ pub fn fit_stress_dilatancy(
         decreasing: false,
     };
     let (a, b) = ols_start(x, y);
-    let report = fit_least_squares(
+    let mut report = fit_least_squares(
         &model,
         &Observations::single("sin_phi", y.clone()),
         &[a, b],
@@ -337,6 +381,42 @@ pub fn fit_stress_dilatancy(
             ValidityRange::of("sin_phi", "1", y),
         ],
     )?;
+    let mut samples = 0;
+    let mut clustered = false;
+    if let Some(sample) = &data.sample {
+        if sample.len() != x.len() {
+            return Err(IdentifyError::LengthMismatch {
+                first: "sin_psi".into(),
+                first_len: x.len(),
+                second: "sample".into(),
+                second_len: sample.len(),
+            });
+        }
+        let (cov, g) = cluster_covariance(x, &report.residuals, sample);
+        samples = g;
+        let wider = (0..2).any(|j| cov[(j, j)] > report.parameters[j].std_error.powi(2));
+        if g >= 2 && wider && cov.iter().all(|v| v.is_finite()) {
+            clustered = true;
+            let t = stats::t_critical(report.confidence, g - 1);
+            // each standard error the larger of the two, with the cluster-robust correlation
+            let corr = correlation_of(&cov);
+            let se: Vec<f64> = (0..2)
+                .map(|j| {
+                    cov[(j, j)]
+                        .max(0.0)
+                        .sqrt()
+                        .max(report.parameters[j].std_error)
+                })
+                .collect();
+            let cov = DMatrix::from_fn(2, 2, |i, j| corr[(i, j)] * se[i] * se[j]);
+            for (j, p) in report.parameters.iter_mut().enumerate() {
+                *p = Estimate::new(&p.name, &p.unit, p.value, se[j], t);
+            }
+            report.t_critical = t;
+            report.covariance = matrix_rows(&cov);
+            report.correlation = matrix_rows(&corr);
+        }
+    }
     Acceptance::new("stress-dilatancy", options.min_r_squared)
         .range(PhysicalRange::new("sin_phi_c", 0.0, 1.0))
         .non_negative(&["beta"])
@@ -347,6 +427,8 @@ pub fn fit_stress_dilatancy(
             beta: report.parameters[1].value,
         },
         report,
+        samples,
+        clustered,
     })
 }
 
@@ -432,6 +514,49 @@ mod tests {
         assert!(g.solid_fraction_replica_sd.is_nan() && g.replica_t.is_nan());
     }
 
+    /// Three samples (pressures) of four windows each on the line 0.25 + 1.0 sin ψ, each
+    /// sample shifted as a whole by −0.02, +0.02, 0 (a sample's plateau, not window noise) and
+    /// by ±0.001 within: least squares takes the 12 points as independent; the cluster-robust
+    /// interval over the 3 samples is wider and covers the line.
+    #[test]
+    fn stress_dilatancy_intervals_cover_the_scatter_between_samples() {
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        let mut sample = Vec::new();
+        for (g, shift) in [-0.02, 0.02, 0.0].iter().enumerate() {
+            for k in 0..4 {
+                let psi = 0.05 * k as f64;
+                x.push(psi);
+                y.push(0.25 + psi + shift + if k % 2 == 0 { 0.001 } else { -0.001 });
+                sample.push(g);
+            }
+        }
+        let plain = StressDilatancyData {
+            sin_psi: x,
+            sin_phi: y,
+            sample: None,
+        };
+        let ls = fit_stress_dilatancy(&plain, &FitOptions::default()).unwrap();
+        assert!(!ls.clustered && ls.samples == 0);
+        let by_sample = StressDilatancyData {
+            sample: Some(sample),
+            ..plain
+        };
+        let cr = fit_stress_dilatancy(&by_sample, &FitOptions::default()).unwrap();
+        assert!(cr.clustered && cr.samples == 3, "{cr:?}");
+        assert!((cr.report.t_critical - stats::t_critical(0.95, 2)).abs() < 1e-12);
+        for j in 0..2 {
+            assert_eq!(cr.report.parameters[j].value, ls.report.parameters[j].value);
+            assert!(cr.report.parameters[j].std_error >= ls.report.parameters[j].std_error);
+        }
+        // the intercept carries the samples' shifts: its interval (t at 2 degrees of freedom,
+        // not 10) more than twice as wide (measured 2.7)
+        let half = |e: &Estimate| e.ci_high - e.value;
+        let ratio = half(&cr.report.parameters[0]) / half(&ls.report.parameters[0]);
+        assert!(ratio > 2.0, "{ratio}");
+        assert!(cr.report.parameters[0].covers(0.25) && cr.report.parameters[1].covers(1.0));
+    }
+
     #[test]
     fn taylor_line_is_recovered() {
         // sin φ = 0.25 + 1.0 sin ψ with a ±0.002 alternating scatter
@@ -445,6 +570,7 @@ mod tests {
             &StressDilatancyData {
                 sin_psi: x,
                 sin_phi: y,
+                sample: None,
             },
             &FitOptions::default(),
         )

@@ -272,6 +272,7 @@ fn every_law() -> Vec<Case> {
                 .map(|(x, e)| 0.27 + 0.9 * x + e)
                 .collect(),
             sin_psi: psi.clone(),
+            sample: None,
         },
         &o,
     )

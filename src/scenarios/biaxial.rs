@@ -1295,6 +1295,8 @@ fn analyse(
     let sd_data = StressDilatancyData {
         sin_psi: hard.iter().map(|w| w[3]).collect(),
         sin_phi: hard.iter().map(|w| w[2]).collect(),
+        // each pressure's test is an independent sample: intervals over them
+        sample: Some(hard.iter().map(|w| w[0] as usize).collect()),
     };
     let mut sd_line = None;
     match (!left("stress-dilatancy"))
@@ -1305,8 +1307,13 @@ fn analyse(
             fit_keys(&mut s, "stress_dilatancy", &f.report.parameters);
             s.num("stress_dilatancy_r_squared", f.report.r_squared)
                 .int("stress_dilatancy_points", f.report.n as u64)
-                // least squares over the windows, several per sample
-                .text("stress_dilatancy_interval", "windows");
+                .int("stress_dilatancy_samples", f.samples as u64)
+                // cluster-robust over the pressures when wider, else least squares over the
+                // windows (several per sample)
+                .text(
+                    "stress_dilatancy_interval",
+                    if f.clustered { "replicas" } else { "windows" },
+                );
             headline.extend(parameter_lines(
                 "stress–dilatancy over the hardening phases, sin φ = sin φ_cv + β sin ψ",
                 f.report.r_squared,
