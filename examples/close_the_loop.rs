@@ -57,7 +57,7 @@ fn csv_columns(
     Ok(out)
 }
 
-/// Runs a built-in scenario into `dir` with `--set` overrides.
+/// Runs a built-in scenario into `dir` with `--set` overrides and prints its verdict.
 fn run_scenario(name: &str, set: &[&str], dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
     let mut ctx = RunContext {
@@ -67,7 +67,11 @@ fn run_scenario(name: &str, set: &[&str], dir: &Path) -> Result<(), Box<dyn std:
         interrupted: Arc::new(AtomicBool::new(false)),
         dump: None,
     };
-    run(&mut ctx)?;
+    let outcome = run(&mut ctx)?;
+    // as `grainlaw run` prints it: a suspect or refused run is said, not hidden
+    for line in outcome.verdict.lines() {
+        println!("{name}: {line}");
+    }
     Ok(())
 }
 

@@ -24,6 +24,10 @@ use crate::scenarios::{self, CheckpointPolicy, RunContext, RunControl, RunOutcom
 /// `interrupted` stops the run after the current step with a checkpoint in `out` and
 /// [`CliError::Interrupted`]; no signal handler is installed (the embedding program owns its
 /// signals). `quiet` turns off the progress lines on stderr (warnings are still printed).
+/// `allow_suspect` is `--allow-suspect`: suspect laws are exported as `NAME_law.json` (marked
+/// suspect) instead of `NAME_law.rejected.json`. The run's verdict is in the outcome
+/// ([`RunOutcome::verdict`]), not an error: the caller decides how loud it is (the command line
+/// exits 3, Python raises).
 ///
 /// Errors: a bad scenario or override ([`CliError::Dataset`]), an `out` that is a file or holds
 /// another scenario's outputs ([`CliError::Usage`]), a failed step ([`CliError::Dem`]), a file
@@ -33,6 +37,7 @@ pub fn run_scenario(
     sets: &[String],
     out: &Path,
     quiet: bool,
+    allow_suspect: bool,
     interrupted: Arc<AtomicBool>,
 ) -> Result<RunOutcome> {
     let loaded = datasets::load(spec, sets)?;
@@ -49,6 +54,7 @@ pub fn run_scenario(
         dump: None,
     };
     let mut ctl = RunControl::new(sets.to_vec(), CheckpointPolicy::default());
+    ctl.allow_suspect = allow_suspect;
     scenarios::run_controlled(&mut ctx, &mut ctl)
 }
 

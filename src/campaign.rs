@@ -632,10 +632,7 @@ type LawWithFallback = (&'static str, Option<&'static str>);
 /// names in its refusal).
 const MERGED: &[(&str, &[LawWithFallback])] = &[(
     "rheology.csv",
-    &[
-        ("mu-i", Some("mu-i-linear")),
-        ("phi-i", Some("phi-i-linear")),
-    ],
+    &[("mu-i", Some("mu-i-linear")), ("phi-i", None)],
 )];
 
 /// `--collect`: the campaign tables, the merged histories and their fits.

@@ -58,7 +58,7 @@ pub enum Command {
         show: Option<String>,
     },
     /// Fit a law to your own data: janssen, janssen-kmu, wall-law, mu-i, mu-i-linear, phi-i,
-    /// phi-i-linear, mohr-coulomb. Exit code 2 for bad input, 3 when the fit is refused.
+    /// mohr-coulomb. Exit code 2 for bad input, 3 when the fit is refused.
     Fit {
         /// Law name.
         law: String,
@@ -573,6 +573,12 @@ fn scenarios_cmd(show: Option<&str>) -> Result<()> {
                 })
             })?;
             print!("{}", b.toml);
+            // the laws it fits and the data each needs, from the same table the load checks
+            let loaded = datasets::load(name, &[])?;
+            let needs = datasets::config::laws::describe(&loaded.scenario.law_needs());
+            if !needs.is_empty() {
+                println!("\n{}", needs.join("\n"));
+            }
         }
         None => {
             for b in datasets::BUILTINS.iter() {

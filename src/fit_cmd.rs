@@ -28,7 +28,8 @@ pub fn fit(law: &str, data: &Path, out: Option<&Path>) -> Result<CalibratedLaw> 
     let cal =
         fit_csv_file(law, data, &CsvFitOptions::default()).map_err(|e| naming_file(data, e))?;
     let left_out = left_out_points(data);
-    report(&cal, data, left_out, out)
+    report(&cal, data, left_out, out)?;
+    Ok(cal)
 }
 
 /// [`fit`] on several tables of the same columns (e.g. the `rheology.csv` of one run per
@@ -92,7 +93,7 @@ fn report(cal: &CalibratedLaw, data: &Path, left_out: usize, out: Option<&Path>)
             print!("{json}");
         }
     }
-    Ok(cal)
+    Ok(())
 }
 
 /// Rows of `data` that the fit left out for their `point_verdict` (0 when the file has no such
@@ -108,7 +109,7 @@ fn left_out_points(data: &Path) -> usize {
 }
 
 /// The printed report: a title line, one line per parameter (in the registry's order), one per
-/// derived quantity.
+/// derived quantity, and the verdict.
 fn report_lines(cal: &CalibratedLaw, data: &Path) -> Vec<String> {
     let mut lines = vec![format!(
         "{} fitted to {} ({} points, R² = {:.4})",
@@ -123,6 +124,10 @@ fn report_lines(cal: &CalibratedLaw, data: &Path) -> Vec<String> {
     for d in &cal.derived {
         lines.push(derived_line(d));
     }
+    lines.push(format!(
+        "verdict: {} (every check of the fit passed; the law's `verdict` key)",
+        cal.verdict.as_deref().unwrap_or("ok")
+    ));
     lines
 }
 

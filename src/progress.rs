@@ -76,6 +76,12 @@ pub fn warn(msg: &str) {
     eprintln!("warning: {msg}");
 }
 
+/// Prints a note on stderr (always, even with `--quiet`): a choice of the plan the run obeys
+/// that changes what it delivers (a law left out).
+pub fn note(msg: &str) {
+    eprintln!("note: {msg}");
+}
+
 /// Prints an informational line on stderr unless quiet.
 pub fn info(v: Verbosity, msg: &str) {
     if v == Verbosity::Normal {

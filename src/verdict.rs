@@ -21,6 +21,7 @@
 //! | relative change of its pressure under the same re-solve | 2.5 % | 10 % |
 //! | samples whose re-solve did not reach 10⁻⁸ | 10 % | — |
 //! | steps of the window whose energy grew beyond `ENERGY_GROWTH_TOLERANCE` | 1 % | 25 % (≥ 20 steps) |
+//! | energy gained by any one step of the window / E_load ([`ENERGY_STEP_SUSPECT`], [`ENERGY_STEP_REFUSED`]) | 1 % | 100 % |
 //! | largest overlap in the window / smallest radius ([`OVERLAP_SUSPECT`], [`OVERLAP_REFUSED`]) | 0.1 % | 1 % |
 //! | solid fraction | — | outside (0, [`max_solid_fraction`]) |
 //!
@@ -46,7 +47,22 @@
 //! move by `θ h Δv` only); the trajectory's drift is what the overlap and energy checks bound.
 //!
 //! and the scenario's own checks (force balance, inertial number against its target, steady
-//! state), documented where they are made.
+//! state, the biaxial's dilatancy), documented where they are made.
+//!
+//! The verdict is as loud wherever a result leaves grainlaw: `grainlaw run` exits with 3 for a
+//! refused run, or a suspect one without `--allow-suspect` ([`RunVerdict::passes`]); Python's
+//! `grainlaw.run` raises `ResultRefused` / `ResultSuspect` (unless `allow_suspect=True`) with the
+//! verdict, its reasons and the result; every law JSON carries its `verdict`, `ok` for a law of
+//! `grainlaw fit` or a Python fit, which return only laws that passed every check
+//! (`identify::user_fit::FIT_VERDICT`). What a plan cannot identify is not left to a verdict
+//! at the end: a plan short of the data a law needs is refused before the run
+//! (`datasets::config::laws`), unless it leaves that law out.
+//!
+//! An interval says which kind it is: the block averages of one sample's window
+//! (`homogenise::averaging`) measure that sample's noise and understate the scatter between
+//! independent samples; where there are replicas (seeds, or pressures for rigid grains) the
+//! interval comes from their scatter (`identify::critical_state::IntervalKind`,
+//! `docs/outputs.md` §2.1).
 
 use std::fmt;
 
@@ -98,6 +114,17 @@ pub const SENSITIVITY_UNRESOLVED_SUSPECT: f64 = 0.1;
 pub const ENERGY_GROWTH_SUSPECT: f64 = 0.01;
 /// Fraction of window steps whose energy grew above which the result is refused (1).
 pub const ENERGY_GROWTH_REFUSED: f64 = 0.25;
+/// Energy gained by one step of the window over the load energy `E_load` (`δ / E_load`,
+/// `dem::energy::load_energy_scale`: the work of every load over one mean diameter) above which
+/// the result is suspect, however few such steps there are (1): a thousand times the growth
+/// that counts a step (`datasets::phases::ENERGY_GROWTH_TOLERANCE`), the energy of the loads
+/// moving by a hundredth of a diameter created in one step. The fraction check cannot see it: one
+/// step in a hundred is not above its 1 % (an I = 0.25 window of simple shear: one step gained
+/// 22 % of E_load and the fraction check passed).
+pub const ENERGY_STEP_SUSPECT: f64 = 0.01;
+/// The same, above which the result is refused (1): one step created more energy than the work
+/// of every load over a whole diameter.
+pub const ENERGY_STEP_REFUSED: f64 = 1.0;
 /// Largest overlap over the smallest radius above which the result is suspect (1).
 pub const OVERLAP_SUSPECT: f64 = 0.001;
 /// Largest overlap over the smallest radius above which the result is refused (1).
@@ -416,6 +443,22 @@ impl Checks {
                 )
             },
         );
+        let step = w
+            .worst_energy_growth_step
+            .map_or_else(|| "?".to_string(), |k| k.to_string());
+        self.at_most(
+            "energy.worst_step_growth",
+            w.worst_energy_growth,
+            ENERGY_STEP_SUSPECT,
+            Some(ENERGY_STEP_REFUSED),
+            |t| {
+                format!(
+                    "{label}: one step (step {step}) gained {:.1} % of the load energy E_load (limit {} % in any single step, whatever the fraction of such steps)",
+                    100.0 * w.worst_energy_growth,
+                    100.0 * t
+                )
+            },
+        );
         self.at_most(
             "overlap.max_over_radius",
             w.max_overlap_ratio,
@@ -452,6 +495,13 @@ pub struct WindowStats {
     pub tolerance: f64,
     /// Steps whose energy residual exceeded the tolerance (`PhaseStats::energy_growth_steps`).
     pub energy_growth: u64,
+    /// Largest energy residual of one step of the window over E_load, `max(δ / E_load, 0)`
+    /// (`PhaseStats::last_energy_growth` of each step; 1).
+    #[serde(default, with = "dem::serde_float")]
+    pub worst_energy_growth: f64,
+    /// World step index of that step (`None` while no step grew).
+    #[serde(default)]
+    pub worst_energy_growth_step: Option<u64>,
     /// Largest overlap at the start of a step over the smallest grain radius (1).
     #[serde(with = "dem::serde_float")]
     pub max_overlap_ratio: f64,
@@ -618,6 +668,10 @@ impl WindowStats {
         if grew {
             self.energy_growth += 1;
         }
+        if phase.last_energy_growth > self.worst_energy_growth {
+            self.worst_energy_growth = phase.last_energy_growth;
+            self.worst_energy_growth_step = Some(r.step);
+        }
         let rmin = datasets::phases::min_grain_radius(world);
         if rmin > 0.0 {
             self.max_overlap_ratio = self.max_overlap_ratio.max(r.max_penetration / rmin);
@@ -648,12 +702,17 @@ impl WindowStats {
         );
         self.tolerance = self.tolerance.max(o.tolerance);
         self.energy_growth += o.energy_growth;
+        if o.worst_energy_growth > self.worst_energy_growth {
+            self.worst_energy_growth = o.worst_energy_growth;
+            self.worst_energy_growth_step = o.worst_energy_growth_step;
+        }
         self.max_overlap_ratio = self.max_overlap_ratio.max(o.max_overlap_ratio);
         self.sensitivity.merge(&o.sensitivity);
     }
 
     /// Summary keys `PREFIX_steps`, `PREFIX_unconverged_steps`, `PREFIX_worst_error`,
     /// `PREFIX_worst_error_without_gap_shifts`, `PREFIX_energy_growth_steps`,
+    /// `PREFIX_worst_energy_growth` (the largest growth of one step over E_load),
     /// `PREFIX_max_overlap_over_radius`; where the solver sensitivity was measured
     /// ([`Sensitivity`]), `PREFIX_resolved_samples`, `PREFIX_unresolved_samples`,
     /// `PREFIX_unavailable_samples`, `PREFIX_resolved_mu_change`,
@@ -667,6 +726,10 @@ impl WindowStats {
                 self.worst_error_without_gap_shifts,
             )
             .int(&format!("{prefix}_energy_growth_steps"), self.energy_growth)
+            .num(
+                &format!("{prefix}_worst_energy_growth"),
+                self.worst_energy_growth,
+            )
             .num(
                 &format!("{prefix}_max_overlap_over_radius"),
                 self.max_overlap_ratio,
@@ -1241,6 +1304,58 @@ mod tests {
         c.window_measured("measurement window", &w, true);
         assert_eq!(c.verdict(), Verdict::Refused);
         assert_eq!(c.reasons[0].threshold, SOLVER_ERROR_REFUSED);
+    }
+
+    #[test]
+    fn one_large_energy_growth_is_a_finding_whatever_the_fraction() {
+        // One step in 100 grew (1 %, at the fraction's limit: passes it), by 22 % of E_load:
+        // suspect by the single-step check; by 150 %, refused; by 0.5 %, nothing.
+        let judge = |g: f64| {
+            let w = WindowStats {
+                steps: 100,
+                energy_growth: 1,
+                worst_energy_growth: g,
+                worst_energy_growth_step: Some(4711),
+                tolerance: 1e-4,
+                ..Default::default()
+            };
+            let mut c = Checks::new();
+            c.window("I = 0.25", &w);
+            c
+        };
+        let c = judge(0.22);
+        assert_eq!(c.verdict(), Verdict::Suspect, "{:?}", c.reasons);
+        assert_eq!(c.reasons.len(), 1, "{:?}", c.reasons);
+        assert_eq!(c.reasons[0].check, "energy.worst_step_growth");
+        assert_eq!(c.reasons[0].value, 0.22);
+        assert!(
+            c.reasons[0].message.contains("step 4711"),
+            "{}",
+            c.reasons[0].message
+        );
+        assert!(
+            c.reasons[0].message.contains("22.0 %"),
+            "{}",
+            c.reasons[0].message
+        );
+        assert_eq!(judge(1.5).verdict(), Verdict::Refused);
+        assert_eq!(judge(0.005).verdict(), Verdict::Ok);
+        // Merged windows keep the largest step and its index.
+        let mut a = WindowStats {
+            worst_energy_growth: 0.02,
+            worst_energy_growth_step: Some(3),
+            ..Default::default()
+        };
+        a.merge(&WindowStats {
+            worst_energy_growth: 0.3,
+            worst_energy_growth_step: Some(9),
+            ..Default::default()
+        });
+        a.merge(&WindowStats::default());
+        assert_eq!(
+            (a.worst_energy_growth, a.worst_energy_growth_step),
+            (0.3, Some(9))
+        );
     }
 
     #[test]

@@ -1025,8 +1025,8 @@ fn fit_ok(d: &Path, law: &str, file: &str) -> (String, serde_json::Value) {
 }
 
 /// Fits that give a law, but not every parameter as an estimate: a Mohr–Coulomb cohesion held at
-/// its bound `c = 0` is printed as at its bound (it printed `cohesion = 0 (95 % CI 0 … 0)`) and
-/// flagged `at_bound` in the JSON; a wall law falling like `a − b ln V`, which the power law
+/// its bound `c = 0` is printed as at its bound (it printed `cohesion = 0 (95 % CI 0 … 0)`) with
+/// the upper end the data allow, and flagged `at_bound` in the JSON with its one-sided interval; a wall law falling like `a − b ln V`, which the power law
 /// reaches only with every interval spanning zero, is not given as a power law (it was the
 /// AIC winner), the power law is listed as failed, not identifiable.
 #[test]
@@ -1053,7 +1053,15 @@ fn fits_do_not_print_numbers_that_are_not_estimates() {
         .unwrap();
     assert_eq!(c["at_bound"], true, "{c}");
     assert_eq!(c["value"], 0.0, "{c}");
-    assert_eq!(c["std_error"], 0.0, "{c}");
+    // one-sided: [0, t se(b)] with the unconstrained intercept's standard error, never [0, 0]
+    // (b < 0 here: the upper end does not fall below t se, what the data resolve)
+    assert_eq!(c["ci_low"], 0.0, "{c}");
+    let (se, high) = (
+        c["std_error"].as_f64().unwrap(),
+        c["ci_high"].as_f64().unwrap(),
+    );
+    assert!(se > 0.0 && high > se, "{c}");
+    assert!(stdout.contains("(the data allow up to "), "{stdout}");
 
     // μ_eff = 0.45 − 0.005 ln V ± 0.001, V = V_s/√(g d) from 0.01 to 10.
     let scale = (9.81f64 * 0.002).sqrt();

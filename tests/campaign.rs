@@ -194,7 +194,7 @@ fn shear_cell_seeds_are_merged_and_fitted() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
         dir.path().join("plan.toml"),
-        "scenario = \"shear-cell\"\n[set]\ngrains = 80\ncell_length_diameters = 10\ninertial_numbers = [0.02, 0.08, 0.3]\nstrain = 1.0\naverage_strain = 0.5\n[sweep]\nseed = [1, 2]\n",
+        "scenario = \"shear-cell\"\n[set]\ngrains = 80\ncell_length_diameters = 10\ninertial_numbers = [0.02, 0.08, 0.3]\nleave_out = [\"mu-i\", \"mu-i-linear\", \"phi-i\"]\nstrain = 1.0\naverage_strain = 0.5\n[sweep]\nseed = [1, 2]\n",
     )
     .unwrap();
     let o = campaign(dir.path(), &["plan.toml", "--out", "c", "--jobs", "2"]);

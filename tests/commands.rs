@@ -21,7 +21,22 @@ fn scenarios_lists_and_shows_every_builtin() {
         let o = grainlaw(&["scenarios", "--show", b.name]);
         assert!(o.status.success());
         let shown = String::from_utf8(o.stdout).unwrap();
-        assert_eq!(shown, b.toml);
+        // the built-in TOML, then (for a scenario that fits laws) the data each law needs, as
+        // comments
+        let rest = shown.strip_prefix(b.toml).expect("the built-in TOML first");
+        assert!(
+            rest.lines().all(|l| l.is_empty() || l.starts_with('#')),
+            "{rest}"
+        );
+        let fits = datasets::load(b.name, &[]).unwrap().scenario.law_needs();
+        for need in &fits {
+            assert!(
+                rest.contains(&format!("#   {} (", need.law)),
+                "{}: {rest}",
+                b.name
+            );
+        }
+        assert_eq!(rest.is_empty(), fits.is_empty(), "{}: {rest}", b.name);
         // The TOML shown is a complete scenario: it loads as a file.
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("s.toml");
@@ -71,7 +86,8 @@ fn solve_fc_one_contact() {
     assert!(v["error"].as_f64().unwrap() <= 1e-10);
 }
 
-/// `grainlaw fit janssen` recovers K and μ_w from an exact Janssen profile (within 1e-3).
+/// `grainlaw fit janssen` recovers K and μ_w from an exact Janssen profile (within 1e-3), and
+/// the law it writes has a verdict (`ok`) like the laws of a run.
 #[test]
 fn fit_janssen_from_csv() {
     let (k, mu, w, rho_b, g) = (0.8, 0.2, 0.03, 1600.0, 9.81);
@@ -115,8 +131,11 @@ fn fit_janssen_from_csv() {
         "mu_w = {}",
         p("mu_w")
     );
+    // A fitted law carries its verdict as a run's laws do: it passed every check, `ok`.
+    assert_eq!(v["verdict"], "ok", "{v}");
     // Without --out the law JSON goes to stdout.
     let o = grainlaw(&["fit", "janssen", data.to_str().unwrap()]);
     assert!(o.status.success());
-    serde_json::from_slice::<Value>(&o.stdout).expect("law JSON on stdout");
+    let v = serde_json::from_slice::<Value>(&o.stdout).expect("law JSON on stdout");
+    assert_eq!(v["verdict"], "ok");
 }

@@ -86,7 +86,7 @@ fn every_fit_input_a_scenario_writes_is_fitted_as_written() {
                 "average_strain=0.5",
             ],
             "rheology.csv",
-            &["mu-i", "mu-i-linear", "phi-i", "phi-i-linear"],
+            &["mu-i", "mu-i-linear", "phi-i"],
         ),
     ];
     for (scenario, sets, file, laws) in runs {

@@ -152,17 +152,16 @@ fn rows() -> Vec<Row> {
             &["mu-i-linear: refused: R² = ", "is below 0.5"],
         ),
         row(
-            "interval crossing a physical bound: φ_min < 0 not excluded, phi-i-linear offered",
+            "interval crossing a physical bound: a solid fraction that grows with I",
             "phi-i",
             format!(
                 "{GRAIN}I,phi\n{}",
-                rows_i(20, 0.001, 0.02, |i| 0.8 - 0.78 * i, 0.001)
+                rows_i(20, 0.01, 0.3, |i| 0.7 + 0.2 * i, 0.002)
             ),
             3,
             &[
-                "phi-i: refused: the 95 % interval of phi_min [",
+                "phi-i: refused: the 95 % interval of a [",
                 "crosses its physical lower bound 0",
-                "; use phi-i-linear",
             ],
         ),
         row(
@@ -324,8 +323,8 @@ fn rows() -> Vec<Row> {
             &["mu_s       = ", "b          = ", "(95 % CI "],
         ),
         row(
-            "linear φ(I) accepted where φ(I) extrapolated to I = 1 is not",
-            "phi-i-linear",
+            "φ(I) accepted whatever its extrapolation to I = 1 (phi_max − a < 0 here)",
+            "phi-i",
             format!("{GRAIN}I,phi\n{}", rows_i(20, 0.001, 0.02, |i| 0.8 - 0.78 * i, 0.001)),
             0,
             &["phi_max    = ", "a          = ", "(95 % CI "],

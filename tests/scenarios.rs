@@ -658,6 +658,7 @@ fn shear_cell_slow_shear_converges() {
             "grains=120",
             "cell_length_diameters=10",
             "inertial_numbers=[0.005, 0.01, 0.02]",
+            r#"leave_out=["mu-i", "mu-i-linear", "phi-i"]"#,
             "strain=0.3",
             "average_strain=0.15",
             "velocity_corrections=0",

@@ -18,6 +18,8 @@ const TINY: &[&str] = &[
     "--set",
     "inertial_numbers=[0.2]",
     "--set",
+    r#"leave_out=["mu-i", "mu-i-linear", "phi-i"]"#,
+    "--set",
     "strain=0.2",
     "--set",
     "average_strain=0.1",
@@ -58,8 +60,9 @@ fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     out
 }
 
-/// Negative pressure, an empty list of inertial numbers, I ≤ 0: one `error:` line naming the
-/// key, exit code 2, nothing run.
+/// Negative pressure, an empty list of inertial numbers, I ≤ 0, too few inertial numbers for
+/// the laws the plan fits, a `leave_out` naming a law it does not fit: one `error:` line naming
+/// the key, exit code 2, nothing run.
 #[test]
 fn bad_inputs_are_refused_with_one_line() {
     for (set, key) in [
@@ -69,6 +72,9 @@ fn bad_inputs_are_refused_with_one_line() {
         ("inertial_numbers=[-0.1]", "inertial_numbers[0]"),
         ("grains=10", "grains"),
         ("average_strain=5", "average_strain"),
+        // checked before the run, not learnt after it: μ(I) needs 5 inertial numbers
+        ("inertial_numbers=[0.05, 0.1, 0.2]", "inertial_numbers"),
+        (r#"leave_out=["wall-law"]"#, "leave_out[0]"),
     ] {
         let o = grainlaw(&["run", "simple-shear", "--set", set], None);
         assert_eq!(o.status.code(), Some(2), "{set}: {}", stderr(&o));
@@ -81,6 +87,49 @@ fn bad_inputs_are_refused_with_one_line() {
             lines[0]
         );
     }
+}
+
+/// A plan that leaves laws out says so at the start (a `note:` line per law, even with `-q`),
+/// fits none of them, writes no law file and records them in `summary.json`.
+#[test]
+fn left_out_laws_are_said_at_start_and_not_fitted() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tiny");
+    let o = grainlaw(TINY, Some(&out));
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(3)),
+        "{}",
+        stderr(&o)
+    );
+    let err = stderr(&o);
+    let first = err.lines().next().unwrap_or_default();
+    assert!(
+        first.starts_with("note: mu-i left out by the plan (leave_out)")
+            && first.contains("this plan has 1 inertial_numbers; it needs at least 5"),
+        "{err}"
+    );
+    for law in ["mu-i-linear", "phi-i"] {
+        assert!(err.contains(&format!("note: {law} left out")), "{err}");
+    }
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(
+        s["laws_left_out"],
+        serde_json::json!(["mu-i", "mu-i-linear", "phi-i"])
+    );
+    for f in [
+        "mu_i_law.json",
+        "mu_i_law.rejected.json",
+        "phi_i_law.json",
+        "phi_i_law.rejected.json",
+    ] {
+        assert!(!out.join(f).exists(), "{f}");
+    }
+    let reasons = s["verdict_reasons"].to_string();
+    assert!(
+        !reasons.contains("mu_i_fit") && !reasons.contains("phi_i_fit"),
+        "{reasons}"
+    );
 }
 
 /// A run stopped after 130 steps (inside the shear run, after the 120 compression steps) and resumed writes the same files as

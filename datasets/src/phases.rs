@@ -98,6 +98,11 @@ pub struct PhaseStats {
     /// Largest energy residual of a step over E_load, `max(δ / E_load, 0)` (1).
     #[serde(with = "dem::serde_float")]
     pub worst_energy_growth: f64,
+    /// Energy residual of the last step over E_load, `max(δ / E_load, 0)` (1; 0 where no
+    /// balance is checked): what a window following the phase step by step reads to find its
+    /// own largest growth.
+    #[serde(default, with = "dem::serde_float")]
+    pub last_energy_growth: f64,
     /// Steps whose position correction moved something (`dem::stabilise`).
     #[serde(default)]
     pub position_corrected_steps: u64,
@@ -221,6 +226,7 @@ impl PhaseStats {
                 self.first_penetration_step = earliest(self.first_penetration_step, Some(r.step));
             }
         }
+        self.last_energy_growth = growth.map_or(0.0, |g| g.max(0.0));
         if let Some(g) = growth {
             self.worst_energy_growth = self.worst_energy_growth.max(g);
             if g > ENERGY_GROWTH_TOLERANCE {
@@ -254,6 +260,7 @@ impl PhaseStats {
         self.first_energy_growth_step =
             earliest(self.first_energy_growth_step, o.first_energy_growth_step);
         self.worst_energy_growth = self.worst_energy_growth.max(o.worst_energy_growth);
+        self.last_energy_growth = o.last_energy_growth;
         self.position_corrected_steps += o.position_corrected_steps;
         self.position_correction_energy += o.position_correction_energy;
         self.subdivided_steps += o.subdivided_steps;
@@ -499,6 +506,23 @@ mod tests {
     use super::*;
     use dem::{ContactLaws, WorldParams};
     use nalgebra::Vector2;
+
+    #[test]
+    fn the_last_step_growth_is_that_steps_own() {
+        // A window reads each step's growth from here: the phase worst would hide a window's
+        // step behind a larger one before it.
+        let mut s = PhaseStats::default();
+        let r = dem::StepReport::default();
+        s.record_checks(&r, 1e-3, Some(0.22));
+        assert_eq!((s.last_energy_growth, s.worst_energy_growth), (0.22, 0.22));
+        s.record_checks(&r, 1e-3, Some(0.05));
+        assert_eq!((s.last_energy_growth, s.worst_energy_growth), (0.05, 0.22));
+        s.record_checks(&r, 1e-3, Some(-0.3));
+        assert_eq!(s.last_energy_growth, 0.0, "dissipation is no growth");
+        s.record_checks(&r, 1e-3, None);
+        assert_eq!(s.last_energy_growth, 0.0);
+        assert_eq!(s.energy_growth_steps, 2);
+    }
 
     #[test]
     fn a_nan_error_stays_in_the_phase_worst() {

@@ -50,6 +50,40 @@ impl Scenario {
         }
     }
 
+    /// The laws it fits and the data each needs (`config::laws`).
+    pub fn law_needs(&self) -> Vec<crate::config::laws::LawNeed> {
+        match self {
+            Scenario::Janssen(_) => vec![crate::config::laws::LawNeed {
+                law: "janssen",
+                formula: "σ_v(z) of Janssen 1895, K and μ_w jointly",
+                key: "",
+                needs: 4,
+                have: None,
+                why: "depth bins of the wall profile in the fit window",
+                instead_of: None,
+            }],
+            Scenario::ShearCell(c) => c.law_needs(),
+            Scenario::SimpleShear(c) => c.law_needs(),
+            Scenario::Biaxial(c) => c.law_needs(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The laws the plan leaves out (`leave_out`; empty for a scenario without the key).
+    pub fn leave_out(&self) -> &[String] {
+        match self {
+            Scenario::ShearCell(c) => &c.leave_out,
+            Scenario::SimpleShear(c) => &c.leave_out,
+            Scenario::Biaxial(c) => &c.leave_out,
+            _ => &[],
+        }
+    }
+
+    /// Whether the plan leaves the law `law` out.
+    pub fn leaves_out(&self, law: &str) -> bool {
+        self.leave_out().iter().any(|l| l == law)
+    }
+
     /// The seed.
     pub fn seed(&self) -> u64 {
         match self {
@@ -283,6 +317,9 @@ pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Resul
             .in_source(source))
         }
     };
+    // before the run, not after: a plan that cannot identify a law it fits is refused here
+    crate::config::laws::check(&scenario.law_needs(), scenario.leave_out())
+        .map_err(|e| e.in_source(source))?;
     Ok(LoadedScenario {
         name: name.to_string(),
         source: source.to_string(),

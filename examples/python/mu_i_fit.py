@@ -1,6 +1,6 @@
 """A μ(I) fit from your own arrays: inertial numbers and stress ratios measured in a shear cell
 (here made up from a known law and a little noise), the law with its intervals, its JSON, and
-its evaluation on a grid. A refused fit says why and what simpler form to try."""
+its evaluation on a grid, its verdict. A refused fit says why and what simpler form to try."""
 
 import numpy as np
 
@@ -15,6 +15,7 @@ for name, value in law.values.items():
     lo, hi = law.intervals[name]
     print(f"{name:5} = {value:.4f}  (95 % CI {lo:.4f} … {hi:.4f})")
 print(f"R² = {law.r_squared:.4f}; μ at I = 0.01, 0.1, 1: {np.round(law.evaluate([0.01, 0.1, 1.0]), 4)}")
+print(f"verdict: {law.verdict}")  # ok: every check passed (a refused fit raises FitRefused)
 law.save("mu_i_law.json")  # schema 2, readable by grainlaw.load_law and continuum solvers
 
 try:  # a narrow range of I does not resolve the saturation: refused, with the simpler form

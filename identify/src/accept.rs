@@ -322,7 +322,7 @@ pub fn check_physical_ranges(
 /// (or `se` is not finite). Its interval `θ ∓ t·se` then spans zero and reaches beyond it by
 /// more than `(t − 1)|θ|` (`t ≈ 2.0–2.8` at 95 %, so the interval is several times wider than
 /// the value): the data fix neither the sign nor the order of magnitude of `θ`. Parameters held
-/// on a bound (`at_bound`, standard error 0 by construction) are skipped.
+/// on a bound (`at_bound`: not estimates, a one-sided interval at most) are skipped.
 pub fn check_identified(report: &FitReport, names: &[&str]) -> Result<()> {
     let estimates: Vec<&Estimate> = report.parameters.iter().collect();
     check_estimates_identified(&report.model, report, &estimates, names)

@@ -67,11 +67,11 @@ use crate::error::{IdentifyError, Result};
 use crate::expr::Expr;
 use crate::janssen::{JanssenFit, JanssenKMuFit};
 use crate::laws::{
-    CriticalStateLaw, JanssenLaw, JanssenVerticalLaw, LinearMuILaw, LinearPhiILaw, MohrCoulombLaw,
-    MuILaw, PhiILaw, StressDilatancyLaw, VelocityBoundaryLayer, WallFrictionLaw,
+    CriticalStateLaw, JanssenLaw, JanssenVerticalLaw, LinearMuILaw, MohrCoulombLaw, MuILaw,
+    PhiILaw, StressDilatancyLaw, VelocityBoundaryLayer, WallFrictionLaw,
 };
 use crate::mohr_coulomb::MohrCoulombFit;
-use crate::mu_i::{LinearMuIFit, LinearPhiIFit, MuIFit, PhiIFit};
+use crate::mu_i::{LinearMuIFit, MuIFit, PhiIFit};
 use crate::report::{Estimate, FitReport, ModelComparison, ValidityRange};
 use crate::wall_law::{BoundaryLayerFit, WallLawFit};
 
@@ -297,12 +297,6 @@ pub const REGISTRY: &[LawSpec] = &[
     ),
     rheology(
         "phi-i",
-        "phi",
-        "phi_max - (phi_max - phi_min)*I",
-        &[("phi_max", "1"), ("phi_min", "1")],
-    ),
-    rheology(
-        "phi-i-linear",
         "phi",
         "phi_max - a*I",
         &[("phi_max", "1"), ("a", "1")],
@@ -755,8 +749,10 @@ pub struct CalibratedLaw {
     pub model_selection: Option<ModelComparison>,
     /// Provenance.
     pub provenance: Provenance,
-    /// Verdict of the `grainlaw run` that produced the law (`ok`, `suspect`, `refused`;
-    /// `docs/outputs.md` §2.1); absent from laws of `grainlaw fit`.
+    /// Verdict of the law (`ok`, `suspect`, `refused`; `docs/outputs.md` §2.1): the `grainlaw
+    /// run` that produced it judged it, or it was fitted by `grainlaw fit` or Python
+    /// (`crate::user_fit`), which return only laws that passed every check: `ok`. Absent only
+    /// from files written before verdicts existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub verdict: Option<String>,
     /// The checks that failed for that verdict (`check`, `verdict`, `value`, `threshold`,
@@ -780,10 +776,8 @@ pub enum Law {
     MuI(MuILaw),
     /// Linear μ(I).
     MuILinear(LinearMuILaw),
-    /// φ(I).
+    /// φ(I) = φ_max − a I.
     PhiI(PhiILaw),
-    /// Linear φ(I), `φ_max − a I`.
-    PhiILinear(LinearPhiILaw),
     /// Mohr–Coulomb, shear strength `τ(σ_n)`.
     MohrCoulomb(MohrCoulombLaw),
     /// Critical state, `q(p)` (and `φ_c`).
@@ -803,7 +797,6 @@ impl Law {
             Law::MuI(l) => l.mu(x),
             Law::MuILinear(l) => l.mu(x),
             Law::PhiI(l) => l.phi(x),
-            Law::PhiILinear(l) => l.phi(x),
             Law::MohrCoulomb(l) => l.shear_strength(x),
             Law::CriticalState(l) => l.q(x),
             Law::StressDilatancy(l) => l.sin_phi(x),
@@ -973,18 +966,9 @@ impl CalibratedLaw {
         Self::rheology("mu-i-linear", &fit.report, grain, provenance)
     }
 
-    /// From a φ(I) fit (parameters `phi_max`, `phi_min`; constants `d`, `rho_s`).
+    /// From a φ(I) fit (parameters `phi_max`, `a`; constants `d`, `rho_s`).
     pub fn from_phi_i(fit: &PhiIFit, grain: GrainScale, provenance: Provenance) -> Self {
         Self::rheology("phi-i", &fit.report, grain, provenance)
-    }
-
-    /// From a linear φ(I) fit (parameters `phi_max`, `a`; constants `d`, `rho_s`).
-    pub fn from_phi_i_linear(
-        fit: &LinearPhiIFit,
-        grain: GrainScale,
-        provenance: Provenance,
-    ) -> Self {
-        Self::rheology("phi-i-linear", &fit.report, grain, provenance)
     }
 
     /// From a Mohr–Coulomb fit (parameters `friction_angle` (rad, with degrees), `cohesion`
@@ -1107,10 +1091,6 @@ impl CalibratedLaw {
             }),
             "phi-i" => Law::PhiI(PhiILaw {
                 phi_max: p("phi_max")?,
-                phi_min: p("phi_min")?,
-            }),
-            "phi-i-linear" => Law::PhiILinear(LinearPhiILaw {
-                phi_max: p("phi_max")?,
                 slope: p("a")?,
             }),
             "mohr-coulomb" => Law::MohrCoulomb(MohrCoulombLaw {
@@ -1187,7 +1167,16 @@ impl CalibratedLaw {
                 .map_err(format_error)?
                 .upgrade()?,
             2 => {
-                let law: CalibratedLaw = serde_json::from_value(value).map_err(format_error)?;
+                let mut law: CalibratedLaw = serde_json::from_value(value).map_err(format_error)?;
+                // `phi-i-linear` was merged into `phi-i` (the same line, same parameters)
+                if law.law == "phi-i-linear" {
+                    law.law = "phi-i".into();
+                }
+                if law.law == "phi-i" && law.parameters.iter().any(|p| p.name == "phi_min") {
+                    return Err(IdentifyError::LawFormat {
+                        message: "law 'phi-i' with parameter 'phi_min': the former form φ_max − (φ_max − φ_min) I; phi-i is now φ_max − a I (parameters phi_max, a): fit it again (grainlaw fit phi-i)".into(),
+                    });
+                }
                 law.check()?;
                 law
             }

@@ -20,11 +20,20 @@
 //! Cohesion at zero is an expected outcome for a cohesionless material, not a failure: the fit
 //! then reports `c = 0` with `at_bound = true`, refits `a` through the origin for the
 //! friction angle's interval, and gives for `c` the one-sided interval
-//! `[0, max(0, b_ols + t·se(b_ols))]` from the unconstrained regression. The friction
-//! coefficient ending at `a = 0` (or `sin φ = 1`) is [`IdentifyError::ParameterAtBound`].
+//! `[0, max(b_ols, 0) + t·se(b_ols)]` from the unconstrained regression (Student's `t` at
+//! `n − 2` degrees of freedom; `b` turned into `c = b / cos φ` for circles), with the standard
+//! error `se(b_ols)` (likewise turned into `c`'s). The upper end never falls below `t·se`, the
+//! end the data would give at `b_ols = 0`: a regression that dips below zero does not claim a
+//! precision the data lack (the power-constrained limit of Cowan, Cranmer, Gross & Vitells,
+//! arXiv:1105.3166, 2011). The friction coefficient ending at `a = 0` (or `sin φ = 1`) is
+//! [`IdentifyError::ParameterAtBound`].
 //!
 //! With the cohesion fixed at zero ([`MohrCoulombOptions::cohesionless`], `# cohesion = 0` in a
 //! CSV) only `a` is fitted, through the origin, and three states at yield suffice (`n ≥ p + 2`).
+//! A cohesion the user fixed is a constant, not an estimate: interval `[0, 0]`, standard error 0.
+//! A cohesion fixed at zero because the data do not support one
+//! ([`MohrCoulombOptions::cohesion_held_by_data`], what [`fit_mohr_coulomb_supported`] falls back
+//! to) is an estimate at its bound and gets the one-sided interval above.
 //!
 //! The fit then passes the checks of [`crate::accept`] or is refused: the interval of `φ`
 //! inside `[0, π/2]` and of `c` above 0 (a cohesion whose interval crosses 0 offers to fix it
@@ -140,6 +149,11 @@ pub struct MohrCoulombOptions {
     pub confidence: f64,
     /// Fix the cohesion at `c = 0` instead of fitting it (default false).
     pub cohesion_fixed_zero: bool,
+    /// With `cohesion_fixed_zero`: the cohesion is held at zero because the data do not support
+    /// one (not asserted by the user), so it is reported as an estimate at its bound, with the
+    /// one-sided interval of the unconstrained regression (module documentation), not `[0, 0]`
+    /// (default false).
+    pub cohesion_held_by_data: bool,
     /// R² threshold (default [`crate::accept::MIN_R_SQUARED`]).
     pub min_r_squared: f64,
 }
@@ -149,6 +163,7 @@ impl Default for MohrCoulombOptions {
         MohrCoulombOptions {
             confidence: 0.95,
             cohesion_fixed_zero: false,
+            cohesion_held_by_data: false,
             min_r_squared: crate::accept::MIN_R_SQUARED,
         }
     }
@@ -296,6 +311,7 @@ pub fn fit_mohr_coulomb_supported(
     let fixed = MohrCoulombOptions {
         confidence,
         cohesion_fixed_zero: true,
+        cohesion_held_by_data: true,
         ..Default::default()
     };
     match (fit_mohr_coulomb_with(data, &fixed), refusal) {
@@ -375,16 +391,18 @@ pub fn fit_mohr_coulomb_with(
         let rss: f64 = x.iter().zip(&y).map(|(u, v)| (v - a0 * u).powi(2)).sum();
         let dof = n - 1;
         let var_a = rss / dof as f64 / sxx;
-        // Fixed by the user: the interval of c is [0, 0]; held at 0 by the data: one-sided.
-        let upper = if fixed {
-            0.0
+        // Fixed by the user: the interval of c is [0, 0]; held at 0 by the data: one-sided,
+        // `[0, max(b_ols, 0) + t se(b_ols)]` with the standard error se(b_ols).
+        let bound = if fixed && !options.cohesion_held_by_data {
+            (0.0, 0.0)
         } else {
             let (_, b_ols, cov_ols, _) = ols(&x, &y);
             let t2 = stats::t_critical(confidence, n - 2);
-            (b_ols + t2 * cov_ols[(1, 1)].max(0.0).sqrt()).max(0.0)
+            let se = cov_ols[(1, 1)].max(0.0).sqrt();
+            (b_ols.max(0.0) + t2 * se, se)
         };
         let cov = DMatrix::from_row_slice(2, 2, &[var_a, 0.0, 0.0, 0.0]);
-        (a0, 0.0, cov, dof, Some(upper))
+        (a0, 0.0, cov, dof, Some(bound))
     } else {
         let (_, _, cov, _) = ols(&x, &y);
         (a, b, cov, n - 2, None)
@@ -411,10 +429,13 @@ pub fn fit_mohr_coulomb_with(
     let n_params = if cohesionless { 1 } else { 2 };
     let friction_angle = Estimate::new("friction_angle", "rad", phi, cov[(0, 0)].sqrt(), t);
     let mut cohesion = Estimate::new("cohesion", "Pa", c, cov[(1, 1)].max(0.0).sqrt(), t);
-    if let Some(upper) = b_upper {
+    if let Some((upper, se)) = b_upper {
+        // c = b / cos φ for circles (b = c cos φ), c = b on a failure plane
+        let to_c = if circles { 1.0 / phi.cos() } else { 1.0 };
         cohesion.at_bound = true;
+        cohesion.std_error = se * to_c;
         cohesion.ci_low = 0.0;
-        cohesion.ci_high = if circles { upper / phi.cos() } else { upper };
+        cohesion.ci_high = upper * to_c;
     }
     let report = FitReport {
         model: "mohr-coulomb".into(),

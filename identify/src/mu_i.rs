@@ -8,9 +8,9 @@
 //! - [`fit_mu_i_linear`]: `μ = μ_s + b I`, the form nested in μ(I) as `I₀ → ∞` with
 //!   `(μ₂ − μ_s)/I₀ = b` ([`compare_mu_i_forms`] ranks both by AIC).
 //! - [`fit_mu_i_or_linear`]: μ(I), or the linear form with the reason μ(I) was refused.
-//! - [`fit_phi_i`]: `φ(I) = φ_max − (φ_max − φ_min) I`, with `0 < φ_min < φ_max ≤ 1`
-//!   (`φ_min` is the value extrapolated to `I = 1`).
-//! - [`fit_phi_i_linear`]: the same line as `φ = φ_max − a I`, which claims nothing at `I = 1`.
+//! - [`fit_phi_i`]: `φ(I) = φ_max − a I`, with `0 ≤ φ_max ≤ 1`, `a ≥ 0` (the former `phi-i`,
+//!   `φ_max − (φ_max − φ_min) I`, and `phi-i-linear` were the same line under two names; merged,
+//!   with the slope as parameter: it claims nothing at `I = 1`, far beyond the data).
 //!
 //! Every fit passes the checks of [`crate::accept`] or is refused. For μ(I): `I₀` inside the
 //! range of `I` in the data (above `I_max` the data see only the initial slope
@@ -18,8 +18,7 @@
 //! `I₀` non-negative, every standard error below its value, `R²` above the threshold, and an
 //! adjusted `R²` not below that of `μ_s + b I`. A refusal offers `use mu-i-linear` when the
 //! linear form passes its own checks. Physical ranges: `μ_s ≥ 0`, `b ≥ 0` (friction grows with
-//! `I`), `0 ≤ φ_min, φ_max ≤ 1`, `a ≥ 0` (dilatancy); a refusal of `phi-i` for `φ_min` offers
-//! `use phi-i-linear` when that passes.
+//! `I`), `0 ≤ φ_max ≤ 1`, `a ≥ 0` (dilatancy).
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -32,7 +31,7 @@ use crate::fit::{
     fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel, Observations,
     ParameterSpec,
 };
-use crate::laws::mu_i::{LinearMuILaw, LinearPhiILaw, MuILaw, PhiILaw};
+use crate::laws::mu_i::{LinearMuILaw, MuILaw, PhiILaw};
 use crate::report::{FitReport, ModelComparison, ValidityRange};
 
 /// Steady-shear measurements (data): one row per steady state.
@@ -73,15 +72,6 @@ pub struct LinearMuIFit {
     pub report: FitReport,
 }
 
-/// Result of [`fit_phi_i_linear`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LinearPhiIFit {
-    /// The calibrated law.
-    pub law: LinearPhiILaw,
-    /// Parameters `phi_max`, `a`.
-    pub report: FitReport,
-}
-
 /// Result of [`fit_mu_i_or_linear`]: the full μ(I) when it is accepted, else the linear form
 /// with the reason the full form was refused.
 #[derive(Debug, Clone, PartialEq)]
@@ -102,7 +92,7 @@ pub enum MuIChoice {
 pub struct PhiIFit {
     /// The calibrated law.
     pub law: PhiILaw,
-    /// Parameters `phi_max`, `phi_min`.
+    /// Parameters `phi_max`, `a`.
     pub report: FitReport,
 }
 
@@ -452,83 +442,33 @@ fn linear_phi_report(series: &RheologySeries, options: &FitOptions) -> Result<Fi
     linear_report(
         series,
         options,
-        "phi-i-linear",
+        "phi-i",
         ("phi", phi, &series.phi_std_error),
         ["phi_max", "a"],
         true,
     )
 }
 
-/// The checks of `phi-i-linear`: `0 ≤ φ_max ≤ 1`, `a ≥ 0`, standard errors, R².
+/// The checks of `phi-i`: `0 ≤ φ_max ≤ 1`, `a ≥ 0`, standard errors, R².
 fn accept_linear_phi(report: &FitReport, options: &FitOptions) -> Result<()> {
-    Acceptance::new("phi-i-linear", options.min_r_squared)
+    Acceptance::new("phi-i", options.min_r_squared)
         .range(PhysicalRange::new("phi_max", 0.0, 1.0))
         .non_negative(&["a"])
         .check(report)
 }
 
-/// Fits `φ(I) = φ_max − a I` (unbounded least squares, exact): the line of [`fit_phi_i`]
-/// without the extrapolated `φ_min = φ(1)`, valid over the `I` of the data. Refusals: the
-/// interval of `φ_max` outside `[0, 1]` or of `a` below 0, a standard error above its value,
-/// `R²` below the threshold.
-pub fn fit_phi_i_linear(series: &RheologySeries, options: &FitOptions) -> Result<LinearPhiIFit> {
+/// Fits `φ(I) = φ_max − a I` ([`PhiILaw`]; unbounded least squares, exact), valid over the
+/// `I` of the data. Refusals: the interval of `φ_max` outside `[0, 1]` or of `a` below 0 (a
+/// solid fraction that does not decrease with `I`), a standard error above its value, `R²`
+/// below the threshold. One law under one name: it was also fitted as `φ_max − (φ_max − φ_min) I`
+/// (the former `phi-i`, refused when the extrapolation `φ_min = φ(1)` left `[0, 1]`, offering
+/// the same line as `phi-i-linear`); the two are merged into this one, `phi-i`.
+pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFit> {
     let report = linear_phi_report(series, options)?;
     accept_linear_phi(&report, options)?;
-    let law = LinearPhiILaw {
-        phi_max: report.parameters[0].value,
-        slope: report.parameters[1].value,
-    };
-    Ok(LinearPhiIFit { law, report })
-}
-
-/// Fits `φ(I) = φ_max − (φ_max − φ_min) I` with `0 < φ_max ≤ 1`, `0 < φ_max − φ_min ≤ 1`;
-/// reported as `(phi_max, phi_min)`. A `φ` that does not decrease with `I` ends at the bound
-/// `φ_max − φ_min = 0` ([`IdentifyError::ParameterAtBound`]). Refusals as [`fit_phi_i_linear`],
-/// and an interval of `φ_min` (the extrapolation to `I = 1`) outside `[0, 1]`, offering
-/// `use phi-i-linear` when that passes.
-pub fn fit_phi_i(series: &RheologySeries, options: &FitOptions) -> Result<PhiIFit> {
-    let (i, phi) = checked_phi(series)?;
-    let simpler = linear_phi_report(series, options)
-        .ok()
-        .filter(|r| accept_linear_phi(r, options).is_ok())
-        .map(|_| "use phi-i-linear");
-    let refuse = |e: IdentifyError| match simpler {
-        Some(s) => e.suggesting(s),
-        None => e,
-    };
-    let model = LinearModel {
-        x: i,
-        name: "phi-i",
-        names: ["phi_max", "delta_phi"],
-        bounds: [(0.0, 1.0), (0.0, 1.0)],
-        decreasing: true,
-    };
-    let (a, b) = ols_start(i, phi);
-    let report = fit_least_squares(
-        &model,
-        &Observations::single("phi", phi.to_vec()).with_std_errors(series.phi_std_error.clone()),
-        &[a.clamp(0.01, 0.99), (-b).clamp(1e-3, 0.99)],
-        options,
-        validity(series),
-    )
-    .map_err(refuse)?;
-    let delta_phi = report.parameters[1].clone();
-    let report = report.reparametrised(&[("phi_max", "1"), ("phi_min", "1")], |p| {
-        (
-            vec![p[0], p[0] - p[1]],
-            DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 1.0, -1.0]),
-        )
-    });
-    Acceptance::new("phi-i", options.min_r_squared)
-        .range(PhysicalRange::new("phi_max", 0.0, 1.0))
-        .range(PhysicalRange::new("phi_min", 0.0, 1.0))
-        .non_negative(&["delta_phi"])
-        .extra(delta_phi)
-        .check(&report)
-        .map_err(refuse)?;
     let law = PhiILaw {
         phi_max: report.parameters[0].value,
-        phi_min: report.parameters[1].value,
+        slope: report.parameters[1].value,
     };
     Ok(PhiIFit { law, report })
 }

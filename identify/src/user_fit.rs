@@ -11,7 +11,7 @@
 //! | `janssen-kmu` | `z_m`, `sigma_v_Pa` | | `width_m`, `bulk_density_kg_m3`; optional `gravity_m_s2`, `depth_min_m`, `depth_max_m`; `wall_friction`, `full_mobilisation` accepted (a `janssen` file) and not used |
 //! | `wall-law` | `slip_velocity_m_s` and either `mu_eff` or both `tau_w_Pa`, `sigma_w_Pa` | | `grain_diameter_m`; optional `gravity_m_s2` |
 //! | `mu-i`, `mu-i-linear` | `I`, `mu` | `P_Pa`, `mu_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` (the law's `d`, `rho_s`) |
-//! | `phi-i`, `phi-i-linear` | `I`, `phi` | `P_Pa`, `phi_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` |
+//! | `phi-i` | `I`, `phi` | `P_Pa`, `phi_std_error` (weights `1/σ`) | `grain_diameter_m`, `grain_density_kg_m3` |
 //! | `mohr-coulomb` | one of: `p_Pa`, `q_Pa` (Mohr circles) · `sigma_xx_Pa`, `sigma_yy_Pa`, `sigma_xy_Pa` (2D tensors, **tension positive**) · `sigma_n_Pa`, `tau_Pa` (failure plane) | | optional `cohesion` (only `0`: fixes `c = 0`, and 3 states suffice) |
 //!
 //! `z` is the depth below the free surface, `I` the inertial number, `mu = τ/P`, `phi` the solid
@@ -35,18 +35,17 @@ use crate::janssen::{
 use crate::law::{CalibratedLaw, GrainScale, Provenance};
 use crate::laws::STANDARD_GRAVITY;
 use crate::mohr_coulomb::{fit_mohr_coulomb_with, MohrCoulombOptions, YieldData};
-use crate::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, fit_phi_i_linear, RheologySeries};
+use crate::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use crate::wall_law::{select_wall_law, WallSlipSeries};
 
 /// Law names accepted by [`fit_csv_file`].
-pub const LAW_NAMES: [&str; 8] = [
+pub const LAW_NAMES: [&str; 7] = [
     "janssen",
     "janssen-kmu",
     "wall-law",
     "mu-i",
     "mu-i-linear",
     "phi-i",
-    "phi-i-linear",
     "mohr-coulomb",
 ];
 
@@ -64,9 +63,7 @@ pub fn metadata_keys(law: &str) -> &'static [&'static str] {
     match law {
         "janssen" | "janssen-kmu" => JANSSEN,
         "wall-law" => &["grain_diameter_m", "gravity_m_s2"],
-        "mu-i" | "mu-i-linear" | "phi-i" | "phi-i-linear" => {
-            &["grain_diameter_m", "grain_density_kg_m3"]
-        }
+        "mu-i" | "mu-i-linear" | "phi-i" => &["grain_diameter_m", "grain_density_kg_m3"],
         "mohr-coulomb" => &["cohesion"],
         _ => &[],
     }
@@ -142,6 +139,11 @@ pub fn fit_csv_text(
     fit_table(law, &table, options)
 }
 
+/// The verdict of a law this module returns (`verdict` of the law JSON, as a `grainlaw run`
+/// writes it, `docs/outputs.md` §2.1): `ok`, since every returned fit passed the checks of
+/// [`crate::accept`]; a fit that does not is refused with an error, not returned.
+pub const FIT_VERDICT: &str = "ok";
+
 /// Name of the column in which grainlaw's scenarios judge each point of a table (0 passed its
 /// checks, 1 suspect, 2 refused; `docs/outputs.md` §2.1).
 pub const POINT_VERDICT: &str = "point_verdict";
@@ -206,6 +208,15 @@ fn check_unique_headers(table: &Table, line: u64) -> Result<()> {
 }
 
 fn check_law_name(law: &str) -> Result<()> {
+    if law == "phi-i-linear" {
+        return Err(IdentifyError::UnknownLaw {
+            name: law.to_string(),
+            known: format!(
+                "{}; phi-i-linear was merged into phi-i, the same line φ_max − a I",
+                LAW_NAMES.join(", ")
+            ),
+        });
+    }
     if !LAW_NAMES.contains(&law) {
         return Err(IdentifyError::UnknownLaw {
             name: law.to_string(),
@@ -281,17 +292,24 @@ pub fn fit_table(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Ca
     check_law_name(law)?;
     check_metadata(law, table, options)?;
     let (passed, left_out) = passed_points(table)?;
-    fit_rows(law, &passed, options).map_err(|e| match e {
-        IdentifyError::TooFewPoints { law, needed, got } if left_out > 0 => {
-            IdentifyError::NotIdentifiable {
-                reason: format!(
-                    "{law}: {got} points passed their run's checks ({left_out} left out for \
+    fit_rows(law, &passed, options)
+        .map(|mut law| {
+            // it passed every check of `crate::accept` (a refused fit returns no law): `ok`, as
+            // a run marks the laws it exports
+            law.verdict = Some(FIT_VERDICT.into());
+            law
+        })
+        .map_err(|e| match e {
+            IdentifyError::TooFewPoints { law, needed, got } if left_out > 0 => {
+                IdentifyError::NotIdentifiable {
+                    reason: format!(
+                        "{law}: {got} points passed their run's checks ({left_out} left out for \
                      {POINT_VERDICT} ≠ 0), at least {needed} needed"
-                ),
+                    ),
+                }
             }
-        }
-        e => e,
-    })
+            e => e,
+        })
 }
 
 /// [`fit_table`] on rows that may all be fitted.
@@ -398,7 +416,7 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
                 provenance,
             ))
         }
-        "mu-i" | "mu-i-linear" | "phi-i" | "phi-i-linear" => {
+        "mu-i" | "mu-i-linear" | "phi-i" => {
             let mut series = RheologySeries {
                 inertial_number: table.column("I")?,
                 pressure_pa: table.optional_column("P_Pa")?,
@@ -423,13 +441,9 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
                     let fit = fit_mu_i_linear(&series, o)?;
                     CalibratedLaw::from_mu_i_linear(&fit, grain_scale(&table)?, provenance)
                 }
-                "phi-i" => {
+                _ => {
                     let fit = fit_phi_i(&series, o)?;
                     CalibratedLaw::from_phi_i(&fit, grain_scale(&table)?, provenance)
-                }
-                _ => {
-                    let fit = fit_phi_i_linear(&series, o)?;
-                    CalibratedLaw::from_phi_i_linear(&fit, grain_scale(&table)?, provenance)
                 }
             })
         }
@@ -472,6 +486,7 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
                     confidence: options.fit.confidence,
                     cohesion_fixed_zero,
                     min_r_squared: options.fit.min_r_squared,
+                    ..MohrCoulombOptions::default()
                 },
             )?;
             Ok(CalibratedLaw::from_mohr_coulomb(&fit, provenance))

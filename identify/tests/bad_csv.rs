@@ -172,11 +172,11 @@ fn rows() -> Vec<Row> {
             needle: "cannot be identified",
         },
         Row {
-            label: "φ(I) increasing: at its bound",
+            label: "φ(I) increasing: a slope below 0",
             law: "phi-i",
             text: "I,phi\n0.01,0.78\n0.02,0.79\n0.05,0.8\n0.1,0.81\n0.2,0.82\n0.3,0.83\n".into(),
-            is_expected: |e| matches!(e, IdentifyError::ParameterAtBound { .. }),
-            needle: "ended at its lower bound",
+            is_expected: |e| matches!(e, IdentifyError::IntervalCrossesBound { .. }),
+            needle: "the 95 % interval of a [",
         },
         Row {
             label: "hydrostatic column: Janssen μ_w at its bound 0",

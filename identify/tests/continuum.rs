@@ -38,7 +38,7 @@ fn flow() -> BagnoldFlow {
         &mu_i,
         SolidFraction::Law(PhiILaw {
             phi_max: 0.82,
-            phi_min: 0.55,
+            slope: 0.27,
         }),
         26f64.to_radians(),
         0.03,

@@ -17,7 +17,7 @@ use identify::laws::{MohrCoulombLaw, MuILaw, VelocityBoundaryLayer, WallFriction
 use identify::mohr_coulomb::{
     fit_mohr_coulomb, fit_mohr_coulomb_with, MohrCoulombOptions, YieldData,
 };
-use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, fit_phi_i_linear, RheologySeries};
+use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use identify::wall_law::{
     fit_boundary_layer, fit_wall_law, VelocityProfile, WallLawForm, WallSlipSeries,
 };
@@ -210,10 +210,10 @@ fn every_law() -> Vec<Case> {
         Box::new(move |i| l.mu(i)),
         is.clone(),
     ));
-    let pl = fit_phi_i_linear(&linear_rheology(2), &o).unwrap();
+    let pl = fit_phi_i(&linear_rheology(2), &o).unwrap();
     let l = pl.law;
     out.push((
-        CalibratedLaw::from_phi_i_linear(&pl, GRAIN, prov()),
+        CalibratedLaw::from_phi_i(&pl, GRAIN, prov()),
         Box::new(move |i| l.phi(i)),
         is,
     ));
@@ -272,6 +272,7 @@ fn every_law() -> Vec<Case> {
                 .map(|(x, e)| 0.27 + 0.9 * x + e)
                 .collect(),
             sin_psi: psi.clone(),
+            sample: None,
         },
         &o,
     )
@@ -468,4 +469,40 @@ fn schema_and_content_errors() {
     let path = dir.path().join("law.json");
     law.save(&path).unwrap();
     assert_eq!(CalibratedLaw::load(&path).unwrap(), law);
+}
+
+/// `phi-i` and `phi-i-linear` were two names of one line: merged into `phi-i`, `φ_max − a I`.
+/// A `phi-i-linear` file reads as `phi-i` (same parameters, same values); a `phi-i` file of the
+/// former form (`phi_min`) is refused with what to do; `phi-i-linear` is no name to fit.
+#[test]
+fn phi_i_linear_is_merged_into_phi_i() {
+    let f = fit_phi_i(&linear_rheology(2), &FitOptions::default()).unwrap();
+    let law = CalibratedLaw::from_phi_i(&f, GRAIN, prov());
+    assert_eq!(law.law, "phi-i");
+    let names: Vec<&str> = law.parameters.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["phi_max", "a"]);
+    // generated as 0.8 − 0.5 I
+    assert!((law.parameter("a").unwrap() - 0.5).abs() < 0.05);
+    let text = law.to_json_string().unwrap();
+    let old = text.replacen("\"law\": \"phi-i\"", "\"law\": \"phi-i-linear\"", 1);
+    assert_ne!(old, text);
+    let read = CalibratedLaw::from_json_str(&old).unwrap();
+    assert_eq!(read.law, "phi-i");
+    assert_eq!(
+        read.evaluate(&[0.1]).unwrap(),
+        law.evaluate(&[0.1]).unwrap()
+    );
+    let former = text.replace("\"a\"", "\"phi_min\"");
+    let e = CalibratedLaw::from_json_str(&former)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("phi_min") && e.contains("fit it again"), "{e}");
+    let e = identify::user_fit::fit_csv_file(
+        "phi-i-linear",
+        std::path::Path::new("nowhere.csv"),
+        &Default::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("merged into phi-i"), "{e}");
 }

@@ -212,6 +212,56 @@ fn unsupported_cohesion_falls_back_to_the_cohesionless_envelope() {
         "sin φ = {} vs {slope}",
         fit.friction_angle.value.sin()
     );
+    // The cohesion held at zero by the data is an estimate at its bound: one-sided interval
+    // [0, max(b, 0) + t₀.₉₇₅,₂ se(b)] / cos φ from the unconstrained regression q = a p + b,
+    // with its standard error se(b) / cos φ; never [0, 0].
+    let (b, se) = ols_intercept(&p, &q);
+    let cos = fit.friction_angle.value.cos();
+    let high = (b.max(0.0) + identify::stats::t_critical(0.95, 2) * se) / cos;
+    let c = &fit.cohesion;
+    assert!(c.at_bound && c.ci_low == 0.0, "{c:?}");
+    assert!(c.ci_high > 0.0 && c.std_error > 0.0, "{c:?}");
+    assert!(
+        (c.ci_high - high).abs() < 1e-6 * high,
+        "{} vs {high}",
+        c.ci_high
+    );
+    assert!((c.std_error - se / cos).abs() < 1e-6 * se, "{c:?}");
+    // Three pressures (the free form is not tried): the same one-sided interval, at 1 degree of
+    // freedom.
+    let three = YieldData::Circles {
+        p_pa: p[..3].to_vec(),
+        q_pa: q[..3].to_vec(),
+    };
+    let (fit3, fixed3, refusal3) = fit_mohr_coulomb_supported(&three, 0.95).unwrap();
+    assert!(fixed3 && refusal3.is_none());
+    let (b3, se3) = ols_intercept(&p[..3], &q[..3]);
+    let high3 = (b3.max(0.0) + identify::stats::t_critical(0.95, 1) * se3)
+        / fit3.friction_angle.value.cos();
+    let c3 = &fit3.cohesion;
+    assert!(
+        c3.at_bound && c3.ci_low == 0.0 && c3.std_error > 0.0,
+        "{c3:?}"
+    );
+    assert!(
+        (c3.ci_high - high3).abs() < 1e-6 * high3,
+        "{} vs {high3}",
+        c3.ci_high
+    );
+    // Fixed by the user (`# cohesion = 0`), it is a constant: [0, 0].
+    let user = identify::mohr_coulomb::fit_mohr_coulomb_with(
+        &three,
+        &identify::mohr_coulomb::MohrCoulombOptions::cohesionless(),
+    )
+    .unwrap();
+    assert_eq!(
+        (
+            user.cohesion.ci_low,
+            user.cohesion.ci_high,
+            user.cohesion.std_error
+        ),
+        (0.0, 0.0, 0.0)
+    );
     // Exact cohesive data keep their free fit.
     let cohesive = YieldData::Circles {
         p_pa: p.clone(),
@@ -219,4 +269,23 @@ fn unsupported_cohesion_falls_back_to_the_cohesionless_envelope() {
     };
     let (fit, fixed, refusal) = fit_mohr_coulomb_supported(&cohesive, 0.95).unwrap();
     assert!(!fixed && refusal.is_none() && fit.cohesion.value > 0.0);
+}
+
+/// Intercept `b` of the ordinary least-squares line `y = a x + b` and its standard error
+/// `s √((XᵀX)⁻¹₂₂)`, `s² = RSS/(n − 2)`.
+fn ols_intercept(x: &[f64], y: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let mx = x.iter().sum::<f64>() / n;
+    let my = y.iter().sum::<f64>() / n;
+    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    let a = x
+        .iter()
+        .zip(y)
+        .map(|(u, v)| (u - mx) * (v - my))
+        .sum::<f64>()
+        / sxx;
+    let b = my - a * mx;
+    let rss: f64 = x.iter().zip(y).map(|(u, v)| (v - a * u - b).powi(2)).sum();
+    let s2 = rss / (n - 2.0);
+    (b, (s2 * (1.0 / n + mx * mx / sxx)).sqrt())
 }

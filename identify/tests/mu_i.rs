@@ -91,7 +91,8 @@ fn aic_prefers_mu_i_over_the_linear_form_on_curved_data() {
 #[test]
 fn phi_i_recovered() {
     let fit = fit_phi_i(&series(4, 0.005), &FitOptions::default()).unwrap();
-    for (p, truth) in fit.report.parameters.iter().zip([0.82, 0.55]) {
+    // generated as φ_max − (φ_max − φ(1)) I: φ_max = 0.82, a = 0.82 − 0.55
+    for (p, truth) in fit.report.parameters.iter().zip([0.82, 0.82 - 0.55]) {
         assert!((p.value - truth).abs() < 3.0 * p.std_error, "{p:?}");
     }
     assert!((fit.law.phi(0.5) - (0.82 + 0.55) / 2.0).abs() < 0.01);
@@ -218,12 +219,12 @@ fn degenerate_series_give_typed_errors() {
         }
     ));
 
-    // φ that grows with I ends on the bound φ_max − φ_min = 0.
+    // φ that grows with I: its slope a below 0, refused by its interval.
     let mut s = good.clone();
     s.phi = Some(s.inertial_number.iter().map(|i| 0.6 + 0.1 * i).collect());
     assert!(matches!(
         fit_phi_i(&s, &o).unwrap_err(),
-        IdentifyError::ParameterAtBound { .. }
+        IdentifyError::IntervalCrossesBound { .. }
     ));
 }
 

@@ -30,7 +30,7 @@ use identify::janssen::{
 use identify::law::{CalibratedLaw, GrainScale, Provenance};
 use identify::laws::{JanssenLaw, MohrCoulombLaw, MuILaw, VelocityBoundaryLayer, WallFrictionLaw};
 use identify::mohr_coulomb::{fit_mohr_coulomb, YieldData};
-use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, fit_phi_i_linear, RheologySeries};
+use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
 use identify::wall_law::{
     fit_boundary_layer, fit_wall_law, VelocityProfile, WallLawForm, WallSlipSeries,
 };
@@ -198,21 +198,10 @@ fn phi_i_and_its_linear_form() {
         10..30usize,
         any::<u64>(),
     );
-    property(
-        "phi-i",
-        strategy.clone(),
-        |&(phi_max, a, sigma, n, seed)| {
-            let f = fit_phi_i(&series(phi_max, a, sigma, n, seed), &o)?;
-            Ok((
-                CalibratedLaw::from_phi_i(&f, GRAIN, prov()),
-                vec![("phi_max", phi_max), ("phi_min", phi_max - a)],
-            ))
-        },
-    );
-    property("phi-i-linear", strategy, |&(phi_max, a, sigma, n, seed)| {
-        let f = fit_phi_i_linear(&series(phi_max, a, sigma, n, seed), &o)?;
+    property("phi-i", strategy, |&(phi_max, a, sigma, n, seed)| {
+        let f = fit_phi_i(&series(phi_max, a, sigma, n, seed), &o)?;
         Ok((
-            CalibratedLaw::from_phi_i_linear(&f, GRAIN, prov()),
+            CalibratedLaw::from_phi_i(&f, GRAIN, prov()),
             vec![("phi_max", phi_max), ("a", a)],
         ))
     });

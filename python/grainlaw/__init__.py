@@ -4,8 +4,11 @@ Python bindings of the grainlaw Rust toolkit (PyO3 + numpy). Units are SI; 2D qu
 per metre of thickness; stress tensors are tension positive, while the fits take
 compressive-positive magnitudes (as ``grainlaw fit`` does).
 
-- ``run(scenario, overrides, out, progress)``: a scenario end to end (simulation,
-  homogenisation, fits), as ``grainlaw run``; returns the summary and the tables as arrays.
+- ``run(scenario, overrides, out, progress, allow_suspect)``: a scenario end to end
+  (simulation, homogenisation, fits), as ``grainlaw run``; returns the summary, the tables as
+  arrays, the laws and the verdict. A run judged ``refused`` raises ``ResultRefused``; one
+  judged ``suspect`` raises ``ResultSuspect`` unless ``allow_suspect=True``: as loud as the
+  command line's exit status 3.
 - ``World`` / ``Snapshot``: the contact-dynamics engine (Moreau–Jean, Coulomb friction).
 - ``grain_stresses``, ``mean_stress``, ``solid_fraction``, ``coordination``, ``fabric``:
   homogenisation of a snapshot.
@@ -15,12 +18,14 @@ compressive-positive magnitudes (as ``grainlaw fit`` does).
 - ``homogenise(format, files, out, ...)``: ``grainlaw homogenise --from FORMAT FILES --out
   OUT`` itself (CSV tables, figures, VTK, summary.json); returns the summary and the paths.
 - ``fit_janssen``, ``fit_janssen_kmu``, ``fit_wall_law``, ``fit_mu_i``, ``fit_mu_i_linear``,
-  ``fit_phi_i``, ``fit_phi_i_linear``, ``fit_mohr_coulomb`` (and the generic ``fit``): laws
+  ``fit_phi_i``, ``fit_mohr_coulomb`` (and the generic ``fit``): laws
   with confidence intervals, as ``Law`` objects; ``load_law`` reads a calibrated-law JSON.
 
 Errors: every exception raised is a ``GrainlawError``: ``InputError`` (bad input),
 ``FitRefused`` (valid data that do not support the law; ``reason``, ``suggestion``),
-``SolverError`` (a step failed), ``OutputError`` (a file could not be written or read).
+``SolverError`` (a step failed), ``OutputError`` (a file could not be written or read),
+``ResultRefused`` / ``ResultSuspect`` (a run's verdict; ``verdict``, ``reasons``, ``result``).
+Every ``Law`` has a ``verdict`` (``ok`` for a fit that passed its checks).
 A run stopped by Ctrl-C raises ``KeyboardInterrupt``.
 """
 
@@ -34,6 +39,8 @@ from ._grainlaw import (
     InputError,
     Law,
     OutputError,
+    ResultRefused,
+    ResultSuspect,
     Snapshot,
     SolverError,
     World,
@@ -58,6 +65,8 @@ __all__ = [
     "FitRefused",
     "SolverError",
     "OutputError",
+    "ResultRefused",
+    "ResultSuspect",
     "Law",
     "Snapshot",
     "World",
@@ -72,7 +81,6 @@ __all__ = [
     "fit_mu_i",
     "fit_mu_i_linear",
     "fit_phi_i",
-    "fit_phi_i_linear",
     "fit_wall_law",
     "grain_stresses",
     "homogenise",
@@ -217,20 +225,13 @@ def fit_mu_i_linear(I, mu, *, grain_diameter: float, grain_density: float, press
 
 
 def fit_phi_i(I, phi, *, grain_diameter: float, grain_density: float, pressure=None, confidence: float = 0.95) -> Law:
-    """φ(I) = φ_max − (φ_max − φ_min) I (da Cruz et al. 2005; docs/physics.md §3.3).
+    """φ(I) = φ_max − a I (da Cruz et al. 2005; docs/physics.md §3.3), valid over the I of the data.
 
     I: inertial number; phi: solid fraction; other arguments as ``fit_mu_i``. Parameters
-    ``phi_max``, ``phi_min``.
+    ``phi_max`` and ``a`` (the slope −dφ/dI). The former ``fit_phi_i_linear`` fitted the same
+    line: the two are merged into this one.
     """
     return _rheology("phi-i", I, phi, "phi", grain_diameter, grain_density, pressure, confidence)
-
-
-def fit_phi_i_linear(I, phi, *, grain_diameter: float, grain_density: float, pressure=None, confidence: float = 0.95) -> Law:
-    """φ(I) = φ_max − a I, the same line with the slope as parameter.
-
-    Arguments as ``fit_phi_i``; parameters ``phi_max``, ``a``.
-    """
-    return _rheology("phi-i-linear", I, phi, "phi", grain_diameter, grain_density, pressure, confidence)
 
 
 def fit_mohr_coulomb(

@@ -6,8 +6,14 @@
 //!     ├── InputError           bad input: scenario, override, TOML, array, metadata, law JSON
 //!     ├── FitRefused           valid data, but the fit was refused (reason, suggestion)
 //!     ├── SolverError          the engine failed during a step (non-finite state, ...)
-//!     └── OutputError          a file could not be written or read
+//!     ├── OutputError          a file could not be written or read
+//!     ├── ResultRefused        a run finished with the verdict `refused` (exit status 3)
+//!     └── ResultSuspect        a run finished `suspect` without `allow_suspect=True` (exit 3)
 //! ```
+//!
+//! `ResultRefused` and `ResultSuspect` carry `verdict` (str), `reasons` (the failed checks,
+//! `summary.json`'s `verdict_reasons`: dicts `check`, `verdict`, `value`, `threshold`,
+//! `message`) and `result` (what `run` would have returned: every file was written).
 //!
 //! A run stopped by Ctrl-C raises `KeyboardInterrupt` (a checkpoint is left in the output
 //! directory). A panic inside Rust (a bug) never crashes the interpreter: in `run` and
@@ -53,6 +59,47 @@ create_exception!(
     GrainlawError,
     "A file could not be written or read (output directory, figure, CSV, law file)."
 );
+
+create_exception!(
+    grainlaw,
+    ResultRefused,
+    GrainlawError,
+    "A run finished with the verdict `refused` (a check failed by far, or a law could not be \
+     fitted): as `grainlaw run` exits with status 3. Attributes: `verdict` ('refused'), \
+     `reasons` (list of dicts: check, verdict, value, threshold, message) and `result` (the dict \
+     `run` returns: every file was written, its laws under `rejected_laws`)."
+);
+create_exception!(
+    grainlaw,
+    ResultSuspect,
+    GrainlawError,
+    "A run finished with the verdict `suspect` and `allow_suspect` was not set: as `grainlaw run` \
+     exits with status 3 without `--allow-suspect`. Attributes as `ResultRefused` (`verdict` \
+     'suspect')."
+);
+
+/// The error of a run whose `verdict` (`refused`, or `suspect` when not allowed) is `raise`d:
+/// [`ResultRefused`] or [`ResultSuspect`] with the message `line` and the attributes `verdict`,
+/// `reasons`, `result`.
+pub fn verdict_err<'py>(
+    py: Python<'py>,
+    verdict: &str,
+    line: String,
+    reasons: Bound<'py, PyAny>,
+    result: Bound<'py, PyAny>,
+) -> PyErr {
+    let err = if verdict == "refused" {
+        ResultRefused::new_err(line)
+    } else {
+        ResultSuspect::new_err(line)
+    };
+    let value = err.value(py);
+    // As in `refused`: setting attributes on a fresh instance cannot fail short of memory.
+    let _ = value.setattr("verdict", verdict);
+    let _ = value.setattr("reasons", reasons);
+    let _ = value.setattr("result", result);
+    err
+}
 
 /// An [`InputError`] with `msg`.
 pub fn input(msg: impl Into<String>) -> PyErr {
@@ -117,8 +164,8 @@ pub fn cli_err(py: Python<'_>, e: CliError) -> PyErr {
             SolverError::new_err(msg)
         }
         CliError::Io { .. } | CliError::Plot { .. } => OutputError::new_err(msg),
-        // A run's verdict is returned in its summary (`verdict`, `verdict_reasons`), not
-        // raised; only the command line turns it into an exit status.
+        // `run` raises a run's verdict itself, with its result (`verdict_err`); the library
+        // returns it in the outcome, never as this error.
         CliError::Verdict { .. } => GrainlawError::new_err(msg),
         CliError::CampaignStopped { .. } => PyKeyboardInterrupt::new_err(msg),
     }

@@ -25,7 +25,7 @@ use crate::errors::{identify_err, input};
 /// --
 ///
 /// Fits `law` ("janssen", "janssen-kmu", "wall-law", "mu-i", "mu-i-linear", "phi-i",
-/// "phi-i-linear", "mohr-coulomb"; "_" may stand for "-") to `columns`, a dict
+/// "mohr-coulomb"; "_" may stand for "-") to `columns`, a dict
 /// ``{header: 1-D array}`` with the headers and units of ``grainlaw fit`` (``z_m``,
 /// ``sigma_v_Pa``, ``I``, ``mu``, ...; identify/README.md), and `metadata`, the ``# key =
 /// value`` constants of that file (``width_m``, ``grain_diameter_m``, ...). Stresses are
@@ -295,6 +295,21 @@ impl Law {
             .map(|c| c.order.clone())
             .unwrap_or_default()
     }
+    /// Verdict of the law: ``ok`` for a fit (it passed every check; a refused fit raises
+    /// FitRefused), the run's verdict of it for a law a run wrote (``ok``, ``suspect``, or
+    /// ``refused`` in a ``NAME_law.rejected.json``); None for a file written before verdicts.
+    #[getter]
+    fn verdict(&self) -> Option<&str> {
+        self.inner.verdict.as_deref()
+    }
+    /// The failed checks behind a verdict other than ``ok``: dicts ``check``, ``verdict``,
+    /// ``value``, ``threshold``, ``message`` (empty for ``ok``).
+    #[getter]
+    fn verdict_reasons<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = serde_json::to_string(&self.inner.verdict_reasons)
+            .map_err(|e| input(format!("verdict reasons: {e}")))?;
+        py.import("json")?.call_method1("loads", (text,))
+    }
     /// R² of the fit.
     #[getter]
     fn r_squared(&self) -> f64 {
@@ -424,7 +439,11 @@ impl Law {
                 identify::error::short(p.ci_high)
             ));
         }
-        s.push_str(&format!(", R² = {:.4})", self.inner.fit.r_squared));
+        s.push_str(&format!(", R² = {:.4}", self.inner.fit.r_squared));
+        if let Some(v) = &self.inner.verdict {
+            s.push_str(&format!(", verdict {v}"));
+        }
+        s.push(')');
         s
     }
 }

@@ -3,8 +3,9 @@
 //! The package (`python/grainlaw/__init__.py`) re-exports everything here and adds the
 //! per-law fit functions. The pieces:
 //!
-//! - [`run`]: `run(scenario, overrides, out, progress)`: a scenario end to end, as
-//!   `grainlaw run` (root crate, `grainlaw::api::run_scenario`), the GIL released;
+//! - [`run`]: `run(scenario, overrides, out, progress, allow_suspect)`: a scenario end to end,
+//!   as `grainlaw run` (root crate, `grainlaw::api::run_scenario`), the GIL released; a run
+//!   whose verdict the command line would exit 3 for raises `ResultRefused` / `ResultSuspect`;
 //! - [`world`]: `World` and `Snapshot` over `dem::World` and `dem::Snapshot`;
 //! - [`homog`]: per-grain and region mean stress (contact + inertia parts), solid fraction,
 //!   coordination and fabric (`homogenise`);
@@ -36,6 +37,8 @@ fn _grainlaw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FitRefused", py.get_type::<errors::FitRefused>())?;
     m.add("SolverError", py.get_type::<errors::SolverError>())?;
     m.add("OutputError", py.get_type::<errors::OutputError>())?;
+    m.add("ResultRefused", py.get_type::<errors::ResultRefused>())?;
+    m.add("ResultSuspect", py.get_type::<errors::ResultSuspect>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(run::scenarios, m)?)?;

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 use crate::arrays::out1;
-use crate::errors::{cli_err, identify_err, input, panic_err, OutputError};
+use crate::errors::{cli_err, identify_err, input, panic_err, verdict_err, OutputError};
 use crate::fit::Law;
 
 /// One override value as TOML text: bool, int, float (its `repr`, which reads back to the same
@@ -80,6 +80,7 @@ fn run_released(
     sets: &[String],
     dir: &Path,
     quiet: bool,
+    allow_suspect: bool,
 ) -> PyResult<grainlaw::scenarios::RunOutcome> {
     let flag = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel();
@@ -87,7 +88,7 @@ fn run_released(
         let worker_flag = flag.clone();
         s.spawn(move || {
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                grainlaw::api::run_scenario(spec, sets, dir, quiet, worker_flag)
+                grainlaw::api::run_scenario(spec, sets, dir, quiet, allow_suspect, worker_flag)
             }));
             let _ = tx.send(r);
         });
@@ -134,7 +135,8 @@ fn read_text(path: &Path) -> PyResult<String> {
 
 /// Everything a run wrote that Python wants back: `summary.json` as a dict (parsed by Python's
 /// `json`, so its numbers are the file's, bit for bit), every CSV table as a dict of arrays
-/// with its `# key = value` constants, every calibrated law.
+/// with its `# key = value` constants, every calibrated law (`laws`) and every law written as
+/// `NAME_law.rejected.json` (`rejected_laws`), the verdict and its reasons.
 fn collect<'py>(
     py: Python<'py>,
     dir: &Path,
@@ -143,7 +145,7 @@ fn collect<'py>(
     let result = PyDict::new(py);
     let json = py.import("json")?;
     let summary = json.call_method1("loads", (read_text(&dir.join("summary.json"))?,))?;
-    result.set_item("summary", summary)?;
+    result.set_item("summary", &summary)?;
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| OutputError::new_err(format!("{}: {e}", dir.display())))?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -152,6 +154,7 @@ fn collect<'py>(
     let tables = PyDict::new(py);
     let constants = PyDict::new(py);
     let laws = PyDict::new(py);
+    let rejected = PyDict::new(py);
     for path in entries {
         let stem = path
             .file_stem()
@@ -177,20 +180,31 @@ fn collect<'py>(
         } else if name.ends_with("_law.json") {
             let law = identify::CalibratedLaw::load(&path).map_err(|e| identify_err(py, e))?;
             laws.set_item(&stem, Law { inner: law })?;
+        } else if let Some(base) = name.strip_suffix("_law.rejected.json") {
+            let law = identify::CalibratedLaw::load(&path).map_err(|e| identify_err(py, e))?;
+            rejected.set_item(format!("{base}_law"), Law { inner: law })?;
         }
     }
     result.set_item("tables", tables)?;
     result.set_item("constants", constants)?;
     result.set_item("laws", laws)?;
+    result.set_item("rejected_laws", rejected)?;
     result.set_item("headline", outcome.headline.clone())?;
+    result.set_item("verdict", outcome.verdict.verdict().as_str())?;
+    result.set_item("verdict_reasons", summary.get_item("verdict_reasons")?)?;
+    result.set_item("verdict_lines", outcome.verdict.lines())?;
     Ok(result)
 }
 
-/// run(scenario="janssen", overrides=None, out=None, progress=False)
+/// run(scenario="janssen", overrides=None, out=None, progress=False, allow_suspect=False)
 /// --
 ///
 /// Runs a scenario end to end, exactly as `grainlaw run SCENARIO --out OUT --set KEY=VALUE ...`
-/// (same seed, same files, same `summary.json` except `wall_seconds`).
+/// (same seed, same files, same `summary.json` except `wall_seconds`), and is as loud about its
+/// verdict as the command line's exit status: a run judged ``refused`` raises ResultRefused, a
+/// run judged ``suspect`` raises ResultSuspect unless ``allow_suspect=True`` (then its suspect
+/// laws are exported as laws, marked suspect, as with ``--allow-suspect``). The exception
+/// carries ``verdict``, ``reasons`` and ``result``, the dict below (every file is written).
 ///
 /// Parameters
 /// ----------
@@ -204,6 +218,9 @@ fn collect<'py>(
 ///     read back and removed.
 /// progress : bool
 ///     Print the phase lines on stderr (warnings are printed in any case).
+/// allow_suspect : bool
+///     Return a ``suspect`` run instead of raising (``--allow-suspect``); ``refused`` always
+///     raises.
 ///
 /// Returns
 /// -------
@@ -212,23 +229,30 @@ fn collect<'py>(
 ///     ``tables``: ``{file stem: {column header: numpy array}}`` for every CSV written
 ///     (histories, profiles; the unit is in each header, e.g. ``sigma_v_Pa``);
 ///     ``constants``: ``{file stem: {key: value}}`` from the tables' ``# key = value`` lines;
-///     ``laws``: ``{file stem: Law}`` for every calibrated law written;
-///     ``headline``: the report lines the CLI prints; ``out``: the directory, or None.
+///     ``laws``: ``{file stem: Law}`` for every calibrated law written (``NAME_law.json``);
+///     ``rejected_laws``: the same for the laws written as ``NAME_law.rejected.json`` (not
+///     calibrated: their ``verdict`` says why);
+///     ``verdict``: ``ok``, ``suspect`` (with ``allow_suspect=True``) or, on the exceptions'
+///     ``result``, ``refused``; ``verdict_reasons``: the failed checks (dicts ``check``,
+///     ``verdict``, ``value``, ``threshold``, ``message``); ``verdict_lines``: the verdict block
+///     the CLI prints; ``headline``: the report lines the CLI prints; ``out``: the directory,
+///     or None.
 ///
 /// The GIL is released during the run. Ctrl-C stops it after the current step (a checkpoint is
 /// left in ``out``) and raises KeyboardInterrupt.
 ///
 /// Raises
 /// ------
-/// InputError, SolverError, OutputError
+/// ResultRefused, ResultSuspect (the verdict), InputError, SolverError, OutputError
 #[pyfunction]
-#[pyo3(signature = (scenario="janssen", overrides=None, out=None, progress=false))]
+#[pyo3(signature = (scenario="janssen", overrides=None, out=None, progress=false, allow_suspect=false))]
 pub fn run<'py>(
     py: Python<'py>,
     scenario: &str,
     overrides: Option<&Bound<'py, PyAny>>,
     out: Option<PathBuf>,
     progress: bool,
+    allow_suspect: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sets = override_args(overrides)?;
     // Without `out`, a temporary directory removed when `_temp` is dropped.
@@ -242,9 +266,28 @@ pub fn run<'py>(
             (t.path().to_path_buf(), Some(t))
         }
     };
-    let outcome = run_released(py, scenario, &sets, &dir, !progress)?;
+    let outcome = run_released(py, scenario, &sets, &dir, !progress, allow_suspect)?;
     let result = collect(py, &dir, &outcome)?;
-    result.set_item("out", out.map(|d| d.display().to_string()))?;
+    let out_name = out.map(|d| d.display().to_string());
+    result.set_item("out", out_name.clone())?;
+    // As loud as the command line's exit status (`RunVerdict::passes`).
+    if !outcome.verdict.passes() {
+        let verdict = outcome.verdict.verdict().as_str();
+        let line = format!(
+            "{}: {}{}",
+            out_name.unwrap_or_else(|| scenario.to_string()),
+            outcome.verdict.failure_line(),
+            if verdict == "suspect" {
+                " (allow_suspect=True returns it)"
+            } else {
+                ""
+            }
+        );
+        let reasons = result
+            .get_item("verdict_reasons")?
+            .unwrap_or_else(|| PyList::empty(py).into_any());
+        return Err(verdict_err(py, verdict, line, reasons, result.into_any()));
+    }
     Ok(result)
 }
 

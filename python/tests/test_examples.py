@@ -23,6 +23,9 @@ def test_janssen_pipeline_refits_the_runs_own_k(tmp_path):
     m = re.search(r"K\s+= (\d+\.\d+)\s+\(95 % CI (\d+\.\d+) … (\d+\.\d+)\); the run's own fit: (\d+\.\d+)", out)
     assert m, out
     k, lo, hi, run_k = (float(x) for x in m.groups())
+    # 140 grains: a suspect run (the CLI exits 3), said before any number and at the number
+    assert "verdict: suspect" in out and "NOT a calibrated law" in out, out
+    assert "the fit's own verdict: ok" in out
     # the profile CSV holds the run's numbers exactly, so the refit is the run's fit
     assert k == run_k
     assert lo < k < hi
@@ -35,5 +38,6 @@ def test_mu_i_fit_prints_the_law_and_the_refusal(tmp_path):
     assert abs(float(values["mu_s"]) - 0.38) < 0.02
     assert abs(float(values["mu_2"]) - 0.64) < 0.05
     assert "refused:" in out and "suggestion: use mu-i-linear" in out
+    assert "verdict: ok" in out
     law = grainlaw.load_law(tmp_path / "mu_i_law.json")
     assert law.name == "mu-i"

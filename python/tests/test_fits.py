@@ -38,6 +38,10 @@ def test_mu_i_recovers_the_generating_law_within_its_interval():
         assert abs(np.sqrt(cov[k, k]) - law.std_errors[name]) <= 1e-12 * law.std_errors[name]
     # the constants record the grain scale
     assert law.constants == {"d": 1e-3, "rho_s": 2500.0}
+    # a fit that passed every check carries the verdict a run's laws carry: ok, no reasons
+    assert law.verdict == "ok" and law.verdict_reasons == []
+    assert law.to_dict()["verdict"] == "ok"
+    assert grainlaw.law_from_json(law.to_json()).verdict == "ok"
 
 
 def test_mu_i_linear_recovers_slope_and_intercept():

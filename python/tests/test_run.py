@@ -70,9 +70,52 @@ def test_run_returns_tables_and_the_calibrated_law(small_run):
     assert np.all(np.diff(prof["z_m"]) > 0)
     # the law written by the run is the one summarised, read back exactly
     law = result["laws"]["janssen_law"]
+    assert result["verdict"] == s["verdict"] == law.verdict == "ok"
     assert law["K"] == s["janssen_K"]
     lo, hi = law.intervals["K"]
     assert lo == s["janssen_K_ci_low"] and hi == s["janssen_K_ci_high"]
+
+
+def test_a_refused_run_raises_with_its_verdict_and_result(tmp_path):
+    # 30 grains: too short a column for Janssen's law; the CLI exits 3 (refused)
+    out = tmp_path / "refused"
+    with pytest.raises(grainlaw.ResultRefused) as info:
+        grainlaw.run("janssen", overrides={**SMALL, "grains": 30}, out=out)
+    e = info.value
+    assert isinstance(e, grainlaw.GrainlawError)
+    assert e.verdict == "refused"
+    assert any(r["check"] == "janssen.fit" and r["verdict"] == "refused" for r in e.reasons), e.reasons
+    assert "janssen.fit (refused)" in str(e)
+    # the result is there, every file written, its law rejected, not calibrated
+    assert e.result["verdict"] == "refused"
+    assert e.result["summary"]["verdict"] == "refused"
+    assert e.result["verdict_reasons"] == e.reasons
+    assert not e.result["laws"]
+    assert (out / "summary.json").exists()
+    # allow_suspect does not let a refused run through
+    with pytest.raises(grainlaw.ResultRefused):
+        grainlaw.run("janssen", overrides={**SMALL, "grains": 30}, allow_suspect=True)
+
+
+def test_a_suspect_run_raises_unless_allowed(tmp_path):
+    # 140 grains without the quick relaxation: the CLI calls it suspect and exports no law
+    # (solver.sensitivity_janssen)
+    out = tmp_path / "suspect"
+    with pytest.raises(grainlaw.ResultSuspect) as info:
+        grainlaw.run("janssen", overrides={"grains": 140}, out=out)
+    e = info.value
+    assert e.verdict == "suspect" and e.reasons
+    assert all(r["verdict"] == "suspect" for r in e.reasons), e.reasons
+    assert "allow_suspect=True" in str(e)
+    assert not e.result["laws"] and "janssen_law" in e.result["rejected_laws"]
+    assert e.result["rejected_laws"]["janssen_law"].verdict == "suspect"
+    # allowed: returned, the law exported and marked suspect, as `--allow-suspect`
+    result = grainlaw.run("janssen", overrides={"grains": 140}, out=out, allow_suspect=True)
+    assert result["verdict"] == "suspect"
+    law = result["laws"]["janssen_law"]
+    assert law.verdict == "suspect"
+    assert [r["check"] for r in law.verdict_reasons] == [r["check"] for r in e.reasons]
+    assert not result["rejected_laws"], "the stale rejected law is removed"
 
 
 def test_run_without_out_uses_a_removed_temporary_directory():

@@ -10,15 +10,18 @@
 //! compression is written to `history_p{k}.csv`. With compression positive, as in soil
 //! mechanics: axial strain `ε_a = −ln(H/H₀)`, volumetric strain `ε_v = −ln(V/V₀)` (positive
 //! in contraction), `p = (σ₁ + σ₃)/2 = −tr Σ/2`, `q = (σ₁ − σ₃)/2`, `sin φ_mob = q/p`. Over bins
-//! of `bin_strain` of axial strain: the peak `sin φ_peak` (largest bin mean of q/p), the
-//! dilatancy `d = −Δε_v/Δε_a` and the 2D dilatancy angle `sin ψ = −ε̇_v/ε̇_γ = d/(2 + d)`
-//! (`ε̇_γ = ε̇₁ − ε̇₃ = 2ε̇_a − ε̇_v`). Over the last `critical_strain`: the critical state, means
-//! and block-averaged standard errors of q/p, φ, p, Z.
+//! of `bin_strain` of axial strain: the peak `sin φ_peak` (largest bin mean of q/p). Over
+//! consecutive windows of [`DILATANCY_WINDOW_BINS`] bins: the 2D dilatancy angle
+//! `sin ψ = −ε̇_v/ε̇_γ` of the window's mean strain-rate tensor ([`dilatancy_ratio`]), reported
+//! only where it lies in [−1, 1] and judged ([`DILATANCY_SE_SUSPECT`]). Over the last
+//! `critical_strain`: the critical state, means and block-averaged standard errors of q/p, φ,
+//! p, Z (of one sample: the critical-state law states its intervals from the pressures as
+//! replicas, `identify::critical_state::IntervalKind`), and the plateau's dilatancy.
 //!
 //! Identification: Mohr–Coulomb (2D Drucker–Prager) over the peak Mohr circles
 //! (`identify::mohr_coulomb`, Clarabel), the critical state (`identify::critical_state`) and a
 //! stress–dilatancy relation `sin φ_mob = sin φ_cv + β sin ψ` fitted over the hardening phase
-//! (bins before the peak) of every pressure.
+//! (dilatancy windows before the peak) of every pressure.
 
 use datasets::config::{BiaxialConfig, CellControlMode, Preparation};
 use datasets::phases::PhaseStats;
@@ -33,8 +36,8 @@ use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
 use super::common::{
-    fit_keys, implicit_cell_control, mean_diameter, parameter_lines, solver_keys, strain_bins,
-    Stop, VtkFrames,
+    fit_keys, implicit_cell_control, mean_diameter, parameter_lines, short_number, solver_keys,
+    strain_bins, Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::sensitivity::{record, resolved_pair};
@@ -87,6 +90,9 @@ const EA: usize = 1;
 const EV: usize = 2;
 const SXX: usize = 3;
 const SYY: usize = 4;
+const DXX: usize = 6;
+const DYY: usize = 7;
+const DXY: usize = 8;
 const P: usize = 9;
 const PHI: usize = 12;
 const Z: usize = 13;
@@ -157,8 +163,19 @@ pub const STEADY_SIN_PHI_TOLERANCE: f64 = 0.02;
 /// Difference of the plateau halves of φ that matters (absolute).
 pub const STEADY_PHI_TOLERANCE: f64 = 0.005;
 
+/// Columns of `dilatancy.csv`: one row per dilatancy window ([`dilatancy_windows`]).
+const DILATANCY: [&str; 7] = [
+    "p0_Pa",
+    "axial_strain",
+    "sin_phi_mob",
+    "sin_psi",
+    "sin_psi_std_error",
+    "dilatancy_ratio",
+    "hardening",
+];
+
 /// Columns of a per-pressure result row ([`State::rows`], `biaxial.csv`).
-const ROW: [&str; 25] = [
+const ROW: [&str; 30] = [
     "p0_Pa",
     "sin_phi_peak",
     "axial_strain_peak",
@@ -184,6 +201,11 @@ const ROW: [&str; 25] = [
     "cell_corrections_per_step",
     "fabric_anisotropy_critical",
     "phi_initial_axial",
+    "sin_psi_max_std_error",
+    "sin_psi_critical_std_error",
+    "dilatancy_ratio_critical",
+    "dilatancy_windows",
+    "dilatancy_undefined_windows",
 ];
 
 /// The plan of the current phase.
@@ -230,10 +252,13 @@ struct State {
     /// ([`COMPRESSION`]).
     #[serde(with = "crate::floats::table")]
     compression: Vec<Vec<f64>>,
-    /// Binned curves of the finished pressures: rows (pressure index, ε_a, sin φ, ε_v, sin ψ,
-    /// hardening flag).
+    /// Binned curves of the finished pressures: rows (pressure index, ε_a, sin φ, ε_v).
     #[serde(with = "crate::floats::table")]
     bins: Vec<Vec<f64>>,
+    /// Dilatancy windows of the finished pressures ([`dilatancy_windows`]): rows ([`DILATANCY`]
+    /// but the pressure's index in place of p₀).
+    #[serde(default, with = "crate::floats::table")]
+    dilatancy: Vec<Vec<f64>>,
     run: RunPlan,
     frames: VtkFrames,
     window: WindowStats,
@@ -281,10 +306,104 @@ fn ratio_of_means(num: &[f64], den: &[f64]) -> (f64, f64) {
     (r, se)
 }
 
-/// The 2D dilatancy angle of the dilatancy `d = −dε_v/dε_a` (compression positive):
-/// `sin ψ = −ε̇_v/ε̇_γ` with `ε̇_γ = 2 ε̇_a − ε̇_v`, i.e. `d/(2 + d)`.
-pub fn sin_psi_of_dilatancy(d: f64) -> f64 {
-    d / (2.0 + d)
+/// Axial-strain bins of `bin_strain` per window of the dilatancy: the windows of the dilatancy
+/// (and of the stress–dilatancy points) are consecutive and do not overlap, 0.02 of axial strain
+/// with the default bins. Measured (100 grains, dense, p₀ = 1 and 4 kPa, seed 5): over one bin
+/// (0.005) a burst of contraction gives `ε̇_v/ε̇_γ` down to −7.9 and the former ratio of bin
+/// differences `d/(2 + d)` −2.1 to −2.5 (and +1.66 in a run of the default scenario, where
+/// `2 + d < 0`); over windows of 0.025 every window lies within ±0.25, the largest
+/// `sin ψ` 0.23 ± 0.03 and 0.25 ± 0.02 (block standard errors).
+pub const DILATANCY_WINDOW_BINS: usize = 4;
+/// Block standard error of the largest window dilatancy above which it is suspect (absolute):
+/// its 95 % interval then spans more than ±0.1, half the dilatancy of a dense packing (measured
+/// 0.02–0.03 at 100 grains; windows of a contraction burst reach 0.2–0.3).
+pub const DILATANCY_SE_SUSPECT: f64 = 0.05;
+
+/// The ratio `−ε̇_v/ε̇_γ = tr D / (D₁ − D₂)` of a mean strain rate `D = [D_xx, D_yy, D_xy]`
+/// (tension positive, 1/s), with `ε̇_v = −tr D` the volumetric rate (compression positive) and
+/// `ε̇_γ = D₁ − D₂ = √((D_xx − D_yy)² + 4 D_xy²)` the difference of its principal rates: the
+/// 2D dilatancy angle `sin ψ` when it lies in `[−1, 1]`, which it does exactly when the principal
+/// rates have opposite signs (a shear with a change of volume; Vermeer & de Borst, Heron 29,
+/// 1984). Outside, the cell contracted (or dilated) along both principal directions: no
+/// dilatancy angle describes that deformation. NaN without any shear rate.
+pub fn dilatancy_ratio(d: [f64; 3]) -> f64 {
+    let g = ((d[0] - d[1]).powi(2) + 4.0 * d[2] * d[2]).sqrt();
+    if g > 0.0 {
+        (d[0] + d[1]) / g
+    } else {
+        f64::NAN
+    }
+}
+
+/// The dilatancy of a run of steps of the axial compression.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Dilatancy {
+    /// `sin ψ` of the mean strain rate of the steps ([`dilatancy_ratio`]), NaN when it is not
+    /// in `[−1, 1]` (no dilatancy angle) or there are no steps.
+    sin_psi: f64,
+    /// Its block-averaged standard error (delta method; NaN with too few steps).
+    std_error: f64,
+    /// The ratio itself, in range or not.
+    ratio: f64,
+}
+
+/// The dilatancy of the steps `rows` of a history ([`HISTORY`]): [`dilatancy_ratio`] of their
+/// mean strain rate `D̄` (the cell's deformation over them: `tr D̄` times their duration is
+/// their `−Δ ln V`), with the block-averaged standard error of the ratio of means
+/// ([`ratio_of_means`] with `tr D_t` over the shear rate of step `t` along `D̄`'s principal
+/// axes, `((D_xx − D_yy)(D̄_xx − D̄_yy) + 4 D_xy D̄_xy)/ε̇_γ`, whose mean is `ε̇_γ`).
+fn dilatancy_over(rows: &[&Vec<f64>]) -> Dilatancy {
+    let nan = Dilatancy {
+        sin_psi: f64::NAN,
+        std_error: f64::NAN,
+        ratio: f64::NAN,
+    };
+    if rows.is_empty() {
+        return nan;
+    }
+    let n = rows.len() as f64;
+    let mean = |j: usize| rows.iter().map(|r| r[j]).sum::<f64>() / n;
+    let (a, b, c) = (mean(DXX), mean(DYY), mean(DXY));
+    let ratio = dilatancy_ratio([a, b, c]);
+    let g = ((a - b).powi(2) + 4.0 * c * c).sqrt();
+    if !ratio.is_finite() {
+        return nan;
+    }
+    let num: Vec<f64> = rows.iter().map(|r| r[DXX] + r[DYY]).collect();
+    let den: Vec<f64> = rows
+        .iter()
+        .map(|r| ((r[DXX] - r[DYY]) * (a - b) + 4.0 * r[DXY] * c) / g)
+        .collect();
+    let (_, se) = ratio_of_means(&num, &den);
+    Dilatancy {
+        sin_psi: if ratio.abs() <= 1.0 { ratio } else { f64::NAN },
+        std_error: se,
+        ratio,
+    }
+}
+
+/// The dilatancy windows of a history: consecutive windows of `width` of axial strain from
+/// ε_a = 0, each with at least one step, the last one only if whole: `(ε_a at its centre, sin φ
+/// as the ratio of its mean stresses, its dilatancy)`.
+fn dilatancy_windows(history: &[Vec<f64>], width: f64) -> Vec<(f64, f64, Dilatancy)> {
+    let end = history.last().map_or(0.0, |r| r[EA]);
+    let mut out = Vec::new();
+    let mut k = 0.0;
+    while (k + 1.0) * width <= end * (1.0 + 1e-9) {
+        let (lo, hi) = (k * width, (k + 1.0) * width);
+        let rows: Vec<&Vec<f64>> = history
+            .iter()
+            .filter(|r| r[EA] >= lo && r[EA] < hi && r[INERTIAL].is_finite())
+            .collect();
+        if !rows.is_empty() {
+            let n = rows.len() as f64;
+            let m = |j: usize| rows.iter().map(|r| r[j]).sum::<f64>() / n;
+            let sin_phi = 0.5 * (m(SXX) - m(SYY)) / m(P);
+            out.push((0.5 * (lo + hi), sin_phi, dilatancy_over(&rows)));
+        }
+        k += 1.0;
+    }
+    out
 }
 
 struct Biaxial<'a> {
@@ -358,31 +477,29 @@ impl Biaxial<'_> {
         let (eps_peak, p_peak, q_peak) = bins
             .get(kpeak)
             .map_or((f64::NAN, f64::NAN, f64::NAN), |b| (b[0], b[4], b[5]));
-        // dilatancy between consecutive bins
-        let mut psi_max = (f64::NEG_INFINITY, f64::NAN);
-        let mut sin_psi = vec![f64::NAN; bins.len()];
-        for j in 1..bins.len() {
-            let de = bins[j][0] - bins[j - 1][0];
-            if de > 0.0 {
-                let d = -(bins[j][2] - bins[j - 1][2]) / de;
-                let s = sin_psi_of_dilatancy(d);
-                let x = 0.5 * (bins[j][0] + bins[j - 1][0]);
-                sin_psi[j] = s;
-                if s > psi_max.0 {
-                    psi_max = (s, x);
-                }
-            }
+        for b in &bins {
+            st.bins.push(vec![i as f64, b[0], b[1], b[2]]);
         }
-        for (j, b) in bins.iter().enumerate() {
-            // mid-bin dilatancy between bins j−1 and j is attributed to bin j; the hardening
-            // phase: bins up to the peak
-            st.bins.push(vec![
+        // dilatancy over windows of DILATANCY_WINDOW_BINS bins; the largest defined one
+        let windows = dilatancy_windows(h, DILATANCY_WINDOW_BINS as f64 * c.bin_strain);
+        let mut psi_max = (f64::NAN, f64::NAN, f64::NAN);
+        let mut undefined = 0usize;
+        for (x, sin_phi, dl) in &windows {
+            if dl.ratio.is_finite() && dl.sin_psi.is_nan() {
+                undefined += 1;
+            }
+            if dl.sin_psi.is_finite() && (psi_max.0.is_nan() || dl.sin_psi > psi_max.0) {
+                psi_max = (dl.sin_psi, *x, dl.std_error);
+            }
+            // the hardening phase: windows whose centre comes before the peak
+            st.dilatancy.push(vec![
                 i as f64,
-                b[0],
-                b[1],
-                b[2],
-                sin_psi[j],
-                if j <= kpeak { 1.0 } else { 0.0 },
+                *x,
+                *sin_phi,
+                dl.sin_psi,
+                dl.std_error,
+                dl.ratio,
+                if *x <= eps_peak { 1.0 } else { 0.0 },
             ]);
         }
         let p_mean = h.iter().map(|r| r[P]).sum::<f64>() / h.len().max(1) as f64;
@@ -401,21 +518,8 @@ impl Biaxial<'_> {
         let (pc, _) = avg(P);
         let (zc, _) = avg(Z);
         let (ac, _) = avg(ANISO);
-        // mean dilatancy over the plateau: slope of ε_v against ε_a
-        let (xe, ye) = (col(EA), col(EV));
-        let slope = {
-            let n = xe.len().max(1) as f64;
-            let mx = xe.iter().sum::<f64>() / n;
-            let my = ye.iter().sum::<f64>() / n;
-            let sxx: f64 = xe.iter().map(|x| (x - mx).powi(2)).sum();
-            let sxy: f64 = xe.iter().zip(&ye).map(|(x, y)| (x - mx) * (y - my)).sum();
-            if sxx > 0.0 {
-                sxy / sxx
-            } else {
-                f64::NAN
-            }
-        };
-        let sin_psi_c = sin_psi_of_dilatancy(-slope);
+        // the dilatancy of the plateau, from its mean strain rate
+        let psi_c = dilatancy_over(&tail);
         let sxx_mean = h.iter().map(|r| r[SXX]).sum::<f64>() / h.len().max(1) as f64;
         let lateral = (sxx_mean + p0).abs() / p0;
         let corr = h.iter().map(|r| r[CORRECTIONS]).sum::<f64>() / h.len().max(1) as f64;
@@ -434,7 +538,7 @@ impl Biaxial<'_> {
             zc,
             psi_max.0,
             psi_max.1,
-            sin_psi_c,
+            psi_c.sin_psi,
             lateral,
             i_mean,
             comp[0],
@@ -446,6 +550,11 @@ impl Biaxial<'_> {
             corr,
             ac,
             h.first().map_or(f64::NAN, |r| r[PHI]),
+            psi_max.2,
+            psi_c.std_error,
+            psi_c.ratio,
+            windows.len() as f64,
+            undefined as f64,
         ]);
         st.checks.push(PressureCheck {
             p0,
@@ -738,6 +847,7 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 history: Vec::new(),
                 compression: Vec::new(),
                 bins: Vec::new(),
+                dilatancy: Vec::new(),
                 run: RunPlan::default(),
                 // frames of the last (highest) pressure's sample
                 frames: VtkFrames::new(t_last / 40.0, 41),
@@ -753,6 +863,7 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         all,
         rows,
         bins,
+        dilatancy,
         frames,
         checks,
         ..
@@ -767,8 +878,53 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         &all,
         &rows,
         &bins,
+        &dilatancy,
         &checks,
     )
+}
+
+/// The checks of one pressure's dilatancy (its row `r` of [`ROW`]): the largest window
+/// dilatancy must exist (some window has a dilatancy angle) and be resolved (block standard
+/// error at most [`DILATANCY_SE_SUSPECT`]); the plateau's must be an angle (its mean strain
+/// rate shears the cell). Suspect otherwise: the value is then not reported (NaN), never a
+/// `sin ψ` outside [−1, 1].
+fn judge_dilatancy(k: &mut Checks, label: &str, r: &[f64]) {
+    let (max, max_se, crit, crit_ratio, windows, undefined) =
+        (r[11], r[25], r[13], r[27], r[28], r[29]);
+    if max.is_nan() {
+        k.fail(
+            "biaxial.dilatancy_undefined",
+            Verdict::Suspect,
+            undefined,
+            windows,
+            format!(
+                "{label}: none of the {windows} dilatancy windows has a dilatancy angle ({undefined} contracted or dilated along both principal directions): no largest sin ψ"
+            ),
+        );
+    } else {
+        k.at_most(
+            "biaxial.dilatancy_resolution",
+            max_se,
+            DILATANCY_SE_SUSPECT,
+            None,
+            |t| {
+                format!(
+                    "{label}: the largest window dilatancy sin ψ = {max:.3} has a block standard error {max_se:.3} (limit {t})"
+                )
+            },
+        );
+    }
+    if crit.is_nan() {
+        k.fail(
+            "biaxial.dilatancy_critical_undefined",
+            Verdict::Suspect,
+            crit_ratio,
+            1.0,
+            format!(
+                "{label}: the plateau's mean strain rate has -ε̇_v/ε̇_γ = {crit_ratio:.3}, no dilatancy angle (|·| > 1 or no shear): sin ψ_c not reported"
+            ),
+        );
+    }
 }
 
 /// The checks, fits, laws, table, figures and summary of a finished run.
@@ -782,11 +938,13 @@ fn analyse(
     all: &PhaseStats,
     rows: &[Vec<f64>],
     bins: &[Vec<f64>],
+    dilatancy: &[Vec<f64>],
     checks: &[PressureCheck],
 ) -> Result<RunOutcome> {
     // --- checks (crate::verdict) ---
     let mut common = Checks::new();
     let mut critical = Checks::new();
+    let mut dilat = Checks::new();
     let mut windows = WindowStats::default();
     let phi_bound = max_solid_fraction(c.grain.radius_spread);
     for (r, pc) in rows.iter().zip(checks) {
@@ -845,14 +1003,23 @@ fn analyse(
             STEADY_PHI_TOLERANCE,
         );
         critical.solid_fraction("biaxial.solid_fraction", &label, r[7], phi_bound);
+        judge_dilatancy(&mut dilat, &label, r);
     }
     let critical = {
         let mut k = critical;
         k.extend(&common);
         k
     };
+    // the dilatancy is reported per pressure whatever is fitted: judged with the run
+    let mut run_checks = critical.clone();
+    run_checks.extend(&dilat);
+    let dilat = {
+        let mut k = common.clone();
+        k.extend(&dilat);
+        k
+    };
     let mut verdict = RunVerdict {
-        run: critical.clone(),
+        run: run_checks,
         allow_suspect: ctl.allow_suspect,
         ..Default::default()
     };
@@ -863,10 +1030,11 @@ fn analyse(
         table.push(r.clone());
     }
     table.comments.push(format!(
-        "biaxial compression ({} preparation) at each confining pressure p0: peak = largest mean of sin_phi_mob = q/p over axial-strain bins of {}, p and q at the peak (means over its bin); critical = means over the last {} of axial strain with block-averaged standard errors; sin_psi = d/(2+d), d = -d(eps_v)/d(eps_a) between bins (2D dilatancy angle sin psi = -rate_v/rate_gamma), sin_psi_critical from the slope of eps_v over the plateau; lateral_stress_error = |<sigma_xx> + p0|/p0 over the axial compression, compression_stress_error the largest of |<sigma_xx> + p0|/p0 and |<sigma_yy> + p0|/p0 over the last 20 % of the isotropic compression; I_mean = rate d / sqrt(<p>/rho) over the axial compression",
+        "biaxial compression ({} preparation) at each confining pressure p0: peak = largest mean of sin_phi_mob = q/p over axial-strain bins of {}, p and q at the peak (means over its bin); critical = means over the last {} of axial strain with block-averaged standard errors (of this sample alone: they understate the scatter between samples, summary.json gives the replica intervals); sin_psi = -rate_v/rate_gamma = tr D/(D1 - D2) of the mean strain rate D over consecutive windows of {} of axial strain (dilatancy.csv), empty where it is outside [-1, 1] (the cell contracted or dilated along both principal directions: no dilatancy angle), sin_psi_max the largest window with its block standard error, sin_psi_critical over the plateau; lateral_stress_error = |<sigma_xx> + p0|/p0 over the axial compression, compression_stress_error the largest of |<sigma_xx> + p0|/p0 and |<sigma_yy> + p0|/p0 over the last 20 % of the isotropic compression; I_mean = rate d / sqrt(<p>/rho) over the axial compression",
         c.preparation.as_str(),
         c.bin_strain,
-        c.critical_strain
+        c.critical_strain,
+        DILATANCY_WINDOW_BINS as f64 * c.bin_strain
     ));
     let d = mean_diameter(world);
     table.metadata = vec![
@@ -875,6 +1043,17 @@ fn analyse(
         ("grain_friction".into(), c.friction.grain_grain),
     ];
     table.write(&mut ctx.out, "biaxial.csv")?;
+    let mut dt = CsvTable::new(&DILATANCY);
+    for w in dilatancy {
+        let mut row = w.clone();
+        row[0] = pressures.get(w[0] as usize).copied().unwrap_or(f64::NAN);
+        dt.push(row);
+    }
+    dt.comments.push(format!(
+        "dilatancy of the axial compression over consecutive windows of {} of axial strain ({DILATANCY_WINDOW_BINS} bins): axial_strain at the window's centre, sin_phi_mob = q_a/p of its mean stresses, dilatancy_ratio = -rate_v/rate_gamma = tr D/(D1 - D2) of its mean strain rate D (tension positive), sin_psi the same where it lies in [-1, 1] (empty: the cell contracted or dilated along both principal directions, no dilatancy angle), with its block standard error; hardening = 1 for windows whose centre comes before the peak (the points of the stress-dilatancy fit)",
+        DILATANCY_WINDOW_BINS as f64 * c.bin_strain
+    ));
+    dt.write(&mut ctx.out, "dilatancy.csv")?;
 
     // --- summary: per pressure ---
     let mut s = Summary::new();
@@ -905,15 +1084,32 @@ fn analyse(
             .num(&format!("{pre}_Z_critical"), r[10])
             .num(&format!("{pre}_fabric_anisotropy_critical"), r[23])
             .num(&format!("{pre}_dilatancy_max_sin_psi"), r[11])
+            .num(&format!("{pre}_dilatancy_max_sin_psi_std_error"), r[25])
             .num(&format!("{pre}_dilatancy_max_angle_deg"), deg(r[11]))
             .num(&format!("{pre}_axial_strain_dilatancy_max"), r[12])
             .num(&format!("{pre}_dilatancy_critical_sin_psi"), r[13])
+            .num(
+                &format!("{pre}_dilatancy_critical_sin_psi_std_error"),
+                r[26],
+            )
+            .num(&format!("{pre}_dilatancy_critical_ratio"), r[27])
+            .int(&format!("{pre}_dilatancy_windows"), r[28] as u64)
+            .int(&format!("{pre}_dilatancy_undefined_windows"), r[29] as u64)
             .num(&format!("{pre}_lateral_stress_error"), r[14])
             .num(&format!("{pre}_I"), r[15])
             .num(&format!("{pre}_axial_rate_1_s"), r[19]);
         headline.push(format!(
-            "p0 = {} Pa: peak sin φ = {:.4} at ε_a = {:.3}; critical sin φ = {:.4} ± {:.4} (s.e.), φ = {:.4} ± {:.4}; max sin ψ = {:.4}",
-            r[0], r[1], r[2], r[5], r[6], r[7], r[8], r[11]
+            "p0 = {} Pa: peak sin φ = {:.4} at ε_a = {:.3}; critical sin φ = {:.4} ± {:.4}, φ = {:.4} ± {:.4} (block s.e. of this sample alone); max sin ψ = {} ± {} (block s.e., windows of {} of ε_a)",
+            r[0],
+            r[1],
+            r[2],
+            r[5],
+            r[6],
+            r[7],
+            r[8],
+            short_number(r[11]),
+            short_number(r[25]),
+            DILATANCY_WINDOW_BINS as f64 * c.bin_strain
         ));
     }
     let provenance = crate::provenance::of_run(ctx, ctl, "biaxial", c.seed);
@@ -927,6 +1123,7 @@ fn analyse(
     };
     // A free cohesion with 4 pressures or more, else (or when the data do not identify it:
     // rigid cohesionless grains have none) the envelope through the origin.
+    let left = |law: &str| c.leave_out.iter().any(|l| l == law);
     let fitted = fit_mohr_coulomb_supported(&peaks, 0.95).map(|(f, fixed, refusal)| {
         if let Some(e) = refusal {
             warn(&format!(
@@ -937,8 +1134,10 @@ fn analyse(
         (f, fixed)
     });
     let mut mc_line = None;
-    match fitted {
-        Ok((f, cohesion_fixed_zero)) => {
+    match (!left("mohr-coulomb")).then_some(fitted) {
+        // left out by the plan (said at the start)
+        None => remove_stale_law(out, "mohr_coulomb")?,
+        Some(Ok((f, cohesion_fixed_zero))) => {
             fit_keys(&mut s, "friction_peak", &f.report.parameters);
             fit_keys(
                 &mut s,
@@ -946,7 +1145,9 @@ fn analyse(
                 std::slice::from_ref(&f.friction_angle_deg),
             );
             s.num("friction_peak_r_squared", f.report.r_squared)
-                .flag("friction_peak_cohesion_fixed_zero", cohesion_fixed_zero);
+                .flag("friction_peak_cohesion_fixed_zero", cohesion_fixed_zero)
+                // the scatter of the peaks, one independent sample per pressure, about the line
+                .text("friction_peak_interval", "replicas");
             mc_line = Some((f.law.friction_angle_rad, f.law.cohesion_pa));
             let law = CalibratedLaw::from_mohr_coulomb(&f, provenance.clone());
             let exported = export_law(out, &mut verdict, "mohr_coulomb", &law, common.clone())?;
@@ -957,7 +1158,7 @@ fn analyse(
                 &[f.friction_angle_deg.clone(), f.cohesion.clone()],
             ));
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("Mohr–Coulomb fit over the peaks refused: {e}"));
             s.text("friction_peak_fit_error", &e.to_string());
             remove_stale_law(out, "mohr_coulomb")?;
@@ -983,8 +1184,9 @@ fn analyse(
             blocks: MIN_BLOCKS,
         })
         .collect();
-    match fit_critical_state(&plateaus, 0.95) {
-        Ok(f) => {
+    match (!left("critical-state")).then(|| fit_critical_state(&plateaus, 0.95)) {
+        None => remove_stale_law(out, "critical_state")?,
+        Some(Ok(f)) => {
             fit_keys(
                 &mut s,
                 "friction_critical",
@@ -1000,12 +1202,45 @@ fn analyse(
                 std::slice::from_ref(&f.solid_fraction),
             );
             s.num("friction_critical_sin_phi_value", f.sin_phi.value)
-                .num("solid_fraction_critical", f.solid_fraction.value);
+                .num("solid_fraction_critical", f.solid_fraction.value)
+                .int("critical_state_replicas", f.replicas as u64)
+                .text("friction_critical_interval", f.sin_phi_interval.as_str())
+                .text(
+                    "solid_fraction_critical_interval",
+                    f.solid_fraction_interval.as_str(),
+                )
+                .num("friction_critical_sin_phi_replica_sd", f.sin_phi_replica_sd)
+                .num(
+                    "solid_fraction_critical_replica_sd",
+                    f.solid_fraction_replica_sd,
+                );
+            // each pressure's plateau value with the interval of one sample among replicas
+            for (k, r) in rows.iter().enumerate() {
+                let pre = format!("p{}", k + 1);
+                let (lo, hi) = f.sample_interval(r[5], f.sin_phi_replica_sd);
+                s.num(
+                    &format!("{pre}_friction_critical_sin_phi_replica_ci_low"),
+                    lo,
+                )
+                .num(
+                    &format!("{pre}_friction_critical_sin_phi_replica_ci_high"),
+                    hi,
+                );
+                let (lo, hi) = f.sample_interval(r[7], f.solid_fraction_replica_sd);
+                s.num(&format!("{pre}_solid_fraction_critical_replica_ci_low"), lo)
+                    .num(
+                        &format!("{pre}_solid_fraction_critical_replica_ci_high"),
+                        hi,
+                    );
+            }
             let law = CalibratedLaw::from_critical_state(&f, provenance.clone());
             let exported = export_law(out, &mut verdict, "critical_state", &law, critical.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
-                "critical state (plateau means over the pressures)",
+                &format!(
+                    "critical state (plateau means over the {} pressures as replicas)",
+                    f.replicas
+                ),
                 f.report.r_squared,
                 &[
                     f.friction_angle_deg.clone(),
@@ -1013,8 +1248,20 @@ fn analyse(
                     f.solid_fraction.clone(),
                 ],
             ));
+            headline.push(format!(
+                "  intervals: sin φ_c from {}; φ_c from {}",
+                f.sin_phi_interval.describe(f.replicas),
+                f.solid_fraction_interval.describe(f.replicas)
+            ));
+            if f.replicas >= 2 {
+                headline.push(format!(
+                    "  one pressure's plateau, as one sample among replicas: sin φ ± {}, φ ± {} (95 %)",
+                    short_number(f.replica_t * f.sin_phi_replica_sd),
+                    short_number(f.replica_t * f.solid_fraction_replica_sd)
+                ));
+            }
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("critical state refused: {e}"));
             s.text("friction_critical_fit_error", &e.to_string());
             remove_stale_law(out, "critical_state")?;
@@ -1029,23 +1276,36 @@ fn analyse(
     }
 
     // --- stress–dilatancy over the hardening phases ---
-    let hard: Vec<&Vec<f64>> = bins
+    // the dilatancy windows of the hardening phases (columns of DILATANCY)
+    let hard: Vec<&Vec<f64>> = dilatancy
         .iter()
-        .filter(|b| b[5] > 0.5 && b[4].is_finite())
+        .filter(|w| w[6] > 0.5 && w[3].is_finite() && w[2].is_finite())
         .collect();
     let sd_data = StressDilatancyData {
-        sin_psi: hard.iter().map(|b| b[4]).collect(),
-        sin_phi: hard.iter().map(|b| b[2]).collect(),
+        sin_psi: hard.iter().map(|w| w[3]).collect(),
+        sin_phi: hard.iter().map(|w| w[2]).collect(),
+        // each pressure's test is an independent sample: intervals over them
+        sample: Some(hard.iter().map(|w| w[0] as usize).collect()),
     };
     let mut sd_line = None;
-    match fit_stress_dilatancy(&sd_data, &identify::FitOptions::default()) {
-        Ok(f) => {
+    match (!left("stress-dilatancy"))
+        .then(|| fit_stress_dilatancy(&sd_data, &identify::FitOptions::default()))
+    {
+        None => remove_stale_law(out, "stress_dilatancy")?,
+        Some(Ok(f)) => {
             fit_keys(&mut s, "stress_dilatancy", &f.report.parameters);
             s.num("stress_dilatancy_r_squared", f.report.r_squared)
-                .int("stress_dilatancy_points", f.report.n as u64);
+                .int("stress_dilatancy_points", f.report.n as u64)
+                .int("stress_dilatancy_samples", f.samples as u64)
+                // cluster-robust over the pressures when wider, else least squares over the
+                // windows (several per sample)
+                .text(
+                    "stress_dilatancy_interval",
+                    if f.clustered { "replicas" } else { "windows" },
+                );
             sd_line = Some((f.law.sin_phi_c, f.law.beta));
             let law = CalibratedLaw::from_stress_dilatancy(&f, provenance.clone());
-            let exported = export_law(out, &mut verdict, "stress_dilatancy", &law, common.clone())?;
+            let exported = export_law(out, &mut verdict, "stress_dilatancy", &law, dilat.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "stress–dilatancy over the hardening phases, sin φ = sin φ_cv + β sin ψ",
@@ -1053,7 +1313,7 @@ fn analyse(
                 &f.report.parameters,
             ));
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("stress–dilatancy fit refused: {e}"));
             s.text("stress_dilatancy_fit_error", &e.to_string());
             remove_stale_law(out, "stress_dilatancy")?;
@@ -1113,7 +1373,7 @@ fn analyse(
         Axis::new("sin φ_mob"),
     );
     psd.series.push(Series::new(
-        "bins before the peak",
+        "dilatancy windows before the peak",
         Style::Points,
         PALETTE[2],
         sd_data
@@ -1188,6 +1448,8 @@ pub fn bench_rve(grains: usize, compress_steps: usize, axial_steps: usize) -> Re
         &[
             format!("grains={grains}"),
             "confining_pressures=[1000.0]".to_string(),
+            // a benchmark of the engine: nothing is fitted
+            r#"leave_out=["mohr-coulomb", "critical-state", "stress-dilatancy"]"#.to_string(),
         ],
     )?;
     let datasets::Scenario::Biaxial(c) = loaded.scenario else {

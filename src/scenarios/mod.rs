@@ -73,6 +73,31 @@ pub struct RunOutcome {
     pub verdict: crate::verdict::RunVerdict,
 }
 
+/// One line per law the plan leaves out (`leave_out`, `datasets::config::laws`): its name,
+/// and the data the plan has against what it needs.
+pub fn left_out_lines(scenario: &Scenario) -> Vec<String> {
+    let needs = scenario.law_needs();
+    scenario
+        .leave_out()
+        .iter()
+        .map(|law| {
+            let why = needs
+                .iter()
+                .find(|n| n.law == law)
+                .and_then(|n| {
+                    n.have.map(|h| {
+                        format!(
+                            " (this plan has {h} {}; it needs at least {})",
+                            n.key, n.needs
+                        )
+                    })
+                })
+                .unwrap_or_default();
+            format!("{law} left out by the plan (leave_out): it is not fitted, no law file{why}")
+        })
+        .collect()
+}
+
 /// Runs the loaded scenario, writes every output and `summary.json` last, with the default
 /// checkpoint policy ([`run_controlled`] with [`RunControl::default`]).
 pub fn run(ctx: &mut RunContext) -> Result<RunOutcome> {
@@ -97,6 +122,10 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
     ctx.out
         .write("scenario.toml", ctx.loaded.effective_toml.as_bytes())?;
     let scenario = ctx.loaded.scenario.clone();
+    // said at the start: what the plan leaves out, and why it could not have had it
+    for line in left_out_lines(&scenario) {
+        crate::progress::note(&line);
+    }
     let mut outcome = match &scenario {
         Scenario::Janssen(c) => janssen::run(c, ctx, ctl)?,
         Scenario::Rolling(c) => rolling::run(c, ctx, ctl)?,
@@ -117,6 +146,10 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
     }
     outcome.verdict.allow_suspect = ctl.allow_suspect;
     outcome.verdict.keys(&mut summary);
+    summary.set(
+        "laws_left_out",
+        serde_json::Value::from(scenario.leave_out().to_vec()),
+    );
     summary.num("wall_seconds", ctl.wall_seconds());
     summary.text("grainlaw_version", env!("CARGO_PKG_VERSION"));
     ctx.out

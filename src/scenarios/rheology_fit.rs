@@ -39,6 +39,8 @@ pub(crate) struct RheologyFit<'a> {
     /// Each point's own verdict (`point_verdict` of `rheology.csv`): a point not ok is drawn
     /// marked.
     pub(crate) point_verdicts: &'a [Verdict],
+    /// The laws the plan leaves out (`mu-i`, `mu-i-linear`, `phi-i`): not fitted.
+    pub(crate) leave_out: &'a [String],
 }
 
 /// Standard errors of a rheology's points, one per point, each optional.
@@ -240,9 +242,9 @@ impl Shown {
     }
 }
 
-/// Fits μ(I) and φ(I) to `series`, writes the laws that pass (or their `.rejected.json`),
-/// records refusals in `verdict`, the keys in `s`, the printed lines in `headline`; returns
-/// the μ(I) and φ(I) figures ([`rheology_plot`]).
+/// Fits μ(I) and φ(I) to `series` (those the plan does not leave out), writes the laws that
+/// pass (or their `.rejected.json`), records refusals in `verdict`, the keys in `s`, the printed
+/// lines in `headline`; returns the μ(I) and φ(I) figures ([`rheology_plot`]).
 pub(crate) fn fit_mu_phi(
     out: &mut OutputDir,
     series: &RheologySeries,
@@ -256,8 +258,16 @@ pub(crate) fn fit_mu_phi(
     // every point enters the fits (a point failing its own checks makes the laws fail theirs)
     let range = finite_range(is.iter().copied()).unwrap_or((0.0, 0.0));
     let mut mu_notes = Vec::new();
-    let mu_curve = match fit_mu_i(series, &opts) {
-        Ok(f) => {
+    let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
+    // μ(I), or its linear form when μ(I) is refused or left out (`leave_out`)
+    let full = if left("mu-i") {
+        None
+    } else {
+        Some(fit_mu_i(series, &opts))
+    };
+    let mut mu_curve = None;
+    let linear_reason = match full {
+        Some(Ok(f)) => {
             let shown = Shown {
                 key: "mu_i",
                 form: Some("mu-i"),
@@ -267,7 +277,7 @@ pub(crate) fn fit_mu_phi(
                 file: "mu_i",
             };
             let law = CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone());
-            Some(shown.record(
+            mu_curve = Some(shown.record(
                 out,
                 verdict,
                 &law,
@@ -284,62 +294,93 @@ pub(crate) fn fit_mu_phi(
                     }
                     .mu(i)
                 },
-            )?)
+            )?);
+            None
         }
-        Err(e) => {
+        Some(Err(e)) => {
+            s.text("mu_i_fit_error", &e.to_string());
+            Some(e.to_string())
+        }
+        None => None,
+    };
+    let try_linear = linear_reason.is_some() || left("mu-i");
+    if try_linear && left("mu-i-linear") {
+        // neither form is fitted: the plan said so at the start
+        crate::verdict::remove_stale_law(out, "mu_i")?;
+        mu_notes.push("no μ(I) law fitted (left out by the plan)".into());
+        if let Some(e) = linear_reason {
+            warn(&format!(
+                "μ(I) fit failed ({e}); its linear form is left out (leave_out)"
+            ));
+            verdict.run.fail(
+                &format!("{}.mu_i_fit", inp.check_prefix),
+                Verdict::Refused,
+                f64::NAN,
+                f64::NAN,
+                format!("no μ(I) law could be fitted: {e}"),
+            );
+        }
+    } else if try_linear {
+        let formula = if let Some(e) = &linear_reason {
             warn(&format!(
                 "μ(I) fit failed ({e}); fitting the linear form μ_s + b I"
             ));
-            s.text("mu_i_fit_error", &e.to_string());
-            match fit_mu_i_linear(series, &opts) {
-                Ok(f) => {
-                    let shown = Shown {
-                        key: "mu_i",
-                        form: Some("mu-i-linear"),
-                        formula: "μ_s + b I (the full μ(I) refused)",
-                        title: "μ(I) = μ_s + b I (linear form)",
-                        linear: true,
-                        file: "mu_i",
-                    };
-                    let law =
-                        CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone());
-                    Some(shown.record(
-                        out,
-                        verdict,
-                        &law,
-                        inp.mu_checks.clone(),
-                        range,
-                        &f.report,
-                        s,
-                        headline,
-                        |p, i| p[0] + p[1] * i,
-                    )?)
-                }
-                Err(e2) => {
-                    warn(&format!("linear μ(I) fit failed too: {e2}"));
-                    s.text("mu_i_linear_fit_error", &e2.to_string());
-                    crate::verdict::remove_stale_law(out, "mu_i")?;
-                    verdict.run.fail(
-                        &format!("{}.mu_i_fit", inp.check_prefix),
-                        Verdict::Refused,
-                        f64::NAN,
-                        f64::NAN,
-                        format!("no μ(I) law could be fitted: {e2}"),
-                    );
-                    mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
-                    None
-                }
+            "μ_s + b I (the full μ(I) refused)"
+        } else {
+            "μ_s + b I (the full μ(I) left out)"
+        };
+        match fit_mu_i_linear(series, &opts) {
+            Ok(f) => {
+                let shown = Shown {
+                    key: "mu_i",
+                    form: Some("mu-i-linear"),
+                    formula,
+                    title: "μ(I) = μ_s + b I (linear form)",
+                    linear: true,
+                    file: "mu_i",
+                };
+                let law = CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone());
+                mu_curve = Some(shown.record(
+                    out,
+                    verdict,
+                    &law,
+                    inp.mu_checks.clone(),
+                    range,
+                    &f.report,
+                    s,
+                    headline,
+                    |p, i| p[0] + p[1] * i,
+                )?);
+            }
+            Err(e2) => {
+                warn(&format!("linear μ(I) fit failed too: {e2}"));
+                s.text("mu_i_linear_fit_error", &e2.to_string());
+                crate::verdict::remove_stale_law(out, "mu_i")?;
+                verdict.run.fail(
+                    &format!("{}.mu_i_fit", inp.check_prefix),
+                    Verdict::Refused,
+                    f64::NAN,
+                    f64::NAN,
+                    format!("no μ(I) law could be fitted: {e2}"),
+                );
+                mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
             }
         }
-    };
+    }
     let mut phi_notes = Vec::new();
-    let phi_curve = match fit_phi_i(series, &opts) {
-        Ok(f) => {
+    let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, &opts)) {
+        // left out by the plan (said at the start)
+        None => {
+            crate::verdict::remove_stale_law(out, "phi_i")?;
+            phi_notes.push("no φ(I) law fitted (left out by the plan)".into());
+            None
+        }
+        Some(Ok(f)) => {
             let shown = Shown {
                 key: "phi_i",
                 form: None,
-                formula: "φ_max − (φ_max − φ_min) I",
-                title: "φ(I) = φ_max − (φ_max − φ_min) I",
+                formula: "φ_max − a I",
+                title: "φ(I) = φ_max − a I",
                 linear: true,
                 file: "phi_i",
             };
@@ -353,10 +394,10 @@ pub(crate) fn fit_mu_phi(
                 &f.report,
                 s,
                 headline,
-                |p, i| p[0] - (p[0] - p[1]) * i,
+                |p, i| p[0] - p[1] * i,
             )?)
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("φ(I) fit failed: {e}"));
             s.text("phi_i_fit_error", &e.to_string());
             crate::verdict::remove_stale_law(out, "phi_i")?;

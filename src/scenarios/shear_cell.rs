@@ -786,6 +786,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             // the wall-bounded cell measures no standard error per point
             std_errors: Default::default(),
             point_verdicts: &point_verdicts,
+            leave_out: &c.leave_out,
         },
         &mut verdict,
         &mut s,
@@ -815,8 +816,11 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         PALETTE[3],
         vs.iter().zip(&mus).map(|(v, m)| (v / scale, *m)).collect(),
     ));
-    match select_wall_law(&ws, &opts) {
-        Ok(sel) => {
+    let wall_left_out = c.leave_out.iter().any(|l| l == "wall-law");
+    match (!wall_left_out).then(|| select_wall_law(&ws, &opts)) {
+        // left out by the plan (said at the start)
+        None => crate::verdict::remove_stale_law(&ctx.out, "wall")?,
+        Some(Ok(sel)) => {
             let best = sel.best();
             // over the measured slips only: the law is not drawn beyond its data
             let (vmin, vmax) = super::rheology_fit::finite_range(vs.iter().map(|v| v / scale))
@@ -870,7 +874,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 &best.report.parameters,
             ));
         }
-        Err(e) => {
+        Some(Err(e)) => {
             warn(&format!("wall-law fit failed: {e}"));
             s.text("wall_law_fit_error", &e.to_string());
             headline.push(format!("wall law not identified: {e}"));

@@ -629,6 +629,7 @@ pub fn run(
                 phi: Some(rows.iter().map(|r| r[6]).collect()),
             },
             point_verdicts: &point_verdicts,
+            leave_out: &c.leave_out,
         },
         &mut verdict,
         &mut s,

@@ -72,9 +72,48 @@ pub struct BiaxialConfig {
     pub initial_solid_fraction: f64,
     /// Contact solver.
     pub solver: SolverSpec,
+    /// Laws not to fit (`grainlaw fit` names), so that a plan short of their data runs
+    /// ([`super::laws`]: checked at load, said at the start of the run).
+    #[serde(default)]
+    pub leave_out: Vec<String>,
 }
 
 impl BiaxialConfig {
+    /// The laws it fits and the data each needs ([`super::laws`]).
+    pub fn law_needs(&self) -> Vec<super::laws::LawNeed> {
+        let n = self.confining_pressures.len();
+        vec![
+            super::laws::LawNeed {
+                law: "mohr-coulomb",
+                formula: "q = p sin φ + c cos φ over the peaks",
+                key: "confining_pressures",
+                needs: 3,
+                have: Some(n),
+                why: "the envelope through the origin, 1 parameter + 2; a free cohesion from 4",
+                instead_of: None,
+            },
+            super::laws::LawNeed {
+                law: "critical-state",
+                formula: "sin φ_c and φ_c, plateau means over the pressures",
+                key: "confining_pressures",
+                needs: 2,
+                have: Some(n),
+                why:
+                    "its intervals come from the scatter between samples, the pressures as replicas",
+                instead_of: None,
+            },
+            super::laws::LawNeed {
+                law: "stress-dilatancy",
+                formula: "sin φ = sin φ_cv + β sin ψ over the hardening phases",
+                key: "",
+                needs: 4,
+                have: None,
+                why: "dilatancy windows before the peaks",
+                instead_of: None,
+            },
+        ]
+    }
+
     /// Checks every value (key named in the error) and that no phase exceeds
     /// [`limits::MAX_STEPS`] steps.
     pub fn validate(&self) -> Result<()> {

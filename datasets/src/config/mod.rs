@@ -7,6 +7,7 @@ pub mod common;
 pub mod deposit;
 pub mod inclined_flow;
 pub mod janssen;
+pub mod laws;
 pub mod rolling;
 pub mod shear_cell;
 pub mod simple_shear;

@@ -62,6 +62,10 @@ pub struct ShearCellConfig {
     pub compression_time: f64,
     /// Contact solver.
     pub solver: SolverSpec,
+    /// Laws not to fit (`grainlaw fit` names), so that a plan short of their data runs
+    /// ([`super::laws`]: checked at load, said at the start of the run).
+    #[serde(default)]
+    pub leave_out: Vec<String>,
 }
 
 /// Default of [`ShearCellConfig::velocity_corrections`].
@@ -86,6 +90,23 @@ fn default_solver_tightenings() -> u32 {
 pub const MAX_SOLVER_TIGHTENINGS: u32 = 4;
 
 impl ShearCellConfig {
+    /// The laws it fits and the data each needs ([`super::laws`]): μ(I), φ(I) and the wall law
+    /// (from both walls of each run: 2 points per inertial number).
+    pub fn law_needs(&self) -> Vec<super::laws::LawNeed> {
+        let n = self.inertial_numbers.len();
+        let mut needs = super::laws::rheology(n);
+        needs.push(super::laws::LawNeed {
+            law: "wall-law",
+            formula: "μ_eff(V) at the walls, best of three forms by AIC",
+            key: "inertial_numbers",
+            needs: 3,
+            have: Some(n),
+            why: "3 parameters + 2 points, two per inertial number (both walls)",
+            instead_of: None,
+        });
+        needs
+    }
+
     /// Checks every value (key named in the error), and that no phase takes more than
     /// [`limits::MAX_STEPS`] steps. A run at inertial number `I` shears at `γ̇ = I √(P/ρ) / d`
     /// (d = 2 R̄) with the step `dt = min(dt_max, travel_per_step · R̄ / V)`, `V = γ̇ H`, so it takes
@@ -101,13 +122,10 @@ impl ShearCellConfig {
         )?;
         self.friction.validate("friction")?;
         limits::pressure("pressure", self.pressure)?;
-        if self.inertial_numbers.len() < 3 {
+        if self.inertial_numbers.is_empty() {
             return Err(DatasetError::invalid(
                 "inertial_numbers",
-                format!(
-                    "needs at least 3 values to fit μ(I), got {}",
-                    self.inertial_numbers.len()
-                ),
+                "is empty: give at least one inertial number (what each law needs: `grainlaw scenarios --show shear-cell`)",
             ));
         }
         limits::at_most("inertial_numbers", self.inertial_numbers.len(), 100)?;

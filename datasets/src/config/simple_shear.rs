@@ -54,9 +54,18 @@ pub struct SimpleShearConfig {
     pub initial_solid_fraction: f64,
     /// Contact solver.
     pub solver: SolverSpec,
+    /// Laws not to fit (`grainlaw fit` names), so that a plan short of their data runs
+    /// ([`super::laws`]: checked at load, said at the start of the run).
+    #[serde(default)]
+    pub leave_out: Vec<String>,
 }
 
 impl SimpleShearConfig {
+    /// The laws it fits and the data each needs ([`super::laws`]).
+    pub fn law_needs(&self) -> Vec<super::laws::LawNeed> {
+        super::laws::rheology(self.inertial_numbers.len())
+    }
+
     /// Checks every value (key named in the error) and that no phase exceeds
     /// [`limits::MAX_STEPS`] steps.
     pub fn validate(&self) -> Result<()> {
@@ -76,7 +85,7 @@ impl SimpleShearConfig {
         if self.inertial_numbers.is_empty() {
             return Err(DatasetError::invalid(
                 "inertial_numbers",
-                "is empty: give at least one inertial number (3 or more to fit μ(I))",
+                "is empty: give at least one inertial number (what each law needs: `grainlaw scenarios --show simple-shear`)",
             ));
         }
         limits::at_most("inertial_numbers", self.inertial_numbers.len(), 100)?;

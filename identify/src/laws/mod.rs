@@ -13,5 +13,5 @@ pub use boundary_layer::VelocityBoundaryLayer;
 pub use critical_state::{CriticalStateLaw, StressDilatancyLaw};
 pub use janssen::{JanssenLaw, JanssenVerticalLaw, STANDARD_GRAVITY};
 pub use mohr_coulomb::{DruckerPrager, MohrCoulombLaw};
-pub use mu_i::{LinearMuILaw, LinearPhiILaw, MuILaw, PhiILaw};
+pub use mu_i::{LinearMuILaw, MuILaw, PhiILaw};
 pub use wall_friction::WallFrictionLaw;

@@ -58,32 +58,19 @@ impl LinearMuILaw {
     }
 }
 
-/// `φ(I) = φ_max − (φ_max − φ_min) I`.
+/// `φ(I) = φ_max − a I`, the dilatancy of dense granular flow (da Cruz, Emam, Prochnow, Roux &
+/// Chevoir, Phys. Rev. E 72, 021309, 2005; GDR MiDi, Eur. Phys. J. E 14, 2004), valid over the
+/// `I` it was calibrated on. (It was also written `φ_max − (φ_max − φ_min) I`, naming
+/// `φ_min = φ(1)` an extrapolation far beyond any dense flow; grainlaw keeps the slope.)
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PhiILaw {
-    /// Solid fraction at `I = 0` (1).
-    pub phi_max: f64,
-    /// Extrapolated solid fraction at `I = 1` (1).
-    pub phi_min: f64,
-}
-
-impl PhiILaw {
-    /// `φ(I)`.
-    pub fn phi(&self, i: f64) -> f64 {
-        self.phi_max - (self.phi_max - self.phi_min) * i
-    }
-}
-
-/// `φ(I) = φ_max − a I`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LinearPhiILaw {
     /// Solid fraction at `I = 0` (1).
     pub phi_max: f64,
     /// Dilatancy slope `a = −dφ/dI` (1).
     pub slope: f64,
 }
 
-impl LinearPhiILaw {
+impl PhiILaw {
     /// `φ(I) = φ_max − a I`.
     pub fn phi(&self, i: f64) -> f64 {
         self.phi_max - self.slope * i
