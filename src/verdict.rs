@@ -100,6 +100,11 @@ pub const SENSITIVITY_MU_REFUSED: f64 = 0.02;
 pub const SENSITIVITY_PRESSURE_SUSPECT: f64 = 0.025;
 /// The same, above which the result is refused (1): I off by 5 %.
 pub const SENSITIVITY_PRESSURE_REFUSED: f64 = 0.10;
+/// Largest solver effect on a reported mean, as a fraction of its statistical error, before
+/// the result is suspect ([`Checks::sensitivity`], where the window's statistical errors are
+/// known): a bias of a tenth of the standard error widens the interval by 0.5 % in
+/// quadrature. The re-solves measure it; the steps are made as cheap as this allows.
+pub const SENSITIVITY_SE_FRACTION: f64 = 0.1;
 /// Tolerance of the re-solve of a sample's step (the error measure of the step's problem,
 /// `dem::fc::fc_error`): 10⁻⁸, tens of thousands of times below the runs' 10⁻⁴ and, with the
 /// open pairs' shifts at most a few hundred times the loaded contacts' scale, below 10⁻⁵ on it.
@@ -298,9 +303,14 @@ impl Checks {
 
     /// The measured solver sensitivity of a window ([`Sensitivity`], module documentation):
     /// its μ change, relative pressure change and failed re-solves against their limits.
-    /// Returns whether it was measured and passed (then it stands in for the loaded-scale
-    /// error's suspect limit). Nothing is checked where nothing was re-solved.
-    pub fn sensitivity(&mut self, label: &str, s: &Sensitivity) -> bool {
+    /// `statistical = [SE(μ), SE(P)/P]` of the window's means (0 or NaN: not known): where
+    /// known, a change above [`SENSITIVITY_SE_FRACTION`] of it is suspect (the solver's effect
+    /// must stay a small part of the result's error); otherwise the absolute limits
+    /// [`SENSITIVITY_MU_SUSPECT`], [`SENSITIVITY_PRESSURE_SUSPECT`]. The refusal limits are
+    /// absolute ([`SENSITIVITY_MU_REFUSED`], [`SENSITIVITY_PRESSURE_REFUSED`]). Returns whether
+    /// it was measured and passed (then it stands in for the suspect limits of the solver's
+    /// proxies, [`Checks::window_measured`]). Nothing is checked where nothing was re-solved.
+    pub fn sensitivity(&mut self, label: &str, s: &Sensitivity, statistical: [f64; 2]) -> bool {
         let tried = s.samples + s.unresolved;
         if tried == 0 {
             return false;
@@ -321,32 +331,51 @@ impl Checks {
                 )
             },
         );
+        let relative = |se: f64, absolute: f64| -> (f64, bool) {
+            if se.is_finite() && se > 0.0 {
+                (SENSITIVITY_SE_FRACTION * se, true)
+            } else {
+                (absolute, false)
+            }
+        };
         if s.samples > 0 {
             let dmu = s.mu_change();
+            let (limit, of_se) = relative(statistical[0], SENSITIVITY_MU_SUSPECT);
             self.at_most(
                 "solver.sensitivity_mu",
                 dmu,
-                SENSITIVITY_MU_SUSPECT,
-                Some(SENSITIVITY_MU_REFUSED),
+                limit,
+                Some(SENSITIVITY_MU_REFUSED.max(limit)),
                 |t| {
                     format!(
-                        "{label}: μ moves by {dmu:.4} when its {} samples are solved to {SENSITIVITY_TOLERANCE:.0e} (limit {t})",
-                        s.samples
+                        "{label}: μ moves by {dmu:.2e} when its {} samples are solved to {SENSITIVITY_TOLERANCE:.0e} (limit {t:.2e}{})",
+                        s.samples,
+                        if of_se {
+                            format!(", a tenth of μ's standard error {:.2e}", statistical[0])
+                        } else {
+                            String::new()
+                        }
                     )
                 },
             );
             let dp = s.pressure_change();
+            let (limit, of_se) = relative(statistical[1], SENSITIVITY_PRESSURE_SUSPECT);
             self.at_most(
                 "solver.sensitivity_pressure",
                 dp,
-                SENSITIVITY_PRESSURE_SUSPECT,
-                Some(SENSITIVITY_PRESSURE_REFUSED),
+                limit,
+                Some(SENSITIVITY_PRESSURE_REFUSED.max(limit)),
                 |t| {
                     format!(
-                        "{label}: the pressure moves by {:.2} % when its {} samples are solved to {SENSITIVITY_TOLERANCE:.0e} (limit {} %)",
+                        "{label}: the pressure moves by {:.3} % when its {} samples are solved to {SENSITIVITY_TOLERANCE:.0e} (limit {:.3} %{})",
                         100.0 * dp,
                         s.samples,
-                        100.0 * t
+                        100.0 * t,
+                        if of_se {
+                            format!(", a tenth of its relative standard error {:.2} %", 100.0 * statistical[1])
+                        } else {
+                            String::new()
+                        }
                     )
                 },
             );
@@ -372,12 +401,25 @@ impl Checks {
         }
         let n = w.steps as f64;
         let long = w.steps >= MIN_STEPS_FOR_FRACTION_REFUSAL;
+        // The solver's effect on the result measured and within its limits: the proxies
+        // (steps above the tolerance, the worst error) are judged against their refusal limits
+        // only; the precision of the result is the criterion, not a residual.
+        let measured =
+            self.sensitivity(label, &w.sensitivity, w.statistical_errors) || measured_passed;
         let f = w.unconverged as f64 / n;
+        let unconverged_limits = if measured {
+            (SOLVER_UNCONVERGED_REFUSED, None)
+        } else {
+            (
+                SOLVER_UNCONVERGED_SUSPECT,
+                long.then_some(SOLVER_UNCONVERGED_REFUSED),
+            )
+        };
         self.at_most(
             "solver.unconverged_fraction",
             f,
-            SOLVER_UNCONVERGED_SUSPECT,
-            long.then_some(SOLVER_UNCONVERGED_REFUSED),
+            unconverged_limits.0,
+            unconverged_limits.1,
             |t| {
                 format!(
                     "{label}: {} of {} steps stopped above the solver tolerance ({:.1} %, limit {:.0} %)",
@@ -392,7 +434,11 @@ impl Checks {
         self.at_most(
             "solver.worst_error_over_tolerance",
             e,
-            SOLVER_ERROR_SUSPECT,
+            if measured {
+                SOLVER_ERROR_REFUSED
+            } else {
+                SOLVER_ERROR_SUSPECT
+            },
             Some(SOLVER_ERROR_REFUSED),
             |t| {
                 format!(
@@ -405,7 +451,6 @@ impl Checks {
         // tolerance only because open pairs' gap-closing shifts inflate the error's scale.
         // Judged where it exceeds the error (not under `error_scale = "loaded"`, whose error
         // already includes it): one cause, one reason.
-        let measured = self.sensitivity(label, &w.sensitivity) || measured_passed;
         let loaded = w.worst_error_without_gap_shifts;
         if loaded > w.worst_error || loaded.is_nan() {
             let e0 = loaded / w.tolerance;
@@ -510,6 +555,11 @@ pub struct WindowStats {
     /// The solver's measured effect on the window's stress, where the scenario measures it.
     #[serde(default)]
     pub sensitivity: Sensitivity,
+    /// The statistical errors of what the window reports, `[SE(μ), SE(P)/P]` (block
+    /// averages), where the scenario sets them before judging (0: not known): the solver's
+    /// measured effect is judged against them ([`Checks::sensitivity`]).
+    #[serde(default)]
+    pub statistical_errors: [f64; 2],
 }
 
 /// The solver's effect on an averaging window's stress (module documentation): the sums of the

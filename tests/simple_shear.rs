@@ -14,7 +14,7 @@ const TINY: &[&str] = &[
     "--set",
     "grains=50",
     "--set",
-    "compression_time=0.06",
+    "compression_duration=13",
     "--set",
     "inertial_numbers=[0.2]",
     "--set",

@@ -154,7 +154,7 @@ pub fn arrangement(c: &ArrangementsConfig, kind: Arrangement) -> Result<World> {
     let width = 2.0 * r * c.columns as f64;
     let top = centres.iter().map(|p| p.y).fold(0.0, f64::max) + 2.0 * r;
     let mut w = world(c.dt, Vector2::new(0.0, -9.81), None, r, &c.friction);
-    w.params.solver = c.solver.params();
+    c.solver.apply(&mut w.params);
     box_walls(&mut w, width);
     w.add_line_wall("top", Vector2::new(0.0, top), Vector2::new(0.0, -1.0), WALL);
     for p in centres {
@@ -247,7 +247,7 @@ pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
         &c.friction,
         "base",
     )?;
-    w.params.solver = c.solver.params();
+    c.solver.apply(&mut w.params);
     for (p, r) in centres.iter().zip(&radii) {
         let b = w.add_grain(*p, *r, g.density, GRAIN);
         // A small random velocity breaks the symmetry of the start.
@@ -280,7 +280,7 @@ pub fn shear_cell(c: &ShearCellConfig) -> Result<(World, f64)> {
         &c.friction,
         "bottom",
     )?;
-    w.params.solver = c.solver.params();
+    c.solver.apply(&mut w.params);
     let top_y = centres
         .iter()
         .zip(&radii)

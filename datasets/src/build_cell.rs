@@ -19,7 +19,7 @@ pub fn simple_shear(c: &SimpleShearConfig) -> Result<World> {
         grain: &c.grain,
         friction: c.friction.grain_grain,
         solid_fraction: c.initial_solid_fraction,
-        dt: c.dt_max,
+        dt: c.compression_dt(2.0 * c.grain.radius_mean),
         solver: &c.solver,
     })
 }
@@ -72,6 +72,7 @@ pub fn loose_cell(c: &LooseCell) -> Result<World> {
         gravity: Vector2::zeros(),
         detection_gap: 0.1 * c.grain.radius_min(),
         solver: c.solver.params(),
+        overlap_rate: c.solver.overlap_rate,
         ..Default::default()
     };
     let laws = dem::ContactLaws::new(&["grain"], c.friction);

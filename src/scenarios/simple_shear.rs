@@ -35,12 +35,22 @@ use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::verdict::{max_solid_fraction, RunVerdict, WindowStats};
 
-/// Every this many steps of an averaging window, the step is solved again to
+/// Re-solved samples of an averaging window, spread evenly over it (at least this many; every
+/// step of a shorter window): each such step is solved again to
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] with the cell's stress-controlled component
-/// (`dem::World::last_step_problem`) and the cell's stress taken both ways: the window's solver
+/// (`dem::World::last_step_problem`) and the cell's stress taken both ways, the window's solver
 /// sensitivity of μ = |Σσ_xy| / (−Σσ_yy) and of σ_yy ([`crate::verdict::Sensitivity`]), judged
-/// by its checks.
-const SENSITIVITY_EVERY: u64 = 10;
+/// against a tenth of their statistical errors ([`crate::verdict::SENSITIVITY_SE_FRACTION`]).
+/// A fixed number, not a fraction of the steps: a re-solve to 10⁻⁸ of a dense step costs
+/// hundreds of the run's own loose solves.
+const SENSITIVITY_SAMPLES: u64 = 20;
+
+/// Whether window step `j` (0-based) of a window of `len` steps is re-solved
+/// ([`SENSITIVITY_SAMPLES`] evenly spread, the last step of each stride).
+fn resolves(j: u64, len: u64) -> bool {
+    let every = (len / SENSITIVITY_SAMPLES).max(1);
+    j % every == every - 1
+}
 
 /// Columns of `history_I{k}.csv`.
 const HISTORY: [&str; 18] = [
@@ -317,19 +327,18 @@ impl PhasedRun for Shear<'_> {
         let c = self.c;
         let d = mean_diameter(world);
         if k == 0 {
-            world.params.dt = c.dt_max;
-            world.cell_control = Some(self.control(c.dt_max, d, None));
+            let dt = c.compression_dt(d);
+            world.params.dt = dt;
+            world.cell_control = Some(self.control(dt, d, None));
             world.validate(1e-9)?;
             return Ok(Some(PhasePlan {
                 name: "compress".into(),
-                stop: Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
+                stop: Stop::Steps(c.compression_steps(d)),
             }));
         }
         let i = self.targets[k - 1];
         let gamma_dot = i * (c.pressure / c.grain.density).sqrt() / d;
-        let dt = c
-            .dt_max
-            .min(c.travel_per_step * c.grain.radius_mean / (gamma_dot * d));
+        let dt = c.shear_dt(gamma_dot, d);
         let steps = (c.strain / (gamma_dot * dt)).ceil() as u64;
         let avg_steps = ((c.average_strain / (gamma_dot * dt)).ceil() as u64).min(steps);
         world.params.dt = dt;
@@ -370,7 +379,12 @@ impl PhasedRun for Shear<'_> {
         let snap = w.snapshot();
         let cs = cell_state(&snap)?;
         let s = cs.stress;
-        if averaged && st.run.n.is_multiple_of(SENSITIVITY_EVERY) {
+        if averaged
+            && resolves(
+                st.run.n + st.run.avg_steps - st.run.steps - 1,
+                st.run.avg_steps,
+            )
+        {
             let resolved = resolved_pair(w, |snap| {
                 let s = cell_state(snap).ok()?.stress;
                 Some([s[(0, 1)], s[(1, 1)]])
@@ -447,6 +461,9 @@ impl PhasedRun for Shear<'_> {
         let gd = st.run.gamma_dot;
         let point = RheologyPoint::of(&samples, gd, d, self.c.grain.density)?;
         let corrections: f64 = col(17).iter().sum();
+        // what the solver's measured effect is judged against (0: not known)
+        let known = |x: f64| if x.is_finite() { x } else { 0.0 };
+        st.window.statistical_errors = [known(point.mu_se), known(point.pn_se / point.pn)];
         st.checks.push(RunCheckData {
             i_target: target,
             i_measured: point.i,
@@ -485,7 +502,7 @@ pub fn run(
     let shear = Shear { c, targets };
     let fresh = || -> Result<(dem::World, State)> {
         let world = datasets::build_cell::simple_shear(c)?;
-        let t_total = c.compression_time
+        let t_total = c.compression_duration * c.grain_time()
             + shear
                 .targets
                 .iter()

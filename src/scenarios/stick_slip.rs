@@ -97,7 +97,7 @@ impl PhasedRun for Push<'_> {
                 c.dt / c.deposit.substeps as f64,
             )?;
             *world = col.world;
-            world.params.solver = c.deposit.solver.params();
+            c.deposit.solver.apply(&mut world.params);
             st.bottom = col.bottom;
             st.weights.push(grain_weight(world));
             Ok(Some(PhasePlan {
@@ -110,7 +110,7 @@ impl PhasedRun for Push<'_> {
             }))
         } else {
             world.params.dt = c.dt;
-            world.params.solver = c.solver.params();
+            c.solver.apply(&mut world.params);
             world.bodies[st.bottom].velocity = Vector2::new(0.0, c.push_velocity);
             st.force = Vec::with_capacity(self.steps() as usize);
             st.window.reset();

@@ -154,10 +154,20 @@ pub struct SolverSpec {
     /// contacts' scale too ([`dem::solver::ErrorScale`]).
     #[serde(default)]
     pub error_scale: dem::solver::ErrorScale,
+    /// Largest overlap growth per step of a converged solve, as a fraction of the smallest
+    /// radius ([`dem::WorldParams::overlap_rate`]: no closed or loaded contact may approach
+    /// faster than `overlap_rate · R_min / h`), ≥ 0 (0: no such condition). Default 10⁻⁴.
+    #[serde(default = "default_overlap_rate")]
+    pub overlap_rate: f64,
 }
 
 fn one() -> usize {
     1
+}
+
+/// Default of [`SolverSpec::overlap_rate`]: the engine's.
+pub fn default_overlap_rate() -> f64 {
+    dem::WorldParams::default().overlap_rate
 }
 
 /// Default of [`SolverSpec::max_halvings`]: up to 8 sub-steps.
@@ -194,7 +204,19 @@ impl SolverSpec {
             self.last_level_sweeps,
             1000,
         )?;
+        in_range(
+            &format!("{prefix}.overlap_rate"),
+            self.overlap_rate,
+            0.0,
+            1.0,
+        )?;
         Ok(())
+    }
+
+    /// Sets the engine's solver parameters ([`SolverSpec::params`]) and overlap rate in `p`.
+    pub fn apply(&self, p: &mut dem::WorldParams) {
+        p.solver = self.params();
+        p.overlap_rate = self.overlap_rate;
     }
 
     /// Engine parameters with this tolerance and sweep cap.

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_cell_compression, CellControlMode, GrainSpec, SolverSpec};
+use super::common::{CellControlMode, GrainSpec, SolverSpec};
 use crate::error::{in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
 
@@ -38,8 +38,11 @@ pub struct SimpleShearConfig {
     pub strain: f64,
     /// The last `average_strain` of each run is averaged (1).
     pub average_strain: f64,
-    /// Largest time step (s).
-    pub dt_max: f64,
+    /// An absolute cap of the time step (s), if any (default none): the steps follow the
+    /// grains' own scales ([`SimpleShearConfig::shear_dt`], [`SimpleShearConfig::compression_dt`]),
+    /// so that a consistent change of units gives the same run.
+    #[serde(default)]
+    pub dt_max: Option<f64>,
     /// Largest relative travel of neighbouring grains per step, `γ̇ d Δt / R̄` (1), sets Δt.
     pub travel_per_step: f64,
     /// Cap of the cell's strain rate under stress control, as an inertial number
@@ -48,8 +51,10 @@ pub struct SimpleShearConfig {
     /// `implicit` (default) or `explicit` control of the cell ([`CellControlMode`]).
     #[serde(default)]
     pub cell_control: CellControlMode,
-    /// Duration of the isotropic compression (s).
-    pub compression_time: f64,
+    /// Duration of the isotropic compression in units of the grains' time `t_g = d √(ρ/P)`
+    /// (1; 32 t_g is 0.15 s for the default 3 mm grains at 1 kPa): the cell's strain-rate cap
+    /// allows `control_inertial_number` of strain per `t_g`.
+    pub compression_duration: f64,
     /// Solid fraction of the initial loose packing (1), in [0.2, 0.6].
     pub initial_solid_fraction: f64,
     /// Contact solver.
@@ -58,9 +63,76 @@ pub struct SimpleShearConfig {
     /// ([`super::laws`]: checked at load, said at the start of the run).
     #[serde(default)]
     pub leave_out: Vec<String>,
+    /// Largest number of time steps of the whole plan ([`SimpleShearConfig::planned_steps`]),
+    /// default [`DEFAULT_MAX_PLAN_STEPS`]: a plan beyond it is refused at load with the numbers
+    /// that make it so, unless this key raises the bound (asked for explicitly).
+    #[serde(default = "default_max_plan_steps")]
+    pub max_steps: f64,
+}
+
+/// Default of [`SimpleShearConfig::max_steps`]: 10⁶ steps (about an hour at a few ms a step).
+pub const DEFAULT_MAX_PLAN_STEPS: f64 = 1e6;
+
+fn default_max_plan_steps() -> f64 {
+    DEFAULT_MAX_PLAN_STEPS
 }
 
 impl SimpleShearConfig {
+    /// The grains' time `t_g = d̄ √(ρ/P)` (s), `d̄ = 2 R̄`: the time a grain takes to move by its
+    /// diameter under the confining pressure; `I = γ̇ t_g`.
+    pub fn grain_time(&self) -> f64 {
+        2.0 * self.grain.radius_mean * (self.grain.density / self.pressure).sqrt()
+    }
+
+    /// Shear rate `γ̇ = I / t_g` (1/s) of target inertial number `i` ([`Self::grain_time`];
+    /// the run's own `d` is the packing's mean diameter, within the spread of `2 R̄`).
+    pub fn shear_rate(&self, i: f64) -> f64 {
+        i / self.grain_time()
+    }
+
+    /// Time step of the shear run at shear rate `gamma_dot` (1/s) with mean diameter `d` (m):
+    /// neighbours a diameter apart travel `travel_per_step · R̄` relative to each other per
+    /// step, `Δt = travel_per_step · R̄ / (γ̇ d)`, capped by `dt_max` if given. A strain of
+    /// `travel_per_step R̄ / d` per step: 0.01 at the default 0.02.
+    pub fn shear_dt(&self, gamma_dot: f64, d: f64) -> f64 {
+        let dt = self.travel_per_step * self.grain.radius_mean / (gamma_dot * d);
+        self.dt_max.map_or(dt, |m| dt.min(m))
+    }
+
+    /// Time step of the isotropic compression with mean diameter `d` (m): the travel rule at
+    /// the cell's strain-rate cap `ε̇_max = control_inertial_number · √(P/ρ) / d`
+    /// ([`Self::shear_dt`] with `γ̇ = ε̇_max`), capped by `dt_max` if given.
+    pub fn compression_dt(&self, d: f64) -> f64 {
+        let rate = self.control_inertial_number * (self.pressure / self.grain.density).sqrt() / d;
+        self.shear_dt(rate, d)
+    }
+
+    /// Steps of the isotropic compression (`compression_duration · t_g / Δt`) with mean
+    /// diameter `d` (m).
+    pub fn compression_steps(&self, d: f64) -> u64 {
+        (self.compression_duration * self.grain_time() / self.compression_dt(d)).ceil() as u64
+    }
+
+    /// Steps of the shear run at target inertial number `i` with mean diameter `d` (m):
+    /// `strain / (γ̇ Δt)`.
+    pub fn shear_steps(&self, i: f64, d: f64) -> u64 {
+        let g = i * (self.pressure / self.grain.density).sqrt() / d;
+        (self.strain / (g * self.shear_dt(g, d))).ceil() as u64
+    }
+
+    /// Steps of the whole plan, the compression and every shear run, at the nominal mean
+    /// diameter `2 R̄`: `(compression, [run per inertial number])`.
+    pub fn planned_steps(&self) -> (u64, Vec<u64>) {
+        let d = 2.0 * self.grain.radius_mean;
+        (
+            self.compression_steps(d),
+            self.inertial_numbers
+                .iter()
+                .map(|&i| self.shear_steps(i, d))
+                .collect(),
+        )
+    }
+
     /// The laws it fits and the data each needs ([`super::laws`]).
     pub fn law_needs(&self) -> Vec<super::laws::LawNeed> {
         super::laws::rheology(self.inertial_numbers.len())
@@ -111,32 +183,60 @@ impl SimpleShearConfig {
             ));
         }
         in_range("travel_per_step", self.travel_per_step, 1e-4, 0.5)?;
-        check_cell_compression(
-            self.dt_max,
+        if let Some(dt) = self.dt_max {
+            positive("dt_max", dt)?;
+        }
+        in_range(
+            "control_inertial_number",
             self.control_inertial_number,
-            self.compression_time,
+            1e-6,
+            0.1,
+        )?;
+        positive("compression_duration", self.compression_duration)?;
+        in_range(
+            "initial_solid_fraction",
             self.initial_solid_fraction,
-            &self.solver,
+            0.2,
+            0.6,
         )?;
-        let d = 2.0 * self.grain.radius_mean;
-        let i_min = self
-            .inertial_numbers
-            .iter()
-            .cloned()
-            .fold(f64::MAX, f64::min);
-        let gamma_dot = i_min * (self.pressure / self.grain.density).sqrt() / d;
-        limits::steps(
-            "inertial_numbers",
-            &format!("strain / (γ̇ dt_max) of the slowest run (I = {i_min:e})"),
-            self.strain / gamma_dot,
-            self.dt_max,
-        )?;
-        limits::steps(
-            "travel_per_step",
-            "strain · d / (travel_per_step · radius_mean)",
-            self.strain * d,
-            self.travel_per_step * self.grain.radius_mean,
-        )?;
+        self.solver.validate("solver")?;
+        in_range("max_steps", self.max_steps, 1.0, limits::MAX_STEPS * 100.0)?;
+        let (compression, runs) = self.planned_steps();
+        let total = compression as f64 + runs.iter().map(|&n| n as f64).sum::<f64>();
+        if !(total <= self.max_steps) {
+            let slowest = runs
+                .iter()
+                .zip(&self.inertial_numbers)
+                .max_by_key(|(n, _)| **n)
+                .map(|(n, i)| format!("{n} at I = {i:e}"))
+                .unwrap_or_default();
+            return Err(DatasetError::invalid(
+                "max_steps",
+                format!(
+                    "the plan takes {total:.3e} time steps (compression {compression}, the slowest run {slowest}: strain {} at a time step of {:.3e} s{}), more than {}: shorten the plan, raise travel_per_step, or set max_steps to ask for it",
+                    num(self.strain),
+                    self.shear_dt(
+                        self.shear_rate(
+                            self.inertial_numbers
+                                .iter()
+                                .cloned()
+                                .fold(f64::MAX, f64::min)
+                        ),
+                        2.0 * self.grain.radius_mean
+                    ),
+                    if self.dt_max.is_some() { ", capped by dt_max" } else { "" },
+                    num(self.max_steps)
+                ),
+            ));
+        }
+        for (n, &i) in runs.iter().zip(&self.inertial_numbers) {
+            limits::steps(
+                "inertial_numbers",
+                &format!("the run at I = {i:e}"),
+                *n as f64,
+                1.0,
+            )?;
+        }
         Ok(())
     }
 }

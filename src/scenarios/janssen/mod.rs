@@ -170,7 +170,7 @@ impl PhasedRun for Column<'_> {
         };
         Ok(match k {
             DEPOSIT => {
-                world.params.solver = c.deposit.solver.params();
+                c.deposit.solver.apply(&mut world.params);
                 plan(
                     "deposit",
                     Stop::UntilRest(RunUntilRest {
@@ -183,7 +183,7 @@ impl PhasedRun for Column<'_> {
             // Relaxation at the scenario's time step, tight tolerance.
             RELAX => {
                 world.params.dt = c.dt;
-                world.params.solver = c.relax.solver.params();
+                c.relax.solver.apply(&mut world.params);
                 plan(
                     "relax",
                     Stop::UntilRest(RunUntilRest {
@@ -197,7 +197,7 @@ impl PhasedRun for Column<'_> {
             // (Coulomb conditions at the wall contacts).
             RELEASE if self.release_steps() > 0 => {
                 world.bodies[st.bottom].velocity = Vector2::new(0.0, -c.release.speed);
-                world.params.solver = c.release.solver.params();
+                c.release.solver.apply(&mut world.params);
                 plan("release", Stop::Steps(self.release_steps()))
             }
             // The stresses are measured at the end of the release, over a window of steps
@@ -214,6 +214,7 @@ impl PhasedRun for Column<'_> {
                     gauss_seidel_attempts: false,
                     ..c.relax.solver.params()
                 };
+                world.params.overlap_rate = c.relax.solver.overlap_rate;
                 let (tol, cap) = (c.relax.solver.tolerance, c.analysis.final_max_iterations);
                 info(
                     env.verbosity,
@@ -303,7 +304,7 @@ impl PhasedRun for Column<'_> {
             RELEASE => st.release = *stats,
             _ => {
                 st.release.merge(stats);
-                world.params.solver = self.c.relax.solver.params();
+                self.c.relax.solver.apply(&mut world.params);
             }
         }
         Ok(())
