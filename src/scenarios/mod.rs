@@ -126,6 +126,21 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
     for line in left_out_lines(&scenario) {
         crate::progress::note(&line);
     }
+    // said at the start: how long the plan is, in steps
+    if let Scenario::SimpleShear(c) = &scenario {
+        let (compression, runs) = c.planned_steps();
+        let total = compression + runs.iter().sum::<u64>();
+        crate::progress::note(&format!(
+            "plan: about {total} time steps (compression {compression}; {}), bound max_steps = {}",
+            c.inertial_numbers
+                .iter()
+                .zip(&runs)
+                .map(|(i, n)| format!("I = {i}: {n}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            c.max_steps
+        ));
+    }
     let mut outcome = match &scenario {
         Scenario::Janssen(c) => janssen::run(c, ctx, ctl)?,
         Scenario::Rolling(c) => rolling::run(c, ctx, ctl)?,

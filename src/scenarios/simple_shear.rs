@@ -339,8 +339,9 @@ impl PhasedRun for Shear<'_> {
         let i = self.targets[k - 1];
         let gamma_dot = i * (c.pressure / c.grain.density).sqrt() / d;
         let dt = c.shear_dt(gamma_dot, d);
-        let steps = (c.strain / (gamma_dot * dt)).ceil() as u64;
-        let avg_steps = ((c.average_strain / (gamma_dot * dt)).ceil() as u64).min(steps);
+        let steps = datasets::config::simple_shear::whole_steps(c.strain / (gamma_dot * dt));
+        let avg_steps =
+            datasets::config::simple_shear::whole_steps(c.average_strain / (gamma_dot * dt)).min(steps);
         world.params.dt = dt;
         let l = world.cell().map_or_else(Mat::zeros, |cell| cell.l);
         world.set_velocity_gradient(Mat::new(0.0, gamma_dot, 0.0, l[(1, 1)]));

@@ -70,6 +70,18 @@ pub struct SimpleShearConfig {
     pub max_steps: f64,
 }
 
+/// The steps that cover a phase of `ratio` time steps: `⌈ratio⌉`, a ratio within 10⁻⁹ of an
+/// integer taken as that integer (rounding in `t / Δt` must not add a step: a consistent change
+/// of units gives the same count).
+pub fn whole_steps(ratio: f64) -> u64 {
+    let r = ratio.round();
+    if (ratio - r).abs() <= 1e-9 * r.max(1.0) {
+        r as u64
+    } else {
+        ratio.ceil() as u64
+    }
+}
+
 /// Default of [`SimpleShearConfig::max_steps`]: 10⁶ steps (about an hour at a few ms a step).
 pub const DEFAULT_MAX_PLAN_STEPS: f64 = 1e6;
 
@@ -110,14 +122,14 @@ impl SimpleShearConfig {
     /// Steps of the isotropic compression (`compression_duration · t_g / Δt`) with mean
     /// diameter `d` (m).
     pub fn compression_steps(&self, d: f64) -> u64 {
-        (self.compression_duration * self.grain_time() / self.compression_dt(d)).ceil() as u64
+        whole_steps(self.compression_duration * self.grain_time() / self.compression_dt(d))
     }
 
     /// Steps of the shear run at target inertial number `i` with mean diameter `d` (m):
     /// `strain / (γ̇ Δt)`.
     pub fn shear_steps(&self, i: f64, d: f64) -> u64 {
         let g = i * (self.pressure / self.grain.density).sqrt() / d;
-        (self.strain / (g * self.shear_dt(g, d))).ceil() as u64
+        whole_steps(self.strain / (g * self.shear_dt(g, d)))
     }
 
     /// Steps of the whole plan, the compression and every shear run, at the nominal mean
@@ -238,5 +250,52 @@ impl SimpleShearConfig {
             )?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scenario::{load, Scenario};
+
+    fn config(sets: &[&str]) -> super::SimpleShearConfig {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        match load("simple-shear", &sets).expect("loads").scenario {
+            Scenario::SimpleShear(c) => c,
+            _ => unreachable!(),
+        }
+    }
+
+    /// Grains given in metres where millimetres were meant (radius 1.5 m): the grains' time
+    /// `d √(ρ/P)` grows 1000-fold and so do the time steps, so the plan takes exactly as many
+    /// steps as the default 3 mm grains' (it took 713 771 steps and 3 min 50 s when the time
+    /// step was an absolute `dt_max`). Analytic: `t_g = 2 R̄ √(ρ/P)` = 4.743 ms at the defaults.
+    #[test]
+    fn a_consistent_change_of_units_gives_the_same_plan() {
+        let mm = config(&[]);
+        let m = config(&["grain.radius_mean=1.5", "grain.radius_spread=0.3"]);
+        let tg = 3e-3 * (2500.0f64 / 1000.0).sqrt();
+        assert!((mm.grain_time() - tg).abs() < 1e-12 * tg);
+        assert!((m.grain_time() / mm.grain_time() - 1000.0).abs() < 1e-9);
+        assert_eq!(mm.planned_steps(), m.planned_steps());
+        // travel rule: a strain of travel_per_step · R̄ / d = 0.0025 per step, 1200 steps for 3
+        let (compression, runs) = mm.planned_steps();
+        assert!(runs.iter().all(|&n| n == 1200), "{runs:?}");
+        // compression: 32 t_g at Δt = travel · R̄ / (I_c √(P/ρ)) = t_g / 8
+        assert_eq!(compression, 256);
+    }
+
+    /// A plan beyond `max_steps` (10⁶ by default) is refused at load, naming the key and the
+    /// numbers; raising `max_steps` asks for it explicitly.
+    #[test]
+    fn a_plan_beyond_its_step_bound_is_refused_unless_asked_for() {
+        let sets: Vec<String> = ["travel_per_step=1e-4", "strain=20", "average_strain=1"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let e = load("simple-shear", &sets).unwrap_err().to_string();
+        assert!(e.contains("max_steps") && e.contains("time steps"), "{e}");
+        let mut more = sets.clone();
+        more.push("max_steps=1e8".into());
+        assert!(load("simple-shear", &more).is_ok());
     }
 }
