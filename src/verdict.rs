@@ -17,8 +17,8 @@
 //! | unconverged steps in the window ([`SOLVER_UNCONVERGED_SUSPECT`], [`SOLVER_UNCONVERGED_REFUSED`]) | 1 % of its steps | 25 % (windows of ≥ [`MIN_STEPS_FOR_FRACTION_REFUSAL`] steps) |
 //! | worst solver error in the window / tolerance ([`SOLVER_ERROR_SUSPECT`], [`SOLVER_ERROR_REFUSED`]) | 10 | 1000 |
 //! | the same over the loaded contacts' scale (`dem::SolveReport::error_without_gap_shifts`) / tolerance | 10 (unless the sensitivity below was measured and passed) | 1000 |
-//! | change of the window's μ when its samples' steps are solved to 10⁻⁸ ([`Sensitivity`]) | 0.005 | 0.02 |
-//! | relative change of its pressure under the same re-solve | 2.5 % | 10 % |
+//! | change of the window's μ when its samples' steps are solved to 10⁻⁸ ([`Sensitivity`]) | a tenth of μ's standard error where the scenario gives it ([`SENSITIVITY_SE_FRACTION`]: simple-shear), else 0.005 | 0.02 |
+//! | relative change of its pressure under the same re-solve | a tenth of its relative standard error where given, else 2.5 % | 10 % |
 //! | samples whose re-solve did not reach 10⁻⁸ | 10 % | — |
 //! | steps of the window whose energy grew beyond `ENERGY_GROWTH_TOLERANCE` | 1 % | 25 % (≥ 20 steps) |
 //! | energy gained by any one step of the window / E_load ([`ENERGY_STEP_SUSPECT`], [`ENERGY_STEP_REFUSED`]) | 1 % | 100 % |
@@ -41,8 +41,9 @@
 //! and Lemke's method, `dem::World::snapshot_with_last_impulses`), and the window's μ and
 //! pressure are taken both ways. When at least [`SENSITIVITY_MIN_SAMPLES`] samples were
 //! re-solved, at most [`SENSITIVITY_UNRESOLVED_SUSPECT`] of them failed, and both changes are
-//! within their suspect limits, the loaded-scale error is judged only against its refusal
-//! limit: its residual was shown not to move the numbers. The re-solve measures the solver's
+//! within their suspect limits, the loaded-scale error, the worst error and the fraction of
+//! steps above the tolerance are judged only against their refusal limits: the residual was
+//! shown not to move the numbers, and the precision of the result is the criterion. The re-solve measures the solver's
 //! effect on the forces of each sampled state, not on the trajectory that led there (positions
 //! move by `θ h Δv` only); the trajectory's drift is what the overlap and energy checks bound.
 //!

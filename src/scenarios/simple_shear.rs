@@ -341,7 +341,8 @@ impl PhasedRun for Shear<'_> {
         let dt = c.shear_dt(gamma_dot, d);
         let steps = datasets::config::simple_shear::whole_steps(c.strain / (gamma_dot * dt));
         let avg_steps =
-            datasets::config::simple_shear::whole_steps(c.average_strain / (gamma_dot * dt)).min(steps);
+            datasets::config::simple_shear::whole_steps(c.average_strain / (gamma_dot * dt))
+                .min(steps);
         world.params.dt = dt;
         let l = world.cell().map_or_else(Mat::zeros, |cell| cell.l);
         world.set_velocity_gradient(Mat::new(0.0, gamma_dot, 0.0, l[(1, 1)]));
