@@ -40,7 +40,7 @@ use crate::verdict::{max_solid_fraction, RunVerdict, WindowStats};
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] with the cell's stress-controlled component
 /// (`dem::World::last_step_problem`) and the cell's stress taken both ways, the window's solver
 /// sensitivity of μ = |Σσ_xy| / (−Σσ_yy) and of σ_yy ([`crate::verdict::Sensitivity`]), judged
-/// against a tenth of their statistical errors ([`crate::verdict::SENSITIVITY_SE_FRACTION`]).
+/// against a quarter of their statistical errors ([`crate::verdict::SENSITIVITY_SE_FRACTION`]).
 /// A fixed number, not a fraction of the steps: a re-solve to 10⁻⁸ of a dense step costs
 /// hundreds of the run's own loose solves.
 const SENSITIVITY_SAMPLES: u64 = 20;
