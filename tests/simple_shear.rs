@@ -7,8 +7,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// A tiny run: 50 grains, a short compression (104 steps), one shear run of strain 0.2 (80
-/// steps), the last 12 averaged (too few to test steadiness).
+/// A tiny run: 50 grains, a short compression (13 grain times, 26 steps), one shear run of
+/// strain 0.6 (60 steps of 0.01), the last 12 averaged (too few to test steadiness).
 const TINY: &[&str] = &[
     "run",
     "simple-shear",
@@ -21,9 +21,9 @@ const TINY: &[&str] = &[
     "--set",
     r#"leave_out=["mu-i", "mu-i-linear", "phi-i"]"#,
     "--set",
-    "strain=0.2",
+    "strain=0.6",
     "--set",
-    "average_strain=0.03",
+    "average_strain=0.12",
     "-q",
 ];
 
@@ -144,7 +144,7 @@ fn resume_is_bit_identical() {
     let o = grainlaw(TINY, Some(&a));
     let code = o.status.code();
     assert!(matches!(code, Some(0) | Some(3)), "{}", stderr(&o));
-    let o = grainlaw(&[TINY, &["--stop-after-steps", "130"]].concat(), Some(&b));
+    let o = grainlaw(&[TINY, &["--stop-after-steps", "50"]].concat(), Some(&b));
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
     let o = grainlaw(&["run", "--resume", b.to_str().unwrap(), "-q"], None);
     assert_eq!(o.status.code(), code, "{}", stderr(&o));
