@@ -717,38 +717,6 @@ fn run_fc(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) ->
     Ok(())
 }
 
-#[cfg(test)]
-mod ratio_tests {
-    use super::RatioOfTotals;
-
-    /// Times proportional to the peer's: the ratio exactly, no spread.
-    #[test]
-    fn proportional_times_have_no_spread() {
-        let pairs = [(2.0, 10.0), (6.0, 30.0), (4.4, 22.0)];
-        let e = RatioOfTotals::estimate(&pairs).unwrap();
-        assert!((e.ratio - 0.2).abs() < 1e-15);
-        assert!(e.standard_error < 1e-15);
-    }
-
-    /// Two seeds worked by hand: R = 4/20 = 0.2, residuals −1 and 1, se = √(2/2)/10 = 0.1, and
-    /// t_{0.975,1} = 12.7062 (tables), so the interval is 0.2 ∓ 1.27062.
-    #[test]
-    fn two_seeds_by_hand() {
-        let e = RatioOfTotals::estimate(&[(1.0, 10.0), (3.0, 10.0)]).unwrap();
-        assert!((e.ratio - 0.2).abs() < 1e-15);
-        assert!((e.standard_error - 0.1).abs() < 1e-12);
-        assert!((e.interval[1] - (0.2 + 1.270_62)).abs() < 1e-4);
-        assert!((e.interval[0] - (0.2 - 1.270_62)).abs() < 1e-4);
-    }
-
-    /// Fewer than two seeds, or no peer time: no estimate.
-    #[test]
-    fn too_few_seeds_give_none() {
-        assert!(RatioOfTotals::estimate(&[(1.0, 5.0)]).is_none());
-        assert!(RatioOfTotals::estimate(&[(1.0, 0.0), (1.0, 0.0)]).is_none());
-    }
-}
-
 /// The laws that a run at one inertial number cannot fit, left out of the race's runs.
 const RVE_LEAVE_OUT: &str = r#"leave_out=["mu-i","mu-i-linear","phi-i"]"#;
 
@@ -1023,7 +991,7 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
         if let Some((per_strain, mu, mu_se, how)) = theirs {
             let z = z_score(mu, mu_se, ours.mu, ours.mu_se);
             println!(
-                "ratio LAMMPS/grainlaw of the seconds per unit shear strain: {:.2} ({how}; LAMMPS gran/hooke/history at {settings}{});\n μ: z = {:.2} ({})",
+                "ratio LAMMPS/grainlaw of the seconds per unit shear strain: {:.3} ({how}; LAMMPS gran/hooke/history at {settings}{});\n μ: z = {:.2} ({})",
                 per_strain / ours_per_strain,
                 if how == "QUOTED" {
                     ", quoted: k_n = 1e7 N/m, dt = 7.6 µs ≈ t_c/12"
@@ -1054,4 +1022,45 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
     }
     println!("(overlap/R_min: largest overlap over the smallest radius, grainlaw at the start of every step, LAMMPS on its snapshots; LAMMPS' shear s is its loop time of the shear run)");
     Ok(())
+}
+
+#[cfg(test)]
+mod ratio_tests {
+    use super::RatioOfTotals;
+
+    /// Times proportional to the peer's: the ratio exactly, no spread.
+    #[test]
+    fn proportional_times_have_no_spread() {
+        let pairs = [(2.0, 10.0), (6.0, 30.0), (4.4, 22.0)];
+        let e = RatioOfTotals::estimate(&pairs).unwrap();
+        assert!((e.ratio - 0.2).abs() < 1e-15);
+        assert!(e.standard_error < 1e-15);
+    }
+
+    /// Two seeds worked by hand: R = 4/20 = 0.2, residuals −1 and 1, se = √(2/2)/10 = 0.1, and
+    /// t_{0.975,1} = 12.7062 (tables), so the interval is 0.2 ∓ 1.27062.
+    #[test]
+    fn two_seeds_by_hand() {
+        let e = RatioOfTotals::estimate(&[(1.0, 10.0), (3.0, 10.0)]).unwrap();
+        assert!((e.ratio - 0.2).abs() < 1e-15);
+        assert!((e.standard_error - 0.1).abs() < 1e-12);
+        assert!((e.interval[1] - (0.2 + 1.270_62)).abs() < 1e-4);
+        assert!((e.interval[0] - (0.2 - 1.270_62)).abs() < 1e-4);
+    }
+
+    /// Fewer than two seeds, or no peer time: no estimate.
+    #[test]
+    fn too_few_seeds_give_none() {
+        assert!(RatioOfTotals::estimate(&[(1.0, 5.0)]).is_none());
+        assert!(RatioOfTotals::estimate(&[(1.0, 0.0), (1.0, 0.0)]).is_none());
+    }
+
+    /// μ of 0.30 ± 0.03 against 0.26 ± 0.04: z = 0.04 / √(0.03² + 0.04²) = 0.8 (a 3-4-5
+    /// triangle); an unknown error gives NaN.
+    #[test]
+    fn z_score_by_hand() {
+        assert!((super::z_score(0.30, 0.03, 0.26, 0.04) - 0.8).abs() < 1e-12);
+        assert!((super::z_score(0.26, 0.04, 0.30, 0.03) + 0.8).abs() < 1e-12);
+        assert!(super::z_score(0.3, f64::NAN, 0.2, 0.01).is_nan());
+    }
 }

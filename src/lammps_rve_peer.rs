@@ -860,12 +860,12 @@ mod tests {
         let every = script_number(&script, "thermo ") as u64;
         assert_eq!(every, 35);
         let multiples = l.end_step / every - l.shear_start / every;
-        let last = u64::from(l.end_step % every != 0);
+        let last = u64::from(!l.end_step.is_multiple_of(every));
         assert_eq!(l.rows.len() as u64, 1 + multiples + last);
         assert_eq!(l.rows[0].step, l.shear_start);
         assert!(l.rows[1..l.rows.len() - 1]
             .iter()
-            .all(|r| r.step % every == 0));
+            .all(|r| r.step.is_multiple_of(every)));
         assert_eq!(l.rows.last().unwrap().step, l.end_step);
         assert!(l.rows.windows(2).all(|w| w[1].step > w[0].step));
         for r in &l.rows {
