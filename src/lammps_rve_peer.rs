@@ -56,7 +56,7 @@
 //! (`fix press/berendsen` refuses triclinic boxes; a Nosé–Hoover `fix nph/sphere` made the
 //! compressed packing bounce off jamming). It acts every [`SERVO_EVERY`] steps, less than a
 //! collision time, on the pressure of that step (`fix ave/time`), so that LAMMPS computes its
-//! virial every tenth step only: a servo every step cost 16 % more time for the same hold of
+//! virial every tenth step only: a servo every step cost 19 % more time for the same hold of
 //! σ_yy (2000 grains, measured on 2026-12-05).
 //!
 //! # Measurement
