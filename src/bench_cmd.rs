@@ -15,7 +15,10 @@
 //!    labelled as quoted.
 //! 5. Biaxial RVEs (the `biaxial` scenario's cell, [`crate::scenarios::biaxial::bench_rve`]):
 //!    time per step and per percent of axial strain, with the solver counts.
-//! 6. Memory per grain and per contact ([`dem::bench::MemoryFootprint`]).
+//! 6. The representative-volume race (`--rve N`, [`rve_rows`]): grainlaw's `simple-shear`
+//!    scenario against LAMMPS on the same grains ([`crate::lammps_rve_peer`]), seconds per unit
+//!    shear strain, μ and φ of both.
+//! 7. Memory per grain and per contact ([`dem::bench::MemoryFootprint`]).
 
 use std::path::Path;
 
@@ -51,6 +54,21 @@ pub struct BenchPlan {
     pub biaxial_compress_steps: usize,
     /// Timed axial steps of a biaxial row.
     pub biaxial_steps: usize,
+    /// The representative-volume race.
+    pub rve: RvePlan,
+}
+
+/// What the representative-volume race runs (`grainlaw bench --rve N`, [`rve_rows`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RvePlan {
+    /// Grain counts (none: no race).
+    pub grains: Vec<usize>,
+    /// Shear strain of each run.
+    pub strain: f64,
+    /// The last `average` of the strain is averaged.
+    pub average: f64,
+    /// Inertial number of the shear.
+    pub inertial: f64,
 }
 
 /// Quoted wall seconds (range) of a soft-contact DEM code for a settled column of `n` grains
@@ -212,8 +230,9 @@ fn columns(plan: &BenchPlan) -> Result<()> {
     );
     match &lammps {
         Some(lmp) => println!(
-            "LAMMPS peer measured in this run ({}, one core, serial): the same initial column, gran/hooke/history, k_n = 2e5 m g/d, k_t = 2/7 k_n,\n restitution 0.2 between mean grains, h = t_c/50, KE/PE checked every {} steps, at most {:.0} s wall (GRAINLAW_LAMMPS_TIMEOUT); ratio = grainlaw/LAMMPS",
+            "LAMMPS peer measured in this run ({}, one core, serial): the same initial column, gran/hooke/history, k_n = 2e5 m g/d, k_t = 2/7 k_n,\n restitution 0.2 between mean grains, h = t_c/{}, KE/PE checked every {} steps, at most {:.0} s wall (GRAINLAW_LAMMPS_TIMEOUT); ratio = grainlaw/LAMMPS",
             lmp.display(),
+            crate::lammps_peer::STEPS_PER_COLLISION,
             crate::lammps_peer::CHECK_EVERY,
             wall_limit
         ),
@@ -411,6 +430,7 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
     columns(plan)?;
     homogenise_rows(plan)?;
     biaxial_rows(plan)?;
+    rve_rows(&plan.rve)?;
     let mem = dem::bench::MemoryFootprint::current(4);
     println!(
         "\nmemory: {} B per grain, {} B per contact; at 2 contacts per grain, 24 GiB hold about {:.1e} grains",
@@ -697,6 +717,313 @@ fn run_fc(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) ->
     Ok(())
 }
 
+/// The laws that a run at one inertial number cannot fit, left out of the race's runs.
+const RVE_LEAVE_OUT: &str = r#"leave_out=["mu-i","mu-i-linear","phi-i"]"#;
+
+/// The hand measurement of LAMMPS on the reference case (2000 grains, I = 0.01, strain 2, the
+/// last 1 averaged; 2026-12-05, this machine, LAMMPS 29 Sep 2021, k_n = 10⁷ N/m, dt = 7.6 µs ≈
+/// t_c/12, y held by a barostat): printed, labelled as quoted, when LAMMPS is not there.
+struct QuotedRve {
+    seconds_per_strain: f64,
+    seconds: f64,
+    steps: u64,
+    mu: f64,
+    mu_se: f64,
+    phi: f64,
+}
+
+const QUOTED_RVE: QuotedRve = QuotedRve {
+    seconds_per_strain: 17.0,
+    seconds: 33.5,
+    steps: 125_228,
+    mu: 0.281,
+    mu_se: 0.005,
+    phi: 0.809,
+};
+
+/// grainlaw's side of one race.
+struct OurRve {
+    loaded: datasets::LoadedScenario,
+    total_seconds: f64,
+    shear_seconds: f64,
+    shear_steps: u64,
+    total_steps: u64,
+    mu: f64,
+    mu_se: f64,
+    phi: f64,
+    phi_se: f64,
+    overlap_ratio: f64,
+    verdict: String,
+    failure: Option<String>,
+}
+
+/// Runs the `simple-shear` scenario as `grainlaw run` does ([`crate::scenarios::run_controlled`]:
+/// the same loading, phases, measurement and verdict), for `n` grains at `plan`'s inertial
+/// number, strain and averaged strain, the laws left out, the scenario's default solver
+/// settings, on one thread, no checkpoints, into a temporary directory removed afterwards.
+fn grainlaw_rve(n: usize, plan: &RvePlan) -> Result<OurRve> {
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+    let sets = vec![
+        format!("grains={n}"),
+        format!("inertial_numbers=[{:e}]", plan.inertial),
+        format!("strain={:e}", plan.strain),
+        format!("average_strain={:e}", plan.average),
+        RVE_LEAVE_OUT.to_string(),
+    ];
+    let loaded = datasets::load("simple-shear", &sets)?;
+    let dir = std::env::temp_dir().join(format!("grainlaw-bench-rve-{}-{n}", std::process::id()));
+    let mut ctx = crate::scenarios::RunContext {
+        out: crate::output::OutputDir::create(&dir)?,
+        verbosity: crate::progress::Verbosity::Quiet,
+        loaded: loaded.clone(),
+        interrupted: Arc::new(AtomicBool::new(false)),
+        dump: None,
+    };
+    let mut ctl = crate::scenarios::RunControl::new(
+        sets,
+        crate::scenarios::CheckpointPolicy {
+            every_steps: None,
+            every_seconds: None,
+        },
+    );
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| CliError::Usage(format!("cannot start a thread pool: {e}")))?;
+    let t0 = std::time::Instant::now();
+    let outcome = pool.install(|| crate::scenarios::run_controlled(&mut ctx, &mut ctl));
+    let total_seconds = t0.elapsed().as_secs_f64();
+    let outcome = match outcome {
+        Ok(o) => o,
+        Err(e) => {
+            return Err(CliError::Usage(format!(
+                "bench --rve {n}: grainlaw's run failed: {} (files kept in {})",
+                e.one_line(),
+                dir.display()
+            )))
+        }
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    let shear: Vec<&crate::scenarios::PhaseTime> = ctl
+        .phase_times
+        .iter()
+        .filter(|p| p.name != "compress")
+        .collect();
+    let get = |k: &str| outcome.summary.get_f64(k).unwrap_or(f64::NAN);
+    Ok(OurRve {
+        loaded,
+        total_seconds,
+        shear_seconds: shear.iter().map(|p| p.wall_seconds).sum(),
+        shear_steps: shear.iter().map(|p| p.steps).sum(),
+        total_steps: ctl.phase_times.iter().map(|p| p.steps).sum(),
+        mu: get("run1_mu"),
+        mu_se: get("run1_mu_std_error"),
+        phi: get("run1_phi"),
+        phi_se: get("run1_phi_std_error"),
+        overlap_ratio: get("max_penetration_over_radius"),
+        verdict: outcome
+            .summary
+            .get("verdict")
+            .and_then(|v| v.as_str())
+            .unwrap_or("?")
+            .to_string(),
+        failure: (!outcome.verdict.passes()).then(|| outcome.verdict.failure_line()),
+    })
+}
+
+/// `m ± se` with the digits of the standard error.
+fn pm(m: f64, se: f64) -> String {
+    if se.is_finite() {
+        format!("{m:.4} ± {se:.4}")
+    } else {
+        format!("{m:.4} ± –")
+    }
+}
+
+/// The z-score of the difference of two means with standard errors, `(a − b) / √(se_a² + se_b²)`
+/// (NaN when an error is not known).
+pub fn z_score(a: f64, se_a: f64, b: f64, se_b: f64) -> f64 {
+    (a - b) / (se_a * se_a + se_b * se_b).sqrt()
+}
+
+/// The representative-volume race (`grainlaw bench --rve N ...`): per grain count, grainlaw's
+/// `simple-shear` scenario ([`grainlaw_rve`]) and LAMMPS on the same initial grains
+/// ([`crate::lammps_rve_peer`]) when it is found (else the quoted hand measurement of the
+/// reference case, labelled so), both on one core; one table of wall seconds (shear, total),
+/// seconds per unit shear strain, steps, μ ± SE, φ ± SE and the largest overlap, then the
+/// ratio LAMMPS / grainlaw of the seconds per unit strain with LAMMPS' settings beside it and
+/// the z-score of the two μ.
+pub fn rve_rows(plan: &RvePlan) -> Result<()> {
+    use crate::lammps_rve_peer::{self as lr, PeerRve, RveOutcome};
+    if plan.grains.is_empty() {
+        return Ok(());
+    }
+    let lammps = crate::lammps_peer::find_lammps();
+    let wall_limit = crate::lammps_peer::wall_limit()?;
+    println!(
+        "\nrepresentative volume (`simple-shear`: biperiodic Lees–Edwards cell, radii 1.5 mm ± 20 %, ρ = 2500 kg/m³, μ_p = 0.5, P = σ_yy = −1 kPa held,\n I = {}, shear strain {}, the last {} averaged; one core each; {}):",
+        plan.inertial,
+        plan.strain,
+        plan.average,
+        match &lammps {
+            Some(l) => format!("LAMMPS measured in this run ({})", l.display()),
+            None => "LAMMPS not found (PATH, GRAINLAW_LAMMPS; or disabled by GRAINLAW_LAMMPS=off): its figures are QUOTED, not measured".to_string(),
+        }
+    );
+    for &n in &plan.grains {
+        let ours = grainlaw_rve(n, plan)?;
+        let datasets::Scenario::SimpleShear(c) = &ours.loaded.scenario else {
+            return Err(CliError::Usage(
+                "bench --rve: not a simple-shear scenario".into(),
+            ));
+        };
+        let peer = PeerRve::from_config(c, plan.inertial, wall_limit)?;
+        let outcome = match &lammps {
+            Some(lmp) => {
+                let dir = std::env::temp_dir()
+                    .join(format!("grainlaw-lammps-rve-{}-{n}", std::process::id()));
+                Some(lr::run(lmp, &peer, &dir)?)
+            }
+            None => None,
+        };
+        println!(
+            "{:<18} {:>9} {:>9} {:>9} {:>15} {:>17} {:>17} {:>13}  verdict",
+            format!("{n} grains"),
+            "shear s",
+            "total s",
+            "s/strain",
+            "steps shear/all",
+            "μ ± SE",
+            "φ ± SE",
+            "overlap/R_min"
+        );
+        let ours_per_strain = ours.shear_seconds / plan.strain;
+        println!(
+            "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
+            "grainlaw",
+            ours.shear_seconds,
+            ours.total_seconds,
+            ours_per_strain,
+            format!("{}/{}", ours.shear_steps, ours.total_steps),
+            pm(ours.mu, ours.mu_se),
+            pm(ours.phi, ours.phi_se),
+            100.0 * ours.overlap_ratio,
+            ours.verdict
+        );
+        let m = &peer.model;
+        let settings = format!(
+            "κ = k_n/(P·1 m) = {:.0e} (k_n = {:.3e} N/m per m), dt = t_c/{} = {:.3} µs (t_c = {:.2} µs, two smallest grains), k_t/k_n = 2/7, e = {} (mean pair)",
+            lr::KAPPA,
+            m.kn,
+            lr::STEPS_PER_COLLISION,
+            m.dt * 1e6,
+            m.collision_time * 1e6,
+            crate::lammps_peer::RESTITUTION
+        );
+        let theirs = match &outcome {
+            Some(RveOutcome::Ran(r)) => {
+                let per_strain = r.log.shear_seconds / plan.strain;
+                println!(
+                    "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
+                    "LAMMPS",
+                    r.log.shear_seconds,
+                    r.wall_seconds,
+                    per_strain,
+                    format!("{}/{}", r.log.shear_steps, r.log.end_step),
+                    pm(r.measure.mu, r.measure.mu_se),
+                    pm(r.measure.phi, r.measure.phi_se),
+                    100.0 * r.overlap_ratio,
+                    if r.finished {
+                        "finished"
+                    } else {
+                        "NOT finished (wall-clock limit, GRAINLAW_LAMMPS_TIMEOUT)"
+                    }
+                );
+                println!(
+                    "{:<18} LAMMPS: compression {:.1} s, ⟨p_yy⟩ = {:.1} ± {:.1} Pa, I = {:.4}, Z = {:.2}, {} samples; overlap over {} snapshots",
+                    "",
+                    r.log.compression_seconds,
+                    r.measure.pn,
+                    r.measure.pn_se,
+                    r.measure.inertial_number,
+                    r.measure.z,
+                    r.measure.samples,
+                    lr::OVERLAP_SNAPSHOTS
+                );
+                r.finished
+                    .then_some((per_strain, r.measure.mu, r.measure.mu_se, "measured"))
+            }
+            Some(RveOutcome::Failed { reason, dir }) => {
+                println!(
+                    "{:<18} FAILED: {reason} (files kept in {})",
+                    "LAMMPS",
+                    dir.display()
+                );
+                None
+            }
+            None => {
+                let reference =
+                    n == 2000 && plan.inertial == 0.01 && plan.strain == 2.0 && plan.average == 1.0;
+                if reference {
+                    let q = &QUOTED_RVE;
+                    println!(
+                        "{:<18} {:>9.1} {:>9} {:>9.2} {:>15} {:>17} {:>17} {:>13}  quoted (hand measurement, 2026-12-05)",
+                        "LAMMPS (quoted)",
+                        q.seconds,
+                        "–",
+                        q.seconds_per_strain,
+                        format!("{}/–", q.steps),
+                        pm(q.mu, q.mu_se),
+                        format!("{:.3}", q.phi),
+                        "≤ 0.1 % d̄",
+                    );
+                    Some((q.seconds_per_strain, q.mu, q.mu_se, "QUOTED"))
+                } else {
+                    println!(
+                        "{:<18} no quoted figures for this case (only 2000 grains, I = 0.01, strain 2, the last 1 averaged)",
+                        "LAMMPS"
+                    );
+                    None
+                }
+            }
+        };
+        if let Some((per_strain, mu, mu_se, how)) = theirs {
+            let z = z_score(mu, mu_se, ours.mu, ours.mu_se);
+            println!(
+                "ratio LAMMPS/grainlaw of the seconds per unit shear strain: {:.3} ({how}; LAMMPS gran/hooke/history at {settings}{});\n μ: z = {:.2} ({})",
+                per_strain / ours_per_strain,
+                if how == "QUOTED" {
+                    ", quoted: k_n = 1e7 N/m, dt = 7.6 µs ≈ t_c/12"
+                } else {
+                    ", σ_yy servo on the height"
+                },
+                z,
+                if !z.is_finite() {
+                    "a standard error is not known"
+                } else if z.abs() <= 2.0 {
+                    "the two μ agree within two combined standard errors"
+                } else {
+                    "the two μ DIFFER by more than two combined standard errors"
+                }
+            );
+        }
+        println!(
+            " grainlaw: `simple-shear` defaults (travel_per_step {}, solver tolerance {:e}, at most {} sweeps, cell control {}), one thread, h = {:.3} ms in the shear; shear s is its shear phase, total s the whole run with its measurement",
+            c.travel_per_step,
+            c.solver.tolerance,
+            c.solver.max_iterations,
+            c.cell_control.as_str(),
+            1e3 * c.shear_dt(peer.gamma_dot, peer.mean_diameter),
+        );
+        if let Some(f) = &ours.failure {
+            println!(" grainlaw's verdict: {f}");
+        }
+    }
+    println!("(overlap/R_min: largest overlap over the smallest radius, grainlaw at the start of every step, LAMMPS on its snapshots; LAMMPS' shear s is its loop time of the shear run)");
+    Ok(())
+}
+
 #[cfg(test)]
 mod ratio_tests {
     use super::RatioOfTotals;
@@ -726,5 +1053,14 @@ mod ratio_tests {
     fn too_few_seeds_give_none() {
         assert!(RatioOfTotals::estimate(&[(1.0, 5.0)]).is_none());
         assert!(RatioOfTotals::estimate(&[(1.0, 0.0), (1.0, 0.0)]).is_none());
+    }
+
+    /// μ of 0.30 ± 0.03 against 0.26 ± 0.04: z = 0.04 / √(0.03² + 0.04²) = 0.8 (a 3-4-5
+    /// triangle); an unknown error gives NaN.
+    #[test]
+    fn z_score_by_hand() {
+        assert!((super::z_score(0.30, 0.03, 0.26, 0.04) - 0.8).abs() < 1e-12);
+        assert!((super::z_score(0.26, 0.04, 0.30, 0.03) + 0.8).abs() < 1e-12);
+        assert!(super::z_score(0.3, f64::NAN, 0.2, 0.01).is_nan());
     }
 }

@@ -7,7 +7,7 @@
 //! grainlaw scenarios [--show NAME]
 //! grainlaw fit LAW DATA.csv [MORE.csv ...] [--out law.json]
 //! grainlaw solve-fc PROBLEM.json [--tol T] [--method nlgs|newton|auto|lemke] [--out SOLUTION.json]
-//! grainlaw bench [--dir DIR] [--engine-grains N ...]
+//! grainlaw bench [--dir DIR] [--engine-grains N ...] [--rve N ...]
 //! ```
 //!
 //! Every error is one line on stderr and exit code 2. A run that finishes with a `refused`
@@ -152,6 +152,19 @@ pub enum Command {
         /// Timed axial steps of a biaxial row.
         #[arg(long, value_name = "STEPS", default_value_t = 20)]
         biaxial_steps: usize,
+        /// Grain counts of the representative-volume race (none by default): grainlaw's
+        /// `simple-shear` scenario against LAMMPS on the same grains, both on one core.
+        #[arg(long, value_name = "N", num_args = 0..)]
+        rve: Vec<usize>,
+        /// Shear strain of the representative-volume runs.
+        #[arg(long, value_name = "S", default_value_t = 2.0)]
+        rve_strain: f64,
+        /// The last part of the strain averaged in the representative-volume runs.
+        #[arg(long, value_name = "A", default_value_t = 1.0)]
+        rve_average: f64,
+        /// Inertial number of the representative-volume runs.
+        #[arg(long, value_name = "I", default_value_t = 0.01)]
+        rve_inertial: f64,
     },
 }
 
@@ -383,6 +396,10 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             biaxial_grains,
             biaxial_compress_steps,
             biaxial_steps,
+            rve,
+            rve_strain,
+            rve_average,
+            rve_inertial,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
             engine_grains,
@@ -395,6 +412,12 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             biaxial_grains,
             biaxial_compress_steps,
             biaxial_steps,
+            rve: crate::bench_cmd::RvePlan {
+                grains: rve,
+                strain: rve_strain,
+                average: rve_average,
+                inertial: rve_inertial,
+            },
         }),
     }
 }

@@ -16,6 +16,7 @@ pub mod fit_cmd;
 pub mod floats;
 pub mod homogenise_cmd;
 pub mod lammps_peer;
+pub mod lammps_rve_peer;
 pub mod output;
 pub mod plot;
 pub mod progress;

@@ -24,7 +24,7 @@ use datasets::{LoadedScenario, Scenario};
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
 use crate::progress::Verbosity;
-pub use phased::{CheckpointPolicy, RunControl};
+pub use phased::{CheckpointPolicy, PhaseTime, RunControl};
 
 /// What a scenario run gets.
 pub struct RunContext {

@@ -74,6 +74,9 @@ pub struct RunControl {
     /// Start date and input hashes of the run, for the provenance of its laws (read from the
     /// checkpoint on resume).
     pub origin: crate::provenance::RunOrigin,
+    /// The phases run by this invocation, in order, with their wall-clock seconds
+    /// (`grainlaw bench` times a scenario's phases apart with it).
+    pub phase_times: Vec<PhaseTime>,
     started: Instant,
     last_checkpoint: Instant,
     steps_since_checkpoint: u64,
@@ -99,6 +102,7 @@ impl RunControl {
             previous_wall_seconds: 0.0,
             allow_suspect: false,
             origin: Default::default(),
+            phase_times: Vec::new(),
             started: now,
             last_checkpoint: now,
             steps_since_checkpoint: 0,
@@ -122,6 +126,19 @@ impl RunControl {
                 .every_seconds
                 .is_some_and(|s| self.last_checkpoint.elapsed().as_secs_f64() >= s)
     }
+}
+
+/// One phase as run by an invocation: its name, the steps this invocation made in it and their
+/// wall-clock seconds (the phase's own `step` and `leave` included; a resumed phase counts from
+/// the resume).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhaseTime {
+    /// The phase's name (`compress`, `I=0.01`, ...).
+    pub name: String,
+    /// Steps made by this invocation.
+    pub steps: u64,
+    /// Wall-clock seconds (s).
+    pub wall_seconds: f64,
 }
 
 /// A scenario's simulation as phases over one world with a serialisable state (module doc).
@@ -235,6 +252,7 @@ pub fn drive<P: PhasedRun>(
         };
         let out = &mut ctx.out;
         let st = &mut state;
+        let (t0, steps0) = (Instant::now(), ctl.steps_this_run);
         let stats = run_phase(
             &env,
             &plan.name,
@@ -281,6 +299,11 @@ pub fn drive<P: PhasedRun>(
             },
         )?;
         run.leave(k, &mut state, &mut ctx.out, &mut world, &stats)?;
+        ctl.phase_times.push(PhaseTime {
+            name: plan.name.clone(),
+            steps: ctl.steps_this_run - steps0,
+            wall_seconds: t0.elapsed().as_secs_f64(),
+        });
         k += 1;
     }
     Ok((world, state))
