@@ -664,6 +664,7 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
             forces: true,
             axis_labels: ("x (m)".into(), "y (m)".into()),
             width_px: 900,
+            overlays: Vec::new(),
         },
     )?;
     Ok(())

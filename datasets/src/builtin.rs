@@ -12,7 +12,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scenario, the default (`janssen`) first.
-pub const BUILTINS: [Builtin; 8] = [
+pub const BUILTINS: [Builtin; 9] = [
     Builtin {
         name: "janssen",
         description: "350 grains deposited in a column, relaxed, released: wall stress vs depth, Janssen fit (Fig. 7)",
@@ -52,6 +52,11 @@ pub const BUILTINS: [Builtin; 8] = [
         name: "biaxial",
         description: "biaxial compression of a biperiodic cell at constant lateral stress over several confining pressures: peak and critical friction, dilatancy, Mohr-Coulomb",
         toml: include_str!("../scenarios/biaxial.toml"),
+    },
+    Builtin {
+        name: "column-collapse",
+        description: "a 2D column of 2500 grains (a = 6.26) collapsing onto a rough floor: front x_f(t), profiles, runout, against contact dynamics",
+        toml: include_str!("../scenarios/column-collapse.toml"),
     },
 ];
 

@@ -1,7 +1,8 @@
 //! # datasets — the paper's experiments as scenarios, and packing generators
 //!
 //! - [`builtin`]: the built-in scenarios, TOML files embedded in the binary (`janssen`, the
-//!   default; `rolling`, `arrangements`, `stick-slip`, `inclined-flow`, `shear-cell`);
+//!   default; `rolling`, `arrangements`, `stick-slip`, `inclined-flow`, `shear-cell`,
+//!   `simple-shear`, `biaxial`, `column-collapse`);
 //! - [`scenario`]: loading a built-in or a TOML path, `--set KEY=VALUE` overrides
 //!   ([`overrides`]) applied on the TOML table, typed deserialisation with unknown keys refused
 //!   and validation that names the key at fault ([`config`]);

@@ -8,8 +8,8 @@ use toml::{Table, Value};
 
 use crate::builtin::{builtin, builtin_names};
 use crate::config::{
-    ArrangementsConfig, BiaxialConfig, InclinedFlowConfig, JanssenConfig, RollingConfig,
-    ShearCellConfig, SimpleShearConfig, StickSlipConfig,
+    ArrangementsConfig, BiaxialConfig, ColumnCollapseConfig, InclinedFlowConfig, JanssenConfig,
+    RollingConfig, ShearCellConfig, SimpleShearConfig, StickSlipConfig,
 };
 use crate::error::{DatasetError, Result};
 use crate::overrides::{apply_override, parse_override};
@@ -33,6 +33,8 @@ pub enum Scenario {
     SimpleShear(SimpleShearConfig),
     /// Biaxial compression of a biperiodic cell at constant lateral stress.
     Biaxial(BiaxialConfig),
+    /// Collapse of a granular column onto a rough floor.
+    ColumnCollapse(ColumnCollapseConfig),
 }
 
 impl Scenario {
@@ -47,6 +49,7 @@ impl Scenario {
             Scenario::ShearCell(_) => "shear-cell",
             Scenario::SimpleShear(_) => "simple-shear",
             Scenario::Biaxial(_) => "biaxial",
+            Scenario::ColumnCollapse(_) => "column-collapse",
         }
     }
 
@@ -95,6 +98,7 @@ impl Scenario {
             Scenario::ShearCell(c) => c.seed,
             Scenario::SimpleShear(c) => c.seed,
             Scenario::Biaxial(c) => c.seed,
+            Scenario::ColumnCollapse(c) => c.seed,
         }
     }
 }
@@ -305,6 +309,11 @@ pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Resul
             let c: BiaxialConfig = typed(table, source)?;
             c.validate().map_err(|e| e.in_source(source))?;
             Scenario::Biaxial(c)
+        }
+        "column-collapse" => {
+            let c: ColumnCollapseConfig = typed(table, source)?;
+            c.validate().map_err(|e| e.in_source(source))?;
+            Scenario::ColumnCollapse(c)
         }
         other => {
             return Err(DatasetError::invalid(

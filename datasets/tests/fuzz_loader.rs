@@ -226,6 +226,7 @@ fn build(s: &Scenario) -> Result<(), DatasetError> {
         Scenario::ShearCell(c) => shear_cell(c).map(drop),
         Scenario::SimpleShear(c) => datasets::build_cell::simple_shear(c).map(drop),
         Scenario::Biaxial(c) => datasets::build_cell::biaxial(c).map(drop),
+        Scenario::ColumnCollapse(c) => datasets::build::column_collapse_deposit(c).map(drop),
     }
 }
 
@@ -239,6 +240,7 @@ fn grains(s: &Scenario) -> usize {
         Scenario::ShearCell(c) => c.grains,
         Scenario::SimpleShear(c) => c.grains,
         Scenario::Biaxial(c) => c.grains,
+        Scenario::ColumnCollapse(c) => c.poured_grains(),
     }
 }
 

@@ -43,6 +43,9 @@ pub struct ParticleView<'a> {
     pub axis_labels: (String, String),
     /// Width of the plotting area in pixels (the height follows the data's aspect).
     pub width_px: u32,
+    /// Polylines drawn over the grains (m), each in its colour (e.g. a height profile); empty
+    /// for none.
+    pub overlays: Vec<(RGBColor, Vec<(f64, f64)>)>,
 }
 
 /// Draws the view as `name`.
@@ -200,6 +203,12 @@ pub fn draw_particles(out: &mut OutputDir, name: &str, view: &ParticleView) -> R
                     font(14.0),
                 ))?;
             }
+        }
+        for (colour, line) in &view.overlays {
+            chart.draw_series(std::iter::once(PathElement::new(
+                line.clone(),
+                colour.stroke_width(3),
+            )))?;
         }
         if let GrainFill::Values { scale, label, .. } = &view.fill {
             colorbar(&bar_area, scale, label)?;

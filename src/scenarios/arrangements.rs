@@ -146,6 +146,7 @@ impl PhasedRun for Stacks<'_> {
                 forces: true,
                 axis_labels: ("x (m)".into(), "y (m)".into()),
                 width_px: 560,
+                overlays: Vec::new(),
             },
         )
     }

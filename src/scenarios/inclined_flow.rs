@@ -388,6 +388,7 @@ pub fn run(
                 "y normal to the slope (m)".into(),
             ),
             width_px: 1300,
+            overlays: Vec::new(),
         },
     )?;
     let mut pv = XyPlot::new(

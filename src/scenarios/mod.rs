@@ -4,6 +4,7 @@
 
 pub mod arrangements;
 pub mod biaxial;
+pub mod column_collapse;
 pub mod common;
 pub mod dump;
 pub mod inclined_flow;
@@ -150,6 +151,7 @@ pub fn run_controlled(ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunO
         Scenario::ShearCell(c) => shear_cell::run(c, ctx, ctl)?,
         Scenario::SimpleShear(c) => simple_shear::run(c, ctx, ctl)?,
         Scenario::Biaxial(c) => biaxial::run(c, ctx, ctl)?,
+        Scenario::ColumnCollapse(c) => column_collapse::run(c, ctx, ctl)?,
     };
     let mut head = Summary::new();
     head.text("scenario", scenario.kind())

@@ -924,6 +924,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             forces: true,
             axis_labels: ("x (m)".into(), "y (m)".into()),
             width_px: 700,
+            overlays: Vec::new(),
         },
     )?;
     solver_keys(&mut s, &all);

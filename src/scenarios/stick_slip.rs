@@ -202,6 +202,7 @@ impl PhasedRun for Push<'_> {
                 forces: true,
                 axis_labels: ("x (m)".into(), "y (m)".into()),
                 width_px: 420,
+                overlays: Vec::new(),
             },
         )
     }

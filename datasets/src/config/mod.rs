@@ -3,6 +3,7 @@
 
 pub mod arrangements;
 pub mod biaxial;
+pub mod column_collapse;
 pub mod common;
 pub mod deposit;
 pub mod inclined_flow;
@@ -15,6 +16,7 @@ pub mod stick_slip;
 
 pub use arrangements::ArrangementsConfig;
 pub use biaxial::{BiaxialConfig, Preparation};
+pub use column_collapse::{CollapseAnalysis, CollapseFriction, ColumnCollapseConfig};
 pub use common::{CellControlMode, FrictionSpec, GrainSpec, SolverSpec};
 pub use deposit::{DepositSpec, RelaxSpec};
 pub use inclined_flow::InclinedFlowConfig;

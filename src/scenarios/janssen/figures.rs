@@ -90,6 +90,7 @@ pub(super) fn draw(ctx: &mut RunContext, f: &Inputs) -> Result<()> {
             forces: true,
             axis_labels: ("x (m)".into(), "y (m)".into()),
             width_px: if f.grains > 3000 { 900 } else { 520 },
+            overlays: Vec::new(),
         },
     )?;
     let t: Vec<(f64, f64)> = f.history.rows.iter().map(|r| (r[0], r[2])).collect();
