@@ -682,6 +682,26 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
     }
     write_campaign_csv(out, plan, &done)?;
     write_stats_csv(out, plan, &done)?;
+    // Runs of `column-collapse`: the runout against the aspect ratio, r_∞(a).
+    let collapses: Vec<crate::scenarios::column_collapse::CampaignRun> = done
+        .iter()
+        .filter(|f| f.numbers.contains_key("column.runout_m"))
+        .map(|f| crate::scenarios::column_collapse::CampaignRun {
+            index: f.spec.index,
+            numbers: &f.numbers,
+            verdict: f.verdict.clone().unwrap_or_default(),
+            code: f.code,
+        })
+        .collect();
+    if !collapses.is_empty() {
+        let mut dir = crate::output::OutputDir::open(out)?;
+        crate::scenarios::column_collapse::write_runout(&mut dir, &collapses)?;
+        println!(
+            "runout of {} column collapses against the aspect ratio: {}/runout.csv and runout.png",
+            collapses.len(),
+            out.display()
+        );
+    }
     println!(
         "campaign: {} runs collected into {}/campaign.csv and campaign_stats.csv",
         done.len(),

@@ -139,7 +139,12 @@ impl ColumnCollapseConfig {
     pub fn validate(&self) -> Result<()> {
         self.grain.validate("grain")?;
         in_range("aspect_ratio", self.aspect_ratio, 0.1, 50.0)?;
-        in_range("half_width_diameters", self.half_width_diameters, 3.0, 1000.0)?;
+        in_range(
+            "half_width_diameters",
+            self.half_width_diameters,
+            3.0,
+            1000.0,
+        )?;
         in_range("floor_length", self.floor_length, 2.0, 1000.0)?;
         let needed = 2.0 * self.grain.radius_max() + 4.0 * 0.02 * self.grain.radius_min();
         if self.half_width() <= needed {
@@ -213,7 +218,11 @@ impl ColumnCollapseConfig {
             if t <= before {
                 return Err(DatasetError::invalid(
                     "analysis.reference_t_star",
-                    format!("must increase strictly, got {} after {}", num(t), num(before)),
+                    format!(
+                        "must increase strictly, got {} after {}",
+                        num(t),
+                        num(before)
+                    ),
                 ));
             }
             before = t;

@@ -171,3 +171,67 @@ pub fn draw(ctx: &mut RunContext, i: &Inputs) -> Result<()> {
     draw_xy(&mut ctx.out, "kinetic_energy.png", &pk)?;
     Ok(())
 }
+
+/// `runout.png` of a campaign: `(r_∞ − R₀)/R₀` against `a` (log axes), the runs whose verdict
+/// is `ok` filled, the others hollow, with the two regimes of [`scaling`] over their ranges.
+pub fn runout_figure(
+    out: &mut crate::output::OutputDir,
+    ok: &[(f64, f64)],
+    other: &[(f64, f64)],
+) -> Result<()> {
+    let mut p = XyPlot::new(
+        "Runout of collapsed columns against the aspect ratio",
+        Axis::new("a = H₀ / R₀").log(),
+        Axis::new("(r_∞ − R₀) / R₀").log(),
+    );
+    let all: Vec<f64> = ok
+        .iter()
+        .chain(other)
+        .map(|q| q.0)
+        .filter(|a| *a > 0.0)
+        .collect();
+    let lo = all.iter().cloned().fold(f64::INFINITY, f64::min).min(0.5);
+    let hi = all.iter().cloned().fold(0.0, f64::max).max(10.0);
+    let curve = |a0: f64, a1: f64, f: fn(f64) -> f64| -> Vec<(f64, f64)> {
+        (0..=40)
+            .map(|k| {
+                let a = a0 * (a1 / a0).powf(k as f64 / 40.0);
+                (a, f(a))
+            })
+            .collect()
+    };
+    p.series.push(Series::new(
+        &format!(
+            "{} a (Lube et al. 2005, 2D, a ≲ {})",
+            scaling::LINEAR,
+            scaling::LINEAR_MAX_A
+        ),
+        Style::Dashed,
+        PALETTE[2],
+        curve(lo, scaling::LINEAR_MAX_A, scaling::linear),
+    ));
+    p.series.push(Series::new(
+        &format!(
+            "{} a^(2/3) (Lube et al. 2005, 2D, a ≳ {})",
+            scaling::POWER,
+            scaling::POWER_MIN_A
+        ),
+        Style::Line,
+        PALETTE[2],
+        curve(scaling::POWER_MIN_A, hi, scaling::power),
+    ));
+    p.series.push(Series::new(
+        "DEM (grainlaw), verdict ok",
+        Style::Points,
+        PALETTE[0],
+        ok.to_vec(),
+    ));
+    p.series.push(Series::new(
+        "DEM, verdict suspect or refused",
+        Style::Circles,
+        PALETTE[1],
+        other.to_vec(),
+    ));
+    p.legend = LegendAt::UpperLeft;
+    draw_xy(out, "runout.png", &p)
+}

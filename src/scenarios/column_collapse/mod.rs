@@ -482,7 +482,10 @@ pub fn run(
     let worst_reference = comparison
         .iter()
         .map(|(_, dem, cd)| ((dem - cd) / cd).abs())
-        .fold(f64::NAN, |a: f64, b| if a.is_nan() || b > a { b } else { a });
+        .fold(
+            f64::NAN,
+            |a: f64, b| if a.is_nan() || b > a { b } else { a },
+        );
 
     // Checks.
     let mut checks = Checks::new();
@@ -561,9 +564,7 @@ pub fn run(
 
     // Outputs: the contract's files.
     let mut front = CsvTable::new(&["t_s", "t_star", "x_f_m"]);
-    front.comments.push(format!(
-        "front of the continuous mass: right edge of the last bin (one mean diameter, {d:.4e} m) of the run from x = 0 whose height exceeds one mean diameter; t_star = t sqrt(g/H0), H0 = {h0:.6e} m"
-    ));
+    // no comment line: the contract's header is the file's first line
     for f in &st.front {
         front.push(vec![f.t, f.t / ts, f.x_f]);
     }
@@ -619,7 +620,10 @@ pub fn run(
         .num("initial_front_m", initial.profile.front(d))
         .num("runout_over_r0", runout / r0)
         .num("normalised_runout", (runout - r0) / r0)
-        .num("runout_scaling_lube_2005", scaling::normalised_runout(c.aspect_ratio))
+        .num(
+            "runout_scaling_lube_2005",
+            scaling::normalised_runout(c.aspect_ratio),
+        )
         .num("final_height_over_r0", final_height / r0)
         .num("final_height_over_h0", final_height / h0)
         .num("rest_time_star", rest_time / ts)
@@ -634,7 +638,10 @@ pub fn run(
         s.num("reference_front_worst_relative_error", worst_reference);
         for (t, dem, cd) in &comparison {
             s.num(&format!("front_over_r0_{}", instant_label(*t)), *dem)
-                .num(&format!("reference_front_over_r0_{}", instant_label(*t)), *cd);
+                .num(
+                    &format!("reference_front_over_r0_{}", instant_label(*t)),
+                    *cd,
+                );
         }
     }
     let mut all = st.deposit;
@@ -718,4 +725,91 @@ fn write_profiles(ctx: &mut RunContext, profiles: &[LabelledProfile], ts: f64) -
     })?;
     ctx.out.write("profiles.csv", &bytes)?;
     Ok(())
+}
+
+/// One finished `column-collapse` run of a campaign: its index, the numeric leaves of its
+/// `summary.json` (dotted keys: `column.runout_m`, …), its verdict and exit status.
+pub struct CampaignRun<'a> {
+    /// Run index.
+    pub index: usize,
+    /// Numeric keys of its summary.
+    pub numbers: &'a std::collections::BTreeMap<String, f64>,
+    /// Its verdict (`ok`, `suspect`, `refused`; empty when unknown).
+    pub verdict: String,
+    /// Its exit status, when recorded.
+    pub code: Option<i32>,
+}
+
+/// The runout against the aspect ratio over the `column-collapse` runs of a campaign (a
+/// `[sweep]` of `aspect_ratio`): `runout.csv`, one row per run sorted by `a` (`run, a,
+/// r0_m, runout_m, runout_over_r0, normalised_runout, final_height_over_r0, rest_time_star,
+/// exit_status, verdict`), and `runout.png`, `(r_∞ − R₀)/R₀` against `a` on log axes with the
+/// scalings of [`scaling`] (every run drawn; those not `ok` hollow).
+pub fn write_runout(out: &mut OutputDir, runs: &[CampaignRun]) -> Result<()> {
+    let num = |r: &CampaignRun, k: &str| r.numbers.get(k).copied().unwrap_or(f64::NAN);
+    let mut rows: Vec<&CampaignRun> = runs.iter().collect();
+    rows.sort_by(|a, b| {
+        num(a, "column.aspect_ratio")
+            .total_cmp(&num(b, "column.aspect_ratio"))
+            .then(a.index.cmp(&b.index))
+    });
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let err = |e: csv::Error| CliError::Io {
+        path: "runout.csv".into(),
+        reason: e.to_string(),
+    };
+    w.write_record([
+        "run",
+        "a",
+        "r0_m",
+        "runout_m",
+        "runout_over_r0",
+        "normalised_runout",
+        "final_height_over_r0",
+        "rest_time_star",
+        "exit_status",
+        "verdict",
+    ])
+    .map_err(err)?;
+    let (mut ok, mut other) = (Vec::new(), Vec::new());
+    for r in &rows {
+        let a = num(r, "column.aspect_ratio");
+        let r0 = num(r, "column.initial_half_width_m");
+        let runout = num(r, "column.runout_m");
+        let h = num(r, "column.final_height_m");
+        let ts = num(r, "time_scale_s");
+        let rest = num(r, "column.rest_time_s") / ts;
+        let n = (runout - r0) / r0;
+        let cell = |v: f64| {
+            if v.is_finite() {
+                format!("{v:e}")
+            } else {
+                String::new()
+            }
+        };
+        w.write_record([
+            format!("{:04}", r.index),
+            cell(a),
+            cell(r0),
+            cell(runout),
+            cell(runout / r0),
+            cell(n),
+            cell(h / r0),
+            cell(rest),
+            r.code.map(|c| c.to_string()).unwrap_or_default(),
+            r.verdict.clone(),
+        ])
+        .map_err(err)?;
+        if r.verdict == "ok" {
+            ok.push((a, n));
+        } else {
+            other.push((a, n));
+        }
+    }
+    let bytes = w.into_inner().map_err(|e| CliError::Io {
+        path: "runout.csv".into(),
+        reason: e.to_string(),
+    })?;
+    out.write("runout.csv", &bytes)?;
+    figures::runout_figure(out, &ok, &other)
 }

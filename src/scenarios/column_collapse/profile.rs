@@ -88,7 +88,10 @@ impl HeightProfile {
 
     /// Number of bins of the continuous mass: from x = 0 up to the first empty bin.
     pub fn mass_bins(&self) -> usize {
-        self.h.iter().position(|&h| h <= 0.0).unwrap_or(self.h.len())
+        self.h
+            .iter()
+            .position(|&h| h <= 0.0)
+            .unwrap_or(self.h.len())
     }
 
     /// The front `x_f` (m): the right edge of the last bin of the run from x = 0 whose height
