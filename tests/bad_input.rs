@@ -674,7 +674,13 @@ fn non_finite_values_in_every_float_key() {
                 ("-inf", f64::NEG_INFINITY),
             ] {
                 let set_arg = if let Some(name) = key.strip_suffix("[0]") {
-                    let mut a = table[name].as_array().unwrap().clone();
+                    // a dotted name reaches an array inside a table (`analysis.reference_t_star`)
+                    let mut a = name
+                        .split('.')
+                        .fold(&Value::Table(table.clone()), |v, p| &v[p])
+                        .as_array()
+                        .unwrap()
+                        .clone();
                     a[0] = Value::Float(v);
                     format!("{name}={}", Value::Array(a))
                 } else {

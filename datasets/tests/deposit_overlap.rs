@@ -72,3 +72,17 @@ fn converged_steps_respect_the_approach_speed_limit() {
         "the relative error alone: {without} fast steps, overlap {overlap_without}: the test shows nothing"
     );
 }
+
+/// Equal disks poured by drop and roll into a column an exact number of diameters wide (the
+/// `column-collapse` built-in with `grain.radius_spread = 0`: R₀ = 20 d): rows fill level
+/// with the walls, and a grain rolling towards a wall it already touches must stop there.
+/// Before the fix it rolled off past the wall, was clamped back onto a grain of its row and
+/// fell through it (two grains at the same centre, "overlap by 5.000e-3 m").
+#[test]
+fn equal_disks_in_an_exact_width_column_do_not_overlap() {
+    let l = datasets::load("column-collapse", &["grain.radius_spread=0".into()]).unwrap();
+    let datasets::Scenario::ColumnCollapse(c) = l.scenario else {
+        unreachable!()
+    };
+    datasets::build::column_collapse_deposit(&c).unwrap();
+}

@@ -213,11 +213,12 @@ impl ColumnCollapseConfig {
             MAX_INSTANTS,
         )?;
         let mut before = 0.0;
-        for &t in &a.reference_t_star {
-            in_range("analysis.reference_t_star", t, 1e-6, 1e6)?;
+        for (i, &t) in a.reference_t_star.iter().enumerate() {
+            let key = format!("analysis.reference_t_star[{i}]");
+            in_range(&key, t, 1e-6, 1e6)?;
             if t <= before {
                 return Err(DatasetError::invalid(
-                    "analysis.reference_t_star",
+                    key,
                     format!(
                         "must increase strictly, got {} after {}",
                         num(t),

@@ -231,6 +231,13 @@ fn roll(
     }
     let to_s = |phi: f64| if right { phi0 - phi } else { phi - phi0 };
     let eps = 1e-10;
+    let start = p + d * Vector2::new(phi0.cos(), phi0.sin());
+    let ahead = |s: Support| match s {
+        Support::Grain(k) => (centres[k].x > start.x) == right,
+        Support::LeftWall => !right,
+        Support::RightWall => right,
+        Support::Floor => false,
+    };
     let mut best: Option<(f64, Support)> = None;
     let consider = |phi: f64, s: Support, best: &mut Option<(f64, Support)>| {
         let phi = if phi < -std::f64::consts::FRAC_PI_2 {
@@ -239,7 +246,14 @@ fn roll(
             phi
         };
         let sv = to_s(phi);
-        if sv > eps && sv <= s_end + eps && best.is_none_or(|(b, _)| sv < to_s(b)) {
+        // A support touched already at the start (s ≈ 0) counts when it lies on the rolling
+        // side: the grain landed on the pivot and on it at once (equal disks in level rows),
+        // and rolling on would take it through that support.
+        let touching_ahead = sv > -eps && ahead(s);
+        if (sv > eps || touching_ahead)
+            && sv <= s_end + eps
+            && best.is_none_or(|(b, _)| sv < to_s(b))
+        {
             *best = Some((phi, s));
         }
     };
