@@ -605,7 +605,7 @@ fn scenarios_cmd(show: Option<&str>) -> Result<()> {
         }
         None => {
             for b in datasets::BUILTINS.iter() {
-                println!("{:<14} {}", b.name, b.description);
+                println!("{:<15} {}", b.name, b.description);
             }
             println!("\nRun one with `grainlaw run NAME`, print its keys with `grainlaw scenarios --show NAME`.");
         }

@@ -436,13 +436,13 @@ pub fn column_collapse_release(c: &ColumnCollapseConfig, settled: &World) -> Res
         .iter()
         .map(|b| b.position.y + b.radius)
         .fold(f64::NEG_INFINITY, f64::max);
-    if !(top > h0) {
+    if top.is_nan() || top <= h0 {
         return Err(DatasetError::Generator(format!(
             "the settled column is {top:.4e} m high, not above H₀ = {h0:.4e} m: it cannot be \
              trimmed to the aspect ratio"
         )));
     }
-    let mut params = settled.params.clone();
+    let mut params = settled.params;
     params.dt = c.dt;
     let mut w = World::new(params, collapse_laws(c));
     let (floor, base, wall) = collapse_walls(&mut w, c);

@@ -55,7 +55,7 @@ pub const BUILTINS: [Builtin; 9] = [
     },
     Builtin {
         name: "column-collapse",
-        description: "a 2D column of 2500 grains (a = 6.26) collapsing onto a rough floor: front x_f(t), profiles, runout, against contact dynamics",
+        description: "a 2D column of about 2500 grains (a = 6.26) collapsing onto a rough floor: front x_f(t), profiles, runout, against contact dynamics",
         toml: include_str!("../scenarios/column-collapse.toml"),
     },
 ];

@@ -230,7 +230,7 @@ impl ColumnCollapseConfig {
         }
         in_range("analysis.sample_t_star", a.sample_t_star, 1e-6, 1.0)?;
         let samples = self.collapse.max_time / (a.sample_t_star * self.time_scale());
-        if !(samples <= MAX_SAMPLES) {
+        if samples.is_nan() || samples > MAX_SAMPLES {
             return Err(DatasetError::invalid(
                 "analysis.sample_t_star",
                 format!(

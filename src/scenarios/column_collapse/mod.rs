@@ -1,7 +1,7 @@
 //! The `column-collapse` scenario: a 2D granular column collapsing onto a rough floor
 //! (Lajeunesse, Mangeney-Castelnau & Vilotte, Phys. Fluids 16, 2004; Lube et al., J. Fluid
 //! Mech. 508, 2004; Staron & Hinch, J. Fluid Mech. 545, 2005; Lagrée, Staron & Popinet, J.
-//! Fluid Mech. 686, 2011), `docs/column-collapse.md`.
+//! Fluid Mech. 686, 2011), `docs/runs.md` §5.
 //!
 //! 1. *Deposit*: polydisperse disks poured by drop and roll between the frictionless symmetry
 //!    wall x = 0 and a gate at x = R₀, on a rough floor (glued disks whose tops are y = 0),
