@@ -237,7 +237,8 @@ fn a_squat_column_keeps_its_top() {
     assert_eq!(s["at_rest"], Value::Bool(true));
 }
 
-/// A run stopped in its collapse (as by Ctrl-C) and resumed writes the same files byte for
+/// A run stopped in the middle of its collapse (as by Ctrl-C: the front samples, profiles,
+/// snapshots and VTK frames so far in the checkpoint) and resumed writes the same files byte for
 /// byte, and the same summary (`wall_seconds` aside), as the run never stopped.
 #[test]
 fn a_resumed_collapse_is_bit_identical() {
@@ -260,12 +261,14 @@ fn a_resumed_collapse_is_bit_identical() {
         out,
         "-q",
         "--allow-suspect",
+        // the deposit takes about 490 steps: stopped in the middle of the collapse
         "--stop-after-steps",
-        "400",
+        "1200",
     ];
     args.extend_from_slice(&small);
     let o = grainlaw(&args);
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
+    assert!(text(&o).contains("of phase `collapse`"), "{}", text(&o));
     let o = grainlaw(&["run", "--resume", out, "-q"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
