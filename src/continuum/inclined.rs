@@ -402,7 +402,7 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
         Axis::new("velocity along the slope u (m/s)"),
         Axis::new("height above the base z (m)"),
     );
-    plot.legend = LegendAt::UpperLeft;
+    plot.legend = LegendAt::LowerRight;
     plot.series.push(Series::new(
         &format!("Bagnold, analytic (I = {i_theta:.3})"),
         Style::Line,

@@ -14,8 +14,8 @@
 //! **Front.** `x_f` is the largest `x` where `h` exceeds a threshold `h_f` (the DEM contract's
 //! one grain diameter, or the cell when it is larger: a layer thinner than one cell is not
 //! resolved and moves with the light phase's viscosity): the right face of the last column
-//! above it, as the DEM takes the edge of its last bin above one diameter; its resolution is
-//! the cell.
+//! above it, as the DEM takes the edge of its last bin above one diameter, advanced into the
+//! next column in proportion to its height (so that `x_f(t)` moves continuously).
 
 use std::path::Path;
 
@@ -38,6 +38,11 @@ pub struct Cell {
     pub p: f64,
     /// The law's inertial number (`Inertial`, 0 outside the grains).
     pub inertial: f64,
+    /// `x` of the interface Gerris reconstructs in the cell (`X` of `VariablePosition X T x`),
+    /// NaN where there is none (Gerris writes `G_MAXDOUBLE`) or the snapshot lacks it.
+    pub interface_x: f64,
+    /// `y` of the reconstructed interface (`Y`), likewise.
+    pub interface_y: f64,
 }
 
 /// A text snapshot.
@@ -95,7 +100,7 @@ impl Snapshot {
                 ))
             }
         };
-        let [it, iu, iv, ip, ii] = ["T", "U", "V", "P", "Inertial"].map(col);
+        let [it, iu, iv, ip, ii, ix2, iy2] = ["T", "U", "V", "P", "Inertial", "X", "Y"].map(col);
         let mut cells = Vec::new();
         for (k, line) in lines {
             let line = line.trim();
@@ -114,6 +119,9 @@ impl Snapshot {
                 ));
             }
             let get = |i: Option<usize>| i.map_or(f64::NAN, |i| f[i]);
+            // Gerris marks "no interface here" with G_MAXDOUBLE
+            let position =
+                |i: Option<usize>| Some(get(i)).filter(|v| v.abs() < 1e300).unwrap_or(f64::NAN);
             cells.push(Cell {
                 x: f[ix],
                 y: f[iy],
@@ -122,6 +130,8 @@ impl Snapshot {
                 v: get(iv),
                 p: get(ip),
                 inertial: get(ii),
+                interface_x: position(ix2),
+                interface_y: position(iy2),
             });
         }
         Ok(Snapshot {
@@ -219,13 +229,15 @@ pub struct InertialStatistics {
 
 /// The front of a height profile `(x_i, h_i)` on columns of side `cell` (module
 /// documentation): the right face `x_i + cell/2` of the last column whose height exceeds
-/// `threshold`, the DEM contract's rule on bins of one cell. `None` when no column exceeds it.
+/// `threshold` (the DEM contract's rule, on bins of one cell), advanced into the next column by
+/// `cell · h_{i+1}/threshold` (that column's height is below the threshold, so the advance is
+/// less than a cell): a front that fills the next column continuously reaches its face when
+/// that column's height reaches the threshold, so `x_f(t)` has no steps of one cell, and a
+/// vertical edge (`h_{i+1} = 0`) is its face. `None` when no column exceeds the threshold.
 pub fn front(profile: &[(f64, f64)], threshold: f64, cell: f64) -> Option<f64> {
-    profile
-        .iter()
-        .rev()
-        .find(|p| p.1 > threshold)
-        .map(|p| p.0 + 0.5 * cell)
+    let last = profile.iter().rposition(|p| p.1 > threshold)?;
+    let next = profile.get(last + 1).map_or(0.0, |p| p.1.max(0.0));
+    Some(profile[last].0 + 0.5 * cell + cell * (next / threshold).min(1.0))
 }
 
 #[cfg(test)]
@@ -250,10 +262,14 @@ mod tests {
         let p = s.height_profile(0.5, "block.txt").unwrap();
         assert_eq!(p, vec![(0.25, 1.25), (0.75, 1.0), (1.25, 0.125)]);
         assert!((s.grain_area(0.5) - (4.0 + 0.5 + 0.25) * 0.25).abs() < 1e-15);
-        // threshold 0.5: the last column above it is x = 0.75 (h 1), its right face 1.0
-        assert_eq!(front(&p, 0.5, 0.5), Some(1.0));
+        // threshold 0.5: the last column above it is x = 0.75 (h 1), its right face 1.0,
+        // advanced by 0.5 · 0.125/0.5 into the next column
+        assert_eq!(front(&p, 0.5, 0.5), Some(1.0 + 0.125));
+        // the last column itself above the threshold: its face, nothing beyond
         assert_eq!(front(&p, 0.1, 0.5), Some(1.5));
         assert_eq!(front(&p, 2.0, 0.5), None);
+        // a vertical edge: the face exactly
+        assert_eq!(front(&[(0.25, 3.0), (0.75, 0.0)], 0.1, 0.5), Some(0.5));
         let st = s.inertial_statistics(0.5, 0.15).unwrap();
         assert_eq!((st.max, st.at), (0.3, (0.25, 0.75)));
         // two of the four full cells above 0.15: 2·0.25 over the area 1.1875
