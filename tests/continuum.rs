@@ -556,3 +556,67 @@ fn gerris_missing_or_failing_exits_3_and_keeps_the_case() {
     assert!(cwd.join("failing/gerris/column.gfs").is_file());
     assert!(cwd.join("failing/gerris/gerris.log").is_file());
 }
+
+/// The code block after `marker` in docs/continuum.md (between its ``` fences).
+fn doc_block(marker: &str) -> String {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/continuum.md"))
+            .unwrap();
+    let at = doc
+        .find(marker)
+        .unwrap_or_else(|| panic!("{marker} not in docs/continuum.md"));
+    let rest = &doc[at..];
+    let start = rest.find("```").unwrap();
+    let body = &rest[start..];
+    let body = &body[body.find('\n').unwrap() + 1..];
+    body[..body.find("```").unwrap()].to_string()
+}
+
+/// docs/continuum.md §9's worked reading in C: the block is what grainlaw writes for the law
+/// (`formula_in_c`), and compiled it gives the Rust evaluation of the law to 1e-12.
+#[test]
+fn worked_reading_in_c() {
+    let block = doc_block("<!-- worked-c");
+    let law = identify::CalibratedLaw::load(&fixture("lagree2011_mu_i_law.json")).unwrap();
+    let expr = law.formula_in_c("I").unwrap();
+    assert!(
+        block.contains(&format!("return {expr};")),
+        "the doc's block is not `{expr}`:\n{block}"
+    );
+    let Some(cc) = ["cc", "gcc", "clang"]
+        .into_iter()
+        .find(|c| Command::new(c).arg("--version").output().is_ok())
+    else {
+        eprintln!("worked_reading_in_c: SKIPPED: no C compiler");
+        return;
+    };
+    let is: Vec<f64> = (0..=12)
+        .map(|k| 1e-3 * 2000f64.powf(k as f64 / 12.0))
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let src = format!(
+        "#include <stdio.h>\n{block}\nint main(void) {{\n{}  return 0;\n}}\n",
+        is.iter()
+            .map(|i| format!("  printf(\"%.17g\\n\", mu_of_I({i:?}));\n"))
+            .collect::<String>()
+    );
+    std::fs::write(dir.path().join("w.c"), src).unwrap();
+    let exe = dir.path().join("w");
+    let out = Command::new(cc)
+        .arg(dir.path().join("w.c"))
+        .arg("-o")
+        .arg(&exe)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let printed = String::from_utf8(Command::new(&exe).output().unwrap().stdout).unwrap();
+    let want = law.evaluate(&is).unwrap();
+    for ((i, line), w) in is.iter().zip(printed.lines()).zip(want) {
+        let got: f64 = line.parse().unwrap();
+        assert!(rel(got, w) < 1e-12, "I = {i}: C {got}, Rust {w}");
+    }
+}
