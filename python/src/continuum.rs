@@ -168,9 +168,8 @@ pub fn continuum<'py>(
     }
     let outcome = match case {
         "column-collapse" => {
-            let dir = out.unwrap_or_else(|| {
-                PathBuf::from("grainlaw-out").join("continuum-column-collapse")
-            });
+            let dir = out
+                .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-column-collapse"));
             let mut plan = ColumnPlan::new(law, dir.clone());
             plan.dem = dem;
             plan.packing_fraction = packing_fraction;
@@ -179,9 +178,8 @@ pub fn continuum<'py>(
             plan.domain = domain;
             plan.end_t_star = t_end;
             plan.band = band;
-            plan.jobs = jobs.unwrap_or_else(|| {
-                std::thread::available_parallelism().map_or(1, |n| n.get())
-            });
+            plan.jobs =
+                jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
             plan.gerris = gerris;
             plan.allow_suspect = allow_suspect;
             if let Some(l) = level {
@@ -205,9 +203,8 @@ pub fn continuum<'py>(
             }
         }
         "inclined-plane" => {
-            let dir = out.unwrap_or_else(|| {
-                PathBuf::from("grainlaw-out").join("continuum-inclined-plane")
-            });
+            let dir = out
+                .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-inclined-plane"));
             let mut plan = InclinedPlan::new(law, dir.clone());
             plan.dem = dem;
             plan.packing_fraction = packing_fraction;

@@ -123,13 +123,16 @@ pub struct ColumnOutcome {
     pub dir: PathBuf,
 }
 
+/// A height profile `(x, h)` at a labelled Gerris time.
+type LabelledProfile = (String, f64, Vec<(f64, f64)>);
+
 /// One Gerris run of the column, read back (Gerris units).
 #[derive(Debug, Clone)]
 struct CaseResult {
     /// `(t, x_f)` every history snapshot.
     front: Vec<(f64, f64)>,
     /// `(label, t, profile)` at the reference instants and `end`.
-    profiles: Vec<(String, f64, Vec<(f64, f64)>)>,
+    profiles: Vec<LabelledProfile>,
     /// Area of the grains at the start and at the end.
     area: (f64, f64),
     /// The law's `I` at every history snapshot.
