@@ -1076,9 +1076,10 @@ fn run_band(
         .collect();
     let verdict_line = if dem.is_some() {
         format!(
-            "band verdict: the DEM front lies inside the law's band at {} of {} instants (reference instants and rest){}",
+            "band verdict: the DEM front lies inside the law's band at {} of {} instants compared (the reference instants{}){}",
             inside_count.0,
             inside_count.1,
+            if dem.and_then(|d| d.summary.runout_m).is_some() { ", and r∞ at rest" } else { "; the DEM run gives no r∞" },
             if inside_count.0 == inside_count.1 { ": consistent with the law within its uncertainty" } else { ": the DEM is NOT explained by the law's uncertainty alone" }
         )
     } else {
@@ -1093,8 +1094,11 @@ fn run_band(
     ));
     for r in &rows {
         lines.push(format!(
-            "  {:<6} x_f/R0 {:.2} [{:.2}, {:.2}]{}",
-            r["label"].as_str().unwrap_or(""),
+            "  {:<9} x_f/R0 {:.2} [{:.2}, {:.2}]{}",
+            match r["label"].as_str().unwrap_or("") {
+                "end" => "r∞ (end)",
+                l => l,
+            },
             r["x_f_central_m"].as_f64().unwrap_or(f64::NAN) / r0,
             r["x_f_low_m"].as_f64().unwrap_or(f64::NAN) / r0,
             r["x_f_high_m"].as_f64().unwrap_or(f64::NAN) / r0,
