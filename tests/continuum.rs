@@ -495,6 +495,29 @@ fn bad_input_is_one_line_and_exit_2() {
     assert!(!cwd
         .join("grainlaw-out/continuum-column-collapse/summary.json")
         .exists());
+    // never into a scenario run's directory (its files would be replaced)
+    std::fs::create_dir_all(cwd.join("flow")).unwrap();
+    std::fs::write(
+        cwd.join("flow/scenario.toml"),
+        "scenario = \"inclined-flow\"\n",
+    )
+    .unwrap();
+    let out = grainlaw(
+        &[
+            "continuum",
+            "inclined-plane",
+            "--law",
+            mu,
+            "--slope-deg",
+            "26",
+            "--packing-fraction",
+            "0.8",
+            "--out",
+            "flow",
+        ],
+        cwd,
+    );
+    check_error(&out, 2, &["--out flow", "`inclined-flow` run"]);
 }
 
 /// Gerris missing, or failing: exit 3, one line quoting its stderr's last lines, the case left

@@ -262,6 +262,17 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
             "the run ends at t* = {end_t_star}: the reference instants after it are left out"
         ));
     }
+    // never into a DEM run's (or another scenario's) directory: its files would be replaced
+    if let Some(d) = &plan.dem {
+        if same_dir(d, &plan.out) {
+            return Err(CliError::Usage(format!(
+                "--out {}: is the DEM run's directory (--dem): choose another",
+                plan.out.display()
+            )));
+        }
+    }
+    crate::cli::check_out_dir(&plan.out, "continuum-column-collapse")?;
+    let started = std::time::Instant::now();
     let mut out = OutputDir::create(&plan.out)?;
     let gerris_cmd = gerris::command(plan.gerris.as_deref());
     let case_dir = plan.out.join("gerris");
@@ -469,6 +480,8 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
         "warnings",
         Value::Array(warnings.iter().map(|w| Value::from(w.as_str())).collect()),
     );
+    s.num("wall_seconds", started.elapsed().as_secs_f64());
+    s.text("grainlaw_version", identify::law::GRAINLAW_VERSION);
     out.write("summary.json", s.to_json().as_bytes())?;
 
     let mut lines = vec![format!("report: {}/", plan.out.display())];
@@ -532,6 +545,14 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
         summary: serde_json::from_str(&s.to_json()).unwrap_or(Value::Null),
         dir: plan.out.clone(),
     })
+}
+
+/// Whether `a` and `b` name the same directory (both canonicalised when they exist).
+pub(crate) fn same_dir(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
 }
 
 fn positive(name: &str, v: f64) -> Result<()> {

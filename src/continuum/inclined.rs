@@ -254,6 +254,15 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
         })?;
     let uv = rheology.units.velocity_m_s();
     let u_surface_g = flow.surface_velocity() / uv;
+    if let Some(d) = &plan.dem {
+        if super::column::same_dir(d, &plan.out) {
+            return Err(CliError::Usage(format!(
+                "--out {}: is the DEM run's directory (--dem): choose another",
+                plan.out.display()
+            )));
+        }
+    }
+    crate::cli::check_out_dir(&plan.out, "continuum-inclined-plane")?;
     let mut out = OutputDir::create(&plan.out)?;
     let case_dir = plan.out.join("gerris");
     let case = InclinedCase {
