@@ -110,6 +110,11 @@ pub enum Command {
         #[arg(long, value_name = "J")]
         jobs: Option<usize>,
     },
+    /// Run a calibrated μ(I) law in a continuum solver (Gerris) and compare with DEM:
+    /// `column-collapse` or `inclined-plane` (docs/continuum.md). Exit code 2 for bad input, 3
+    /// for a refused result or a missing or failing solver.
+    #[command(subcommand)]
+    Continuum(ContinuumCommand),
     /// Homogenise snapshots of another DEM code (LAMMPS/LIGGGHTS dumps, LMGC90 files, plain
     /// grainlaw-snapshot-v1 JSON): stresses, fabric, wall loads, profiles, figures, VTK.
     Homogenise(HomogeniseArgs),
@@ -166,6 +171,188 @@ pub enum Command {
         #[arg(long, value_name = "I", default_value_t = 0.01)]
         rve_inertial: f64,
     },
+}
+
+/// The cases of `grainlaw continuum`.
+#[derive(Debug, Subcommand)]
+pub enum ContinuumCommand {
+    /// The 2D collapse of a granular column (Lagrée, Staron & Popinet 2011): front x_f(t*) and
+    /// height profiles h(x), compared with a DEM `column-collapse` run's.
+    ColumnCollapse(ColumnArgs),
+    /// Steady flow down a slope: Gerris' profile against the analytic Bagnold profile of the
+    /// law and a DEM `inclined-flow` run's velocity profile.
+    InclinedPlane(InclinedArgs),
+}
+
+/// The options of `grainlaw continuum column-collapse`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ColumnArgs {
+    /// The calibrated μ(I) law (`mu_i_law.json`, schema 2: mu-i or mu-i-linear).
+    #[arg(long, value_name = "LAW.json")]
+    pub law: PathBuf,
+    /// The continuum solver (only `gerris`).
+    #[arg(long, default_value = "gerris")]
+    pub solver: String,
+    /// Output directory (default `grainlaw-out/continuum-column-collapse`).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// A DEM `column-collapse` output directory: compared with, and the set-up (a, R0, φ, g,
+    /// the instants, the time of rest) taken from it.
+    #[arg(long, value_name = "DEM_OUTPUT_DIR")]
+    pub dem: Option<PathBuf>,
+    /// Aspect ratio a = H0/R0 (default: the DEM's, else 6.26).
+    #[arg(long, value_name = "A")]
+    pub aspect_ratio: Option<f64>,
+    /// Initial half-width R0 (m) (default: the DEM's, else d/0.04623 as in the Gerris example).
+    #[arg(long, value_name = "METRES")]
+    pub half_width: Option<f64>,
+    /// Packing fraction φ of the continuum, its density φ ρ_s (default: the DEM's initial one;
+    /// needed without --dem).
+    #[arg(long, value_name = "PHI")]
+    pub packing_fraction: Option<f64>,
+    /// Gerris refinement level: cells of domain/2^L in and around the grains.
+    #[arg(long, value_name = "L", default_value_t = crate::continuum::column::DEFAULT_LEVEL)]
+    pub level: u32,
+    /// Side of the square domain, in units of R0 (default: the power of two ≥ 2.5 a).
+    #[arg(long, value_name = "R0S")]
+    pub domain: Option<f64>,
+    /// End of the run in t* = t √(g/H0) (default: the DEM's time of rest, else 4).
+    #[arg(long, value_name = "T_STAR")]
+    pub t_end: Option<f64>,
+    /// Cap of the μ(I) viscosity in Gerris units ρ_b √(g R0³) (the zones at rest creep at
+    /// about μ P / cap).
+    #[arg(long, value_name = "ETA", default_value_t = crate::continuum::column::DEFAULT_VISCOSITY_CAP)]
+    pub viscosity_cap: f64,
+    /// Also run the band of the law's uncertainty (2p + 1 runs along the covariance's
+    /// principal axes) and say whether the DEM lies inside it.
+    #[arg(long)]
+    pub band: bool,
+    /// Gerris runs at once for the band (default: the cores available).
+    #[arg(long, value_name = "J")]
+    pub jobs: Option<usize>,
+    /// The Gerris 2D command (default `gerris2D` on the PATH).
+    #[arg(long, value_name = "PATH")]
+    pub gerris: Option<PathBuf>,
+    /// A suspect result (the law used far outside its calibrated range) exits 0.
+    #[arg(long)]
+    pub allow_suspect: bool,
+    /// No report on stdout.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// The options of `grainlaw continuum inclined-plane`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct InclinedArgs {
+    /// The calibrated μ(I) law (`mu_i_law.json`, schema 2: mu-i or mu-i-linear).
+    #[arg(long, value_name = "LAW.json")]
+    pub law: PathBuf,
+    /// The continuum solver (only `gerris`).
+    #[arg(long, default_value = "gerris")]
+    pub solver: String,
+    /// Output directory (default `grainlaw-out/continuum-inclined-plane`).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// A DEM `inclined-flow` output directory: compared with, slope, depth and φ taken from it.
+    #[arg(long, value_name = "DEM_OUTPUT_DIR")]
+    pub dem: Option<PathBuf>,
+    /// Slope angle (degrees) (default: the DEM's).
+    #[arg(long, value_name = "DEG")]
+    pub slope_deg: Option<f64>,
+    /// Layer thickness H (m) (default: the DEM's flow height, else 20 d).
+    #[arg(long, value_name = "METRES")]
+    pub depth: Option<f64>,
+    /// Packing fraction φ of the layer (default: the DEM layer's mean; needed without --dem).
+    #[arg(long, value_name = "PHI")]
+    pub packing_fraction: Option<f64>,
+    /// Gerris refinement level (2^L cells across the layer).
+    #[arg(long, value_name = "L", default_value_t = crate::continuum::inclined::DEFAULT_LEVEL)]
+    pub level: u32,
+    /// Cap of the μ(I) viscosity in Gerris units ρ_b √(g H³).
+    #[arg(long, value_name = "ETA", default_value_t = crate::continuum::inclined::DEFAULT_VISCOSITY_CAP)]
+    pub viscosity_cap: f64,
+    /// The Gerris 2D command (default `gerris2D` on the PATH).
+    #[arg(long, value_name = "PATH")]
+    pub gerris: Option<PathBuf>,
+    /// A suspect result exits 0.
+    #[arg(long)]
+    pub allow_suspect: bool,
+    /// No report on stdout.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn check_solver(solver: &str) -> Result<()> {
+    if solver == "gerris" {
+        Ok(())
+    } else {
+        Err(CliError::Usage(format!(
+            "--solver {solver}: the only continuum solver is `gerris`"
+        )))
+    }
+}
+
+/// `grainlaw continuum …`: runs the case, prints its warnings (stderr) and report (stdout);
+/// exit 3 when its verdict does not pass.
+fn continuum_cmd(cmd: ContinuumCommand) -> Result<()> {
+    let (lines, warnings, verdict, dir, quiet) = match cmd {
+        ContinuumCommand::ColumnCollapse(a) => {
+            check_solver(&a.solver)?;
+            let out = a
+                .out
+                .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-column-collapse"));
+            let mut plan = crate::continuum::ColumnPlan::new(a.law, out);
+            plan.dem = a.dem;
+            plan.aspect_ratio = a.aspect_ratio;
+            plan.half_width_m = a.half_width;
+            plan.packing_fraction = a.packing_fraction;
+            plan.level = a.level;
+            plan.domain = a.domain;
+            plan.end_t_star = a.t_end;
+            plan.viscosity_cap = a.viscosity_cap;
+            plan.band = a.band;
+            plan.jobs = a
+                .jobs
+                .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+            plan.gerris = a.gerris;
+            plan.allow_suspect = a.allow_suspect;
+            let o = crate::continuum::column_collapse(&plan)?;
+            (o.lines, o.warnings, o.verdict, o.dir, a.quiet)
+        }
+        ContinuumCommand::InclinedPlane(a) => {
+            check_solver(&a.solver)?;
+            let out = a
+                .out
+                .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-inclined-plane"));
+            let mut plan = crate::continuum::InclinedPlan::new(a.law, out.clone());
+            plan.dem = a.dem;
+            plan.slope_deg = a.slope_deg;
+            plan.depth_m = a.depth;
+            plan.packing_fraction = a.packing_fraction;
+            plan.level = a.level;
+            plan.viscosity_cap = a.viscosity_cap;
+            plan.gerris = a.gerris;
+            plan.allow_suspect = a.allow_suspect;
+            let o = crate::continuum::inclined_plane(&plan)?;
+            (o.lines, o.warnings, o.verdict, out, a.quiet)
+        }
+    };
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    if !quiet {
+        for l in &lines {
+            println!("{l}");
+        }
+    }
+    if verdict.passes() {
+        Ok(())
+    } else {
+        Err(CliError::Verdict {
+            dir: dir.display().to_string(),
+            reason: verdict.failure_line(),
+        })
+    }
 }
 
 /// Parses `args` and runs; returns the process exit code (0; 2 on any error; 3 for a refused
@@ -360,6 +547,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
     match cmd.unwrap_or(Command::Run(RunArgs::default())) {
         Command::Run(args) => run(args),
         Command::Homogenise(args) => homogenise_cmd(args),
+        Command::Continuum(cmd) => continuum_cmd(cmd),
         Command::Scenarios { show } => scenarios_cmd(show.as_deref()),
         Command::Fit { law, data, out } => crate::fit_cmd::fit_files(&law, &data, out.as_deref()),
         Command::Campaign {

@@ -5,7 +5,8 @@ use thiserror::Error;
 /// Everything `grainlaw` can fail with. [`CliError::one_line`] is what is printed; the exit code
 /// ([`CliError::exit_code`]) is 2 for all of them (bad input, unreadable file, failed run),
 /// after no partial output that looks complete, except 130 for [`CliError::Interrupted`] and 3
-/// for [`CliError::FitRefused`].
+/// for a refused result ([`CliError::FitRefused`], [`CliError::Verdict`], ...) or an external
+/// solver that is missing or failed ([`CliError::ExternalSolver`]).
 #[derive(Debug, Error)]
 pub enum CliError {
     /// Scenario loading, validation, generation.
@@ -99,6 +100,19 @@ pub enum CliError {
     /// A command-line argument is wrong.
     #[error("{0}")]
     Usage(String),
+    /// An external solver (Gerris) is missing or failed: its case directory is left in place
+    /// to be rerun by hand, and the exit code is 3 (`grainlaw continuum`, `docs/continuum.md`).
+    #[error("{solver}: {reason}; the case is left in {dir}: rerun it there with `{rerun}`")]
+    ExternalSolver {
+        /// The solver's command (`gerris2D`).
+        solver: String,
+        /// What happened, with the last lines of its stderr (folded onto one line).
+        reason: String,
+        /// The case directory.
+        dir: String,
+        /// The command that reruns the case in `dir`.
+        rerun: String,
+    },
     /// A campaign was stopped (Ctrl-C, SIGTERM): its running runs wrote their checkpoints.
     #[error(
         "campaign stopped: the running runs wrote their checkpoints; continue with the same command (finished runs are not redone), in {dir}"
@@ -127,7 +141,8 @@ impl CliError {
             CliError::Interrupted { .. } | CliError::CampaignStopped { .. } => 130,
             CliError::FitRefused { .. }
             | CliError::NotConverged { .. }
-            | CliError::Verdict { .. } => 3,
+            | CliError::Verdict { .. }
+            | CliError::ExternalSolver { .. } => 3,
             _ => 2,
         }
     }

@@ -10,6 +10,7 @@ pub mod bench_cmd;
 pub mod campaign;
 pub mod checkpoint;
 pub mod cli;
+pub mod continuum;
 pub mod error;
 pub mod fc_cmd;
 pub mod fit_cmd;

@@ -115,16 +115,7 @@ impl BagnoldFlow {
         grain_diameter_m: f64,
         gravity_m_s2: f64,
     ) -> Result<Self> {
-        check_setup_positive("depth_m", depth_m)?;
-        check_setup_positive("grain_diameter_m", grain_diameter_m)?;
-        check_setup_positive("gravity_m_s2", gravity_m_s2)?;
-        if !(slope_rad > 0.0 && slope_rad < std::f64::consts::FRAC_PI_2) {
-            return Err(IdentifyError::InvalidSetup {
-                field: "slope_rad".into(),
-                value: slope_rad,
-                expected: "an angle in (0, π/2)".into(),
-            });
-        }
+        check_slope(slope_rad)?;
         let tan = slope_rad.tan();
         let i = mu_i
             .inertial_number_for(tan)
@@ -144,6 +135,27 @@ impl BagnoldFlow {
             SolidFraction::Constant(p) => p,
             SolidFraction::Law(l) => l.phi(i),
         };
+        Self::with_inertial_number(i, phi, slope_rad, depth_m, grain_diameter_m, gravity_m_s2)
+    }
+
+    /// The flow of a given uniform inertial number `I` (the root of `μ(I) = tan θ` of any μ(I)
+    /// law, e.g. the linear form's `(tan θ − μ_s)/b`) and solid fraction `φ`. Errors:
+    /// [`IdentifyError::InvalidSetup`] for a non-positive `I`, depth, diameter, gravity, a
+    /// slope outside `(0, π/2)` or a solid fraction outside `(0, 1]`.
+    pub fn with_inertial_number(
+        inertial_number: f64,
+        phi: f64,
+        slope_rad: f64,
+        depth_m: f64,
+        grain_diameter_m: f64,
+        gravity_m_s2: f64,
+    ) -> Result<Self> {
+        check_setup_positive("inertial_number", inertial_number)?;
+        check_setup_positive("depth_m", depth_m)?;
+        check_setup_positive("grain_diameter_m", grain_diameter_m)?;
+        check_setup_positive("gravity_m_s2", gravity_m_s2)?;
+        check_slope(slope_rad)?;
+        let i = inertial_number;
         if !(phi > 0.0 && phi <= 1.0) {
             return Err(IdentifyError::InvalidSetup {
                 field: "solid_fraction".into(),
@@ -211,4 +223,15 @@ impl BagnoldFlow {
             })
             .collect()
     }
+}
+
+fn check_slope(slope_rad: f64) -> Result<()> {
+    if !(slope_rad > 0.0 && slope_rad < std::f64::consts::FRAC_PI_2) {
+        return Err(IdentifyError::InvalidSetup {
+            field: "slope_rad".into(),
+            value: slope_rad,
+            expected: "an angle in (0, π/2)".into(),
+        });
+    }
+    Ok(())
 }

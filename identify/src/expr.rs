@@ -217,6 +217,28 @@ impl Expr {
         })
     }
 
+    /// The expression as C source (C99 `<math.h>`), every operation parenthesised so that C
+    /// evaluates the same tree in the same order: `a^b` → `pow(a, b)`, `ln` → `log`, the other
+    /// functions by their own name. Each variable is replaced by `subst(name)`: a C expression
+    /// (a literal, a variable of the calling code), or `None` for a variable with no value
+    /// ([`IdentifyError::LawFormat`]). Numbers are written in Rust's shortest round-trip form
+    /// (`{:?}`), which a C compiler reads back to the same double (IEEE 754, round to nearest).
+    pub fn to_c(&self, subst: &dyn Fn(&str) -> Option<String>) -> Result<String> {
+        Ok(match self {
+            Expr::Number(v) => c_literal(*v),
+            Expr::Variable(n) => subst(n).ok_or_else(|| IdentifyError::LawFormat {
+                message: format!("formula variable '{n}' has no value"),
+            })?,
+            Expr::Neg(e) => format!("(-{})", e.to_c(subst)?),
+            Expr::Binary('^', a, b) => format!("pow({}, {})", a.to_c(subst)?, b.to_c(subst)?),
+            Expr::Binary(op, a, b) => format!("({} {op} {})", a.to_c(subst)?, b.to_c(subst)?),
+            Expr::Call(f, e) => {
+                let name = if f == "ln" { "log" } else { f.as_str() };
+                format!("{name}({})", e.to_c(subst)?)
+            }
+        })
+    }
+
     /// The variable names the expression uses (sorted, each once).
     pub fn variables(&self) -> Vec<String> {
         let mut out = Vec::new();
@@ -236,6 +258,25 @@ impl Expr {
                 b.collect(out);
             }
         }
+    }
+}
+
+/// A double as a C literal that reads back to the same value: Rust's shortest round-trip
+/// digits (`{:?}`), with a `.0` kept so that C reads a double, never an integer; negative values
+/// parenthesised; non-finite values as `(1.0/0.0)`, `(-1.0/0.0)`, `(0.0/0.0)`.
+pub fn c_literal(v: f64) -> String {
+    if v.is_nan() {
+        "(0.0/0.0)".into()
+    } else if v.is_infinite() {
+        if v > 0.0 {
+            "(1.0/0.0)".into()
+        } else {
+            "(-1.0/0.0)".into()
+        }
+    } else if v < 0.0 || (v == 0.0 && v.is_sign_negative()) {
+        format!("(-{:?})", -v)
+    } else {
+        format!("{v:?}")
     }
 }
 
@@ -269,5 +310,33 @@ mod tests {
             assert!(Expr::parse(bad).is_err(), "{bad}");
         }
         assert!(Expr::parse("x").unwrap().eval(&BTreeMap::new()).is_err());
+    }
+    #[test]
+    fn c_source_keeps_the_tree_and_the_digits() {
+        let e = Expr::parse("mu_s + (mu_2 - mu_s)*I/(I + I_0)").unwrap();
+        let c = e
+            .to_c(&|n| match n {
+                "I" => Some("In".into()),
+                "mu_s" => Some(c_literal(0.31999475797599297)),
+                "mu_2" => Some(c_literal(0.6)),
+                "I_0" => Some(c_literal(1e-7)),
+                _ => None,
+            })
+            .unwrap();
+        assert_eq!(
+            c,
+            "(0.31999475797599297 + (((0.6 - 0.31999475797599297) * In) / (In + 1e-7)))"
+        );
+        let p = Expr::parse("-a^2 + ln(b)").unwrap();
+        assert_eq!(
+            p.to_c(&|n| Some(n.to_string())).unwrap(),
+            "((-pow(a, 2.0)) + log(b))"
+        );
+        assert!(p.to_c(&|_| None).is_err());
+        assert_eq!(c_literal(-2.5), "(-2.5)");
+        assert_eq!(c_literal(3.0), "3.0");
+        for v in [0.1, 1.0 / 3.0, 6.02214076e23, 5e-324] {
+            assert_eq!(c_literal(v).parse::<f64>().unwrap(), v);
+        }
     }
 }

@@ -1134,6 +1134,54 @@ impl CalibratedLaw {
             .collect()
     }
 
+    /// The law's formula as C source (module [`crate::expr`], [`Expr::to_c`]): its input
+    /// variable written `input` (a C expression of the calling code, e.g. `In`), every parameter
+    /// and constant replaced by its value as a round-trip literal
+    /// ([`crate::expr::c_literal`]). What a C solver (Gerris' `SourceViscosity`, a user
+    /// function of another code) compiles to evaluate the law; it evaluates the same operations
+    /// in the same order as [`CalibratedLaw::evaluate_formula`]. Errors:
+    /// [`IdentifyError::LawFormat`] for a formula that does not parse or a variable with no
+    /// value.
+    pub fn formula_in_c(&self, input: &str) -> Result<String> {
+        let expr = Expr::parse(&self.expression.formula)?;
+        let values: BTreeMap<&str, f64> = self
+            .parameters
+            .iter()
+            .map(|p| (p.name.as_str(), p.value))
+            .chain(self.constants.iter().map(|c| (c.name.as_str(), c.value)))
+            .collect();
+        let input_name = self.expression.input.name.as_str();
+        expr.to_c(&|n| {
+            if n == input_name {
+                Some(input.to_string())
+            } else {
+                values.get(n).map(|v| crate::expr::c_literal(*v))
+            }
+        })
+    }
+
+    /// The same law with the parameter values `values` (in the order of the covariance, i.e.
+    /// the registry's, [`CalibratedLaw::parameters`]), e.g. a draw from its covariance;
+    /// intervals and standard errors are kept as they are. Errors:
+    /// [`IdentifyError::LawFormat`] when the number of values differs from the parameters'.
+    pub fn with_parameter_values(&self, values: &[f64]) -> Result<Self> {
+        if values.len() != self.parameters.len() {
+            return Err(IdentifyError::LawFormat {
+                message: format!(
+                    "law '{}': {} parameter values given for {} parameters",
+                    self.law,
+                    values.len(),
+                    self.parameters.len()
+                ),
+            });
+        }
+        let mut law = self.clone();
+        for (p, v) in law.parameters.iter_mut().zip(values) {
+            p.estimate.value = *v;
+        }
+        Ok(law)
+    }
+
     /// True when `x` lies inside the validity range of the law's input variable (true when
     /// the range of that variable is not recorded).
     pub fn in_validity_range(&self, x: f64) -> bool {

@@ -17,6 +17,9 @@ compressive-positive magnitudes (as ``grainlaw fit`` does).
   above.
 - ``homogenise(format, files, out, ...)``: ``grainlaw homogenise --from FORMAT FILES --out
   OUT`` itself (CSV tables, figures, VTK, summary.json); returns the summary and the paths.
+- ``continuum(case, law, out, dem=..., ...)``: a calibrated μ(I) law run in the continuum
+  solver Gerris (``"column-collapse"``, ``"inclined-plane"``), compared with a DEM run, as
+  ``grainlaw continuum``; returns the summary, the front and profiles as arrays, the comparison.
 - ``fit_janssen``, ``fit_janssen_kmu``, ``fit_wall_law``, ``fit_mu_i``, ``fit_mu_i_linear``,
   ``fit_phi_i``, ``fit_mohr_coulomb`` (and the generic ``fit``): laws
   with confidence intervals, as ``Law`` objects; ``load_law`` reads a calibrated-law JSON.
@@ -45,6 +48,7 @@ from ._grainlaw import (
     SolverError,
     World,
     __version__,
+    continuum,
     coordination,
     fabric,
     fit,
@@ -71,6 +75,7 @@ __all__ = [
     "Snapshot",
     "World",
     "__version__",
+    "continuum",
     "coordination",
     "fabric",
     "fit",

@@ -51,7 +51,8 @@ create_exception!(
     grainlaw,
     SolverError,
     GrainlawError,
-    "The engine failed during a step (a non-finite state, a checkpoint that cannot be used)."
+    "The engine failed during a step (a non-finite state, a checkpoint that cannot be used), or \
+     an external solver (Gerris) is missing or failed."
 );
 create_exception!(
     grainlaw,
@@ -160,9 +161,10 @@ pub fn cli_err(py: Python<'_>, e: CliError) -> PyErr {
         CliError::Identify(i) => identify_err(py, i),
         CliError::FitRefused { reason, .. } => refused(py, reason, None),
         CliError::Interrupted { .. } => PyKeyboardInterrupt::new_err(msg),
-        CliError::Fc(_) | CliError::NotConverged { .. } | CliError::Checkpoint { .. } => {
-            SolverError::new_err(msg)
-        }
+        CliError::Fc(_)
+        | CliError::NotConverged { .. }
+        | CliError::Checkpoint { .. }
+        | CliError::ExternalSolver { .. } => SolverError::new_err(msg),
         CliError::Io { .. } | CliError::Plot { .. } => OutputError::new_err(msg),
         // `run` raises a run's verdict itself, with its result (`verdict_err`); the library
         // returns it in the outcome, never as this error.

@@ -13,6 +13,8 @@
 //!   (`grainlaw homogenise --from`: every output written, the GIL released);
 //! - [`fit`]: the fits of `identify` from numpy columns and `Law`, the calibrated-law JSON
 //!   (schemas 1 and 2) with vectorised evaluation;
+//! - [`continuum`]: `continuum(case, law, ...)`: a μ(I) law run in Gerris (`grainlaw continuum`,
+//!   root crate `grainlaw::continuum`), the GIL released;
 //! - [`errors`]: the exception hierarchy (`GrainlawError` and its subclasses).
 //!
 //! Units SI, 2D quantities per metre of thickness, stresses tension positive (the fits take
@@ -21,6 +23,7 @@
 use pyo3::prelude::*;
 
 mod arrays;
+mod continuum;
 mod errors;
 mod fit;
 mod homog;
@@ -56,5 +59,6 @@ fn _grainlaw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(fit::load_law, m)?)?;
     m.add_function(wrap_pyfunction!(fit::law_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(continuum::continuum, m)?)?;
     Ok(())
 }

@@ -56,6 +56,12 @@ impl LinearMuILaw {
     pub fn mu(&self, i: f64) -> f64 {
         self.mu_s + self.slope * i
     }
+
+    /// Inverse: the `I` with `μ(I) = μ`, `I = (μ − μ_s)/b`; `None` unless `μ > μ_s` and
+    /// `b > 0` (no steady flow otherwise).
+    pub fn inertial_number_for(&self, mu: f64) -> Option<f64> {
+        (mu > self.mu_s && self.slope > 0.0).then(|| (mu - self.mu_s) / self.slope)
+    }
 }
 
 /// `φ(I) = φ_max − a I`, the dilatancy of dense granular flow (da Cruz, Emam, Prochnow, Roux &
@@ -94,5 +100,12 @@ mod tests {
         assert!((law.mu(i) - 0.5).abs() < 1e-15);
         assert!(law.inertial_number_for(0.3).is_none());
         assert!(law.inertial_number_for(0.7).is_none());
+        let lin = LinearMuILaw {
+            mu_s: 0.29,
+            slope: 0.94,
+        };
+        let i = lin.inertial_number_for(0.4877).unwrap();
+        assert!((lin.mu(i) - 0.4877).abs() < 1e-15);
+        assert!(lin.inertial_number_for(0.2).is_none());
     }
 }

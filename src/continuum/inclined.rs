@@ -1,0 +1,548 @@
+//! `grainlaw continuum inclined-plane`: the law's steady flow down a slope computed by Gerris
+//! (a layer periodic along the slope), against the analytic Bagnold profile of the same law and
+//! a DEM `inclined-flow` run's velocity profile (`docs/continuum.md` §7).
+//!
+//! Steady uniform flow of thickness `H` at angle `θ`: `τ = ρ_b g sin θ (H − z)`,
+//! `P = ρ_b g cos θ (H − z)`, so `μ(I) = tan θ` fixes a uniform `I_θ` (`μ_s < tan θ < μ₂`;
+//! `I_θ = I₀ (tan θ − μ_s)/(μ₂ − tan θ)` for the saturating law, `(tan θ − μ_s)/b` for the linear
+//! one) and `u(z) = (2/3)(I_θ/d)√(φ g cos θ)(H^{3/2} − (H − z)^{3/2})` (GDR MiDi, Eur. Phys.
+//! J. E 14, 2004; Jop, Forterre & Pouliquen, J. Fluid Mech. 541, 2005), evaluated by
+//! [`identify::continuum::BagnoldFlow`]. In Gerris' units (`H = 1`, `g = 1`, `ρ_b = 1`):
+//! `u = (2/3)(√φ I_θ/D)√(cos θ)(1 − (1 − z)^{3/2})`.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+use identify::continuum::BagnoldFlow;
+
+use super::column::interpolate;
+use super::dem_column::{read_rows, write_rows};
+use super::gerris;
+use super::gfs::{InclinedCase, SNAPSHOT_DIR};
+use super::rheology::{load_continuum_law, GerrisRheology};
+use super::snapshot::Snapshot;
+use crate::error::{CliError, Result};
+use crate::output::{OutputDir, Summary};
+use crate::plot::xy::{draw_xy, Axis, LegendAt, Series, Style, XyPlot};
+use crate::plot::PALETTE;
+use crate::verdict::{Checks, RunVerdict, Verdict};
+
+/// Default refinement level (`2^6 = 64` cells across the layer).
+pub const DEFAULT_LEVEL: u32 = 6;
+/// Default layer thickness without a DEM run or `--depth`, in grain diameters.
+pub const DEFAULT_DEPTH_DIAMETERS: f64 = 20.0;
+/// Largest number of Gerris time steps.
+pub const MAX_STEPS: u64 = 4000;
+/// Steady state: `U` changes by less than this fraction of the analytic surface velocity over
+/// 10 steps.
+pub const STEADY_TOLERANCE: f64 = 2e-6;
+/// Default viscosity cap (Gerris units of the layer).
+pub const DEFAULT_VISCOSITY_CAP: f64 = 1000.0;
+/// Gravity of the DEM scenarios (m/s²).
+pub const GRAVITY: f64 = 9.81;
+
+/// What `grainlaw continuum inclined-plane` runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InclinedPlan {
+    /// The μ(I) law JSON.
+    pub law: PathBuf,
+    /// Output directory.
+    pub out: PathBuf,
+    /// A DEM `inclined-flow` output directory.
+    pub dem: Option<PathBuf>,
+    /// Slope (degrees) (default: the DEM's).
+    pub slope_deg: Option<f64>,
+    /// Layer thickness `H` (m) (default: the DEM's flow height, else 20 d).
+    pub depth_m: Option<f64>,
+    /// Packing fraction (default: the DEM layer's mean; required without).
+    pub packing_fraction: Option<f64>,
+    /// Refinement level.
+    pub level: u32,
+    /// Viscosity cap (Gerris units).
+    pub viscosity_cap: f64,
+    /// The Gerris command.
+    pub gerris: Option<PathBuf>,
+    /// A suspect run exits 0.
+    pub allow_suspect: bool,
+}
+
+impl InclinedPlan {
+    /// The plan with the defaults for `law` and `out`.
+    pub fn new(law: PathBuf, out: PathBuf) -> Self {
+        InclinedPlan {
+            law,
+            out,
+            dem: None,
+            slope_deg: None,
+            depth_m: None,
+            packing_fraction: None,
+            level: DEFAULT_LEVEL,
+            viscosity_cap: DEFAULT_VISCOSITY_CAP,
+            gerris: None,
+            allow_suspect: false,
+        }
+    }
+}
+
+/// A finished inclined-plane run.
+#[derive(Debug, Clone)]
+pub struct InclinedOutcome {
+    /// The report printed on stdout.
+    pub lines: Vec<String>,
+    /// Warnings.
+    pub warnings: Vec<String>,
+    /// The verdict.
+    pub verdict: RunVerdict,
+    /// `summary.json`'s content.
+    pub summary: Value,
+    /// `(z, u)` of Gerris (Gerris units, averaged along the slope).
+    pub gerris_profile: Vec<(f64, f64)>,
+    /// Largest `|u_Gerris − u_Bagnold|` over the analytic surface velocity.
+    pub max_relative_error: f64,
+}
+
+/// A row of the DEM `inclined-flow` `profiles.csv`.
+#[derive(Debug, Clone, Deserialize)]
+struct DemFlowRow {
+    height_m: f64,
+    velocity_m_s: Option<f64>,
+    solid_fraction: Option<f64>,
+}
+
+/// The DEM run's set-up and profile.
+#[derive(Debug, Clone)]
+struct DemFlow {
+    dir: PathBuf,
+    slope_deg: f64,
+    depth_m: f64,
+    diameter_m: f64,
+    packing_fraction: f64,
+    /// `(z, u)` (m, m/s) of the bins with grains up to the flow height.
+    profile: Vec<(f64, f64)>,
+}
+
+fn read_dem(dir: &Path) -> Result<DemFlow> {
+    let sp = dir.join("summary.json");
+    let bad = |p: &Path, r: String| CliError::Input {
+        path: p.display().to_string(),
+        reason: r,
+    };
+    let text = std::fs::read_to_string(&sp).map_err(|e| bad(&sp, e.to_string()))?;
+    let v: Value = serde_json::from_str(&text).map_err(|e| bad(&sp, e.to_string()))?;
+    if v["scenario"].as_str() != Some("inclined-flow") {
+        return Err(bad(
+            &sp,
+            format!(
+                "scenario {}: not the output of an inclined-flow run",
+                v["scenario"]
+            ),
+        ));
+    }
+    let num = |k: &str| -> Result<f64> {
+        v[k].as_f64()
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .ok_or_else(|| bad(&sp, format!("`{k}` missing or not a positive number")))
+    };
+    let (slope_deg, depth_m, diameter_m) = (
+        num("slope_deg")?,
+        num("flow_height_m")?,
+        num("mean_diameter_m")?,
+    );
+    let rows: Vec<DemFlowRow> = read_rows(&dir.join("profiles.csv"))?;
+    let inside: Vec<&DemFlowRow> = rows.iter().filter(|r| r.height_m <= depth_m).collect();
+    let phis: Vec<f64> = inside.iter().filter_map(|r| r.solid_fraction).collect();
+    let packing_fraction = phis.iter().sum::<f64>() / phis.len().max(1) as f64;
+    let profile = inside
+        .iter()
+        .filter_map(|r| r.velocity_m_s.map(|u| (r.height_m, u)))
+        .collect();
+    Ok(DemFlow {
+        dir: dir.to_path_buf(),
+        slope_deg,
+        depth_m,
+        diameter_m,
+        packing_fraction,
+        profile,
+    })
+}
+
+/// One row of `profile.csv`.
+#[derive(Debug, Clone, Serialize)]
+struct ProfileRow {
+    height_m: f64,
+    velocity_gerris_m_s: f64,
+    velocity_bagnold_m_s: f64,
+}
+
+/// One row of `comparison.csv` (at the DEM's bins).
+#[derive(Debug, Clone, Serialize)]
+struct DemRow {
+    height_m: f64,
+    velocity_dem_m_s: f64,
+    velocity_gerris_m_s: f64,
+    velocity_bagnold_m_s: f64,
+}
+
+/// Runs the inclined plane of `plan` (module documentation). Errors as
+/// [`super::column::column_collapse`]; a slope without steady flow for the law is bad input.
+pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
+    crate::plot::init_font();
+    let law_path = plan.law.display().to_string();
+    let law = load_continuum_law(&plan.law)?;
+    let dem = plan.dem.as_deref().map(read_dem).transpose()?;
+    let mut warnings = Vec::new();
+    if !(3..=10).contains(&plan.level) {
+        return Err(CliError::Usage(format!(
+            "--level must lie in 3..=10, got {}",
+            plan.level
+        )));
+    }
+    let d_m = law.constant("d").unwrap_or(f64::NAN);
+    let slope_deg = plan
+        .slope_deg
+        .or(dem.as_ref().map(|d| d.slope_deg))
+        .ok_or_else(|| CliError::Usage("the slope is needed: give --slope-deg or --dem".into()))?;
+    if !(slope_deg > 0.0 && slope_deg < 90.0) {
+        return Err(CliError::Usage(format!(
+            "--slope-deg must lie in (0, 90), got {slope_deg}"
+        )));
+    }
+    let depth = plan
+        .depth_m
+        .or(dem.as_ref().map(|d| d.depth_m))
+        .unwrap_or(DEFAULT_DEPTH_DIAMETERS * d_m);
+    let phi = plan
+        .packing_fraction
+        .or(dem.as_ref().map(|d| d.packing_fraction))
+        .ok_or_else(|| {
+            CliError::Usage(
+                "the layer's packing fraction is needed (its density is φ ρ_s): give --packing-fraction or --dem".into(),
+            )
+        })?;
+    if let Some(d) = &dem {
+        if (d.diameter_m - d_m).abs() > 0.05 * d.diameter_m {
+            warnings.push(format!(
+                "the law's grain diameter d = {d_m:.4e} m differs from the DEM grains' {:.4e} m: the law is used with its own d",
+                d.diameter_m
+            ));
+        }
+    }
+    let rheology = GerrisRheology::new(
+        law.clone(),
+        &law_path,
+        depth,
+        GRAVITY,
+        phi,
+        plan.viscosity_cap,
+    )?;
+    let theta = slope_deg.to_radians();
+    let i_theta = rheology.inertial_number_for(theta.tan()).ok_or_else(|| CliError::Input {
+        path: law_path.clone(),
+        reason: format!(
+            "no steady flow on a {slope_deg}° slope: tan θ = {:.4} is outside the law's range of friction (μ(0) = {:.4}{})",
+            theta.tan(),
+            rheology.mu(0.0),
+            if law.law == "mu-i" { format!(", μ(∞) = {:.4}", law.parameter("mu_2").unwrap_or(f64::NAN)) } else { String::new() }
+        ),
+    })?;
+    let flow = BagnoldFlow::with_inertial_number(i_theta, phi, theta, depth, d_m, GRAVITY)
+        .map_err(|e| CliError::Input {
+            path: law_path.clone(),
+            reason: e.to_string(),
+        })?;
+    let uv = rheology.units.velocity_m_s();
+    let u_surface_g = flow.surface_velocity() / uv;
+    if let Some(d) = &plan.dem {
+        if super::column::same_dir(d, &plan.out) {
+            return Err(CliError::Usage(format!(
+                "--out {}: is the DEM run's directory (--dem): choose another",
+                plan.out.display()
+            )));
+        }
+    }
+    crate::cli::check_out_dir(&plan.out, "continuum-inclined-plane")?;
+    let mut out = OutputDir::create(&plan.out)?;
+    let case_dir = plan.out.join("gerris");
+    let case = InclinedCase {
+        rheology: rheology.clone(),
+        slope_rad: theta,
+        level: plan.level,
+        initial_surface_velocity: 2.0 * u_surface_g,
+        steady_tolerance: STEADY_TOLERANCE * u_surface_g,
+        max_steps: MAX_STEPS,
+        comments: vec![format!(
+            "grainlaw {} continuum inclined-plane: the {} law of {law_path}; slope {slope_deg} deg, H = {depth} m, level {}",
+            identify::law::GRAINLAW_VERSION,
+            law.law,
+            plan.level
+        )],
+    };
+    let snaps = case_dir.join(SNAPSHOT_DIR);
+    if snaps.exists() {
+        std::fs::remove_dir_all(&snaps).map_err(|e| CliError::io(&snaps, e))?;
+    }
+    std::fs::create_dir_all(&snaps).map_err(|e| CliError::io(&snaps, e))?;
+    crate::output::dir::write_atomic(&case_dir.join("inclined.gfs"), case.to_gfs()?.as_bytes())?;
+    let gerris_cmd = gerris::command(plan.gerris.as_deref());
+    let run = gerris::run(&gerris_cmd, &case_dir, "inclined.gfs")?;
+    let endp = snaps.join("end.txt");
+    if !endp.is_file() {
+        return Err(CliError::ExternalSolver {
+            solver: gerris_cmd.display().to_string(),
+            reason: "finished without its end snapshot".into(),
+            dir: case_dir.display().to_string(),
+            rerun: format!("{} inclined.gfs", gerris_cmd.display()),
+        });
+    }
+    let snap = Snapshot::read(&endp)?;
+    let steps = last_step(&case_dir.join("gerris.log"));
+    // average along the slope: one value per row of cells
+    let mut rows: Vec<(f64, f64, f64)> = Vec::new(); // (y, sum u, n)
+    for c in &snap.cells {
+        match rows.iter_mut().find(|r| (r.0 - c.y).abs() < 1e-9) {
+            Some(r) => {
+                r.1 += c.u;
+                r.2 += 1.0;
+            }
+            None => rows.push((c.y, c.u, 1.0)),
+        }
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let gerris_profile: Vec<(f64, f64)> = rows.iter().map(|r| (r.0, r.1 / r.2)).collect();
+    let analytic = |z: f64| flow.velocity(z * depth) / uv;
+    let max_err = gerris_profile
+        .iter()
+        .map(|&(z, u)| (u - analytic(z)).abs())
+        .fold(0.0, f64::max)
+        / u_surface_g;
+    let rms_err = (gerris_profile
+        .iter()
+        .map(|&(z, u)| (u - analytic(z)).powi(2))
+        .sum::<f64>()
+        / gerris_profile.len().max(1) as f64)
+        .sqrt()
+        / u_surface_g;
+    let table: Vec<ProfileRow> = gerris_profile
+        .iter()
+        .map(|&(z, u)| ProfileRow {
+            height_m: z * depth,
+            velocity_gerris_m_s: u * uv,
+            velocity_bagnold_m_s: flow.velocity(z * depth),
+        })
+        .collect();
+    write_rows(
+        &mut out,
+        "profile.csv",
+        &table,
+        "steady flow down the slope: Gerris (averaged along the slope, cell centres) and the analytic Bagnold profile of the same law; height above the base",
+    )?;
+    let mut checks = Checks::new();
+    if steps.is_some_and(|s| s + 10 >= MAX_STEPS) {
+        checks.fail(
+            "continuum.steady",
+            Verdict::Suspect,
+            steps.unwrap_or(0) as f64,
+            MAX_STEPS as f64,
+            format!(
+                "Gerris stopped at its step limit ({MAX_STEPS}) before U changed by less than {STEADY_TOLERANCE:e} of the surface velocity per 10 steps: not steady"
+            ),
+        );
+    }
+    if let Some(limit) = rheology.validity_max() {
+        if i_theta > limit {
+            warnings.push(format!(
+                "the slope's I = {i_theta:.3} is above the law's calibrated range (I ≤ {limit:.3}, {:.1} × the limit): the whole layer flows on the law's extrapolation",
+                i_theta / limit
+            ));
+            checks.fail(
+                "continuum.validity_range",
+                Verdict::Suspect,
+                1.0,
+                super::column::VALIDITY_SUSPECT,
+                format!("the whole layer flows at I = {i_theta:.3}, above the law's calibrated I = {limit:.3}"),
+            );
+        }
+    }
+    let dem_rows: Vec<DemRow> = dem
+        .as_ref()
+        .map(|d| {
+            d.profile
+                .iter()
+                .map(|&(z, u)| DemRow {
+                    height_m: z,
+                    velocity_dem_m_s: u,
+                    velocity_gerris_m_s: interpolate(&gerris_profile, z / depth) * uv,
+                    velocity_bagnold_m_s: flow.velocity(z),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let dem_json = dem.as_ref().map(|d| {
+        let us = d.profile.iter().map(|p| p.1).fold(f64::NAN, f64::max);
+        let rms = (dem_rows
+            .iter()
+            .map(|r| (r.velocity_gerris_m_s - r.velocity_dem_m_s).powi(2))
+            .sum::<f64>()
+            / dem_rows.len().max(1) as f64)
+            .sqrt();
+        json!({
+            "dir": d.dir.display().to_string(),
+            "dem_surface_velocity_m_s": us,
+            "gerris_surface_velocity_m_s": gerris_profile.last().map_or(f64::NAN, |p| p.1) * uv,
+            "bagnold_surface_velocity_m_s": flow.surface_velocity(),
+            "rms_difference_gerris_minus_dem_m_s": rms,
+            "rms_difference_over_dem_surface_velocity": rms / us,
+            "dem_packing_fraction": d.packing_fraction,
+        })
+    });
+    if !dem_rows.is_empty() {
+        write_rows(
+            &mut out,
+            "comparison.csv",
+            &dem_rows,
+            "the DEM's time-averaged velocity profile against Gerris (interpolated) and the analytic Bagnold profile, at the DEM's bins",
+        )?;
+    }
+    // figure
+    let mut plot = XyPlot::new(
+        &format!("Steady flow down a {slope_deg}° slope: μ(I) in Gerris, Bagnold, DEM"),
+        Axis::new("velocity along the slope u (m/s)"),
+        Axis::new("height above the base z (m)"),
+    );
+    plot.legend = LegendAt::LowerRight;
+    plot.series.push(Series::new(
+        &format!("Bagnold, analytic (I = {i_theta:.3})"),
+        Style::Line,
+        PALETTE[6],
+        flow.profile(200).into_iter().map(|(z, u)| (u, z)).collect(),
+    ));
+    plot.series.push(Series::new(
+        &format!(
+            "Gerris, level {} ({} cells across)",
+            plan.level,
+            1u32 << plan.level
+        ),
+        Style::Circles,
+        PALETTE[0],
+        table
+            .iter()
+            .map(|r| (r.velocity_gerris_m_s, r.height_m))
+            .collect(),
+    ));
+    if let Some(d) = &dem {
+        plot.series.push(Series::new(
+            "DEM (inclined-flow, time average)",
+            Style::Points,
+            PALETTE[1],
+            d.profile.iter().map(|&(z, u)| (u, z)).collect(),
+        ));
+    }
+    plot.notes.push(format!(
+        "{}: {}; φ = {phi:.3}, H = {:.2} mm, d = {:.2} mm",
+        law.law,
+        law.parameters
+            .iter()
+            .map(|p| format!("{} = {:.3}", p.name, p.value))
+            .collect::<Vec<_>>()
+            .join(", "),
+        depth * 1e3,
+        d_m * 1e3
+    ));
+    draw_xy(&mut out, "velocity.png", &plot)?;
+    let verdict = RunVerdict {
+        run: checks,
+        laws: Vec::new(),
+        allow_suspect: plan.allow_suspect,
+    };
+    let mut s = Summary::new();
+    s.text("scenario", "continuum-inclined-plane")
+        .text("solver", "gerris")
+        .text("solver_version", run.version.as_deref().unwrap_or(""))
+        .num("solver_wall_seconds", run.wall_seconds)
+        .text("law_file", &law_path)
+        .text("law", &law.law)
+        .num("slope_deg", slope_deg)
+        .num("depth_m", depth)
+        .num("packing_fraction", phi)
+        .num("inertial_number", i_theta)
+        .num("bagnold_surface_velocity_m_s", flow.surface_velocity())
+        .num(
+            "gerris_surface_velocity_m_s",
+            gerris_profile.last().map_or(f64::NAN, |p| p.1) * uv,
+        )
+        .num("max_relative_error_vs_bagnold", max_err)
+        .num("rms_relative_error_vs_bagnold", rms_err)
+        .set(
+            "gerris",
+            json!({
+                "case": "gerris/inclined.gfs",
+                "level": plan.level,
+                "cells_across": 1u32 << plan.level,
+                "steps": steps,
+                "units": rheology.units,
+                "grain_diameter_over_H": rheology.grain_diameter(),
+                "regularisation": rheology.regularisation,
+            }),
+        );
+    if let Some(j) = &dem_json {
+        s.set("dem", j.clone());
+    }
+    verdict.keys(&mut s);
+    s.set(
+        "warnings",
+        Value::Array(warnings.iter().map(|w| Value::from(w.as_str())).collect()),
+    );
+    s.text("grainlaw_version", identify::law::GRAINLAW_VERSION);
+    out.write("summary.json", s.to_json().as_bytes())?;
+    let mut lines = vec![
+        format!("report: {}/", plan.out.display()),
+        format!(
+            "{} on a {slope_deg}° slope (tan θ = {:.4}): I = {i_theta:.4}; layer H = {:.2} mm = {:.1} d, φ = {phi:.3}",
+            law.law,
+            theta.tan(),
+            depth * 1e3,
+            depth / d_m
+        ),
+        format!(
+            "Gerris level {} ({} cells across), {} steps, {:.1} s: surface velocity {:.4} m/s, Bagnold {:.4} m/s; largest difference {:.2e} of it (RMS {:.2e})",
+            plan.level,
+            1u32 << plan.level,
+            steps.map_or("?".into(), |s| s.to_string()),
+            run.wall_seconds,
+            gerris_profile.last().map_or(f64::NAN, |p| p.1) * uv,
+            flow.surface_velocity(),
+            max_err,
+            rms_err
+        ),
+    ];
+    if let Some(j) = &dem_json {
+        lines.push(format!(
+            "DEM surface velocity {:.4} m/s; RMS difference Gerris − DEM {:.4} m/s ({:.0} % of the DEM's surface velocity)",
+            j["dem_surface_velocity_m_s"].as_f64().unwrap_or(f64::NAN),
+            j["rms_difference_gerris_minus_dem_m_s"].as_f64().unwrap_or(f64::NAN),
+            100.0 * j["rms_difference_over_dem_surface_velocity"].as_f64().unwrap_or(f64::NAN)
+        ));
+    }
+    lines.extend(verdict.lines());
+    Ok(InclinedOutcome {
+        lines,
+        warnings,
+        verdict,
+        summary: serde_json::from_str(&s.to_json()).unwrap_or(Value::Null),
+        gerris_profile,
+        max_relative_error: max_err,
+    })
+}
+
+/// The last `step: N` of Gerris' progress lines in `log`.
+fn last_step(log: &Path) -> Option<u64> {
+    let text = std::fs::read_to_string(log).ok()?;
+    text.lines().rev().find_map(|l| {
+        l.trim()
+            .strip_prefix("step:")
+            .and_then(|r| r.split_whitespace().next())
+            .and_then(|n| n.parse().ok())
+    })
+}
