@@ -50,8 +50,10 @@
 //! swept on one thread (the cell is shared by every coupled contact).
 
 use crate::cell::{Cell, CellControl, Imposed, Mat};
+use crate::colouring::ContactColouring;
 use crate::contact::{ContactGeometry, ContactRow};
 use crate::local::Delassus2;
+use crate::parallel::coloured_sweep_where;
 use crate::solver::update;
 
 /// The components `(i, j)` of `L` a cell control can impose a stress on: xx, yy, xy.
@@ -269,19 +271,92 @@ impl CellCoupling {
             let s = self.slot[i as usize];
             if s == NONE {
                 update(c, vel, inv, omega);
-                continue;
-            }
-            let s = s as usize;
-            c.affine = self.affine_of(s, &self.delta);
-            let before = c.r;
-            if update(c, vel, inv, omega) {
-                let d = [c.r[0] - before[0], c.r[1] - before[1]];
-                for k in 0..3 {
-                    let b = self.coef[s][k];
-                    self.delta[k] += self.compliance[k] * (b[0] * d[0] + b[1] * d[1]);
-                }
+            } else {
+                self.update_coupled(c, s as usize, vel, inv, omega);
             }
         }
+        self.sync(rows);
+    }
+
+    /// The Gauss–Seidel update of the contact of slot `s` with `δ` current, then `δ` moved by
+    /// its impulse's change.
+    #[inline(always)]
+    fn update_coupled(
+        &mut self,
+        c: &mut ContactRow,
+        s: usize,
+        vel: &mut [[f64; 3]],
+        inv: &[[f64; 3]],
+        omega: f64,
+    ) {
+        c.affine = self.affine_of(s, &self.delta);
+        let before = c.r;
+        if update(c, vel, inv, omega) {
+            let d = [c.r[0] - before[0], c.r[1] - before[1]];
+            for k in 0..3 {
+                let b = self.coef[s][k];
+                self.delta[k] += self.compliance[k] * (b[0] * d[0] + b[1] * d[1]);
+            }
+        }
+    }
+
+    /// Whether row `i` is coupled to the cell.
+    #[inline(always)]
+    pub fn is_coupled(&self, i: usize) -> bool {
+        self.slot.get(i).is_some_and(|&s| s != NONE)
+    }
+
+    /// One Gauss–Seidel sweep in colour order on all rayon threads with the cell's components
+    /// kept current (module documentation, *Parallel sweeps*): the contacts not coupled to the
+    /// cell by [`coloured_sweep_where`] (blocks' interiors concurrently, then the colour
+    /// classes), then the coupled ones on the calling thread in slot order, each with the
+    /// current `δ`. The blocks must be [`CellCoupling::attach`]ed and `colouring` built from
+    /// `rows` and `mobile`. Every contact is visited once in an order fixed by the colouring
+    /// and the slots, so the impulses, velocities and `δ` have the same bits on any number of
+    /// threads.
+    #[allow(clippy::too_many_arguments)]
+    pub fn sweep_coupled(
+        &mut self,
+        rows: &mut [ContactRow],
+        colouring: &ContactColouring,
+        vel: &mut [[f64; 3]],
+        inv: &[[f64; 3]],
+        mobile: &[bool],
+        omega: f64,
+    ) {
+        assert_eq!(self.slot.len(), rows.len(), "coupling of other rows");
+        let slot = &self.slot;
+        coloured_sweep_where(rows, colouring, vel, inv, mobile, omega, |i| {
+            slot[i] == NONE
+        });
+        for s in 0..self.rows.len() {
+            let i = self.rows[s] as usize;
+            self.update_coupled(&mut rows[i], s, vel, inv, omega);
+        }
+        self.sync(rows);
+    }
+
+    /// The same coupling for the rows renumbered so that new row `j` is old row
+    /// `row_old[j]` (a permutation: the block-contiguous copy of the parallel solve,
+    /// [`crate::blocked::BlockLayout`]). The slots keep their order.
+    pub fn renumbered(&self, row_old: &[u32]) -> CellCoupling {
+        assert_eq!(row_old.len(), self.slot.len(), "a permutation of the rows");
+        let mut c = self.clone();
+        c.slot.clear();
+        c.slot
+            .extend(row_old.iter().map(|&k| self.slot[k as usize]));
+        for (new, &s) in c.slot.iter().enumerate() {
+            if s != NONE {
+                c.rows[s as usize] = new as u32;
+            }
+        }
+        c
+    }
+
+    /// Takes `δ` from `solved` (this coupling [`CellCoupling::renumbered`], after its solve)
+    /// and sets this coupling's rows' affine velocities from it.
+    pub fn adopt(&mut self, solved: &CellCoupling, rows: &mut [ContactRow]) {
+        self.delta = solved.delta;
         self.sync(rows);
     }
 
