@@ -110,8 +110,10 @@ fn coupled_steps_have_the_same_bits_on_one_and_two_threads() {
 
 /// One step of the sheared crystal (24 × 24, after 3 steps) solved to 10⁻¹⁰ in colour order
 /// with the coupled contacts last (parallel, two threads) and in natural order (one thread):
-/// both converge, and the cell's `L⁺_yy` and every body's velocity agree to 10⁻⁶ of the
-/// shear's velocity scale `γ̇ ℓ` (ℓ the cell's height), the stress `σ_yy` to 10⁻⁴ of P.
+/// both converge, and the cell's `L⁺_yy ℓ` and every body's velocity agree to 10⁻⁷ of the
+/// shear's velocity scale `γ̇ ℓ` (ℓ the cell's height), the stress `σ_yy` to 10⁻⁶ of P
+/// (measured 2026-12: 1.4·10⁻⁹, 1.7·10⁻⁹ and 2·10⁻⁹, the two solves 243 sweeps each: different
+/// orders of one Gauss–Seidel, each within 10⁻¹⁰ of the solution).
 #[test]
 fn the_parallel_coupled_sweep_solves_the_same_step() {
     let mut start = sheared_crystal(24, false, 1e-8, 20_000);
@@ -135,17 +137,17 @@ fn the_parallel_coupled_sweep_solves_the_same_step() {
     let gd = cs.l[(0, 1)];
     let scale = gd * cs.h[(1, 1)];
     let dl = (cs.l[(1, 1)] - cp.l[(1, 1)]).abs() * cs.h[(1, 1)];
-    assert!(dl <= 1e-6 * scale, "L_yy {} vs {}", cs.l[(1, 1)], cp.l[(1, 1)]);
+    assert!(dl <= 1e-7 * scale, "L_yy {} vs {}", cs.l[(1, 1)], cp.l[(1, 1)]);
     let dv = seq
         .bodies
         .iter()
         .zip(&par.bodies)
         .map(|(a, b)| (a.velocity - b.velocity).norm())
         .fold(0.0, f64::max);
-    assert!(dv <= 1e-6 * scale, "velocities differ by {dv:e} m/s");
+    assert!(dv <= 1e-7 * scale, "velocities differ by {dv:e} m/s");
     let (ss, sp) = (seq.cell_stress().unwrap(), par.cell_stress().unwrap());
     assert!(
-        (ss[(1, 1)] - sp[(1, 1)]).abs() <= 1e-4 * P,
+        (ss[(1, 1)] - sp[(1, 1)]).abs() <= 1e-6 * P,
         "σ_yy {} vs {}",
         ss[(1, 1)],
         sp[(1, 1)]
