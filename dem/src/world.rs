@@ -1144,8 +1144,9 @@ impl World {
     /// masses must be current).
     ///
     /// `free_change`: the impulse-free change `δ⁰` of an implicit cell control over the step
-    /// ([`World::implicit_free_change`]); the swept margins cover the images' drift under it,
-    /// as the sum of its components' magnitudes. Normal impulses across the boundary mostly
+    /// ([`World::implicit_free_change`]); the reach of the pairs through the cell's boundary
+    /// covers the images' drift under it, as the sum of its components' magnitudes (the pairs
+    /// inside the cell do not drift with the cell). Normal impulses across the boundary mostly
     /// open the cell further, but frictional or shear ones can close it more: a change beyond
     /// the margins detects again after the step (`image_outran`).
     fn detect_step_contacts(&mut self, free_change: Option<[f64; 3]>) -> Result<(), DemError> {
