@@ -46,8 +46,32 @@
 //! Gauss–Seidel keeps `δ` current: the update of a coupled contact uses the augmented diagonal
 //! block `W_cc + m Σ_κ B_cκ B_cκᵀ` and the velocity with the current `δ`, then adds
 //! `m B_cκ · Δr_c` to `δ_κ` (an exact Gauss–Seidel step on the eliminated problem). The global
-//! methods assemble the augmented operator ([`CellCoupling::add_to_delassus`]). A coupled step is
-//! swept on one thread (the cell is shared by every coupled contact).
+//! methods assemble the augmented operator ([`CellCoupling::add_to_delassus`]).
+//!
+//! *Parallel sweeps* ([`CellCoupling::sweep_coupled`], `solver.parallel`). Two contacts
+//! conflict when they share a mobile body or are both coupled to the cell (`δ` is read and
+//! written by every coupled update). The colour-ordered sweep of [`crate::parallel`] (Renouf,
+//! Dubois & Alart 2004, "A parallel version of the non smooth contact dynamics algorithm
+//! applied to the simulation of granular media", J. Comput. Appl. Math. 168, 375–382: the
+//! contacts of a colour class, sharing no body, are updated concurrently) therefore visits
+//! the contacts *not* coupled, whose updates do not depend on `δ`
+//! (`u_c = H_c v + q_c` without a `B_cκ` term), then the coupled ones on one thread with `δ`
+//! current:
+//!
+//! ```text
+//! for block, class in colouring:    (blocks concurrently, then classes; coupled c skipped)
+//!     r_c ← solve_local(W_cc, u_c − W_cc r_c)
+//! for c in coupled (slot order):    (one thread)
+//!     u_c includes Σ_κ B_cκ δ_κ;  r_c ← solve_local(W_cc + m Σ_κ B_cκ B_cκᵀ, …);
+//!     δ_κ += m B_cκ · Δr_c
+//! ```
+//!
+//! Every contact is visited once per sweep in an order fixed by the positions (the colouring)
+//! and the contact order (the slots): one Gauss–Seidel sweep, exact on the eliminated problem,
+//! in another order than the natural one, with the same bits on any number of threads. The
+//! contacts through the boundary are a few percent of a large cell's (about 2 % at 10⁴
+//! grains). (Sweeping each class in fixed chunks with `δ` frozen and the chunks' increments
+//! added in chunk order is also deterministic, but is a Jacobi step on the cell's rank-3 term.)
 
 use crate::cell::{Cell, CellControl, Imposed, Mat};
 use crate::colouring::ContactColouring;

@@ -711,9 +711,8 @@ fn cell_detection_finds_every_pair_an_image_drift_closes() {
                 let touch = (-1..=1).any(|i| {
                     (-1..=1).any(|j| {
                         let k = Vect::new(i as f64, j as f64);
-                        let gap = (x[b] + h * k - x[a]).norm()
-                            - w.bodies[a].radius
-                            - w.bodies[b].radius;
+                        let gap =
+                            (x[b] + h * k - x[a]).norm() - w.bodies[a].radius - w.bodies[b].radius;
                         gap <= 0.0
                     })
                 });

@@ -137,7 +137,12 @@ fn the_parallel_coupled_sweep_solves_the_same_step() {
     let gd = cs.l[(0, 1)];
     let scale = gd * cs.h[(1, 1)];
     let dl = (cs.l[(1, 1)] - cp.l[(1, 1)]).abs() * cs.h[(1, 1)];
-    assert!(dl <= 1e-7 * scale, "L_yy {} vs {}", cs.l[(1, 1)], cp.l[(1, 1)]);
+    assert!(
+        dl <= 1e-7 * scale,
+        "L_yy {} vs {}",
+        cs.l[(1, 1)],
+        cp.l[(1, 1)]
+    );
     let dv = seq
         .bodies
         .iter()
