@@ -17,7 +17,7 @@ const RHO: f64 = 2500.0;
 /// Imposed σ_yy = −P (Pa).
 const P: f64 = 100.0;
 
-/// An `n × n` hexagonal crystal (n even) of disks of radius `R (0.96 … 1)` (seeded) filling a
+/// An `n × n` hexagonal crystal (n even) of disks of radius `R (0.98 … 1)` (seeded) filling a
 /// biperiodic cell at pitch `2R`, μ = 0.3, sheared at `γ̇ = I √(P/ρ)/d` (I = 0.05) with
 /// L_xx = 0 and σ_yy = −P held by the implicit control (gain `10 γ̇/P`, rate cap γ̇); time
 /// step from a relative travel of 0.02 R a step, solved by Gauss–Seidel alone.
@@ -27,7 +27,7 @@ fn sheared_crystal(n: usize, parallel: bool, tolerance: f64, max_iterations: usi
     let params = WorldParams {
         dt: 0.02 * R / (gd * d),
         gravity: Vector2::zeros(),
-        detection_gap: 1e-2 * R,
+        detection_gap: 5e-2 * R,
         solver: SolverParams {
             tolerance,
             max_iterations,
@@ -44,7 +44,7 @@ fn sheared_crystal(n: usize, parallel: bool, tolerance: f64, max_iterations: usi
         for i in 0..n {
             let shift = if j % 2 == 1 { R } else { 0.0 };
             let x = Vect::new(R + 2.0 * R * i as f64 + shift, 0.5 * dy + dy * j as f64);
-            w.add_grain(x, R * rng.random_range(0.96..1.0), RHO, 0);
+            w.add_grain(x, R * rng.random_range(0.98..1.0), RHO, 0);
         }
     }
     w.set_cell(Some(
@@ -72,7 +72,7 @@ fn state(w: &World) -> Vec<u64> {
 }
 
 /// `steps` parallel steps of the 48 × 48 crystal on a pool of `threads` threads: the state's
-/// bits, the sweeps and the contacts coupled to the cell summed over the steps.
+/// bits, the sweeps summed over the steps and the fewest contacts of a step.
 fn run_on(threads: usize, steps: usize) -> (Vec<u64>, usize, usize) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -80,18 +80,18 @@ fn run_on(threads: usize, steps: usize) -> (Vec<u64>, usize, usize) {
         .unwrap();
     pool.install(|| {
         let mut w = sheared_crystal(48, true, 1e-6, 200);
-        let (mut sweeps, mut contacts) = (0, 0);
+        let (mut sweeps, mut contacts) = (0, usize::MAX);
         for _ in 0..steps {
             let r = w.step().unwrap();
             sweeps += r.solver.iterations;
-            contacts += r.contacts;
+            contacts = contacts.min(r.contacts);
         }
         (state(&w), sweeps, contacts)
     })
 }
 
-/// 2304 grains, about 7000 contacts (16 blocks swept concurrently, Anderson vectors split in
-/// chunks), a few hundred across the cell's boundary: after 4 coupled steps the positions,
+/// 2304 grains, over 4096 contacts a step (16 blocks swept concurrently, Anderson vectors
+/// split in chunks), a few hundred across the cell's boundary: after 4 coupled steps the positions,
 /// angles, velocities, impulses, `h` and `L` are bit-identical on one and two threads, and the
 /// cell moved (its `L_yy` is no longer 0).
 #[test]
@@ -99,8 +99,8 @@ fn coupled_steps_have_the_same_bits_on_one_and_two_threads() {
     let (one, sweeps, contacts) = run_on(1, 4);
     assert!(sweeps > 4 * 10, "the solves must do work: {sweeps} sweeps");
     assert!(
-        contacts > 4 * 4096,
-        "{contacts} contacts in 4 steps: the blocked sweep needs 4096 a step"
+        contacts >= 4096,
+        "a step with {contacts} contacts: the blocked sweep needs 4096"
     );
     let (two, _, _) = run_on(2, 4);
     assert!(one == two, "two threads differ from one");
@@ -112,7 +112,7 @@ fn coupled_steps_have_the_same_bits_on_one_and_two_threads() {
 /// with the coupled contacts last (parallel, two threads) and in natural order (one thread):
 /// both converge, and the cell's `L⁺_yy ℓ` and every body's velocity agree to 10⁻⁷ of the
 /// shear's velocity scale `γ̇ ℓ` (ℓ the cell's height), the stress `σ_yy` to 10⁻⁶ of P
-/// (measured 2026-12: 1.4·10⁻⁹, 1.7·10⁻⁹ and 2·10⁻⁹, the two solves 243 sweeps each: different
+/// (measured 2026-12: 1.3·10⁻⁹, 1.6·10⁻⁹ and 5.9·10⁻⁹, in 339 and 355 sweeps: different
 /// orders of one Gauss–Seidel, each within 10⁻¹⁰ of the solution).
 #[test]
 fn the_parallel_coupled_sweep_solves_the_same_step() {
