@@ -69,6 +69,39 @@ pub struct RvePlan {
     pub average: f64,
     /// Inertial number of the shear.
     pub inertial: f64,
+    /// Settings of grainlaw's run (`KEY=VALUE`, as `grainlaw run --set`), after the race's own.
+    pub sets: Vec<String>,
+}
+
+/// The standard error of μ the race prices (issue 34's target: a μ point with SE ≤ 0.005).
+pub const TARGET_MU_SE: f64 = 0.005;
+
+/// Seconds to a μ point whose standard error is `target`, estimated from a run that took
+/// `prep` s to prepare its packing and `shear` s to shear it by `strain`, of which the last
+/// `average` was averaged with standard error `se`. The standard error of a time average over
+/// a stationary signal falls as `1/√T` once `T` exceeds its correlation time (Allen &
+/// Tildesley, *Computer Simulation of Liquids*, 2nd ed. 2017, §8.4), so the averaged strain
+/// needed is `a' = a (se/target)²` and
+///
+/// ```text
+/// t = prep + (shear / strain) · (strain − a + a')
+/// ```
+///
+/// (the transient `strain − a` is kept whole). NaN when an input is not finite or
+/// `strain ≤ 0`.
+pub fn seconds_to_precision(
+    prep: f64,
+    shear: f64,
+    strain: f64,
+    average: f64,
+    se: f64,
+    target: f64,
+) -> f64 {
+    if !(strain > 0.0 && average > 0.0 && se.is_finite() && target > 0.0) {
+        return f64::NAN;
+    }
+    let needed = average * (se / target).powi(2);
+    prep + shear / strain * (strain - average + needed)
 }
 
 /// Quoted wall seconds (range) of a soft-contact DEM code for a settled column of `n` grains
@@ -745,6 +778,7 @@ const QUOTED_RVE: QuotedRve = QuotedRve {
 struct OurRve {
     loaded: datasets::LoadedScenario,
     total_seconds: f64,
+    prep_seconds: f64,
     shear_seconds: f64,
     shear_steps: u64,
     total_steps: u64,
@@ -771,6 +805,7 @@ fn grainlaw_rve(n: usize, plan: &RvePlan) -> Result<OurRve> {
         format!("average_strain={:e}", plan.average),
         RVE_LEAVE_OUT.to_string(),
     ];
+    let sets: Vec<String> = sets.into_iter().chain(plan.sets.iter().cloned()).collect();
     let loaded = datasets::load("simple-shear", &sets)?;
     let dir = std::env::temp_dir().join(format!("grainlaw-bench-rve-{}-{n}", std::process::id()));
     let mut ctx = crate::scenarios::RunContext {
@@ -814,6 +849,12 @@ fn grainlaw_rve(n: usize, plan: &RvePlan) -> Result<OurRve> {
     Ok(OurRve {
         loaded,
         total_seconds,
+        prep_seconds: ctl
+            .phase_times
+            .iter()
+            .filter(|p| p.name == "compress")
+            .map(|p| p.wall_seconds)
+            .sum(),
         shear_seconds: shear.iter().map(|p| p.wall_seconds).sum(),
         shear_steps: shear.iter().map(|p| p.steps).sum(),
         total_steps: ctl.phase_times.iter().map(|p| p.steps).sum(),
@@ -988,6 +1029,29 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
                 }
             }
         };
+        let ours_to_se = seconds_to_precision(
+            ours.prep_seconds,
+            ours.shear_seconds,
+            plan.strain,
+            plan.average,
+            ours.mu_se,
+            TARGET_MU_SE,
+        );
+        let theirs_to_se = match &outcome {
+            Some(RveOutcome::Ran(r)) if r.finished => seconds_to_precision(
+                r.log.compression_seconds,
+                r.log.shear_seconds,
+                plan.strain,
+                plan.average,
+                r.measure.mu_se,
+                TARGET_MU_SE,
+            ),
+            _ => f64::NAN,
+        };
+        println!(
+            "seconds to a μ point with SE {TARGET_MU_SE} (estimated: preparation + transient + the averaged strain that SE needs, SE ∝ 1/√strain): grainlaw {ours_to_se:.1}, LAMMPS {theirs_to_se:.1}, ratio LAMMPS/grainlaw {:.3}",
+            theirs_to_se / ours_to_se
+        );
         if let Some((per_strain, mu, mu_se, how)) = theirs {
             let z = z_score(mu, mu_se, ours.mu, ours.mu_se);
             println!(
@@ -1009,8 +1073,14 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
             );
         }
         println!(
-            " grainlaw: `simple-shear` defaults (travel_per_step {}, solver tolerance {:e}, at most {} sweeps, cell control {}), one thread, h = {:.3} ms in the shear; shear s is its shear phase, total s the whole run with its measurement",
+            " grainlaw: `simple-shear` {} (travel_per_step {}, solver {} to tolerance {:e}, at most {} sweeps, cell control {}), one thread, h = {:.3} ms in the shear; shear s is its shear phase, total s the whole run with its measurement",
+            if plan.sets.is_empty() {
+                "defaults".to_string()
+            } else {
+                format!("with {}", plan.sets.join(" "))
+            },
             c.travel_per_step,
+            c.solver.method.name(),
             c.solver.tolerance,
             c.solver.max_iterations,
             c.cell_control.as_str(),
@@ -1053,6 +1123,18 @@ mod ratio_tests {
     fn too_few_seeds_give_none() {
         assert!(RatioOfTotals::estimate(&[(1.0, 5.0)]).is_none());
         assert!(RatioOfTotals::estimate(&[(1.0, 0.0), (1.0, 0.0)]).is_none());
+    }
+
+    /// Prepared in 20 s, sheared by 5 in 100 s with the last 4 averaged to SE 0.01: a SE of
+    /// 0.005 needs 4 × (0.01/0.005)² = 16 averaged, so 20 + 20 × (1 + 16) = 360 s.
+    #[test]
+    fn seconds_to_precision_by_hand() {
+        let t = super::seconds_to_precision(20.0, 100.0, 5.0, 4.0, 0.01, 0.005);
+        assert!((t - 360.0).abs() < 1e-9, "{t}");
+        // Already precise enough: fewer averaged strain than run (0.25 × 4 = 1), 20 + 20 × 2.
+        let t = super::seconds_to_precision(20.0, 100.0, 5.0, 4.0, 0.0025, 0.005);
+        assert!((t - 60.0).abs() < 1e-9, "{t}");
+        assert!(super::seconds_to_precision(1.0, 1.0, 1.0, 1.0, f64::NAN, 0.005).is_nan());
     }
 
     /// μ of 0.30 ± 0.03 against 0.26 ± 0.04: z = 0.04 / √(0.03² + 0.04²) = 0.8 (a 3-4-5

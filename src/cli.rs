@@ -170,6 +170,11 @@ pub enum Command {
         /// Inertial number of the representative-volume runs.
         #[arg(long, value_name = "I", default_value_t = 0.01)]
         rve_inertial: f64,
+        /// A setting of grainlaw's `simple-shear` run in the race, as `grainlaw run --set`
+        /// takes it (repeatable), e.g. `--rve-set solver.max_iterations=300`; the LAMMPS side
+        /// follows the same grains, pressure and inertial number.
+        #[arg(long = "rve-set", value_name = "KEY=VALUE")]
+        rve_set: Vec<String>,
     },
 }
 
@@ -588,6 +593,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             rve_strain,
             rve_average,
             rve_inertial,
+            rve_set,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
             engine_grains,
@@ -605,6 +611,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
                 strain: rve_strain,
                 average: rve_average,
                 inertial: rve_inertial,
+                sets: rve_set,
             },
         }),
     }

@@ -100,6 +100,11 @@ impl BlockLayout {
             .extend(self.body_old.iter().map(|&i| pos[i as usize]));
     }
 
+    /// Old index of each new contact (the copy's row `j` is the problem's row `row_old()[j]`).
+    pub fn row_old(&self) -> &[u32] {
+        &self.row_old
+    }
+
     /// Copies the impulses (with the Lemke basis bits that go with them) and velocities back
     /// to the world's numbering.
     pub fn scatter(&self, rows: &mut [ContactRow], vel: &mut [[f64; 3]]) {

@@ -163,6 +163,21 @@ pub fn coloured_sweep(
     mobile: &[bool],
     omega: f64,
 ) {
+    coloured_sweep_where(rows, colouring, vel, inv, mobile, omega, |_| true)
+}
+
+/// [`coloured_sweep`] over the contacts `i` with `keep(i)` only, the others left as they are
+/// (the cell-coupled sweep, [`crate::cell_coupling::CellCoupling::sweep_coupled`], updates
+/// the contacts coupled to a cell after the others).
+pub(crate) fn coloured_sweep_where(
+    rows: &mut [ContactRow],
+    colouring: &ContactColouring,
+    vel: &mut [[f64; 3]],
+    inv: &[[f64; 3]],
+    mobile: &[bool],
+    omega: f64,
+    keep: impl Fn(usize) -> bool + Sync,
+) {
     assert_eq!(
         colouring.order.len() + colouring.block_order.len(),
         rows.len(),
@@ -173,6 +188,9 @@ pub fn coloured_sweep(
     let (pr, pv) = (Shared(rows.as_mut_ptr()), Shared(vel.as_mut_ptr()));
     for_each_coloured(colouring, |i| {
         assert!(i < n_rows);
+        if !keep(i) {
+            return;
+        }
         // SAFETY: within a parallel class no two contacts share a row or a mobile body
         // (`ContactColouring::build`); sequential classes run on one thread; `i` checked, body
         // indices checked in `update_shared`.

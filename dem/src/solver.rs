@@ -548,8 +548,9 @@ impl SweepOrder<'_> {
 /// `max_iterations` bounds the sweeps in all, smoothing sweeps included.
 ///
 /// With `cell`, the stress-controlled components of a biperiodic cell are unknowns of the
-/// problem ([`crate::cell_coupling`]): the sweeps keep them current (one thread: `order` must be
-/// [`SweepOrder::Natural`]) and the global methods assemble the augmented operator; on return
+/// problem ([`crate::cell_coupling`]): the sweeps keep them current (in natural order on one
+/// thread, in colour order on all threads with the coupled contacts last,
+/// [`CellCoupling::sweep_coupled`]) and the global methods assemble the augmented operator; on return
 /// [`CellCoupling::delta`] is the change of `L` that goes with the returned impulses.
 ///
 /// Without a cell, the sweeps of [`SweepOrder::Natural`] run in the wavefront schedule of the
@@ -958,6 +959,11 @@ impl SweepProblem for Step<'_> {
                 cell.sweep(self.rows, order, self.vel, self.inv, self.omega);
                 None
             }
+            // All threads: the uncoupled contacts in colour order, then the coupled ones.
+            (Some(cell), SweepOrder::Coloured { colouring, mobile }) => {
+                cell.sweep_coupled(self.rows, colouring, self.vel, self.inv, mobile, self.omega);
+                None
+            }
             // One thread: in the wavefront schedule of the order while there is one.
             (None, SweepOrder::Natural(order)) => {
                 let order = self.wave.unwrap_or(order);
@@ -975,8 +981,7 @@ impl SweepProblem for Step<'_> {
                     None
                 }
             }
-            (cell, order) => {
-                debug_assert!(cell.is_none(), "a coupled step is swept on one thread");
+            (None, order) => {
                 order.sweep(self.rows, self.vel, self.inv, self.omega);
                 None
             }

@@ -1144,8 +1144,9 @@ impl World {
     /// masses must be current).
     ///
     /// `free_change`: the impulse-free change `δ⁰` of an implicit cell control over the step
-    /// ([`World::implicit_free_change`]); the swept margins cover the images' drift under it,
-    /// as the sum of its components' magnitudes. Normal impulses across the boundary mostly
+    /// ([`World::implicit_free_change`]); the reach of the pairs through the cell's boundary
+    /// covers the images' drift under it, as the sum of its components' magnitudes (the pairs
+    /// inside the cell do not drift with the cell). Normal impulses across the boundary mostly
     /// open the cell further, but frictional or shear ones can close it more: a change beyond
     /// the margins detects again after the step (`image_outran`).
     fn detect_step_contacts(&mut self, free_change: Option<[f64; 3]>) -> Result<(), DemError> {
@@ -1436,10 +1437,11 @@ impl World {
                 coupling.as_ref(),
             )
         });
-        // The cell is shared by every coupled contact: a coupled step is swept on one thread.
         // Without a contact across the boundary the cell's change is δ⁰ whatever the impulses.
+        // In parallel the coupled contacts are swept after the others, on one thread
+        // (`CellCoupling::sweep_coupled`).
         let coupled = coupling.as_mut().filter(|c| c.coupled_contacts() > 0);
-        let report = if self.params.solver.parallel && coupled.is_none() {
+        let report = if self.params.solver.parallel {
             self.mobile.clear();
             self.mobile
                 .extend(self.inv.iter().map(|i| i.iter().any(|&x| x != 0.0)));
@@ -1469,6 +1471,8 @@ impl World {
                 mobile: &l.mobile,
             };
             solver::rebuild_velocities(&l.rows, &mut l.vel, &l.v_free, &l.inv, &order);
+            // The coupling in the copy's numbering; its δ comes back with the impulses.
+            let mut renumbered = coupled.as_deref().map(|c| c.renumbered(l.row_old()));
             let report = solver::solve(
                 &mut l.rows,
                 order,
@@ -1479,9 +1483,12 @@ impl World {
                 approach_limit,
                 &self.params.solver,
                 &mut self.work,
-                None,
+                renumbered.as_mut(),
             );
             l.scatter(&mut self.contacts.rows, &mut self.vel);
+            if let (Some(c), Some(solved)) = (coupled, &renumbered) {
+                c.adopt(solved, &mut self.contacts.rows);
+            }
             report
         } else {
             self.order.clear();
