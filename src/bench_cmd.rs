@@ -1049,8 +1049,16 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
             _ => f64::NAN,
         };
         println!(
-            "seconds to a μ point with SE {TARGET_MU_SE} (estimated: preparation + transient + the averaged strain that SE needs, SE ∝ 1/√strain): grainlaw {ours_to_se:.1}, LAMMPS {theirs_to_se:.1}, ratio LAMMPS/grainlaw {:.3}",
-            theirs_to_se / ours_to_se
+            "seconds to a μ point with SE {TARGET_MU_SE} (estimated: preparation + transient + the averaged strain that SE needs, SE ∝ 1/√strain): grainlaw {ours_to_se:.1} (verdict {}), {}",
+            ours.verdict,
+            if theirs_to_se.is_finite() {
+                format!(
+                    "LAMMPS {theirs_to_se:.1}, ratio LAMMPS/grainlaw {:.3}",
+                    theirs_to_se / ours_to_se
+                )
+            } else {
+                "LAMMPS not measured in this run".to_string()
+            }
         );
         if let Some((per_strain, mu, mu_se, how)) = theirs {
             let z = z_score(mu, mu_se, ours.mu, ours.mu_se);

@@ -270,6 +270,37 @@ fn bagnold_profile_from_gerris_at_level_6() {
     assert!(dir.path().join("b/gerris/inclined.gfs").is_file());
 }
 
+/// `grainlaw continuum column-collapse` at level 7 with the fixtures `law` and `dem` (and
+/// `extra` arguments) into `cwd/col`, which must succeed: the rows of its `comparison.json`.
+fn column_comparison(law: &str, dem: &str, extra: &[&str], cwd: &Path) -> Vec<serde_json::Value> {
+    let (law, dem) = (fixture(law), fixture(dem));
+    let mut args = vec![
+        "continuum",
+        "column-collapse",
+        "--law",
+        law.to_str().unwrap(),
+        "--dem",
+        dem.to_str().unwrap(),
+        "--level",
+        "7",
+        "--out",
+        "col",
+    ];
+    args.extend_from_slice(extra);
+    let out = grainlaw(&args, cwd);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(cwd.join("col/comparison.json")).unwrap())
+            .unwrap();
+    c["rows"].as_array().unwrap().clone()
+}
+
 /// The column of Lagrée et al. (a = 6.26, their law, φ = 1 as in their I) at level 7 against
 /// Staron's contact dynamics: the fronts within 12 % at the five reference instants (measured:
 /// 7 % at worst at level 7, 9.5 % at level 9, docs/continuum.md §8), mass kept, the files
@@ -280,31 +311,11 @@ fn column_collapse_against_staron_at_level_7() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let law = fixture("lagree2011_mu_i_law.json");
-    let dem = fixture("staron2005");
-    let out = grainlaw(
-        &[
-            "continuum",
-            "column-collapse",
-            "--law",
-            law.to_str().unwrap(),
-            "--dem",
-            dem.to_str().unwrap(),
-            "--packing-fraction",
-            "1",
-            "--level",
-            "7",
-            "--out",
-            "col",
-        ],
+    let rows = column_comparison(
+        "lagree2011_mu_i_law.json",
+        "staron2005",
+        &["--packing-fraction", "1"],
         dir.path(),
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let col = dir.path().join("col");
     for f in [
@@ -319,10 +330,6 @@ fn column_collapse_against_staron_at_level_7() {
     ] {
         assert!(col.join(f).is_file(), "{f} missing");
     }
-    let c: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(col.join("comparison.json")).unwrap())
-            .unwrap();
-    let rows = c["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
     for r in rows {
         let d = r["x_f_relative_difference"].as_f64().unwrap();
@@ -347,34 +354,12 @@ fn column_collapse_with_the_column_grains_law_against_the_dem() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let law = fixture("column_grains_mu_i_linear_law.json");
-    let dem = fixture("column-collapse-dem");
-    let out = grainlaw(
-        &[
-            "continuum",
-            "column-collapse",
-            "--law",
-            law.to_str().unwrap(),
-            "--dem",
-            dem.to_str().unwrap(),
-            "--level",
-            "7",
-            "--out",
-            "col",
-        ],
+    let rows = column_comparison(
+        "column_grains_mu_i_linear_law.json",
+        "column-collapse-dem",
+        &[],
         dir.path(),
     );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let c: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.path().join("col/comparison.json")).unwrap(),
-    )
-    .unwrap();
-    let rows = c["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 6, "five instants and rest");
     for r in rows {
         let t = r["t_star"].as_f64().unwrap();

@@ -324,12 +324,6 @@ impl CellCoupling {
         }
     }
 
-    /// Whether row `i` is coupled to the cell.
-    #[inline(always)]
-    pub fn is_coupled(&self, i: usize) -> bool {
-        self.slot.get(i).is_some_and(|&s| s != NONE)
-    }
-
     /// One Gauss–Seidel sweep in colour order on all rayon threads with the cell's components
     /// kept current (module documentation, *Parallel sweeps*): the contacts not coupled to the
     /// cell by [`coloured_sweep_where`] (blocks' interiors concurrently, then the colour
