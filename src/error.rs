@@ -142,7 +142,10 @@ impl CliError {
             CliError::FitRefused { .. }
             | CliError::NotConverged { .. }
             | CliError::Verdict { .. }
-            | CliError::ExternalSolver { .. } => 3,
+            | CliError::ExternalSolver { .. }
+            | CliError::Dem(
+                dem::DemError::NonFinite { .. } | dem::DemError::NonFiniteCell { .. },
+            ) => 3,
             _ => 2,
         }
     }

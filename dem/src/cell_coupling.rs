@@ -46,7 +46,8 @@
 //! Gauss–Seidel keeps `δ` current: the update of a coupled contact uses the augmented diagonal
 //! block `W_cc + m Σ_κ B_cκ B_cκᵀ` and the velocity with the current `δ`, then adds
 //! `m B_cκ · Δr_c` to `δ_κ` (an exact Gauss–Seidel step on the eliminated problem). The global
-//! methods assemble the augmented operator ([`CellCoupling::add_to_delassus`]).
+//! methods take the cell's term as a rank-three term beside the sparse operator
+//! ([`CellCoupling::low_rank`], [`crate::fc::LowRank`]).
 //!
 //! *Parallel sweeps* ([`CellCoupling::sweep_coupled`], `solver.parallel`). Two contacts
 //! conflict when they share a mobile body or are both coupled to the cell (`δ` is read and
@@ -118,11 +119,13 @@ impl CellCoupling {
     /// start of the step). `δ` is set from the rows' (warm-start) impulses and the coupled rows'
     /// affine velocities with it ([`CellCoupling::refresh`]). `None` when `ctl` is not implicit
     /// or imposes no stress.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctl: &CellControl,
         cell: &Cell,
         rows: &mut [ContactRow],
         geometry: &[ContactGeometry],
+        follows: &[bool],
         dt: f64,
         thickness: f64,
         delta0: [f64; 3],
@@ -150,7 +153,19 @@ impl CellCoupling {
             ..CellCoupling::default()
         };
         for (i, (row, geo)) in rows.iter().zip(geometry).enumerate() {
-            if geo.image == [0.0, 0.0] {
+            // The branch vector the cell's change acts on: between the centres when both
+            // bodies follow it within the step, else the image shift alone.
+            let follow = |b: u32| follows.get(b as usize).copied().unwrap_or(false);
+            let both = follow(row.a) && follow(row.b);
+            let arm = if both {
+                [
+                    geo.lever_a[0] - geo.lever_b[0],
+                    geo.lever_a[1] - geo.lever_b[1],
+                ]
+            } else {
+                geo.image
+            };
+            if arm == [0.0, 0.0] {
                 continue;
             }
             let [nx, ny] = row.n;
@@ -159,7 +174,7 @@ impl CellCoupling {
             let mut coupled = false;
             for (k, &(a, b)) in COMPONENTS.iter().enumerate() {
                 if compliance[k] > 0.0 {
-                    coef[k] = [n[a] * geo.image[b], t[a] * geo.image[b]];
+                    coef[k] = [n[a] * arm[b], t[a] * arm[b]];
                     coupled |= coef[k] != [0.0, 0.0];
                 }
             }
@@ -397,24 +412,17 @@ impl CellCoupling {
         }
     }
 
-    /// Appends the cell's term `m Σ_κ B_cκ B_c'κᵀ` of every pair of coupled contacts to the
-    /// triplets `(row, col, value)` of an assembled Delassus operator (scalar indices `2c + i`).
-    pub fn add_to_delassus(&self, ri: &mut Vec<usize>, ci: &mut Vec<usize>, v: &mut Vec<f64>) {
-        for (s, &a) in self.rows.iter().enumerate() {
-            for (t, &b) in self.rows.iter().enumerate() {
-                for i in 0..2 {
-                    for j in 0..2 {
-                        let x: f64 = (0..3)
-                            .map(|k| self.compliance[k] * self.coef[s][k][i] * self.coef[t][k][j])
-                            .sum();
-                        if x != 0.0 {
-                            ri.push(2 * a as usize + i);
-                            ci.push(2 * b as usize + j);
-                            v.push(x);
-                        }
-                    }
-                }
-            }
+    /// The cell's term `m Σ_κ B_cκ B_c'κᵀ` of the eliminated problem as a rank-three term
+    /// beside the sparse Delassus operator ([`crate::fc::LowRank`]; dense among the coupled
+    /// contacts, which are all of them when the grains follow the cell within the step).
+    pub fn low_rank(&self) -> crate::fc::LowRank {
+        let mut coef = vec![[[0.0; 2]; 3]; self.slot.len()];
+        for (s, &i) in self.rows.iter().enumerate() {
+            coef[i as usize] = self.coef[s];
+        }
+        crate::fc::LowRank {
+            compliance: self.compliance,
+            coef,
         }
     }
 }

@@ -191,6 +191,7 @@ mod tests {
             tolerance: 0.0,
             max_corrections: 0,
             implicit: false,
+            affine: false,
         });
         let expected = 2.0 * 100.0 * 1e-2 * 2e-3;
         let s = load_energy_scale(&w);

@@ -55,6 +55,13 @@ pub enum DemError {
         /// What became non-finite.
         what: String,
     },
+    /// The biperiodic cell's velocity gradient or shape became non-finite during a step (its
+    /// stress control ran away).
+    #[error("step {step}: the cell's velocity gradient or shape became non-finite (its stress control ran away)")]
+    NonFiniteCell {
+        /// Step index.
+        step: u64,
+    },
     /// A checkpoint could not be written or read.
     #[error("checkpoint {path}: {reason}")]
     Checkpoint {

@@ -502,6 +502,24 @@ impl World {
         m / (cell.volume() * self.grain_thickness())
     }
 
+    /// Whether each body follows a change of the cell's velocity gradient within a step (a grain
+    /// with both translations free: [`World::set_velocity_gradient`] drags it); empty without
+    /// an implicit cell control whose grains follow it within the step
+    /// ([`CellControl::affine`]). The cell's change then acts on the contacts between two such
+    /// bodies through their whole branch vector ([`crate::cell_coupling`]).
+    fn follows_cell(&self) -> Vec<bool> {
+        match (self.cell, self.cell_control) {
+            (Some(_), Some(ctl)) if ctl.implicit && ctl.affine => self
+                .bodies
+                .iter()
+                .map(|b| {
+                    b.kind == BodyKind::Grain && b.dofs[0] == Dof::Free && b.dofs[1] == Dof::Free
+                })
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
     /// Wraps every grain into the cell (`x ← x + h k`) with `v ← v + L h k`; returns the kinetic
     /// energy change (J). Without a cell, wraps x into `periodic_x`.
     fn wrap_grains(&mut self) -> f64 {
@@ -1414,12 +1432,14 @@ impl World {
         //    implicit control, `crate::cell_coupling`).
         let q_norms = solver::free_velocity_norms(&self.contacts.rows, &self.vel);
         let thickness = self.grain_thickness();
+        let follows = self.follows_cell();
         let mut coupling = match (self.cell_control, self.cell, free_change) {
             (Some(ctl), Some(cell), Some(delta0)) => CellCoupling::new(
                 &ctl,
                 &cell,
                 &mut self.contacts.rows,
                 &self.contacts.geometry,
+                &follows,
                 h,
                 thickness,
                 delta0,
@@ -1527,7 +1547,10 @@ impl World {
             (None, _) => None,
         };
 
-        // 4. Positions, accelerations.
+        // 4. Positions, accelerations. The grains that follow the cell's change move with it
+        //    over the step (their velocities take it at 6.).
+        let affine = !follows.is_empty();
+        let drag_centre = self.cell.filter(|_| affine).map(|c| c.centre());
         self.displacement.clear();
         for (i, b) in self.bodies.iter_mut().enumerate() {
             let v = self.vel[i];
@@ -1543,11 +1566,16 @@ impl World {
             let vm = [b.velocity.x, b.velocity.y, b.omega];
             b.acceleration = Vector2::new((v[0] - vm[0]) / h, (v[1] - vm[1]) / h);
             b.angular_acceleration = (v[2] - vm[2]) / h;
-            let d = [
+            let mut d = [
                 h * ((1.0 - theta) * vm[0] + theta * v[0]),
                 h * ((1.0 - theta) * vm[1] + theta * v[1]),
                 h * ((1.0 - theta) * vm[2] + theta * v[2]),
             ];
+            if let (Some(c), true) = (drag_centre, follows.get(i) == Some(&true)) {
+                let a = delta * (b.position - c);
+                d[0] += h * theta * a.x;
+                d[1] += h * theta * a.y;
+            }
             self.displacement.push(d);
             b.position.x += d[0];
             b.position.y += d[1];
@@ -1573,7 +1601,11 @@ impl World {
             self.fluct_displacement.clear();
             for (b, d) in self.bodies.iter().zip(&self.displacement) {
                 let x_old = b.position - Vect::new(d[0], d[1]);
-                let a = l * (x_old - c) * h;
+                let a = if affine {
+                    (l + delta) * (x_old - c) * h
+                } else {
+                    l * (x_old - c) * h
+                };
                 self.fluct_displacement.push([d[0] - a.x, d[1] - a.y, d[2]]);
             }
             cell.advance_with(&(l + delta), h);
@@ -1637,6 +1669,30 @@ impl World {
                 if l != cell.l {
                     cell_work += self.set_velocity_gradient(l);
                 }
+            }
+        }
+
+        // A cell whose control ran away (an undamped cell ringing up, `CellControl::free_change`)
+        // makes the grains' velocities non-finite only here: the step fails, not the
+        // measurement after it.
+        if let Some(cell) = &self.cell {
+            if !cell.l.iter().chain(cell.h.iter()).all(|x| x.is_finite()) {
+                return Err(DemError::NonFiniteCell {
+                    step: self.step_index + 1,
+                });
+            }
+            if let Some(i) = self.bodies.iter().position(|b| {
+                !(b.position
+                    .iter()
+                    .chain(b.velocity.iter())
+                    .all(|x| x.is_finite())
+                    && b.omega.is_finite())
+            }) {
+                return Err(DemError::NonFinite {
+                    step: self.step_index + 1,
+                    body: i,
+                    what: "position or velocity after the cell's change".into(),
+                });
             }
         }
 

@@ -454,6 +454,7 @@ impl Biaxial<'_> {
             tolerance: CONTROL_TOLERANCE * p0,
             max_corrections: MAX_CORRECTIONS,
             implicit: false,
+            affine: false,
         }
     }
 

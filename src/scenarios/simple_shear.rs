@@ -293,7 +293,8 @@ impl Shear<'_> {
                 max_rate,
                 p,
                 gamma_dot.is_none(),
-            );
+            )
+            .with_affine(c.cell_affine);
         }
         CellControl {
             xx,
@@ -305,6 +306,7 @@ impl Shear<'_> {
             tolerance: CONTROL_TOLERANCE * p,
             max_corrections: MAX_CORRECTIONS,
             implicit: false,
+            affine: false,
         }
     }
 }

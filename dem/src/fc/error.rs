@@ -9,6 +9,16 @@ use thiserror::Error;
 /// the file (`path: key mu[1]: …`).
 #[derive(Debug, Error)]
 pub enum FcError {
+    /// A global method (Newton, the active-set finish, Lemke) was asked to solve a problem with
+    /// a low-rank term ([`super::LowRank`], a biperiodic cell's stress-controlled components)
+    /// too large to fold into `W` ([`super::FcProblem::expanded`]).
+    #[error("{contacts} contacts with a cell's low-rank term: more than the {limit} a global method folds into W")]
+    LowRankTooLarge {
+        /// Contacts of the problem.
+        contacts: usize,
+        /// [`super::LOW_RANK_EXPAND_MAX_CONTACTS`].
+        limit: usize,
+    },
     /// An error in the content of a problem file, with the file's path in front.
     #[error("{path}: {source}")]
     InFile {

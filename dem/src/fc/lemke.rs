@@ -646,6 +646,9 @@ pub fn solve(
     tolerance: f64,
     params: &LemkeParams,
 ) -> Result<(Option<LemkeSolution>, LemkeReport), FcError> {
+    if problem.low_rank().is_some() {
+        return solve(&problem.expanded()?, warm, tolerance, params);
+    }
     let nc = problem.contacts();
     if params.refactor_every == 0 {
         return Err(FcError::Option {

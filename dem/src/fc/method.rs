@@ -267,7 +267,11 @@ impl AutoStages for FcStages<'_> {
     }
 
     fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), FcError> {
-        let (s, stats) = newton::solve(self.problem, &self.options(sweeps), self.params)?;
+        let (s, stats) = match newton::solve(self.problem, &self.options(sweeps), self.params) {
+            // A cell's term too large to fold into W: Gauss–Seidel alone solves it.
+            Err(FcError::LowRankTooLarge { .. }) => return Ok((0, false)),
+            other => other?,
+        };
         let out = (stats.smoothing_sweeps, s.converged);
         self.sweeps += stats.smoothing_sweeps;
         self.stats = stats;
@@ -286,7 +290,7 @@ impl AutoStages for FcStages<'_> {
         } else {
             0
         };
-        let out = exact_finish(
+        let out = match exact_finish(
             self.problem,
             &last.r,
             last.error,
@@ -294,7 +298,10 @@ impl AutoStages for FcStages<'_> {
             max_contacts,
             None,
             &mut work,
-        )?;
+        ) {
+            Err(FcError::LowRankTooLarge { .. }) => return Ok((false, false)),
+            other => other?,
+        };
         self.pivots += out.pivots;
         if out.active_set {
             self.stats.iterations += 1;

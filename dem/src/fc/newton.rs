@@ -390,6 +390,10 @@ pub fn solve_with(
     work: &mut NewtonWork,
     accept: impl Fn(&[f64], &[f64]) -> bool,
 ) -> Result<(FcSolution, NewtonStats), FcError> {
+    if problem.low_rank().is_some() {
+        // The cell's rank-three term folded into W (or refused when too large).
+        return solve_with(&problem.expanded()?, options, params, work, accept);
+    }
     params.validate()?;
     let n = problem.contacts();
     let t0 = Instant::now();
@@ -578,6 +582,9 @@ pub fn active_set_finish(
     let n = problem.contacts();
     if n == 0 || r.len() != 2 * n || !active_set_applies(error_now) {
         return Ok(None);
+    }
+    if problem.low_rank().is_some() {
+        return active_set_finish(&problem.expanded()?, r, error_now, work);
     }
     let (diag, rho) = scales(problem);
     work.reset(n);

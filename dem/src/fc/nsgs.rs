@@ -128,6 +128,11 @@ struct Workspace {
     u: Vec<[f64; 2]>,
     /// Over-relaxation factor of [`SweepProblem::sweep`].
     omega: f64,
+    /// The problem's low-rank term in sweep order (empty without one): `B_cκ` per contact,
+    /// `m_κ`, and the current sums `s_κ = Σ_c B_cκ · r_c`, kept current by the sweep.
+    lr_coef: Vec<[[f64; 2]; 3]>,
+    lr_m: [f64; 3],
+    lr_s: [f64; 3],
 }
 
 impl Workspace {
@@ -174,6 +179,13 @@ impl Workspace {
             mu.push(p.mu()[old]);
             q.push([p.q()[2 * old], p.q()[2 * old + 1]]);
         }
+        let (lr_coef, lr_m) = match p.low_rank() {
+            Some(l) => (
+                perm.iter().map(|&old| l.coef[old as usize]).collect(),
+                l.compliance,
+            ),
+            None => (Vec::new(), [0.0; 3]),
+        };
         Self {
             perm,
             row_ptr,
@@ -186,7 +198,35 @@ impl Workspace {
             r: vec![[0.0; 2]; n],
             u: vec![[0.0; 2]; n],
             omega: 1.0,
+            lr_coef,
+            lr_m,
+            lr_s: [0.0; 3],
         }
+    }
+
+    /// Sets the low-rank sums `s_κ` from the current impulses.
+    fn refresh_low_rank(&mut self) {
+        let mut s = [0.0; 3];
+        for (c, r) in self.lr_coef.iter().zip(&self.r) {
+            for (s, b) in s.iter_mut().zip(c) {
+                *s += b[0] * r[0] + b[1] * r[1];
+            }
+        }
+        self.lr_s = s;
+    }
+
+    /// The low-rank term's part of `u_α` from the other contacts,
+    /// `Σ_κ m_κ B_ακ (s_κ − B_ακ · r_α)`, and `s` moved by `Δr_α` after an update.
+    #[inline(always)]
+    fn low_rank_q(&self, a: usize) -> [f64; 2] {
+        let r = self.r[a];
+        let mut x = [0.0; 2];
+        for ((b, m), s) in self.lr_coef[a].iter().zip(self.lr_m).zip(self.lr_s) {
+            let f = m * (s - (b[0] * r[0] + b[1] * r[1]));
+            x[0] += b[0] * f;
+            x[1] += b[1] * f;
+        }
+        x
     }
 
     /// `q_α + Σ_{β≠α} W_αβ r_β + K_α r_α`.
@@ -229,8 +269,14 @@ impl Workspace {
     /// One forward sweep with over-relaxation `omega`; returns `Σ_α |Δr_α|²`.
     fn relaxed_sweep(&mut self, omega: f64) -> f64 {
         let mut d = 0.0;
+        let low_rank = !self.lr_coef.is_empty();
         for a in 0..self.r.len() {
-            let qa = self.local_q(a);
+            let mut qa = self.local_q(a);
+            if low_rank {
+                let x = self.low_rank_q(a);
+                qa[0] += x[0];
+                qa[1] += x[1];
+            }
             let mu = self.mu[a];
             let (mut rn, _) = solve_local(&self.diag[a], qa, mu);
             let old = self.r[a];
@@ -244,6 +290,11 @@ impl Workspace {
             self.r[a] = rn;
             let d0 = rn[0] - old[0];
             let d1 = rn[1] - old[1];
+            if low_rank {
+                for (s, b) in self.lr_s.iter_mut().zip(&self.lr_coef[a]) {
+                    *s += b[0] * d0 + b[1] * d1;
+                }
+            }
             d += d0 * d0 + d1 * d1;
         }
         d
@@ -253,8 +304,17 @@ impl Workspace {
     fn evaluate(&mut self) -> f64 {
         let mut res2 = 0.0;
         let (mut q2, mut r2, mut u2) = (0.0, 0.0, 0.0);
+        if !self.lr_coef.is_empty() {
+            // Fresh sums: the sweeps' running ones drift by rounding.
+            self.refresh_low_rank();
+        }
         for a in 0..self.r.len() {
             let mut u = self.local_q(a);
+            if !self.lr_coef.is_empty() {
+                let x = self.low_rank_q(a);
+                u[0] += x[0];
+                u[1] += x[1];
+            }
             let ra = self.r[a];
             // local_q has q_α, the off-diagonal blocks and the skew part K_α r_α; add S_α r_α.
             let s = self.diag[a].mul(ra);
@@ -309,6 +369,9 @@ impl SweepProblem for Workspace {
 
     fn load(&mut self, x: &[f64]) {
         self.r.as_flattened_mut().copy_from_slice(x);
+        if !self.lr_coef.is_empty() {
+            self.refresh_low_rank();
+        }
     }
 }
 
@@ -364,6 +427,7 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
             ws.r[new] = [g[2 * old], g[2 * old + 1]];
         }
     }
+    ws.refresh_low_rank();
     ws.omega = options.omega;
     let memory = match options.acceleration {
         Acceleration::Anderson { memory } => memory,

@@ -58,6 +58,14 @@ pub fn write_problem(
     meta: serde_json::Value,
 ) -> Result<(), FcError> {
     let path = path.as_ref();
+    // A cell's low-rank term is written folded into W (fc-problem-v1 has one W).
+    let expanded;
+    let problem = if problem.low_rank().is_some() {
+        expanded = problem.expanded()?;
+        &expanded
+    } else {
+        problem
+    };
     let w = problem.w();
     let nnz = 4 * w.nnz_blocks();
     let (mut row, mut col, mut val) = (

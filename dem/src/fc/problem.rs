@@ -22,6 +22,53 @@ pub struct FcProblem {
     w: BlockCsr2,
     diag: Vec<Delassus2>,
     skew: Vec<f64>,
+    low_rank: Option<LowRank>,
+}
+
+/// Largest number of contacts whose problem with a [`LowRank`] term the global methods fold
+/// into `W` ([`FcProblem::expanded`]: `(2 nc)²` entries, 1.3·10⁷ here, about 0.3 GB while it is
+/// built); above it, only Gauss–Seidel solves such a problem (it keeps the term's three sums
+/// current, [`super::nsgs`]).
+pub const LOW_RANK_EXPAND_MAX_CONTACTS: usize = 1800;
+
+/// A rank-three term `Σ_κ m_κ b_κ b_κᵀ` of the Delassus operator: a biperiodic cell's
+/// stress-controlled components eliminated from the step's problem (`crate::cell_coupling`:
+/// `m_κ = g/(h V)`, `b_κ` stacked from each contact's `B_cκ`). Every contact the cell's change
+/// reaches has a non-zero `b`, so the term is dense: it is kept apart from the sparse `W`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LowRank {
+    /// `m_κ` of xx, yy, xy (1/(kg·m²)); 0 for a component whose rate is imposed.
+    pub compliance: [f64; 3],
+    /// `B_cκ = (b_κ,2c, b_κ,2c+1)` per contact and component (m); zero for a contact the cell's
+    /// change does not reach.
+    pub coef: Vec<[[f64; 2]; 3]>,
+}
+
+impl LowRank {
+    /// `Σ_κ m_κ B_cκ B_c'κᵀ` as a 2×2 block `[nn, nt, tn, tt]` of contacts `c`, `c'`.
+    pub fn block(&self, c: usize, d: usize) -> [f64; 4] {
+        let (a, b) = (&self.coef[c], &self.coef[d]);
+        let mut out = [0.0; 4];
+        for k in 0..3 {
+            let m = self.compliance[k];
+            out[0] += m * a[k][0] * b[k][0];
+            out[1] += m * a[k][0] * b[k][1];
+            out[2] += m * a[k][1] * b[k][0];
+            out[3] += m * a[k][1] * b[k][1];
+        }
+        out
+    }
+
+    /// `s_κ = b_κᵀ r` for impulses `r` (interleaved, length 2 nc).
+    pub fn sums(&self, r: &[f64]) -> [f64; 3] {
+        let mut s = [0.0; 3];
+        for (c, x) in self.coef.iter().zip(r.chunks_exact(2)) {
+            for k in 0..3 {
+                s[k] += c[k][0] * x[0] + c[k][1] * x[1];
+            }
+        }
+        s
+    }
 }
 
 impl FcProblem {
@@ -92,6 +139,7 @@ impl FcProblem {
             w,
             diag,
             skew,
+            low_rank: None,
         })
     }
 
@@ -99,9 +147,24 @@ impl FcProblem {
     /// construction, and a diagonal block may be singular (a contact between two bodies whose
     /// degrees of freedom are all imposed cannot react; the solvers leave it at zero).
     pub(crate) fn from_engine(mu: Vec<f64>, q: Vec<f64>, w: BlockCsr2) -> Self {
+        Self::from_engine_with(mu, q, w, None)
+    }
+
+    /// [`FcProblem::from_engine`] with a [`LowRank`] term besides the sparse `W` (its diagonal
+    /// blocks included in [`FcProblem::delassus`]).
+    pub(crate) fn from_engine_with(
+        mu: Vec<f64>,
+        q: Vec<f64>,
+        w: BlockCsr2,
+        low_rank: Option<LowRank>,
+    ) -> Self {
         let (diag, skew) = (0..mu.len())
             .map(|a| {
-                let b = w.diagonal(a);
+                let mut b = w.diagonal(a);
+                if let Some(l) = &low_rank {
+                    let d = l.block(a, a);
+                    (0..4).for_each(|k| b[k] += d[k]);
+                }
                 (
                     Delassus2 {
                         nn: b[0],
@@ -118,7 +181,56 @@ impl FcProblem {
             w,
             diag,
             skew,
+            low_rank,
         }
+    }
+
+    /// The rank-three term of the operator besides [`FcProblem::w`], if any.
+    pub fn low_rank(&self) -> Option<&LowRank> {
+        self.low_rank.as_ref()
+    }
+
+    /// The same problem with its [`LowRank`] term folded into `W` (dense among the contacts it
+    /// reaches), for the methods that factor `W` (Newton, the active-set finish, Lemke) and for
+    /// writing it; a clone without one.
+    ///
+    /// # Errors
+    /// [`FcError::LowRankTooLarge`] above [`LOW_RANK_EXPAND_MAX_CONTACTS`] contacts.
+    pub fn expanded(&self) -> Result<FcProblem, FcError> {
+        let Some(l) = &self.low_rank else {
+            return Ok(self.clone());
+        };
+        let n = self.contacts();
+        if n > LOW_RANK_EXPAND_MAX_CONTACTS {
+            return Err(FcError::LowRankTooLarge {
+                contacts: n,
+                limit: LOW_RANK_EXPAND_MAX_CONTACTS,
+            });
+        }
+        let (mut ri, mut ci, mut v) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..n {
+            for (j, b) in self.w.row(i) {
+                for (k, &x) in b.iter().enumerate() {
+                    ri.push(2 * i + k / 2);
+                    ci.push(2 * j + k % 2);
+                    v.push(x);
+                }
+            }
+        }
+        let reached: Vec<usize> = (0..n).filter(|&c| l.coef[c] != [[0.0; 2]; 3]).collect();
+        for &i in &reached {
+            for &j in &reached {
+                for (k, x) in l.block(i, j).into_iter().enumerate() {
+                    if x != 0.0 {
+                        ri.push(2 * i + k / 2);
+                        ci.push(2 * j + k % 2);
+                        v.push(x);
+                    }
+                }
+            }
+        }
+        let w = BlockCsr2::from_triplets(n, &ri, &ci, &v)?;
+        Ok(Self::from_engine(self.mu.clone(), self.q.clone(), w))
     }
 
     /// Number of contacts `nc`.
@@ -136,7 +248,8 @@ impl FcProblem {
         &self.q
     }
 
-    /// Delassus matrix `W` (1/kg) in block CSR.
+    /// Delassus matrix `W` (1/kg) in block CSR: its sparse part, without the [`LowRank`] term
+    /// if the problem has one ([`FcProblem::low_rank`], [`FcProblem::expanded`]).
     pub fn w(&self) -> &BlockCsr2 {
         &self.w
     }
@@ -160,6 +273,90 @@ impl FcProblem {
         assert_eq!(r.len(), self.q.len(), "r has the wrong length");
         let mut u = vec![0.0; r.len()];
         self.w.mul_add(r, &self.q, &mut u);
+        if let Some(l) = &self.low_rank {
+            let s = l.sums(r);
+            for (c, x) in l.coef.iter().zip(u.chunks_exact_mut(2)) {
+                for k in 0..3 {
+                    let m = l.compliance[k] * s[k];
+                    x[0] += c[k][0] * m;
+                    x[1] += c[k][1] * m;
+                }
+            }
+        }
         u
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fc::{nsgs, FcOptions};
+
+    /// Three contacts with a diagonal sparse `W` and a cell's rank-three term reaching two of
+    /// them: `u = W r + q` with the term kept apart equals the folded operator's to rounding, and
+    /// Gauss–Seidel solves both to the same impulses (to 10⁻⁹ of their scale at 10⁻¹²); the
+    /// term's diagonal blocks are in the local solver's blocks. Above
+    /// [`LOW_RANK_EXPAND_MAX_CONTACTS`] contacts the fold is refused.
+    #[test]
+    fn a_low_rank_term_kept_apart_is_the_folded_operator() {
+        let n = 3;
+        let (mut ri, mut ci, mut v) = (Vec::new(), Vec::new(), Vec::new());
+        for a in 0..n {
+            for (k, x) in [2.0 + a as f64, 0.1, 0.1, 3.0].into_iter().enumerate() {
+                ri.push(2 * a + k / 2);
+                ci.push(2 * a + k % 2);
+                v.push(x);
+            }
+        }
+        let w = BlockCsr2::from_triplets(n, &ri, &ci, &v).unwrap();
+        let low = LowRank {
+            compliance: [0.0, 0.8, 0.3],
+            coef: vec![
+                [[0.0; 2]; 3],
+                [[0.0, 0.0], [0.5, -0.2], [0.1, 0.4]],
+                [[0.0, 0.0], [-0.7, 0.3], [0.2, 0.1]],
+            ],
+        };
+        // Approaching contacts: the cell's term carries load between contacts 1 and 2.
+        let q = vec![-1.0, 0.2, -0.5, 0.3, -0.8, -0.1];
+        let mu = vec![0.5, 0.3, 0.4];
+        let kept = FcProblem::from_engine_with(mu, q, w, Some(low));
+        let folded = kept.expanded().unwrap();
+        assert!(folded.low_rank().is_none());
+        let r = [0.3, 0.1, 0.2, -0.05, 0.4, 0.02];
+        for (a, b) in kept.velocity(&r).iter().zip(folded.velocity(&r)) {
+            assert!((a - b).abs() < 1e-14, "{a} vs {b}");
+        }
+        for a in 0..n {
+            assert_eq!(kept.delassus(a), folded.delassus(a));
+        }
+        let options = FcOptions {
+            tolerance: 1e-12,
+            max_iterations: 10_000,
+            ..FcOptions::default()
+        };
+        let (s1, s2) = (
+            nsgs::solve(&kept, &options).unwrap(),
+            nsgs::solve(&folded, &options).unwrap(),
+        );
+        assert!(s1.converged && s2.converged);
+        let scale = s2.r.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        assert!(scale > 0.1, "loaded: {:?}", s2.r);
+        for (a, b) in s1.r.iter().zip(&s2.r) {
+            assert!((a - b).abs() < 1e-9 * scale, "{a} vs {b}");
+        }
+        let big = FcProblem::from_engine_with(
+            vec![0.5; LOW_RANK_EXPAND_MAX_CONTACTS + 1],
+            vec![0.0; 2 * (LOW_RANK_EXPAND_MAX_CONTACTS + 1)],
+            BlockCsr2::from_triplets(LOW_RANK_EXPAND_MAX_CONTACTS + 1, &[], &[], &[]).unwrap(),
+            Some(LowRank {
+                compliance: [1.0, 0.0, 0.0],
+                coef: vec![[[1.0, 0.0], [0.0; 2], [0.0; 2]]; LOW_RANK_EXPAND_MAX_CONTACTS + 1],
+            }),
+        );
+        assert!(matches!(
+            big.expanded(),
+            Err(FcError::LowRankTooLarge { .. })
+        ));
     }
 }
