@@ -15,7 +15,7 @@
 //! Snapshot velocities are total velocities (affine field included, `dem::cell`); the
 //! fluctuations relative to the affine field are what carries momentum flux. Tension positive.
 
-use dem::math::{Tensor, Vector};
+use dem::math::{SymTensor, Tensor, Vector};
 use dem::snapshot::{BodyKind, Snapshot};
 use serde::{Deserialize, Serialize};
 
@@ -29,7 +29,7 @@ pub struct CellState {
     /// Cell volume `det h · t` (m³; m² per metre of thickness).
     pub volume: f64,
     /// Mean stress `Σ` (Pa), symmetric part, kinetic stress included.
-    pub stress: Tensor,
+    pub stress: SymTensor,
     /// Contact part `(1/V) Σ_p V_p Σ_c,p` (Pa).
     pub contact: Tensor,
     /// Rotational inertia part `(1/V) Σ_p V_p Σ_i,p` (Pa).
@@ -37,7 +37,7 @@ pub struct CellState {
     /// Kinetic part `−(1/V) Σ_p m_p ṽ_p ⊗ ṽ_p` (Pa).
     pub kinetic: Tensor,
     /// Strain rate of the cell `D = (L + Lᵀ)/2` (1/s).
-    pub strain_rate: Tensor,
+    pub strain_rate: SymTensor,
     /// Velocity gradient of the cell `L` (1/s).
     pub velocity_gradient: Tensor,
     /// Pressure `p = −tr Σ / 2` (Pa).
@@ -49,7 +49,7 @@ pub struct CellState {
     /// Coordination number `Z = 2 N_c / N` over contacts carrying a normal force (1).
     pub coordination: f64,
     /// Fabric tensor `(1/N_c) Σ_c n ⊗ n` over contacts carrying a normal force (1).
-    pub fabric: Tensor,
+    pub fabric: SymTensor,
     /// Grains.
     pub grains: usize,
 }

@@ -7,7 +7,7 @@
 //! `W = (L − Lᵀ)/2`, and the **shear rate** `γ̇ = √(2 D' : D')`, `D' = D − (tr D / 2) 𝟙`; for a
 //! simple shear `v_x = γ̇ y` it is `γ̇ = |∂v_x/∂y| = 2 |D_xy|`.
 
-use dem::math::{Tensor, Vector};
+use dem::math::{SymTensor, Tensor, Vector};
 use dem::snapshot::{BodyKind, Snapshot, WallGeometry};
 use serde::{Deserialize, Serialize};
 
@@ -43,7 +43,7 @@ pub struct AffineFit {
 
 impl AffineFit {
     /// Strain-rate tensor `D = (L + Lᵀ)/2` (1/s).
-    pub fn strain_rate(&self) -> Tensor {
+    pub fn strain_rate(&self) -> SymTensor {
         symmetric_part(&self.gradient)
     }
 

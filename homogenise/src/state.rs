@@ -20,7 +20,7 @@ use crate::error::{HomogeniseError, Result};
 use crate::region::Region;
 use crate::tensor::outer;
 use crate::validate::check_snapshot;
-use dem::math::Tensor;
+use dem::math::{SymTensor, Tensor};
 
 /// Which contacts count, for coordination and fabric.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -60,7 +60,7 @@ pub struct Coordination {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Fabric {
     /// `F = (1/N_c) Σ n ⊗ n` (dimensionless, trace 1); zero when no contact.
-    pub tensor: Tensor,
+    pub tensor: SymTensor,
     /// Number of contacts used `N_c`.
     pub contacts: usize,
     /// Anisotropy `a = 2 (λ₁ − λ₂)` ∈ [0, 2].

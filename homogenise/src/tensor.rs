@@ -6,7 +6,7 @@
 //! Convention for dyads: `(a ⊗ b)_ij = a_i b_j`, so the Love–Weber term `r ⊗ (x − c)` has the
 //! force in the row index and the lever in the column index.
 
-use dem::math::{Tensor, Vector};
+use dem::math::{SymTensor, Tensor, Vector};
 
 /// Cross product of two vectors, `a × b = a_x b_y − a_y b_x` in the plane (from the dimension
 /// layer).
@@ -27,7 +27,7 @@ pub fn outer(a: &Vector, b: &Vector) -> Tensor {
 }
 
 /// Symmetric part `(T + Tᵀ)/2`.
-pub fn symmetric_part(t: &Tensor) -> Tensor {
+pub fn symmetric_part(t: &Tensor) -> SymTensor {
     (t + t.transpose()) * 0.5
 }
 
