@@ -1,5 +1,6 @@
 //! Exploration: time of the parallel kernels on 1 and 2 threads.
 use dem::colouring::ContactColouring;
+use dem::math::Twist;
 use std::time::Instant;
 
 fn main() {
@@ -16,10 +17,11 @@ fn main() {
         .iter()
         .map(|b| [b.position.x, b.position.y])
         .collect();
+    // The engine's packed twists (v_x, v_y, ω), the layout of its kernels.
     let vfree: Vec<[f64; 3]> = w
         .bodies
         .iter()
-        .map(|b| [b.velocity.x, b.velocity.y, b.omega])
+        .map(|b| Twist::new(b.velocity, b.omega).to_array())
         .collect();
     let blocks: usize = std::env::var("BLOCKS").map_or(16, |v| v.parse().unwrap());
     let mut l = dem::blocked::BlockLayout::default();

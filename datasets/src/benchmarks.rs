@@ -16,9 +16,9 @@
 use std::time::Instant;
 
 use dem::bench::{energy_ratio, settle, SettleReport};
+use dem::math::Vector;
 use dem::step_control::StepControl;
 use dem::World;
-use nalgebra::Vector2;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -230,7 +230,7 @@ fn benchmark_grains(n: usize, seed: u64) -> (GrainSpec, ChaCha8Rng, Vec<f64>) {
 fn box_world(
     width: f64,
     run: &ColumnRun,
-    centres: &[Vector2<f64>],
+    centres: &[Vector],
     radii: &[f64],
     density: f64,
 ) -> World {

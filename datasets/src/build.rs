@@ -4,8 +4,8 @@
 //! The engine's checks ([`dem::World::validate`]) run on every built world: no overlap, no
 //! grain behind a wall, finite positive sizes.
 
+use dem::math::Vector;
 use dem::{Dof, World, WorldParams};
-use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -31,7 +31,7 @@ const BUILD_TOLERANCE: f64 = 1e-12;
 
 fn world(
     dt: f64,
-    gravity: Vector2<f64>,
+    gravity: Vector,
     periodic_x: Option<[f64; 2]>,
     r_min: f64,
     friction: &FrictionSpec,
@@ -43,7 +43,7 @@ fn world(
 /// the smallest radius `r_min`, and the contact laws `laws`.
 fn world_with_laws(
     dt: f64,
-    gravity: Vector2<f64>,
+    gravity: Vector,
     periodic_x: Option<[f64; 2]>,
     r_min: f64,
     laws: dem::ContactLaws,
@@ -62,12 +62,12 @@ fn world_with_laws(
 /// material [`WALL`], and returns their body indices.
 pub fn box_walls(w: &mut World, width: f64) -> [usize; 3] {
     [
-        w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), WALL),
-        w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), WALL),
+        w.add_line_wall("bottom", Vector::zeros(), Vector::new(0.0, 1.0), WALL),
+        w.add_line_wall("left", Vector::zeros(), Vector::new(1.0, 0.0), WALL),
         w.add_line_wall(
             "right",
-            Vector2::new(width, 0.0),
-            Vector2::new(-1.0, 0.0),
+            Vector::new(width, 0.0),
+            Vector::new(-1.0, 0.0),
             WALL,
         ),
     ]
@@ -121,7 +121,7 @@ pub fn column(
     )?;
     let mut w = world(
         dt,
-        Vector2::new(0.0, -9.81),
+        Vector::new(0.0, -9.81),
         None,
         grain.radius_min(),
         friction,
@@ -143,18 +143,18 @@ pub fn column(
 /// The rolling disk: slope through the origin descending to the right, e₁ = (cos φ, −sin φ)
 /// down the slope, e₂ = (sin φ, cos φ) its outward normal; the disk touches the slope at the
 /// origin, at rest. Body 0 is the wall `slope`, body 1 the disk.
-pub fn rolling(c: &RollingConfig) -> Result<(World, Vector2<f64>, Vector2<f64>)> {
+pub fn rolling(c: &RollingConfig) -> Result<(World, Vector, Vector)> {
     let phi = c.slope_deg.to_radians();
-    let e1 = Vector2::new(phi.cos(), -phi.sin());
-    let e2 = Vector2::new(phi.sin(), phi.cos());
+    let e1 = Vector::new(phi.cos(), -phi.sin());
+    let e2 = Vector::new(phi.sin(), phi.cos());
     let f = FrictionSpec {
         grain_grain: c.friction,
         grain_wall: c.friction,
     };
-    let mut w = world(c.dt, Vector2::new(0.0, -9.81), None, c.radius, &f);
+    let mut w = world(c.dt, Vector::new(0.0, -9.81), None, c.radius, &f);
     w.params.solver.tolerance = 1e-12;
     w.params.solver.max_iterations = 100;
-    w.add_line_wall("slope", Vector2::zeros(), e2, WALL);
+    w.add_line_wall("slope", Vector::zeros(), e2, WALL);
     w.add_grain(e2 * c.radius, c.radius, c.density, GRAIN);
     w.validate(BUILD_TOLERANCE)?;
     Ok((w, e1, e2))
@@ -168,10 +168,10 @@ pub fn arrangement(c: &ArrangementsConfig, kind: Arrangement) -> Result<World> {
     let centres = lattice(kind, c.columns, c.rows, r, c.gap, c.jitter, &mut rng);
     let width = 2.0 * r * c.columns as f64;
     let top = centres.iter().map(|p| p.y).fold(0.0, f64::max) + 2.0 * r;
-    let mut w = world(c.dt, Vector2::new(0.0, -9.81), None, r, &c.friction);
+    let mut w = world(c.dt, Vector::new(0.0, -9.81), None, r, &c.friction);
     c.solver.apply(&mut w.params);
     box_walls(&mut w, width);
-    w.add_line_wall("top", Vector2::new(0.0, top), Vector2::new(0.0, -1.0), WALL);
+    w.add_line_wall("top", Vector::new(0.0, top), Vector::new(0.0, -1.0), WALL);
     for p in centres {
         w.add_grain(p, r, c.density, GRAIN);
     }
@@ -181,11 +181,11 @@ pub fn arrangement(c: &ArrangementsConfig, kind: Arrangement) -> Result<World> {
 
 /// Centres of a rough wall: disks of radius `r` evenly spaced along `[0, length)` at height `y`,
 /// `gap_fraction · 2r` apart (surface to surface).
-fn rough_row(length: f64, r: f64, y: f64) -> (Vec<Vector2<f64>>, Vec<f64>) {
+fn rough_row(length: f64, r: f64, y: f64) -> (Vec<Vector>, Vec<f64>) {
     let m = ((length / (2.0 * r)).floor() as usize).max(1);
     let pitch = length / m as f64;
     let centres = (0..m)
-        .map(|k| Vector2::new((k as f64 + 0.5) * pitch, y))
+        .map(|k| Vector::new((k as f64 + 0.5) * pitch, y))
         .collect();
     (centres, vec![r; m])
 }
@@ -197,7 +197,7 @@ struct RoughBed {
     world: World,
     rng: ChaCha8Rng,
     radii: Vec<f64>,
-    centres: Vec<Vector2<f64>>,
+    centres: Vec<Vector>,
     gap: f64,
 }
 
@@ -208,7 +208,7 @@ fn rough_bed(
     grains: usize,
     length: f64,
     dt: f64,
-    gravity: Vector2<f64>,
+    gravity: Vector,
     friction: &FrictionSpec,
     base_name: &str,
 ) -> Result<RoughBed> {
@@ -245,7 +245,7 @@ pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
     let g = &c.grain;
     let length = c.cell_length_diameters * 2.0 * g.radius_mean;
     let theta = c.slope_deg.to_radians();
-    let gravity = Vector2::new(9.81 * theta.sin(), -9.81 * theta.cos());
+    let gravity = Vector::new(9.81 * theta.sin(), -9.81 * theta.cos());
     let RoughBed {
         world: mut w,
         mut rng,
@@ -266,7 +266,7 @@ pub fn inclined_flow(c: &InclinedFlowConfig) -> Result<World> {
     for (p, r) in centres.iter().zip(&radii) {
         let b = w.add_grain(*p, *r, g.density, GRAIN);
         // A small random velocity breaks the symmetry of the start.
-        w.bodies[b as usize].velocity = Vector2::new(rng.random_range(-0.01..0.01), 0.0);
+        w.bodies[b as usize].velocity = Vector::new(rng.random_range(-0.01..0.01), 0.0);
     }
     w.validate(BUILD_TOLERANCE)?;
     Ok(w)
@@ -291,7 +291,7 @@ pub fn shear_cell(c: &ShearCellConfig) -> Result<(World, f64)> {
         c.grains,
         length,
         c.dt_max,
-        Vector2::zeros(),
+        Vector::zeros(),
         &c.friction,
         "bottom",
     )?;
@@ -314,7 +314,7 @@ pub fn shear_cell(c: &ShearCellConfig) -> Result<(World, f64)> {
     body.dofs = [Dof::Imposed, Dof::Free, Dof::Imposed];
     body.mass = c.wall_mass_ratio * grain_mass;
     body.gravity = false;
-    body.applied_force = Vector2::new(0.0, -c.pressure * length * body.thickness);
+    body.applied_force = Vector::new(0.0, -c.pressure * length * body.thickness);
     if !(body.mass.is_finite() && body.mass > 0.0) {
         return Err(DatasetError::invalid(
             "wall_mass_ratio",
@@ -378,8 +378,8 @@ fn collapse_walls(w: &mut World, c: &ColumnCollapseConfig) -> (usize, usize, usi
     let rf = c.grain.radius_mean;
     let (fc, fr) = rough_row(c.floor_extent(), rf, -rf);
     let floor = w.add_clump("floor", &fc, &fr, WALL) as usize;
-    let base = w.add_line_wall("base", Vector2::new(0.0, -rf), Vector2::new(0.0, 1.0), WALL);
-    let wall = w.add_line_wall("wall", Vector2::zeros(), Vector2::new(1.0, 0.0), SIDE);
+    let base = w.add_line_wall("base", Vector::new(0.0, -rf), Vector::new(0.0, 1.0), WALL);
+    let wall = w.add_line_wall("wall", Vector::zeros(), Vector::new(1.0, 0.0), SIDE);
     (floor, base as usize, wall as usize)
 }
 
@@ -394,7 +394,7 @@ pub fn column_collapse_deposit(c: &ColumnCollapseConfig) -> Result<CollapseWorld
     let centres = deposit(&mut rng, &radii, c.half_width(), gap)?.centres;
     let mut w = world_with_laws(
         c.dt / c.deposit.substeps as f64,
-        Vector2::new(0.0, -crate::config::column_collapse::GRAVITY),
+        Vector::new(0.0, -crate::config::column_collapse::GRAVITY),
         None,
         c.grain.radius_min(),
         collapse_laws(c),
@@ -403,8 +403,8 @@ pub fn column_collapse_deposit(c: &ColumnCollapseConfig) -> Result<CollapseWorld
     let (floor, base, wall) = collapse_walls(&mut w, c);
     let gate = w.add_line_wall(
         "gate",
-        Vector2::new(c.half_width(), 0.0),
-        Vector2::new(-1.0, 0.0),
+        Vector::new(c.half_width(), 0.0),
+        Vector::new(-1.0, 0.0),
         SIDE,
     ) as usize;
     for (p, r) in centres.iter().zip(&radii) {

@@ -2,8 +2,8 @@
 //! deformable cell (`dem::cell`), no walls, no gravity.
 
 use dem::cell::Cell;
+use dem::math::Vector;
 use dem::World;
-use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -69,7 +69,7 @@ pub fn loose_cell(c: &LooseCell) -> Result<World> {
     let side = spacing * n_side as f64;
     let params = dem::WorldParams {
         dt: c.dt,
-        gravity: Vector2::zeros(),
+        gravity: Vector::zeros(),
         detection_gap: 0.1 * c.grain.radius_min(),
         solver: c.solver.params(),
         overlap_rate: c.solver.overlap_rate,
@@ -80,8 +80,8 @@ pub fn loose_cell(c: &LooseCell) -> Result<World> {
     let slack = 0.5 * (spacing - 2.0 * r_max) * 0.9;
     for (k, &r) in radii.iter().enumerate() {
         let (i, j) = (k % n_side, k / n_side);
-        let jitter = Vector2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)) * slack;
-        let x = Vector2::new(i as f64 + 0.5, j as f64 + 0.5) * spacing + jitter;
+        let jitter = Vector::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)) * slack;
+        let x = Vector::new(i as f64 + 0.5, j as f64 + 0.5) * spacing + jitter;
         w.add_grain(x, r, c.grain.density, 0);
     }
     let cell = Cell::rectangle(side, side)?;

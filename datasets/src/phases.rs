@@ -504,8 +504,8 @@ pub fn continue_steps(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dem::math::Vector;
     use dem::{ContactLaws, WorldParams};
-    use nalgebra::Vector2;
 
     #[test]
     fn the_last_step_growth_is_that_steps_own() {
@@ -553,15 +553,10 @@ mod tests {
     /// every other one shifted sideways by `shift` r.
     fn stack(n: usize, r: f64, gap: f64, shift: f64, theta: f64) -> World {
         let mut w = World::new(params(theta), ContactLaws::new(&["glass"], 0.3));
-        w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
+        w.add_line_wall("floor", Vector::zeros(), Vector::new(0.0, 1.0), 0);
         for k in 0..n {
             let x = if k % 2 == 0 { 0.0 } else { shift * r };
-            w.add_grain(
-                Vector2::new(x, r + k as f64 * (2.0 * r + gap)),
-                r,
-                2500.0,
-                0,
-            );
+            w.add_grain(Vector::new(x, r + k as f64 * (2.0 * r + gap)), r, 2500.0, 0);
         }
         w
     }
@@ -604,8 +599,8 @@ mod tests {
     fn free_fall_residual_is_the_analytic_one() {
         for (theta, expected) in [(1.0, -0.5), (0.5, 0.0)] {
             let mut w = World::new(params(theta), ContactLaws::new(&["glass"], 0.3));
-            w.add_grain(Vector2::new(0.0, 1.0), 1e-3, 2500.0, 0);
-            w.bodies[0].velocity = Vector2::new(0.3, 0.7);
+            w.add_grain(Vector::new(0.0, 1.0), 1e-3, 2500.0, 0);
+            w.bodies[0].velocity = Vector::new(0.3, 0.7);
             let m = w.bodies[0].mass;
             let (h, g) = (w.params.dt, w.params.gravity.norm());
             for _ in 0..5 {
@@ -628,11 +623,11 @@ mod tests {
     fn driven_floor_work_balances_the_lift() {
         let v = 0.01;
         let mut w = World::new(params(1.0), ContactLaws::new(&["glass"], 0.3));
-        let floor = w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0) as usize;
-        w.bodies[floor].velocity = Vector2::new(0.0, v);
+        let floor = w.add_line_wall("floor", Vector::zeros(), Vector::new(0.0, 1.0), 0) as usize;
+        w.bodies[floor].velocity = Vector::new(0.0, v);
         let r = 1e-3;
-        let g = w.add_grain(Vector2::new(0.0, r), r, 2500.0, 0) as usize;
-        w.bodies[g].velocity = Vector2::new(0.0, v);
+        let g = w.add_grain(Vector::new(0.0, r), r, 2500.0, 0) as usize;
+        w.bodies[g].velocity = Vector::new(0.0, v);
         let m = w.bodies[g].mass;
         let scale = load_energy_scale(&w);
         let lift = m * w.params.gravity.norm() * v * w.params.dt;
@@ -694,8 +689,8 @@ mod tests {
     fn position_correction_is_accounted_apart_from_the_residual() {
         let r = 1e-3;
         let mut w = World::new(params(1.0), ContactLaws::new(&["glass"], 0.3));
-        w.add_line_wall("floor", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-        let g = w.add_grain(Vector2::new(0.0, 0.95 * r), r, 2500.0, 0) as usize;
+        w.add_line_wall("floor", Vector::zeros(), Vector::new(0.0, 1.0), 0);
+        let g = w.add_grain(Vector::new(0.0, 0.95 * r), r, 2500.0, 0) as usize;
         let m = w.bodies[g].mass;
         let e_pot = w.potential_energy();
         let s = run_steps(&mut w, 5, |_, _| true).unwrap();

@@ -47,6 +47,7 @@ pub mod fc;
 pub mod hydrostatic;
 pub mod local;
 pub mod material;
+pub mod math;
 pub mod nlgs;
 pub mod parallel;
 pub mod serde_float;

@@ -15,13 +15,13 @@
 //! Snapshot velocities are total velocities (affine field included, `dem::cell`); the
 //! fluctuations relative to the affine field are what carries momentum flux. Tension positive.
 
+use dem::math::{SymTensor, Tensor, Vector};
 use dem::snapshot::{BodyKind, Snapshot};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{HomogeniseError, Result};
 use crate::stress::grain_stresses;
-use crate::tensor::{outer, Tensor2};
+use crate::tensor::outer;
 
 /// Whole-cell measures of one snapshot (module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -29,17 +29,17 @@ pub struct CellState {
     /// Cell volume `det h · t` (m³; m² per metre of thickness).
     pub volume: f64,
     /// Mean stress `Σ` (Pa), symmetric part, kinetic stress included.
-    pub stress: Tensor2,
+    pub stress: SymTensor,
     /// Contact part `(1/V) Σ_p V_p Σ_c,p` (Pa).
-    pub contact: Tensor2,
+    pub contact: Tensor,
     /// Rotational inertia part `(1/V) Σ_p V_p Σ_i,p` (Pa).
-    pub inertia: Tensor2,
+    pub inertia: Tensor,
     /// Kinetic part `−(1/V) Σ_p m_p ṽ_p ⊗ ṽ_p` (Pa).
-    pub kinetic: Tensor2,
+    pub kinetic: Tensor,
     /// Strain rate of the cell `D = (L + Lᵀ)/2` (1/s).
-    pub strain_rate: Tensor2,
+    pub strain_rate: SymTensor,
     /// Velocity gradient of the cell `L` (1/s).
-    pub velocity_gradient: Tensor2,
+    pub velocity_gradient: Tensor,
     /// Pressure `p = −tr Σ / 2` (Pa).
     pub pressure: f64,
     /// Deviatoric stress `q = √(((Σ_xx − Σ_yy)/2)² + Σ_xy²)` (Pa).
@@ -49,7 +49,7 @@ pub struct CellState {
     /// Coordination number `Z = 2 N_c / N` over contacts carrying a normal force (1).
     pub coordination: f64,
     /// Fabric tensor `(1/N_c) Σ_c n ⊗ n` over contacts carrying a normal force (1).
-    pub fabric: Tensor2,
+    pub fabric: SymTensor,
     /// Grains.
     pub grains: usize,
 }
@@ -66,7 +66,7 @@ pub fn cell_state(snapshot: &Snapshot) -> Result<CellState> {
     let gs = grain_stresses(snapshot)?;
     let thickness = gs.first().map_or(1.0, |g| g.thickness);
     let volume = cell.volume() * thickness;
-    let (mut contact, mut inertia) = (Tensor2::zeros(), Tensor2::zeros());
+    let (mut contact, mut inertia) = (Tensor::zeros(), Tensor::zeros());
     let mut area = 0.0;
     for g in &gs {
         contact += g.contact * g.volume;
@@ -80,7 +80,7 @@ pub fn cell_state(snapshot: &Snapshot) -> Result<CellState> {
         .iter()
         .filter(|b| b.kind == BodyKind::Grain)
         .collect();
-    let (mut mass, mut mom) = (0.0, Vector2::zeros());
+    let (mut mass, mut mom) = (0.0, Vector::zeros());
     for b in &grains {
         mass += b.mass;
         mom += (b.velocity - l * (b.position - c)) * b.mass;
@@ -88,9 +88,9 @@ pub fn cell_state(snapshot: &Snapshot) -> Result<CellState> {
     let mean = if mass > 0.0 {
         mom / mass
     } else {
-        Vector2::zeros()
+        Vector::zeros()
     };
-    let mut kinetic = Tensor2::zeros();
+    let mut kinetic = Tensor::zeros();
     for b in &grains {
         let v = b.velocity - l * (b.position - c) - mean;
         kinetic -= outer(&v, &v) * b.mass;
@@ -98,7 +98,7 @@ pub fn cell_state(snapshot: &Snapshot) -> Result<CellState> {
     let (contact, inertia, kinetic) = (contact / volume, inertia / volume, kinetic / volume);
     let total = contact + inertia + kinetic;
     let stress = (total + total.transpose()) * 0.5;
-    let mut fabric = Tensor2::zeros();
+    let mut fabric = Tensor::zeros();
     let mut nc = 0usize;
     for ct in snapshot.contacts.iter().filter(|c| c.force_n > 0.0) {
         fabric += outer(&ct.normal, &ct.normal);

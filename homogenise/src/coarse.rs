@@ -19,14 +19,14 @@
 //! `r_c`, when the grid covers the sample with a margin of `r_c`: relative error ≤ 1e-6 for
 //! `cutoff = 5`, `Δ ≤ w` (tested); about 5e-6 for `cutoff = 4`, `Δ = w/2`.
 
+use dem::math::{Tensor, Vector};
 use dem::snapshot::{BodyKind, Snapshot};
-use nalgebra::Vector2;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{positive, HomogeniseError, Result};
 use crate::stress::GrainStress;
-use crate::tensor::{outer, Tensor2};
+use crate::tensor::outer;
 use crate::validate::check_snapshot;
 
 /// Largest number of grid nodes accepted by [`coarse_grain`] (each node holds 15 `f64`).
@@ -36,7 +36,7 @@ pub const MAX_NODES: usize = 20_000_000;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Grid {
     /// Position of node (0, 0) (m).
-    pub origin: Vector2<f64>,
+    pub origin: Vector,
     /// Node spacing Δ (m), the same along x and y.
     pub spacing: f64,
     /// Number of nodes along x.
@@ -47,8 +47,8 @@ pub struct Grid {
 
 impl Grid {
     /// Position of node `(i, j)` (m).
-    pub fn node(&self, i: usize, j: usize) -> Vector2<f64> {
-        self.origin + Vector2::new(i as f64, j as f64) * self.spacing
+    pub fn node(&self, i: usize, j: usize) -> Vector {
+        self.origin + Vector::new(i as f64, j as f64) * self.spacing
     }
 
     /// A grid covering the grains' disks with a margin (m) on every side (along x: the periodic
@@ -82,7 +82,7 @@ impl Grid {
             None => x0,
         };
         Ok(Self {
-            origin: Vector2::new(x0, y0),
+            origin: Vector::new(x0, y0),
             spacing,
             nx,
             ny: n(y0, y1),
@@ -114,7 +114,7 @@ impl TensorField {
         }
     }
 
-    fn add(&mut self, j: usize, i: usize, t: &Tensor2) {
+    fn add(&mut self, j: usize, i: usize, t: &Tensor) {
         self.xx[[j, i]] += t[(0, 0)];
         self.xy[[j, i]] += t[(0, 1)];
         self.yx[[j, i]] += t[(1, 0)];
@@ -122,8 +122,8 @@ impl TensorField {
     }
 
     /// The tensor at node `(i, j)`.
-    pub fn at(&self, i: usize, j: usize) -> Tensor2 {
-        Tensor2::new(
+    pub fn at(&self, i: usize, j: usize) -> Tensor {
+        Tensor::new(
             self.xx[[j, i]],
             self.xy[[j, i]],
             self.yx[[j, i]],
@@ -185,9 +185,9 @@ impl Kernel {
 fn for_nodes(
     grid: &Grid,
     periodic: Option<[f64; 2]>,
-    c: &Vector2<f64>,
+    c: &Vector,
     kernel: &Kernel,
-    mut f: impl FnMut(usize, usize, f64, Vector2<f64>),
+    mut f: impl FnMut(usize, usize, f64, Vector),
 ) {
     let rc = kernel.rc;
     // every periodic image whose kernel reaches the grid's x range
@@ -204,7 +204,7 @@ fn for_nodes(
     };
     let h = grid.spacing;
     for s in shifts {
-        let cs = Vector2::new(c.x + s, c.y);
+        let cs = Vector::new(c.x + s, c.y);
         let i0 = ((cs.x - rc - grid.origin.x) / h).ceil().max(0.0);
         let i1 = ((cs.x + rc - grid.origin.x) / h).floor();
         let j0 = ((cs.y - rc - grid.origin.y) / h).ceil().max(0.0);
@@ -301,7 +301,7 @@ pub fn coarse_grain(
     for b in &bodies {
         let m = b.mass / b.thickness;
         for_nodes(grid, per, &b.position, &kernel, |i, j, k, _| {
-            let dv = b.velocity - Vector2::new(vx[[j, i]], vy[[j, i]]);
+            let dv = b.velocity - Vector::new(vx[[j, i]], vy[[j, i]]);
             kinetic.add(j, i, &(outer(&dv, &dv) * (-m * k)));
         });
     }

@@ -21,8 +21,8 @@
 //! downward load over the weight); at rest the two add up to 1.
 //! The column must stand along y with gravity along −y.
 
+use dem::math::Vector;
 use dem::snapshot::{BodyKind, Snapshot, WallGeometry};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::depth::{DepthAxis, DepthBins};
@@ -110,7 +110,7 @@ pub fn column_profile(snapshot: &Snapshot, spec: &ColumnSpec) -> Result<ColumnPr
     };
     let width = xr - xl;
     positive("width", width)?;
-    let axis = DepthAxis::new(Vector2::new(0.0, -1.0), Vector2::new(0.0, y1))?;
+    let axis = DepthAxis::new(Vector::new(0.0, -1.0), Vector::new(0.0, y1))?;
     let height = y1 - y0;
     let count = ((height / spec.bin_width).ceil() as usize).max(1);
     let bins = DepthBins::new(axis, spec.bin_width, count)?;
@@ -131,8 +131,8 @@ pub fn column_profile(snapshot: &Snapshot, spec: &ColumnSpec) -> Result<ColumnPr
     for k in 0..count {
         let (d0, d1) = bins.bounds(k);
         let region = Region::Rectangle {
-            min: Vector2::new(xl, y1 - d1),
-            max: Vector2::new(xr, y1 - d0),
+            min: Vector::new(xl, y1 - d1),
+            max: Vector::new(xr, y1 - d0),
         };
         let m = mean_stress(snapshot, &grains, &region)?;
         sigma_v_mean.push(-m.total[(1, 1)]);
@@ -170,8 +170,8 @@ pub fn column_profile(snapshot: &Snapshot, spec: &ColumnSpec) -> Result<ColumnPr
     let rho = gbodies.iter().map(|b| b.mass).sum::<f64>()
         / gbodies.iter().map(|b| b.volume()).sum::<f64>();
     let whole = Region::Rectangle {
-        min: Vector2::new(xl, y0),
-        max: Vector2::new(xr, y1),
+        min: Vector::new(xl, y0),
+        max: Vector::new(xr, y1),
     };
     let column_solid_fraction = crate::state::solid_fraction(snapshot, &whole)?;
     let bottom = plane_stress_profile(snapshot, &[y0], Some(width))?[0];

@@ -3,8 +3,8 @@
 //! `depth(x) = (x − s) · e_down`, with `e_down` a unit vector (down the column: along gravity)
 //! and `s` a point at depth 0 (the free surface). Bin `k` holds depths in `[k Δ, (k+1) Δ)`.
 
+use dem::math::Vector;
 use dem::snapshot::{BodyKind, Snapshot};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{positive, HomogeniseError, Result};
@@ -13,14 +13,14 @@ use crate::error::{positive, HomogeniseError, Result};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DepthAxis {
     /// Unit vector pointing to increasing depth.
-    pub down: Vector2<f64>,
+    pub down: Vector,
     /// A point at depth 0 (m).
-    pub surface: Vector2<f64>,
+    pub surface: Vector,
 }
 
 impl DepthAxis {
     /// An axis along `down` (normalised) with depth 0 at `surface`.
-    pub fn new(down: Vector2<f64>, surface: Vector2<f64>) -> Result<Self> {
+    pub fn new(down: Vector, surface: Vector) -> Result<Self> {
         let n = down.norm();
         if !(n.is_finite() && n > 0.0 && surface.x.is_finite() && surface.y.is_finite()) {
             return Err(HomogeniseError::InvalidParameter {
@@ -65,12 +65,12 @@ impl DepthAxis {
     }
 
     /// Depth of a point (m).
-    pub fn depth(&self, x: &Vector2<f64>) -> f64 {
+    pub fn depth(&self, x: &Vector) -> f64 {
         (x - self.surface).dot(&self.down)
     }
 
     /// The point on the axis through `surface` at the given depth (m).
-    pub fn point_at(&self, depth: f64) -> Vector2<f64> {
+    pub fn point_at(&self, depth: f64) -> Vector {
         self.surface + self.down * depth
     }
 }
@@ -100,7 +100,7 @@ impl DepthBins {
     }
 
     /// Bin index of a point, `None` outside `[0, count · width)`.
-    pub fn bin_of(&self, x: &Vector2<f64>) -> Option<usize> {
+    pub fn bin_of(&self, x: &Vector) -> Option<usize> {
         let d = self.axis.depth(x) / self.width;
         (d >= 0.0 && d < self.count as f64).then(|| (d.floor() as usize).min(self.count - 1))
     }

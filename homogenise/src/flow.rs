@@ -13,8 +13,8 @@
 //!
 //! The slices span the sample's width (the periodic cell when x is periodic).
 
+use dem::math::{Tensor, Vector};
 use dem::snapshot::{BodyKind, Snapshot};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{positive, HomogeniseError, Result};
@@ -22,7 +22,6 @@ use crate::inertia_ratio::inertia_ratios;
 use crate::invariants::{inertial_number, stress_invariants};
 use crate::region::Region;
 use crate::stress::{mean_stress, GrainStress};
-use crate::tensor::Tensor2;
 
 /// Grain scale of the flow, for the inertial number.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -43,13 +42,13 @@ pub struct FlowSlice {
     /// Weighted number of grains.
     pub grains: f64,
     /// Mass-weighted mean velocity (m/s); zero in an empty slice.
-    pub velocity: Vector2<f64>,
+    pub velocity: Vector,
     /// Mass-weighted mean height of the grains' centres `ȳ` (m); the middle if empty.
     pub mean_y: f64,
     /// Solid fraction.
     pub solid_fraction: f64,
     /// Mean stress with inertia (Pa).
-    pub stress: Tensor2,
+    pub stress: Tensor,
     /// Pressure `P` (Pa).
     pub pressure: f64,
     /// Shear stress `τ` (Pa).
@@ -109,7 +108,7 @@ pub fn flow_profile(
         };
         let rect = region.resolve(snapshot)?;
         let ms = mean_stress(snapshot, grains, &region)?;
-        let (mut mv, mut my, mut m) = (Vector2::zeros(), 0.0, 0.0);
+        let (mut mv, mut my, mut m) = (Vector::zeros(), 0.0, 0.0);
         for b in snapshot.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
             let f = rect.disk_fraction(&b.position, b.radius);
             mv += b.velocity * (f * b.mass);
@@ -130,7 +129,7 @@ pub fn flow_profile(
             y_min: w[0],
             y_max: w[1],
             grains: ms.grains,
-            velocity: if m > 0.0 { mv / m } else { Vector2::zeros() },
+            velocity: if m > 0.0 { mv / m } else { Vector::zeros() },
             mean_y: if m > 0.0 { my / m } else { 0.5 * (w[0] + w[1]) },
             solid_fraction: ms.grain_area / ms.area,
             stress: ms.total,

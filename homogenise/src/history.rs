@@ -12,6 +12,7 @@
 //! (share of contacts with `m ≥ 0.99`, [`crate::mobilisation`]); then for every wall `w`
 //! `wall_w_fx`, `wall_w_fy [N]` (total force on the wall).
 
+use dem::math::Twist;
 use dem::snapshot::{BodyKind, Snapshot};
 use serde::{Deserialize, Serialize};
 
@@ -166,7 +167,7 @@ pub fn sample_row(snapshot: &Snapshot, config: &SamplerConfig) -> Result<Vec<(Co
     push("fabric_angle", "rad", if has { f.major_angle } else { nan });
     let ke: f64 = gs
         .iter()
-        .map(|b| 0.5 * b.mass * b.velocity.norm_squared() + 0.5 * b.inertia * b.omega * b.omega)
+        .map(|b| Twist::new(b.velocity, b.omega).kinetic_energy(b.mass, b.inertia))
         .sum();
     push("kinetic_energy", "J", ke);
     push(

@@ -2,7 +2,7 @@
 //! Fig. 4 field): `χ_p = ‖Σ_i‖_F / ‖Σ_c‖_F`. Large in fluid-like (collisional, rotating) zones,
 //! small in solid-like (enduring-contact) zones of a flow.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{HomogeniseError, Result};
@@ -15,7 +15,7 @@ pub struct InertiaRatio {
     /// Index of the grain in `Snapshot::bodies`.
     pub body: usize,
     /// Centre of the grain (m), for maps.
-    pub position: Vector2<f64>,
+    pub position: Vector,
     /// `‖Σ_i‖_F / ‖Σ_c‖_F`; `None` when the grain carries no contact force (`‖Σ_c‖_F = 0`:
     /// free flight, counted as fluid-like).
     pub ratio: Option<f64>,
@@ -58,12 +58,12 @@ pub fn fluid_fraction(ratios: &[InertiaRatio], threshold: f64) -> Result<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tensor::Tensor2;
+    use dem::math::Tensor;
 
-    fn grain(body: usize, contact: Tensor2, inertia: Tensor2) -> GrainStress {
+    fn grain(body: usize, contact: Tensor, inertia: Tensor) -> GrainStress {
         GrainStress {
             body,
-            position: Vector2::zeros(),
+            position: Vector::zeros(),
             radius: 1e-3,
             volume: 1e-6,
             thickness: 1.0,
@@ -75,13 +75,13 @@ mod tests {
 
     #[test]
     fn ratio_and_fluid_share() {
-        let c = Tensor2::new(-3.0, 0.0, 0.0, -4.0); // ‖·‖ = 5
-        let i = Tensor2::new(1.0, -1.0, 1.0, 1.0); // ‖·‖ = 2
+        let c = Tensor::new(-3.0, 0.0, 0.0, -4.0); // ‖·‖ = 5
+        let i = Tensor::new(1.0, -1.0, 1.0, 1.0); // ‖·‖ = 2
         let g = [
             grain(0, c, i),
             grain(1, c, i * 5.0),
-            grain(2, Tensor2::zeros(), i),
-            grain(3, c, Tensor2::zeros()),
+            grain(2, Tensor::zeros(), i),
+            grain(3, c, Tensor::zeros()),
         ];
         let r = inertia_ratios(&g);
         assert!((r[0].ratio.unwrap() - 0.4).abs() < 1e-15);

@@ -10,7 +10,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{positive, HomogeniseError, Result};
-use crate::tensor::{deviator, symmetric_part, Tensor2};
+use crate::tensor::{deviator, symmetric_part};
+use dem::math::Tensor;
 
 /// Invariants of a plane stress tensor (tension positive).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -18,7 +19,7 @@ pub struct StressInvariants {
     /// Pressure `P = −tr Σ / 2` (Pa), positive in compression.
     pub pressure: f64,
     /// Deviatoric part `s = Σ + P 𝟙` (Pa).
-    pub deviator: Tensor2,
+    pub deviator: Tensor,
     /// Shear stress `τ = √(s_sym : s_sym / 2)` of the symmetric deviator (Pa).
     pub shear_stress: f64,
     /// Stress ratio `μ = τ / P`; `None` when `P ≤ 0` (no compressive pressure).
@@ -26,7 +27,7 @@ pub struct StressInvariants {
 }
 
 /// Pressure, deviator, shear stress and stress ratio of `sigma` (Pa, tension positive).
-pub fn stress_invariants(sigma: &Tensor2) -> StressInvariants {
+pub fn stress_invariants(sigma: &Tensor) -> StressInvariants {
     let pressure = -sigma.trace() / 2.0;
     let dev = deviator(sigma);
     let s = symmetric_part(&dev);
@@ -63,17 +64,17 @@ mod tests {
         // principal stresses −3 and −1 kPa rotated by 30°: P = 2 kPa, τ = 1 kPa, μ = 0.5
         let a: f64 = 30f64.to_radians();
         let (c, s) = (a.cos(), a.sin());
-        let q = Tensor2::new(c, -s, s, c);
-        let sigma = q * Tensor2::new(-3000.0, 0.0, 0.0, -1000.0) * q.transpose();
+        let q = Tensor::new(c, -s, s, c);
+        let sigma = q * Tensor::new(-3000.0, 0.0, 0.0, -1000.0) * q.transpose();
         let inv = stress_invariants(&sigma);
         assert!((inv.pressure - 2000.0).abs() < 1e-9);
         assert!((inv.shear_stress - 1000.0).abs() < 1e-9);
         assert!((inv.friction.unwrap() - 0.5).abs() < 1e-12);
         assert!(inv.deviator.trace().abs() < 1e-9);
         // simple shear stress state: τ = |σ_xy|
-        let inv = stress_invariants(&Tensor2::new(-100.0, 35.0, 35.0, -100.0));
+        let inv = stress_invariants(&Tensor::new(-100.0, 35.0, 35.0, -100.0));
         assert!((inv.shear_stress - 35.0).abs() < 1e-12);
-        assert!(stress_invariants(&Tensor2::new(5.0, 0.0, 0.0, 5.0))
+        assert!(stress_invariants(&Tensor::new(5.0, 0.0, 0.0, 5.0))
             .friction
             .is_none());
     }

@@ -7,13 +7,13 @@
 //! `W = (L − Lᵀ)/2`, and the **shear rate** `γ̇ = √(2 D' : D')`, `D' = D − (tr D / 2) 𝟙`; for a
 //! simple shear `v_x = γ̇ y` it is `γ̇ = |∂v_x/∂y| = 2 |D_xy|`.
 
+use dem::math::{SymTensor, Tensor, Vector};
 use dem::snapshot::{BodyKind, Snapshot, WallGeometry};
-use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{HomogeniseError, Result};
 use crate::region::Region;
-use crate::tensor::{deviator, outer, skew_part, symmetric_part, Tensor2};
+use crate::tensor::{deviator, outer, skew_part, symmetric_part};
 use crate::validate::check_snapshot;
 
 /// Weight of each grain in the velocity fit, multiplied by its area fraction inside the region.
@@ -30,11 +30,11 @@ pub enum VelocityWeight {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AffineFit {
     /// Weighted mean position `x̄` (m); x relative to the region's centre when periodic.
-    pub mean_position: Vector2<f64>,
+    pub mean_position: Vector,
     /// Weighted mean velocity `v̄` (m/s).
-    pub mean_velocity: Vector2<f64>,
+    pub mean_velocity: Vector,
     /// Velocity gradient `L_ij = ∂v_i/∂x_j` (1/s).
-    pub gradient: Tensor2,
+    pub gradient: Tensor,
     /// Number of grains with a non-zero weight (at least partly inside the region).
     pub grains: usize,
     /// Root-mean-square (weighted) velocity residual of the fit (m/s): the velocity fluctuation.
@@ -43,12 +43,12 @@ pub struct AffineFit {
 
 impl AffineFit {
     /// Strain-rate tensor `D = (L + Lᵀ)/2` (1/s).
-    pub fn strain_rate(&self) -> Tensor2 {
+    pub fn strain_rate(&self) -> SymTensor {
         symmetric_part(&self.gradient)
     }
 
     /// Spin tensor `W = (L − Lᵀ)/2` (1/s).
-    pub fn spin(&self) -> Tensor2 {
+    pub fn spin(&self) -> Tensor {
         skew_part(&self.gradient)
     }
 
@@ -59,7 +59,7 @@ impl AffineFit {
 }
 
 /// Shear rate `γ̇ = √(2 D' : D')` (1/s) of a strain-rate tensor `D` (its symmetric part is used).
-pub fn shear_rate(d: &Tensor2) -> f64 {
+pub fn shear_rate(d: &Tensor) -> f64 {
     let dd = deviator(&symmetric_part(d));
     (2.0 * dd.component_mul(&dd).sum()).sqrt()
 }
@@ -77,7 +77,7 @@ pub fn velocity_gradient(
     check_snapshot(snapshot)?;
     let rect = region.resolve(snapshot)?;
     let yc = 0.5 * (rect.min.y + rect.max.y);
-    let mut pts: Vec<(f64, Vector2<f64>, Vector2<f64>)> = Vec::new();
+    let mut pts: Vec<(f64, Vector, Vector)> = Vec::new();
     for b in snapshot.bodies.iter().filter(|b| b.kind == BodyKind::Grain) {
         let w = rect.disk_fraction(&b.position, b.radius);
         if w > 0.0 {
@@ -85,7 +85,7 @@ pub fn velocity_gradient(
                 VelocityWeight::Uniform => w,
                 VelocityWeight::Mass => w * b.mass,
             };
-            let x = Vector2::new(rect.dx_from_centre(b.position.x), b.position.y - yc);
+            let x = Vector::new(rect.dx_from_centre(b.position.x), b.position.y - yc);
             pts.push((w, x, b.velocity));
         }
     }
@@ -96,9 +96,9 @@ pub fn velocity_gradient(
         )));
     }
     let wsum: f64 = pts.iter().map(|p| p.0).sum();
-    let xm = pts.iter().map(|p| p.1 * p.0).sum::<Vector2<f64>>() / wsum;
-    let vm = pts.iter().map(|p| p.2 * p.0).sum::<Vector2<f64>>() / wsum;
-    let (mut a, mut b) = (Matrix2::zeros(), Matrix2::zeros());
+    let xm = pts.iter().map(|p| p.1 * p.0).sum::<Vector>() / wsum;
+    let vm = pts.iter().map(|p| p.2 * p.0).sum::<Vector>() / wsum;
+    let (mut a, mut b) = (Tensor::zeros(), Tensor::zeros());
     for (w, x, v) in &pts {
         let dx = x - xm;
         a += outer(&dx, &dx) * *w;
@@ -119,7 +119,7 @@ pub fn velocity_gradient(
         .map(|(w, x, v)| w * (v - vm - l * (x - xm)).norm_squared())
         .sum();
     Ok(AffineFit {
-        mean_position: xm + Vector2::new(0.5 * (rect.min.x + rect.max.x), yc),
+        mean_position: xm + Vector::new(0.5 * (rect.min.x + rect.max.x), yc),
         mean_velocity: vm,
         gradient: l,
         grains: pts.len(),
@@ -135,8 +135,8 @@ pub fn wall_driven_velocity_gradient(
     snapshot: &Snapshot,
     wall_a: &str,
     wall_b: &str,
-    normal: Option<Vector2<f64>>,
-) -> Result<Tensor2> {
+    normal: Option<Vector>,
+) -> Result<Tensor> {
     check_snapshot(snapshot)?;
     let find = |name: &str| {
         snapshot

@@ -15,7 +15,8 @@
 //!   block-averaging standard errors ([`averaging`]);
 //! - Gaussian coarse-grained fields ([`coarse`]).
 //!
-//! Units SI; stresses in Pa with tension positive; tensors are `nalgebra::Matrix2` with
+//! Units SI; stresses in Pa with tension positive; vectors and tensors are those of the
+//! dimension layer, [`dem::math::Vector`] and [`dem::math::Tensor`], with
 //! `(a ⊗ b)_ij = a_i b_j` ([`tensor`]).
 
 pub mod averaging;

@@ -7,7 +7,7 @@
 //! The area inside `[x₀, x₁] × [y₀, y₁]` is then the inclusion–exclusion
 //! `F(x₁, y₁) − F(x₀, y₁) − F(x₁, y₀) + F(x₀, y₀)`.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 
 /// `H(x) = ∫_0^x √(R² − u²) du` for `|x| ≤ R`.
 fn h(x: f64, r: f64) -> f64 {
@@ -43,12 +43,7 @@ fn quadrant_area(a: f64, b: f64, r: f64) -> f64 {
 
 /// Exact area (m²) of the disk of centre `centre` and radius `radius` inside the rectangle
 /// `[min.x, max.x] × [min.y, max.y]`. Returns 0 for an empty rectangle or a non-positive radius.
-pub fn disk_rectangle_area(
-    centre: &Vector2<f64>,
-    radius: f64,
-    min: &Vector2<f64>,
-    max: &Vector2<f64>,
-) -> f64 {
+pub fn disk_rectangle_area(centre: &Vector, radius: f64, min: &Vector, max: &Vector) -> f64 {
     if radius <= 0.0 || max.x <= min.x || max.y <= min.y {
         return 0.0;
     }
@@ -70,17 +65,17 @@ mod tests {
 
     #[test]
     fn half_and_quarter_disks() {
-        let c = Vector2::new(0.2, -0.1);
+        let c = Vector::new(0.2, -0.1);
         let r = 0.5;
         let big = 10.0;
-        let half = disk_rectangle_area(&c, r, &Vector2::new(c.x, -big), &Vector2::new(big, big));
+        let half = disk_rectangle_area(&c, r, &Vector::new(c.x, -big), &Vector::new(big, big));
         assert!((half - PI * r * r / 2.0).abs() < 1e-14);
         let lower_half =
-            disk_rectangle_area(&c, r, &Vector2::new(-big, -big), &Vector2::new(big, c.y));
+            disk_rectangle_area(&c, r, &Vector::new(-big, -big), &Vector::new(big, c.y));
         assert!((lower_half - PI * r * r / 2.0).abs() < 1e-14);
-        let quarter = disk_rectangle_area(&c, r, &c, &Vector2::new(big, big));
+        let quarter = disk_rectangle_area(&c, r, &c, &Vector::new(big, big));
         assert!((quarter - PI * r * r / 4.0).abs() < 1e-14);
-        let none = disk_rectangle_area(&c, r, &Vector2::new(1.0, 1.0), &Vector2::new(2.0, 2.0));
+        let none = disk_rectangle_area(&c, r, &Vector::new(1.0, 1.0), &Vector::new(2.0, 2.0));
         assert_eq!(none, 0.0);
     }
 
@@ -90,10 +85,10 @@ mod tests {
         let r = 1.3;
         for &d in &[-0.9, -0.2, 0.0, 0.4, 1.1] {
             let seg = disk_rectangle_area(
-                &Vector2::zeros(),
+                &Vector::zeros(),
                 r,
-                &Vector2::new(d, -5.0),
-                &Vector2::new(5.0, 5.0),
+                &Vector::new(d, -5.0),
+                &Vector::new(5.0, 5.0),
             );
             let exact = r * r * (d / r).acos() - d * (r * r - d * d).sqrt();
             assert!((seg - exact).abs() < 1e-13, "d = {d}: {seg} vs {exact}");
@@ -103,7 +98,7 @@ mod tests {
     #[test]
     fn tiling_sums_to_the_disk() {
         // a 7 × 5 irregular grid of rectangles covering the disk: areas add up to π r²
-        let c = Vector2::new(0.13, 0.71);
+        let c = Vector::new(0.13, 0.71);
         let r = 0.37;
         let xs = [-1.0, -0.1, 0.05, 0.1, 0.22, 0.3, 0.49, 2.0];
         let ys = [-1.0, 0.4, 0.6, 0.75, 0.9, 3.0];
@@ -113,8 +108,8 @@ mod tests {
                 total += disk_rectangle_area(
                     &c,
                     r,
-                    &Vector2::new(xs[i], ys[j]),
-                    &Vector2::new(xs[i + 1], ys[j + 1]),
+                    &Vector::new(xs[i], ys[j]),
+                    &Vector::new(xs[i + 1], ys[j + 1]),
                 );
             }
         }
@@ -124,9 +119,9 @@ mod tests {
     #[test]
     fn matches_a_fine_quadrature() {
         // midpoint rule on a 4000 × 4000 grid over the disk's box: error O(r²/N^1.5)
-        let c = Vector2::new(0.0, 0.0);
+        let c = Vector::new(0.0, 0.0);
         let r = 1.0;
-        let (min, max) = (Vector2::new(-0.3, -2.0), Vector2::new(0.8, 0.45));
+        let (min, max) = (Vector::new(-0.3, -2.0), Vector::new(0.8, 0.45));
         let exact = disk_rectangle_area(&c, r, &min, &max);
         let n = 4000;
         let dx = 2.0 * r / n as f64;

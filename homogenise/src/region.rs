@@ -14,8 +14,8 @@
 //! rectangle or slice of a cell whose first edge lies along x (`a₁ = (l_x, 0)`, as in LAMMPS'
 //! boxes and the engine's cells) is periodic along x with the period `l_x`.
 
+use dem::math::Vector;
 use dem::snapshot::{BodyKind, Snapshot};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{finite, HomogeniseError, Result};
@@ -27,9 +27,9 @@ pub enum Region {
     /// The rectangle `[min.x, max.x] × [min.y, max.y]` (m).
     Rectangle {
         /// Lower-left corner (m).
-        min: Vector2<f64>,
+        min: Vector,
         /// Upper-right corner (m).
-        max: Vector2<f64>,
+        max: Vector,
     },
     /// The horizontal slice `y_min ≤ y ≤ y_max` (m) across the sample's width: the periodic
     /// cell when x is periodic, else the grains' extent `[min(x_p − R_p), max(x_p + R_p)]`.
@@ -49,9 +49,9 @@ pub enum Region {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Rect {
     /// Lower-left corner (m).
-    pub min: Vector2<f64>,
+    pub min: Vector,
     /// Upper-right corner (m).
-    pub max: Vector2<f64>,
+    pub max: Vector,
     /// Periodic cell along x, `[x_min, x_max)` (m), if any.
     pub periodic_x: Option<[f64; 2]>,
     /// The whole biperiodic cell: its area `det h` (m²). Every grain counts whole in it;
@@ -84,8 +84,8 @@ impl Region {
             let lo = |v: &[f64; 4]| v.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = |v: &[f64; 4]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             return Ok(Rect {
-                min: Vector2::new(lo(&xs), lo(&ys)),
-                max: Vector2::new(hi(&xs), hi(&ys)),
+                min: Vector::new(lo(&xs), lo(&ys)),
+                max: Vector::new(hi(&xs), hi(&ys)),
                 periodic_x: None,
                 cell_area: Some(cell.volume()),
             });
@@ -113,14 +113,14 @@ impl Region {
                 finite("y_min", y_min)?;
                 finite("y_max", y_max)?;
                 let (a, b) = x_range()?;
-                (Vector2::new(a, y_min), Vector2::new(b, y_max))
+                (Vector::new(a, y_min), Vector::new(b, y_max))
             }
             Region::Whole => {
                 let (_, _, y0, y1) = grain_extent(snapshot).ok_or_else(|| {
                     HomogeniseError::EmptyRegion("whole sample: no grains".into())
                 })?;
                 let (a, b) = x_range()?;
-                (Vector2::new(a, y0), Vector2::new(b, y1))
+                (Vector::new(a, y0), Vector::new(b, y1))
             }
         };
         for (name, v) in [
@@ -170,7 +170,7 @@ impl Rect {
     }
 
     /// Whether the point lies in the region (closed rectangle; periodic in x when the cell is).
-    pub fn contains(&self, p: &Vector2<f64>) -> bool {
+    pub fn contains(&self, p: &Vector) -> bool {
         if self.cell_area.is_some() {
             return true;
         }
@@ -199,7 +199,7 @@ impl Rect {
 
     /// Fraction `w ∈ [0, 1]` of the disk of the given centre and radius inside the region:
     /// `|D ∩ R| / (π R²)`, exact, summed over periodic images.
-    pub fn disk_fraction(&self, centre: &Vector2<f64>, radius: f64) -> f64 {
+    pub fn disk_fraction(&self, centre: &Vector, radius: f64) -> f64 {
         if self.cell_area.is_some() {
             return 1.0;
         }
@@ -208,8 +208,8 @@ impl Rect {
         }
         let full = std::f64::consts::PI * radius * radius;
         let area = if self.spans_cell() {
-            let min = Vector2::new(centre.x - 2.0 * radius, self.min.y);
-            let max = Vector2::new(centre.x + 2.0 * radius, self.max.y);
+            let min = Vector::new(centre.x - 2.0 * radius, self.min.y);
+            let max = Vector::new(centre.x + 2.0 * radius, self.max.y);
             disk_rectangle_area(centre, radius, &min, &max)
         } else if let Some([a, b]) = self.periodic_x {
             let l = b - a;
@@ -217,7 +217,7 @@ impl Rect {
             let x0 = self.wrap_x(centre.x);
             (-1..=1)
                 .map(|k| {
-                    let c = Vector2::new(x0 + k as f64 * l, centre.y);
+                    let c = Vector::new(x0 + k as f64 * l, centre.y);
                     disk_rectangle_area(&c, radius, &self.min, &self.max)
                 })
                 .sum()

@@ -18,8 +18,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{HomogeniseError, Result};
 use crate::region::Region;
-use crate::tensor::{outer, Tensor2};
+use crate::tensor::outer;
 use crate::validate::check_snapshot;
+use dem::math::{SymTensor, Tensor};
 
 /// Which contacts count, for coordination and fabric.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -59,7 +60,7 @@ pub struct Coordination {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Fabric {
     /// `F = (1/N_c) Σ n ⊗ n` (dimensionless, trace 1); zero when no contact.
-    pub tensor: Tensor2,
+    pub tensor: SymTensor,
     /// Number of contacts used `N_c`.
     pub contacts: usize,
     /// Anisotropy `a = 2 (λ₁ − λ₂)` ∈ [0, 2].
@@ -196,7 +197,7 @@ pub fn fabric(snapshot: &Snapshot, region: &Region, counting: &ContactCounting) 
     check_counting(counting)?;
     let rect = region.resolve(snapshot)?;
     let is_grain = |i: u32| snapshot.bodies[i as usize].kind == BodyKind::Grain;
-    let mut f = Tensor2::zeros();
+    let mut f = Tensor::zeros();
     let mut nc = 0usize;
     for c in &snapshot.contacts {
         if c.force_n <= counting.force_threshold || !rect.contains(&c.point) {

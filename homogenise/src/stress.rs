@@ -21,13 +21,13 @@
 //! Wall contacts count as contacts of the grain; levers come from the snapshot (`lever_a`,
 //! `lever_b`), so a periodic x direction needs no image handling.
 
+use dem::math::{Tensor, Vector};
 use dem::snapshot::{BodyKind, Snapshot};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{HomogeniseError, Result};
 use crate::region::{Rect, Region};
-use crate::tensor::{outer, rotation_generator, Tensor2};
+use crate::tensor::{outer, rotation_generator};
 use crate::validate::check_snapshot;
 
 /// The mean stress of one grain and its two parts (Pa, tension positive).
@@ -36,7 +36,7 @@ pub struct GrainStress {
     /// Index of the grain in `Snapshot::bodies`.
     pub body: usize,
     /// Centre of the grain (m).
-    pub position: Vector2<f64>,
+    pub position: Vector,
     /// Radius (m).
     pub radius: f64,
     /// Volume `V_p = π R² · thickness` (m³).
@@ -45,11 +45,11 @@ pub struct GrainStress {
     pub thickness: f64,
     /// Contact (Love–Weber) term `Σ_c = (1/V_p) Σ_α r_α ⊗ (x_α − c_p)` (Pa); not symmetric in
     /// dynamics.
-    pub contact: Tensor2,
+    pub contact: Tensor,
     /// Inertia term `Σ_i = (I/(2V_p)) (−ω̇ j + ω² 𝟙)` (Pa).
-    pub inertia: Tensor2,
+    pub inertia: Tensor,
     /// Total `Σ_p = Σ_c + Σ_i` (Pa); symmetric when `ω̇` is consistent with the forces.
-    pub total: Tensor2,
+    pub total: Tensor,
 }
 
 impl GrainStress {
@@ -62,8 +62,8 @@ impl GrainStress {
 /// Contact term `Σ_α r_α ⊗ (x_α − c_p)` (N·m) of every body, indexed like `Snapshot::bodies`
 /// (walls get theirs too, unused). Body `b` of a contact receives `f_n n + f_t t` at lever
 /// `lever_b`; body `a` receives the opposite at `lever_a`.
-pub(crate) fn contact_moments(snapshot: &Snapshot) -> Vec<Tensor2> {
-    let mut m = vec![Tensor2::zeros(); snapshot.bodies.len()];
+pub(crate) fn contact_moments(snapshot: &Snapshot) -> Vec<Tensor> {
+    let mut m = vec![Tensor::zeros(); snapshot.bodies.len()];
     for c in &snapshot.contacts {
         let f = c.force_on_b();
         m[c.body_b as usize] += outer(&f, &c.lever_b);
@@ -74,9 +74,9 @@ pub(crate) fn contact_moments(snapshot: &Snapshot) -> Vec<Tensor2> {
 
 /// Inertia term `Σ_i = (I/(2V)) (−ω̇ j + ω² 𝟙)` (Pa) of a rigid disk of moment of inertia `I`
 /// (kg·m²), volume `V` (m³), angular velocity `ω` (rad/s) and angular acceleration `ω̇` (rad/s²).
-pub fn disk_inertia_stress(inertia: f64, volume: f64, omega: f64, omega_dot: f64) -> Tensor2 {
+pub fn disk_inertia_stress(inertia: f64, volume: f64, omega: f64, omega_dot: f64) -> Tensor {
     let k = inertia / (2.0 * volume);
-    (rotation_generator() * (-omega_dot) + Tensor2::identity() * (omega * omega)) * k
+    (rotation_generator() * (-omega_dot) + Tensor::identity() * (omega * omega)) * k
 }
 
 /// Per-grain mean stresses `Σ_p` (contact, inertia, total) of every grain of the snapshot, in
@@ -119,11 +119,11 @@ pub struct RegionStress {
     /// Weighted number of grains `Σ_p w_p`.
     pub grains: f64,
     /// Mean stress `Σ = (1/A_R) Σ_p w_p A_p Σ_p` (Pa), eq. 9.
-    pub total: Tensor2,
+    pub total: Tensor,
     /// Mean of the contact terms alone (Pa).
-    pub contact: Tensor2,
+    pub contact: Tensor,
     /// Mean of the inertia terms alone (Pa).
-    pub inertia: Tensor2,
+    pub inertia: Tensor,
 }
 
 /// Region mean `Σ = (1/A_R) Σ_p w_p A_p Σ_p` (Pa) of per-grain stresses, `w_p` the fraction of
@@ -142,8 +142,7 @@ pub fn mean_stress(
 /// [`mean_stress`] over an already resolved rectangle.
 pub fn mean_stress_in(rect: &Rect, grains: &[GrainStress]) -> RegionStress {
     let area = rect.area();
-    let (mut total, mut contact, mut inertia) =
-        (Tensor2::zeros(), Tensor2::zeros(), Tensor2::zeros());
+    let (mut total, mut contact, mut inertia) = (Tensor::zeros(), Tensor::zeros(), Tensor::zeros());
     let (mut grain_area, mut count) = (0.0, 0.0);
     for g in grains {
         let w = rect.disk_fraction(&g.position, g.radius);
@@ -205,10 +204,10 @@ pub fn slice_stress_profile(
 /// relative to `origin` (the identity holds for any origin; a nearby one limits rounding).
 /// Used to check [`grain_stresses`] against the forces the walls carry; also the "virial"
 /// route to the whole-sample stress.
-pub fn boundary_moment(snapshot: &Snapshot, origin: &Vector2<f64>) -> Result<Tensor2> {
+pub fn boundary_moment(snapshot: &Snapshot, origin: &Vector) -> Result<Tensor> {
     check_snapshot(snapshot)?;
     let is_grain = |i: u32| snapshot.bodies[i as usize].kind == BodyKind::Grain;
-    let mut m = Tensor2::zeros();
+    let mut m = Tensor::zeros();
     for c in &snapshot.contacts {
         let f = c.force_on_b();
         let (ga, gb) = (is_grain(c.body_a), is_grain(c.body_b));

@@ -1,12 +1,12 @@
 //! Checks on a snapshot before it is homogenised: every later computation may then assume
 //! finite numbers, valid indices and grains with positive radius, mass, inertia and thickness.
 
+use dem::math::Vector;
 use dem::snapshot::{BodyKind, Snapshot};
-use nalgebra::Vector2;
 
 use crate::error::{HomogeniseError, Result};
 
-fn finite_vec(v: &Vector2<f64>) -> bool {
+fn finite_vec(v: &Vector) -> bool {
     v.x.is_finite() && v.y.is_finite()
 }
 

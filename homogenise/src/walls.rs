@@ -15,8 +15,8 @@
 //! equilibrium; in flows it leaves out the momentum flux of grains crossing the plane.
 //! At the bottom of a column at rest, `−σ_yy W t` is the weight minus what the side walls carry.
 
+use dem::math::{Twist, Vector};
 use dem::snapshot::{BodyKind, Snapshot, WallGeometry, WallState};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::depth::DepthBins;
@@ -42,11 +42,11 @@ pub struct WallContact {
     /// Index of the grain in `Snapshot::bodies`.
     pub grain: usize,
     /// Contact point (m).
-    pub point: Vector2<f64>,
+    pub point: Vector,
     /// Unit normal from the wall into the grain.
-    pub normal: Vector2<f64>,
+    pub normal: Vector,
     /// Force of the wall on the grain (N).
-    pub force_on_grain: Vector2<f64>,
+    pub force_on_grain: Vector,
     /// Normal force `f_n ≥ 0` (N).
     pub force_n: f64,
     /// Tangential force magnitude `|f_t|` (N).
@@ -126,9 +126,9 @@ impl WallStressBin {
 }
 
 /// Unit direction of a wall, if it has one (lines and segments).
-fn wall_direction(w: &WallState) -> Option<Vector2<f64>> {
+fn wall_direction(w: &WallState) -> Option<Vector> {
     match &w.geometry {
-        WallGeometry::Line { normal, .. } => Some(Vector2::new(-normal.y, normal.x)),
+        WallGeometry::Line { normal, .. } => Some(Vector::new(-normal.y, normal.x)),
         WallGeometry::Segment { a, b } => {
             let d = b - a;
             let n = d.norm();
@@ -206,7 +206,7 @@ pub struct PlaneStress {
     pub y: f64,
     /// Force per unit thickness that the material below exerts on the material above across
     /// the plane, `T` (N/m).
-    pub force: Vector2<f64>,
+    pub force: Vector,
     /// Width of the sample used `W` (m).
     pub width: f64,
     /// `σ_yy = −T_y / W` (Pa, tension positive).
@@ -236,7 +236,7 @@ pub fn plane_stress_profile(
     };
     let is_grain = |i: u32| snapshot.bodies[i as usize].kind == BodyKind::Grain;
     // branch ends (y of a's end, y of b's end) and the force on b per unit thickness
-    let branches: Vec<(f64, f64, Vector2<f64>)> = snapshot
+    let branches: Vec<(f64, f64, Vector)> = snapshot
         .contacts
         .iter()
         .filter(|c| c.force_n != 0.0 || c.force_t != 0.0)
@@ -268,7 +268,7 @@ pub fn plane_stress_profile(
                     reason: format!("non-finite level {y0}"),
                 });
             }
-            let mut t = Vector2::zeros();
+            let mut t = Vector::zeros();
             for &(ya, yb, f) in &branches {
                 if ya <= y0 && yb > y0 {
                     t += f; // b is above: force of the lower (a) on the upper (b)
@@ -293,11 +293,11 @@ pub struct NearWallSpec {
     /// Name of the wall.
     pub wall: String,
     /// Direction of the flow along the wall (normalised, its normal part removed).
-    pub flow_direction: Vector2<f64>,
+    pub flow_direction: Vector,
     /// Unit normal from the wall into the grains; by default that of a line wall, the segment's
     /// perpendicular on the grains' side, or for a clump the axis direction (±x or ±y) closest
     /// to the direction from the clump's centre to the grains' mean position.
-    pub normal: Option<Vector2<f64>>,
+    pub normal: Option<Vector>,
     /// Width of the distance bins (m).
     pub bin_width: f64,
     /// Number of distance bins.
@@ -311,9 +311,9 @@ pub struct NearWallSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NearWallProfile {
     /// Unit normal into the grains used.
-    pub normal: Vector2<f64>,
+    pub normal: Vector,
     /// Unit flow direction used.
-    pub flow_direction: Vector2<f64>,
+    pub flow_direction: Vector,
     /// Position of the wall surface along the normal `s_w` (m): the line itself, or the
     /// clump disks' outermost point `max_k (c_k · n + r_k)`.
     pub surface: f64,
@@ -361,8 +361,8 @@ pub fn near_wall_profile(snapshot: &Snapshot, spec: &NearWallSpec) -> Result<Nea
             "no grains near the wall".into(),
         ));
     }
-    let mean_grain = grains.iter().map(|b| b.position).sum::<Vector2<f64>>() / grains.len() as f64;
-    let toward = |base: Vector2<f64>, n: Vector2<f64>| {
+    let mean_grain = grains.iter().map(|b| b.position).sum::<Vector>() / grains.len() as f64;
+    let toward = |base: Vector, n: Vector| {
         if (mean_grain - base).dot(&n) < 0.0 {
             -n
         } else {
@@ -372,13 +372,13 @@ pub fn near_wall_profile(snapshot: &Snapshot, spec: &NearWallSpec) -> Result<Nea
     let n = match (spec.normal, &w.geometry) {
         (Some(n), _) => n,
         (None, WallGeometry::Line { normal, .. }) => *normal,
-        (None, WallGeometry::Segment { a, b }) => toward(*a, Vector2::new(a.y - b.y, b.x - a.x)),
+        (None, WallGeometry::Segment { a, b }) => toward(*a, Vector::new(a.y - b.y, b.x - a.x)),
         (None, WallGeometry::Clump { .. }) => {
             let d = mean_grain - body.position;
             if d.x.abs() > d.y.abs() {
-                Vector2::new(d.x.signum(), 0.0)
+                Vector::new(d.x.signum(), 0.0)
             } else {
-                Vector2::new(0.0, d.y.signum())
+                Vector::new(0.0, d.y.signum())
             }
         }
     };
@@ -421,7 +421,7 @@ pub fn near_wall_profile(snapshot: &Snapshot, spec: &NearWallSpec) -> Result<Nea
         let d = g.position.dot(&n) - surface;
         let proj = g.position - n * d;
         let r = proj - body.position;
-        let vw = body.velocity + Vector2::new(-r.y, r.x) * body.omega;
+        let vw = Twist::new(body.velocity, body.omega).velocity_at(&r);
         let u = (g.velocity - vw).dot(&e);
         if d >= 0.0 && d < spec.first_layer {
             slip_mv += g.mass * u;

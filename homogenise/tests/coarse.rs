@@ -2,9 +2,9 @@
 
 mod support;
 
+use dem::math::Tensor;
 use homogenise::coarse::{coarse_grain, Grid};
 use homogenise::stress::grain_stresses;
-use nalgebra::Matrix2;
 use support::v;
 
 #[test]
@@ -40,8 +40,8 @@ fn density_integrates_to_the_mass_and_stress_to_its_total() {
         }
     }
     // ∫ σ dA = Σ_p A_p Σ_p
-    let total: Matrix2<f64> = g.iter().map(|p| p.total * p.area()).sum();
-    let mut sum = Matrix2::zeros();
+    let total: Tensor = g.iter().map(|p| p.total * p.area()).sum();
+    let mut sum = Tensor::zeros();
     for j in 0..grid.ny {
         for i in 0..grid.nx {
             sum += f.stress.at(i, j) * (grid.spacing * grid.spacing);

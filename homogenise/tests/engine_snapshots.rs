@@ -1,10 +1,10 @@
 //! Homogenisation of snapshots produced by the engine itself (dem::World), not hand-built ones:
 //! the stages must agree on levers, forces and accelerations.
 
+use dem::math::{Tensor, Vector};
 use dem::{BodyKind, ContactLaws, SolverParams, World, WorldParams};
 use homogenise::grain_stresses;
 use homogenise::tensor::{in_frame, skew_ratio, slope_frame};
-use nalgebra::{Matrix2, Vector2};
 
 const G: f64 = 9.81;
 
@@ -23,11 +23,11 @@ fn engine_rolling_disk_matches_the_exact_stress() {
             let phi = phi_deg.to_radians();
             let (e1, e2) = slope_frame(phi);
             let (gravity, normal) = if tilted {
-                (Vector2::new(0.0, -G), e2)
+                (Vector::new(0.0, -G), e2)
             } else {
                 (
-                    Vector2::new(G * phi.sin(), -G * phi.cos()),
-                    Vector2::new(0.0, 1.0),
+                    Vector::new(G * phi.sin(), -G * phi.cos()),
+                    Vector::new(0.0, 1.0),
                 )
             };
             let params = WorldParams {
@@ -42,7 +42,7 @@ fn engine_rolling_disk_matches_the_exact_stress() {
             };
             let rho = 2600.0;
             let mut w = World::new(params, ContactLaws::new(&["m"], 0.6));
-            w.add_line_wall("slope", Vector2::zeros(), normal, 0);
+            w.add_line_wall("slope", Vector::zeros(), normal, 0);
             let b = w.add_grain(normal * a, a, rho, 0) as usize;
             let x0 = w.bodies[b].position;
             for _ in 0..steps {
@@ -53,15 +53,15 @@ fn engine_rolling_disk_matches_the_exact_stress() {
             let (f1, f2) = if tilted {
                 (e1, e2)
             } else {
-                (Vector2::x(), Vector2::y())
+                (Vector::x(), Vector::y())
             };
             let l = (snap.bodies[b].position - x0).dot(&f1);
             let total = in_frame(&gs[0].total, &f1, &f2);
             let contact = in_frame(&gs[0].contact, &f1, &f2);
             let (s, c) = phi.sin_cos();
-            let exact = Matrix2::new(0.0, s / 6.0, s / 6.0, -c) * (rho * G * a)
-                + Matrix2::identity() * (rho * G * l * s / 3.0);
-            let exact_contact = Matrix2::new(0.0, s / 3.0, 0.0, -c) * (rho * G * a);
+            let exact = Tensor::new(0.0, s / 6.0, s / 6.0, -c) * (rho * G * a)
+                + Tensor::identity() * (rho * G * l * s / 3.0);
+            let exact_contact = Tensor::new(0.0, s / 3.0, 0.0, -c) * (rho * G * a);
             assert!(
                 (total - exact).norm() <= 1e-6 * exact.norm(),
                 "φ {phi_deg}°, a {a}: {total} vs {exact}"
@@ -86,14 +86,9 @@ fn deposit(n: usize, seed: u64) -> World {
     };
     let mut w = World::new(params, ContactLaws::new(&["grain"], 0.4));
     let width = 0.06;
-    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        0,
-    );
+    w.add_line_wall("bottom", Vector::zeros(), Vector::new(0.0, 1.0), 0);
+    w.add_line_wall("left", Vector::zeros(), Vector::new(1.0, 0.0), 0);
+    w.add_line_wall("right", Vector::new(width, 0.0), Vector::new(-1.0, 0.0), 0);
     let mut s = seed;
     let mut u = move || {
         s = s
@@ -107,8 +102,8 @@ fn deposit(n: usize, seed: u64) -> World {
         let r = 1.5e-3 + 0.5e-3 * u();
         let x = pitch * ((i % per_row) as f64 + 0.5);
         let y = pitch * ((i / per_row) as f64 + 0.5);
-        let g = w.add_grain(Vector2::new(x, y), r, 2500.0, 0) as usize;
-        w.bodies[g].velocity = Vector2::new(0.1 * (u() - 0.5), 0.0);
+        let g = w.add_grain(Vector::new(x, y), r, 2500.0, 0) as usize;
+        w.bodies[g].velocity = Vector::new(0.1 * (u() - 0.5), 0.0);
     }
     w
 }

@@ -3,20 +3,20 @@
 
 mod support;
 
+use dem::math::Tensor;
 use homogenise::kinematics::{
     shear_rate, velocity_gradient, wall_driven_velocity_gradient, VelocityWeight,
 };
 use homogenise::state::{coordination, fabric, rattlers, solid_fraction, ContactCounting};
 use homogenise::stress::{grain_stresses, mean_stress};
 use homogenise::walls::{near_wall_profile, NearWallSpec};
-use homogenise::{Region, Tensor2};
-use nalgebra::Matrix2;
+use homogenise::Region;
 use support::{rel, v, Builder};
 
 #[test]
 fn affine_fit_recovers_an_exact_velocity_gradient() {
     let mut snap = support::random_dynamic(1, 9, 7, v(0.5, -0.2));
-    let l = Matrix2::new(0.7, -2.3, 1.1, -0.4);
+    let l = Tensor::new(0.7, -2.3, 1.1, -0.4);
     let v0 = v(0.05, -0.02);
     for b in snap.bodies.iter_mut().filter(|b| b.radius > 0.0) {
         b.velocity = v0 + l * b.position;
@@ -44,10 +44,10 @@ fn affine_fit_recovers_an_exact_velocity_gradient() {
 fn shear_rate_definition() {
     // simple shear v_x = γ̇ y: D = [[0, γ̇/2], [γ̇/2, 0]] → γ̇; pure shear diag(ε, −ε) → 2ε;
     // isotropic expansion and rigid rotation → 0
-    assert!((shear_rate(&Matrix2::new(0.0, 3.0, 0.0, 0.0)) - 3.0).abs() < 1e-15);
-    assert!((shear_rate(&Matrix2::new(0.5, 0.0, 0.0, -0.5)) - 1.0).abs() < 1e-15);
-    assert!(shear_rate(&Matrix2::new(2.0, 0.0, 0.0, 2.0)).abs() < 1e-15);
-    assert!(shear_rate(&Matrix2::new(0.0, -1.0, 1.0, 0.0)).abs() < 1e-15);
+    assert!((shear_rate(&Tensor::new(0.0, 3.0, 0.0, 0.0)) - 3.0).abs() < 1e-15);
+    assert!((shear_rate(&Tensor::new(0.5, 0.0, 0.0, -0.5)) - 1.0).abs() < 1e-15);
+    assert!(shear_rate(&Tensor::new(2.0, 0.0, 0.0, 2.0)).abs() < 1e-15);
+    assert!(shear_rate(&Tensor::new(0.0, -1.0, 1.0, 0.0)).abs() < 1e-15);
 }
 
 /// Grains in `layers` rows on a bottom wall moving at `u_wall`, velocity
@@ -138,7 +138,7 @@ fn wall_driven_strain_rate() {
     b.grain(v(0.01, 0.01), 1e-3, 2500.0, 1.0);
     let snap = b.finish();
     let l = wall_driven_velocity_gradient(&snap, "bottom", "top", None).unwrap();
-    assert!(rel(&l, &Matrix2::new(0.0, 5.0, 0.0, 0.0)) < 1e-14);
+    assert!(rel(&l, &Tensor::new(0.0, 5.0, 0.0, 0.0)) < 1e-14);
     assert!((shear_rate(&l) - 5.0).abs() < 1e-13);
     assert!(wall_driven_velocity_gradient(&snap, "bottom", "lid", None).is_err());
     // clumps need their normal
@@ -197,7 +197,7 @@ fn solid_fraction_coordination_and_fabric_of_a_column() {
     // fabric: 2n horizontal wall contacts and n vertical ones: F = diag(2/3, 1/3)
     let f = fabric(&snap, &Region::Whole, &counting).unwrap();
     assert_eq!(f.contacts, 3 * n);
-    assert!(rel(&f.tensor, &Matrix2::new(2.0 / 3.0, 0.0, 0.0, 1.0 / 3.0)) < 1e-14);
+    assert!(rel(&f.tensor, &Tensor::new(2.0 / 3.0, 0.0, 0.0, 1.0 / 3.0)) < 1e-14);
     assert!((f.anisotropy - 2.0 / 3.0).abs() < 1e-14 && f.major_angle.abs() < 1e-14);
     let f = fabric(&snap, &Region::Whole, &no_walls).unwrap();
     assert!((f.anisotropy - 2.0).abs() < 1e-14);
@@ -271,7 +271,7 @@ fn grains_cut_by_the_border_count_by_their_area_fraction() {
     };
     let m = mean_stress(&r, &g, &half).unwrap();
     assert!((m.grains - 0.5).abs() < 1e-14);
-    let expected: Tensor2 = g[0].total * (0.5 * std::f64::consts::PI * a * a / 4.0);
+    let expected: Tensor = g[0].total * (0.5 * std::f64::consts::PI * a * a / 4.0);
     assert!(rel(&m.total, &expected) < 1e-13);
     // a quarter
     let quarter = Region::Rectangle {
@@ -336,8 +336,8 @@ fn the_whole_of_a_biperiodic_cell_is_the_cell() {
         b.grain(p, 1.0, 1.0, 1.0);
     }
     let mut snap = b.finish();
-    let h = Matrix2::new(10.0, 4.0, 0.0, 8.0);
-    snap.cell = Some(dem::cell::Cell::new(h, Matrix2::zeros()).unwrap());
+    let h = Tensor::new(10.0, 4.0, 0.0, 8.0);
+    snap.cell = Some(dem::cell::Cell::new(h, Tensor::zeros()).unwrap());
     let phi = solid_fraction(&snap, &Region::Whole).unwrap();
     assert!(
         (phi - 3.0 * std::f64::consts::PI / 80.0).abs() < 1e-15,

@@ -3,11 +3,11 @@
 
 mod support;
 
+use dem::math::Tensor;
 use homogenise::inertia_ratio::inertia_ratios;
 use homogenise::stress::{boundary_moment, grain_stresses, mean_stress};
 use homogenise::tensor::{frobenius, in_frame, skew_ratio};
 use homogenise::Region;
-use nalgebra::Matrix2;
 use support::{rel, rolling_disk, v};
 
 #[test]
@@ -184,7 +184,7 @@ fn whole_sample_stress_equals_the_boundary_moment() {
     ];
     for snap in &snaps {
         let g = grain_stresses(snap).unwrap();
-        let sum: Matrix2<f64> = g.iter().map(|p| p.total * p.volume).sum();
+        let sum: Tensor = g.iter().map(|p| p.total * p.volume).sum();
         let m0 = boundary_moment(snap, &v(0.0, 0.0)).unwrap();
         let m1 = boundary_moment(snap, &v(0.013, -0.021)).unwrap();
         assert!(rel(&m0, &sum) < 1e-10, "{}", rel(&m0, &sum));
@@ -206,7 +206,7 @@ fn region_means_are_additive_over_a_partition() {
         .map(|k| y0 + (y1 - y0) * (k as f64 / 7.0).powf(1.3))
         .collect();
     let slices = homogenise::stress::slice_stress_profile(&snap, &g, &edges).unwrap();
-    let sum: Matrix2<f64> = slices.iter().map(|s| s.total * s.area).sum();
+    let sum: Tensor = slices.iter().map(|s| s.total * s.area).sum();
     assert!(rel(&sum, &(whole.total * whole.area)) < 1e-12);
     let count: f64 = slices.iter().map(|s| s.grains).sum();
     assert!((count - 64.0).abs() < 1e-12);

@@ -8,11 +8,11 @@
 //! Each case draws the number of grains, their radii and velocities, the friction and
 //! restitution coefficients and the time step; the case seed is printed on failure.
 
+use dem::math::Vector;
 use dem::{BodyKind, ContactLaws, SolverParams, World, WorldParams};
 use homogenise::stress::{grain_stresses, mean_stress};
 use homogenise::tensor::skew_ratio;
 use homogenise::Region;
-use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -53,21 +53,21 @@ fn random_box(rng: &mut ChaCha8Rng) -> World {
     let mut laws = ContactLaws::new(&["m"], mu);
     laws.set_restitution(0, 0, e);
     let mut w = World::new(params, laws);
-    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    w.add_line_wall("top", Vector2::new(0.0, SIDE), Vector2::new(0.0, -1.0), 0);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall("right", Vector2::new(SIDE, 0.0), Vector2::new(-1.0, 0.0), 0);
+    w.add_line_wall("bottom", Vector::zeros(), Vector::new(0.0, 1.0), 0);
+    w.add_line_wall("top", Vector::new(0.0, SIDE), Vector::new(0.0, -1.0), 0);
+    w.add_line_wall("left", Vector::zeros(), Vector::new(1.0, 0.0), 0);
+    w.add_line_wall("right", Vector::new(SIDE, 0.0), Vector::new(-1.0, 0.0), 0);
     let pitch = 4.5e-3;
     let per_row = (SIDE / pitch) as usize - 1;
     for i in 0..n {
         let r = rng.random_range(1e-3..2e-3);
-        let p = Vector2::new(
+        let p = Vector::new(
             pitch * ((i % per_row) as f64 + 1.0),
             pitch * ((i / per_row) as f64 + 1.0),
         );
         let b = w.add_grain(p, r, 2500.0, 0) as usize;
         w.bodies[b].velocity =
-            Vector2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            Vector::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
         w.bodies[b].omega = rng.random_range(-50.0..50.0);
     }
     w.validate(1e-12).unwrap();

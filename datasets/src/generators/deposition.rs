@@ -9,7 +9,7 @@
 //!
 //! Contact distances include a gap `gap` (m) so that no two grains overlap after rounding.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
@@ -35,7 +35,7 @@ pub enum Support {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Deposition {
     /// Centres (m), in the order of the radii.
-    pub centres: Vec<Vector2<f64>>,
+    pub centres: Vec<Vector>,
     /// Supports of each grain: the floor alone, or the grain it rolled over and the one (or the
     /// wall) that stopped it. A grain left after [`MAX_MOVES`] rolls keeps its last pivot only.
     pub supports: Vec<[Option<Support>; 2]>,
@@ -55,7 +55,7 @@ impl Grid {
     fn row(&self, y: f64) -> usize {
         (y / self.cell).floor().max(0.0) as usize
     }
-    fn insert(&mut self, i: usize, c: Vector2<f64>) {
+    fn insert(&mut self, i: usize, c: Vector) {
         let row = self.row(c.y);
         if (row + 1) * self.cols > self.cells.len() {
             self.cells.resize_with((row + 1) * self.cols, Vec::new);
@@ -98,13 +98,13 @@ pub fn deposit(rng: &mut ChaCha8Rng, radii: &[f64], width: f64, gap: f64) -> Res
         cols: ((width / (2.0 * r_max + gap)).ceil() as usize).max(1),
         cells: Vec::new(),
     };
-    let mut centres: Vec<Vector2<f64>> = Vec::with_capacity(radii.len());
+    let mut centres: Vec<Vector> = Vec::with_capacity(radii.len());
     let mut supports = Vec::with_capacity(radii.len());
     let mut near = Vec::new();
     let mut top = 0.0f64; // highest grain top so far
     for (i, &r) in radii.iter().enumerate() {
         let (xl, xr) = (r + gap, width - r - gap);
-        let mut c = Vector2::new(rng.random_range(xl..=xr), top + 2.0 * r + 2.0 * gap);
+        let mut c = Vector::new(rng.random_range(xl..=xr), top + 2.0 * r + 2.0 * gap);
         let mut moves = 0;
         let rests: [Option<Support>; 2];
         'grain: loop {
@@ -134,7 +134,7 @@ pub fn deposit(rng: &mut ChaCha8Rng, radii: &[f64], width: f64, gap: f64) -> Res
                     &grid, &centres, radii, p, pivot, d, phi0, right, r, gap, xl, xr, &mut near,
                 ) {
                     Some((phi, s)) => {
-                        c = p + d * Vector2::new(phi.cos(), phi.sin());
+                        c = p + d * Vector::new(phi.cos(), phi.sin());
                         let stable = match s {
                             Support::Floor => true,
                             Support::LeftWall => !right,
@@ -157,7 +157,7 @@ pub fn deposit(rng: &mut ChaCha8Rng, radii: &[f64], width: f64, gap: f64) -> Res
                     None => {
                         // rolled off: centre level with the pivot, falls again
                         let end = if right { 0.0 } else { std::f64::consts::PI };
-                        c = p + d * Vector2::new(end.cos(), end.sin());
+                        c = p + d * Vector::new(end.cos(), end.sin());
                         c.x = c.x.clamp(xl, xr);
                         c.y -= 1e-12;
                         continue 'grain;
@@ -176,9 +176,9 @@ pub fn deposit(rng: &mut ChaCha8Rng, radii: &[f64], width: f64, gap: f64) -> Res
 /// Highest landing height of a grain of radius `r` falling from `c`, and its support.
 fn fall(
     grid: &Grid,
-    centres: &[Vector2<f64>],
+    centres: &[Vector],
     radii: &[f64],
-    c: Vector2<f64>,
+    c: Vector,
     r: f64,
     gap: f64,
     near: &mut Vec<u32>,
@@ -207,9 +207,9 @@ fn fall(
 #[allow(clippy::too_many_arguments)]
 fn roll(
     grid: &Grid,
-    centres: &[Vector2<f64>],
+    centres: &[Vector],
     radii: &[f64],
-    p: Vector2<f64>,
+    p: Vector,
     pivot: usize,
     d: f64,
     phi0: f64,
@@ -231,7 +231,7 @@ fn roll(
     }
     let to_s = |phi: f64| if right { phi0 - phi } else { phi - phi0 };
     let eps = 1e-10;
-    let start = p + d * Vector2::new(phi0.cos(), phi0.sin());
+    let start = p + d * Vector::new(phi0.cos(), phi0.sin());
     let ahead = |s: Support| match s {
         Support::Grain(k) => (centres[k].x > start.x) == right,
         Support::LeftWall => !right,
@@ -316,7 +316,7 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
 
-    fn check(centres: &[Vector2<f64>], radii: &[f64], width: f64, gap: f64) -> f64 {
+    fn check(centres: &[Vector], radii: &[f64], width: f64, gap: f64) -> f64 {
         let mut area = 0.0;
         let mut height = 0.0f64;
         for (i, (c, r)) in centres.iter().zip(radii).enumerate() {
@@ -370,7 +370,7 @@ mod tests {
             if ci.y - ri < 1e-6 {
                 continue;
             }
-            let touching: Vec<Vector2<f64>> = c[..i]
+            let touching: Vec<Vector> = c[..i]
                 .iter()
                 .zip(&radii)
                 .filter(|(cj, rj)| ((*ci - **cj).norm() - (ri + **rj)).abs() < 1e-6)

@@ -8,7 +8,7 @@
 //! Rows are separated by an extra gap `gap · R` (and a random `[0, jitter · R]` per disk) so that
 //! the stack settles under gravity into the contacts of the ideal lattice.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -52,7 +52,7 @@ pub fn lattice(
     gap: f64,
     jitter: f64,
     rng: &mut ChaCha8Rng,
-) -> Vec<Vector2<f64>> {
+) -> Vec<Vector> {
     let mut out = Vec::new();
     let (pitch, nrows) = match kind {
         Arrangement::Rectangular => (2.0 * r, rows),
@@ -78,7 +78,7 @@ pub fn lattice(
             } else {
                 0.0
             };
-            out.push(Vector2::new(x0 + 2.0 * r * i as f64, base + dy));
+            out.push(Vector::new(x0 + 2.0 * r * i as f64, base + dy));
         }
         base += pitch + (gap + jitter) * r;
     }

@@ -7,7 +7,7 @@
 //! outgrow it. Numbered along a Z-order (Morton) curve of cells about one grain diameter wide,
 //! touching grains get nearby indices.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 
 /// Bits per coordinate of the Morton key (cells per side up to 2³²).
 const BITS: u32 = 32;
@@ -15,7 +15,7 @@ const BITS: u32 = 32;
 /// The permutation `p` that sorts `centres` along a Z-order curve of square cells of side
 /// `cell` (m): `centres[p[0]], centres[p[1]], …` are in curve order. Ties (same cell) keep the
 /// input order, so the result is deterministic.
-pub fn spatial_order(centres: &[Vector2<f64>], cell: f64) -> Vec<usize> {
+pub fn spatial_order(centres: &[Vector], cell: f64) -> Vec<usize> {
     if centres.is_empty() {
         return Vec::new();
     }
@@ -30,7 +30,7 @@ pub fn spatial_order(centres: &[Vector2<f64>], cell: f64) -> Vec<usize> {
         1.0
     };
     let max = ((1u64 << BITS) - 1) as f64;
-    let key = |c: &Vector2<f64>| {
+    let key = |c: &Vector| {
         let ix = ((c.x - x0) / cell).floor().clamp(0.0, max) as u64;
         let iy = ((c.y - y0) / cell).floor().clamp(0.0, max) as u64;
         interleave(ix) | (interleave(iy) << 1)
@@ -69,7 +69,7 @@ mod tests {
         let mut pts = Vec::new();
         for y in 0..4 {
             for x in 0..4 {
-                pts.push(Vector2::new(x as f64 + 0.5, y as f64 + 0.5));
+                pts.push(Vector::new(x as f64 + 0.5, y as f64 + 0.5));
             }
         }
         pts.reverse();

@@ -4,7 +4,7 @@
 //! gaps that share out the row's slack, and at random heights inside the band. Successive bands
 //! are separated by `gap`, so no two grains overlap and none crosses the side walls.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
@@ -27,7 +27,7 @@ pub struct RainBox {
 
 /// Centres (m) for grains of the given radii (in order), placed as described in the module
 /// documentation. Fails when a grain is wider than the box.
-pub fn rain(rng: &mut ChaCha8Rng, radii: &[f64], b: &RainBox) -> Result<Vec<Vector2<f64>>> {
+pub fn rain(rng: &mut ChaCha8Rng, radii: &[f64], b: &RainBox) -> Result<Vec<Vector>> {
     let width = b.x_max - b.x_min;
     if !(width.is_finite() && width > 0.0 && b.gap >= 0.0) {
         return Err(DatasetError::Generator(format!(
@@ -67,7 +67,7 @@ pub fn rain(rng: &mut ChaCha8Rng, radii: &[f64], b: &RainBox) -> Result<Vec<Vect
         for (k, &r) in row.iter().enumerate() {
             let cx = x + r;
             let cy = y + rmax + rng.random_range(-1.0..=1.0) * (rmax - r);
-            out.push(Vector2::new(cx, cy));
+            out.push(Vector::new(cx, cy));
             x = cx + r + b.gap + w[k + 1];
         }
         y += 2.0 * rmax + b.gap;

@@ -6,19 +6,13 @@
 use std::f64::consts::PI;
 
 use dem::local::ContactStatus;
+use dem::math::{cross, Tensor, Vector};
 use dem::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
-use nalgebra::{Matrix2, Vector2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-pub type V2 = Vector2<f64>;
-
-pub fn v(x: f64, y: f64) -> V2 {
-    Vector2::new(x, y)
-}
-
-fn cross(a: &V2, b: &V2) -> f64 {
-    a.x * b.y - a.y * b.x
+pub fn v(x: f64, y: f64) -> Vector {
+    Vector::new(x, y)
 }
 
 /// Builds a snapshot body by body and contact by contact; `finish` sets the grains'
@@ -28,7 +22,7 @@ pub struct Builder {
 }
 
 impl Builder {
-    pub fn new(gravity: V2) -> Self {
+    pub fn new(gravity: Vector) -> Self {
         Self {
             snap: Snapshot {
                 step: 1,
@@ -44,16 +38,16 @@ impl Builder {
         }
     }
 
-    pub fn grain(&mut self, position: V2, radius: f64, density: f64, thickness: f64) -> u32 {
+    pub fn grain(&mut self, position: Vector, radius: f64, density: f64, thickness: f64) -> u32 {
         let mass = density * PI * radius * radius * thickness;
         self.snap.bodies.push(BodyState {
             kind: BodyKind::Grain,
             name: String::new(),
             position,
             angle: 0.0,
-            velocity: V2::zeros(),
+            velocity: Vector::zeros(),
             omega: 0.0,
-            acceleration: V2::zeros(),
+            acceleration: Vector::zeros(),
             angular_acceleration: 0.0,
             mass,
             inertia: 0.5 * mass * radius * radius,
@@ -64,21 +58,21 @@ impl Builder {
         (self.snap.bodies.len() - 1) as u32
     }
 
-    pub fn motion(&mut self, id: u32, velocity: V2, omega: f64) {
+    pub fn motion(&mut self, id: u32, velocity: Vector, omega: f64) {
         let b = &mut self.snap.bodies[id as usize];
         b.velocity = velocity;
         b.omega = omega;
     }
 
-    fn wall_body(&mut self, name: &str, position: V2, geometry: WallGeometry) -> u32 {
+    fn wall_body(&mut self, name: &str, position: Vector, geometry: WallGeometry) -> u32 {
         self.snap.bodies.push(BodyState {
             kind: BodyKind::Wall,
             name: name.to_string(),
             position,
             angle: 0.0,
-            velocity: V2::zeros(),
+            velocity: Vector::zeros(),
             omega: 0.0,
-            acceleration: V2::zeros(),
+            acceleration: Vector::zeros(),
             angular_acceleration: 0.0,
             mass: f64::INFINITY,
             inertia: f64::INFINITY,
@@ -91,27 +85,36 @@ impl Builder {
             body: id,
             name: name.to_string(),
             geometry,
-            force: V2::zeros(),
+            force: Vector::zeros(),
             torque: 0.0,
         });
         id
     }
 
     /// A line wall through `point` with unit `normal` into the grains.
-    pub fn line_wall(&mut self, name: &str, point: V2, normal: V2) -> u32 {
+    pub fn line_wall(&mut self, name: &str, point: Vector, normal: Vector) -> u32 {
         self.wall_body(name, point, WallGeometry::Line { point, normal })
     }
 
     /// A rough wall: a clump of disks, body centre at the disks' mean.
-    pub fn clump_wall(&mut self, name: &str, centres: Vec<V2>, radii: Vec<f64>) -> u32 {
-        let c = centres.iter().sum::<V2>() / centres.len() as f64;
+    pub fn clump_wall(&mut self, name: &str, centres: Vec<Vector>, radii: Vec<f64>) -> u32 {
+        let c = centres.iter().sum::<Vector>() / centres.len() as f64;
         self.wall_body(name, c, WallGeometry::Clump { centres, radii })
     }
 
     /// A contact between `a` and `b` at `point` with normal `n` (from a to b) and forces on b
     /// `f_n n + f_t t`; levers from the bodies' positions. (Mirrors `ContactState`'s fields.)
     #[allow(clippy::too_many_arguments)]
-    pub fn contact(&mut self, a: u32, b: u32, point: V2, normal: V2, f_n: f64, f_t: f64, mu: f64) {
+    pub fn contact(
+        &mut self,
+        a: u32,
+        b: u32,
+        point: Vector,
+        normal: Vector,
+        f_n: f64,
+        f_t: f64,
+        mu: f64,
+    ) {
         let status = if f_n <= 0.0 {
             ContactStatus::Open
         } else if f_t.abs() >= mu * f_n * (1.0 - 1e-12) {
@@ -137,8 +140,8 @@ impl Builder {
     }
 
     /// Net contact force and torque on every body.
-    pub fn net(&self) -> Vec<(V2, f64)> {
-        let mut net = vec![(V2::zeros(), 0.0); self.snap.bodies.len()];
+    pub fn net(&self) -> Vec<(Vector, f64)> {
+        let mut net = vec![(Vector::zeros(), 0.0); self.snap.bodies.len()];
         for c in &self.snap.contacts {
             let f = c.force_on_b();
             net[c.body_b as usize].0 += f;
@@ -171,14 +174,14 @@ impl Builder {
 pub struct Rolling {
     pub snap: Snapshot,
     /// Down the slope.
-    pub e1: V2,
+    pub e1: Vector,
     /// Outward normal of the slope.
-    pub e2: V2,
+    pub e2: Vector,
     pub travelled: f64,
     /// Expected Σ_p in the slope frame.
-    pub sigma: Matrix2<f64>,
+    pub sigma: Tensor,
     /// Expected contact part in the slope frame.
-    pub contact: Matrix2<f64>,
+    pub contact: Tensor,
     pub omega: f64,
     pub omega_dot: f64,
 }
@@ -186,7 +189,7 @@ pub struct Rolling {
 /// A disk of radius `a`, density `rho`, released at rest at t = 0 on a slope `phi` going down
 /// to the right (or to the left when `mirrored`), rolling without slipping, at time `t`.
 /// The slope passes through `origin`; gravity g = 9.81.
-pub fn rolling_disk(phi: f64, a: f64, rho: f64, t: f64, mirrored: bool, origin: V2) -> Rolling {
+pub fn rolling_disk(phi: f64, a: f64, rho: f64, t: f64, mirrored: bool, origin: Vector) -> Rolling {
     let g = 9.81;
     let (e1, e2) = if mirrored {
         (v(-phi.cos(), -phi.sin()), v(-phi.sin(), phi.cos()))
@@ -226,9 +229,9 @@ pub fn rolling_disk(phi: f64, a: f64, rho: f64, t: f64, mirrored: bool, origin: 
         e1,
         e2,
         travelled,
-        sigma: Matrix2::new(0.0, s / 6.0, s / 6.0, -c) * (rho * g * a)
-            + Matrix2::identity() * (rho * g * travelled * s / 3.0),
-        contact: Matrix2::new(0.0, s / 3.0, 0.0, -c) * (rho * g * a),
+        sigma: Tensor::new(0.0, s / 6.0, s / 6.0, -c) * (rho * g * a)
+            + Tensor::identity() * (rho * g * travelled * s / 3.0),
+        contact: Tensor::new(0.0, s / 3.0, 0.0, -c) * (rho * g * a),
         omega,
         omega_dot,
     }
@@ -314,7 +317,7 @@ pub fn cannonball(r: f64, rho: f64) -> Snapshot {
 /// bottom and two side walls (everything shifted by `offset`), contacts between lattice
 /// neighbours and with the walls, random forces inside the Coulomb cone, random velocities;
 /// accelerations consistent with the forces. Same seed, same state (up to the offset).
-pub fn random_dynamic(seed: u64, nx: usize, ny: usize, offset: V2) -> Snapshot {
+pub fn random_dynamic(seed: u64, nx: usize, ny: usize, offset: Vector) -> Snapshot {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let r0 = 1.5e-3;
     let cell = 2.0 * r0;
@@ -381,6 +384,6 @@ pub fn random_dynamic(seed: u64, nx: usize, ny: usize, offset: V2) -> Snapshot {
 }
 
 /// Largest relative difference `‖a − b‖_F / max(‖b‖_F, tiny)`.
-pub fn rel(a: &Matrix2<f64>, b: &Matrix2<f64>) -> f64 {
+pub fn rel(a: &Tensor, b: &Tensor) -> f64 {
     (a - b).norm() / b.norm().max(1e-300)
 }
