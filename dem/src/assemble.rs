@@ -35,6 +35,16 @@ fn body_rows(c: &ContactRow, side: usize) -> [[f64; 3]; 2] {
 /// `W = H M⁻¹ Hᵀ` of the contacts `rows` with inverse masses `inv` (per body `[1/m, 1/m, 1/I]`,
 /// zero for imposed degrees of freedom).
 pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
+    delassus_with(rows, inv, None)
+}
+
+/// [`delassus_matrix`] plus the term `m Σ_κ B_κ B_κᵀ` of a cell whose stress-controlled
+/// components are unknowns of the step ([`crate::cell_coupling`]).
+pub fn delassus_with(
+    rows: &[ContactRow],
+    inv: &[[f64; 3]],
+    cell: Option<&CellCoupling>,
+) -> BlockCsr2 {
     // Body → (contact, side) adjacency in compressed form.
     let nb = inv.len();
     let mut count = vec![0usize; nb + 1];
@@ -77,6 +87,9 @@ pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
             }
         }
     }
+    if let Some(cell) = cell {
+        cell.add_to_delassus(&mut ri, &mut ci, &mut v);
+    }
     // Indices are in range and the values finite by construction.
     BlockCsr2::from_triplets(rows.len(), &ri, &ci, &v)
         .unwrap_or_else(|e| panic!("engine Delassus assembly: {e}"))
@@ -97,7 +110,11 @@ pub fn contact_problem_with(
     inv: &[[f64; 3]],
     cell: Option<&CellCoupling>,
 ) -> FcProblem {
-    let w = delassus_matrix(rows, inv);
+    // Up to the global methods' limit the cell's term is folded into W as it is assembled
+    // (the operator every method then sees); above it, it is kept apart (dense among all the
+    // contacts when the grains follow the cell within the step).
+    let fold = cell.filter(|_| rows.len() <= crate::fc::LOW_RANK_EXPAND_MAX_CONTACTS);
+    let w = delassus_with(rows, inv, fold);
     let mut q = Vec::with_capacity(2 * rows.len());
     for (i, c) in rows.iter().enumerate() {
         let mut u = c.velocity(&v_free[c.a as usize], &v_free[c.b as usize]);
@@ -108,16 +125,10 @@ pub fn contact_problem_with(
         }
         q.extend_from_slice(&u);
     }
-    let problem = FcProblem::from_engine_with(
+    FcProblem::from_engine_with(
         rows.iter().map(|c| c.mu).collect(),
         q,
         w,
-        cell.map(CellCoupling::low_rank),
-    );
-    // Up to the global methods' limit the cell's term is folded into W at once: the operator
-    // every method then sees, as assembled before the term was kept apart.
-    match problem.expanded() {
-        Ok(folded) => folded,
-        Err(_) => problem,
-    }
+        cell.filter(|_| fold.is_none()).map(CellCoupling::low_rank),
+    )
 }

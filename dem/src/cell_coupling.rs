@@ -412,6 +412,27 @@ impl CellCoupling {
         }
     }
 
+    /// Appends the cell's term `m Σ_κ B_cκ B_c'κᵀ` of every pair of coupled contacts to the
+    /// triplets `(row, col, value)` of an assembled Delassus operator (scalar indices `2c + i`).
+    pub fn add_to_delassus(&self, ri: &mut Vec<usize>, ci: &mut Vec<usize>, v: &mut Vec<f64>) {
+        for (s, &a) in self.rows.iter().enumerate() {
+            for (t, &b) in self.rows.iter().enumerate() {
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let x: f64 = (0..3)
+                            .map(|k| self.compliance[k] * self.coef[s][k][i] * self.coef[t][k][j])
+                            .sum();
+                        if x != 0.0 {
+                            ri.push(2 * a as usize + i);
+                            ci.push(2 * b as usize + j);
+                            v.push(x);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// The cell's term `m Σ_κ B_cκ B_c'κᵀ` of the eliminated problem as a rank-three term
     /// beside the sparse Delassus operator ([`crate::fc::LowRank`]; dense among the coupled
     /// contacts, which are all of them when the grains follow the cell within the step).
