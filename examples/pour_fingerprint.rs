@@ -38,10 +38,10 @@ fn main() {
         run.step_control().is_none(),
         "the pour runs at a fixed step"
     );
-    // `dem::bench::settle` without step control, step by step, with the subdivision's counts.
+    // `dem::settle::settle` without step control, step by step, with the subdivision's counts.
     let t0 = Instant::now();
     let mut sub = dem::step_control::Subdivision::default();
-    let (mut steps, mut simulated, mut ratio) = (0u64, 0.0f64, dem::bench::energy_ratio(&w));
+    let (mut steps, mut simulated, mut ratio) = (0u64, 0.0f64, dem::settle::energy_ratio(&w));
     let mut hist = [0usize; 101];
     let trace = std::env::var_os("POUR_TRACE").is_some();
     let (mut sweeps, mut discarded, mut capped, mut substeps, mut retries) = (0, 0, 0, 0, 0);
@@ -60,7 +60,7 @@ fn main() {
                 hist[sub.report.solver.iterations.min(100)] += 1;
             }
         }
-        ratio = dem::bench::energy_ratio(&w);
+        ratio = dem::settle::energy_ratio(&w);
         if trace {
             eprintln!(
                 "{steps} {} {} {ratio:.3e} {:.3}",

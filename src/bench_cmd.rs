@@ -1,7 +1,7 @@
 //! `grainlaw bench`: the performance figures of the project in one table.
 //!
 //! 1. Frictional-contact problems of `docs/formats.md` §1 solved to 10⁻⁶ against Siconos fc2d
-//!    NSGS ([`dem::fc::bench`]), and the hard ones by Lemke's method against Siconos' NSGS and
+//!    NSGS ([`crate::fc_bench`]), and the hard ones by Lemke's method against Siconos' NSGS and
 //!    Lemke: Siconos measured in the same run when it is installed ([`crate::siconos_peer`]),
 //!    else its quoted figures, labelled as quoted.
 //! 2. Bare Gauss–Seidel sweep throughput (contact updates per second, one core).
@@ -18,7 +18,7 @@
 //! 6. The representative-volume race (`--rve N`, [`rve_rows`]): grainlaw's `simple-shear`
 //!    scenario against LAMMPS on the same grains ([`crate::lammps_rve_peer`]), seconds per unit
 //!    shear strain, μ and φ of both.
-//! 7. Memory per grain and per contact ([`dem::bench::MemoryFootprint`]).
+//! 7. Memory per grain and per contact ([`crate::engine_bench::MemoryFootprint`]).
 
 use std::path::Path;
 
@@ -130,7 +130,7 @@ fn engine_rows(plan: &BenchPlan) -> Result<Vec<ScalingRow>> {
     let mut one_thread = Vec::new();
     for &n in &plan.engine_grains {
         let w0 = scaling_deposit(n, plan.relax_steps, true, 1)?;
-        let rate = dem::bench::sweep_rate(&w0, 20);
+        let rate = crate::engine_bench::sweep_rate(&w0, 20);
         let steps = if n >= 500_000 {
             3
         } else if n >= 50_000 {
@@ -464,15 +464,15 @@ pub fn bench(plan: &BenchPlan) -> Result<()> {
     homogenise_rows(plan)?;
     biaxial_rows(plan)?;
     rve_rows(&plan.rve)?;
-    let mem = dem::bench::MemoryFootprint::current(4);
+    let mem = crate::engine_bench::MemoryFootprint::current(4);
     println!(
         "\nmemory: {} B per grain, {} B per contact; at 2 contacts per grain, 24 GiB hold about {:.1e} grains",
         mem.per_grain,
         mem.per_contact,
         mem.largest_sample(24 << 30, 2.0) as f64
     );
-    let extra = dem::bench::MemoryFootprint::parallel_extra();
-    let both = dem::bench::MemoryFootprint {
+    let extra = crate::engine_bench::MemoryFootprint::parallel_extra();
+    let both = crate::engine_bench::MemoryFootprint {
         per_grain: mem.per_grain + extra.per_grain,
         per_contact: mem.per_contact + extra.per_contact,
     };
@@ -498,7 +498,7 @@ fn hard_rows(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>)
     if !dir.is_dir() {
         return Ok(());
     }
-    let files = dem::fc::bench::problem_files(dir)?;
+    let files = crate::fc_bench::problem_files(dir)?;
     println!(
         "
 hard problems ({}), Lemke's method from a cold start to 1e-8, one thread; {}:",
@@ -530,7 +530,7 @@ hard problems ({}), Lemke's method from a cold start to 1e-8, one thread; {}:",
         })?;
         let seconds = t0.elapsed().as_secs_f64();
         let error = sol.map_or(f64::NAN, |s| dem::fc::fc_error(&problem, &s.r));
-        let name = dem::fc::bench::problem_name(dir, &f);
+        let name = crate::fc_bench::problem_name(dir, &f);
         let (nsgs, lemke) = match peer {
             Ok(python) => {
                 let req = |solver, max_iter| sp::PeerRequest {
@@ -648,11 +648,11 @@ fn homogenise_rows(plan: &BenchPlan) -> Result<()> {
 }
 
 /// The reference problems (`DIR`, tolerance 10⁻⁶ from `r = 0`, one thread) with
-/// [`dem::fc::bench::run_reference_benchmarks`], beside Siconos 4.4 fc2d NSGS (sparse block
+/// [`crate::fc_bench::run_reference_benchmarks`], beside Siconos 4.4 fc2d NSGS (sparse block
 /// storage, 10⁻⁶, `r = 0`, one core): measured in this run when the peer is available
 /// (`peer = Ok(python)`, [`crate::siconos_peer`]: seconds of the solver call timed inside the
 /// script, best of up to 3 solves within 1 s, 300 s wall-clock cap per problem), else quoted
-/// from [`dem::fc::bench::SICONOS_REFERENCE`] and labelled so.
+/// from [`crate::fc_bench::SICONOS_REFERENCE`] and labelled so.
 fn run_fc(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) -> Result<()> {
     use crate::siconos_peer::{self as sp, SiconosCell};
     // one thread: the comparison with Siconos is per core
@@ -660,11 +660,11 @@ fn run_fc(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) ->
         .num_threads(1)
         .build()
         .map_err(|e| CliError::Usage(format!("cannot start a thread pool: {e}")))?;
-    let rows = pool.install(|| dem::fc::bench::run_reference_benchmarks(dir))?;
+    let rows = pool.install(|| crate::fc_bench::run_reference_benchmarks(dir))?;
     if rows.is_empty() {
         return Err(CliError::io(dir, "no .json or .json.gz problems found"));
     }
-    let files = dem::fc::bench::problem_files(dir)?;
+    let files = crate::fc_bench::problem_files(dir)?;
     println!(
         "frictional-contact problems ({}), one thread; {}:",
         dir.display(),
@@ -694,7 +694,7 @@ fn run_fc(dir: &Path, peer: &std::result::Result<std::path::PathBuf, String>) ->
             Ok(python) => {
                 let file = files
                     .iter()
-                    .find(|f| dem::fc::bench::problem_name(dir, f) == r.problem);
+                    .find(|f| crate::fc_bench::problem_name(dir, f) == r.problem);
                 SiconosCell::Measured(match file {
                     Some(f) => sp::solve(
                         python,

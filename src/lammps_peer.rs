@@ -38,7 +38,7 @@
 //!
 //! # Stop criterion
 //!
-//! As the engine's (`dem::bench::energy_ratio`): `KE / PE < 10⁻⁸` with
+//! As the engine's (`dem::settle::energy_ratio`): `KE / PE < 10⁻⁸` with
 //! `KE = Σ ½ m |v|² + ¼ m r² ω²` and `PE = Σ m g y` (floor at `y = 0`), checked every
 //! [`CHECK_EVERY`] steps by `fix halt`, within the engine's longest simulated time and a
 //! wall-clock limit (`timer timeout`). Whether the column settled is decided here from the

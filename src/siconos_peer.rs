@@ -18,7 +18,7 @@
 //! outlasts its wall-clock cap is reported as such ([`PeerOutcome`]), never as figures.
 //!
 //! Without the peer the tables keep the figures quoted from an earlier measurement
-//! ([`dem::fc::bench::SICONOS_REFERENCE`], [`QUOTED_HARD`]), labelled as quoted.
+//! ([`crate::fc_bench::SICONOS_REFERENCE`], [`QUOTED_HARD`]), labelled as quoted.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};

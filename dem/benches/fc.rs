@@ -2,7 +2,8 @@
 //! of `datasets/fc-problems/` (tolerance 1e-6 from r = 0), and the raw cost of one plain
 //! Gauss–Seidel sweep (throughput in contact updates per second).
 //!
-//! `cargo bench -p dem --bench fc`; the summary table beside Siconos is `--bench fc_table`.
+//! `cargo bench -p dem --bench fc`; the summary table beside Siconos is the
+//! root package's `cargo bench --bench fc_table`.
 
 use std::path::PathBuf;
 use std::time::Duration;

@@ -15,9 +15,10 @@
 //! - [`crate::assemble`]: the problem of an engine step, for the Newton solver and for files;
 //! - [`ordering`]: contact orderings of the sweeps;
 //! - [`crate::anderson`]: Anderson acceleration of the sweeps (shared with the engine);
-//! - [`output`]: the solution file, written atomically;
-//! - [`command`]: what `grainlaw solve-fc` does ([`solve_fc`]);
-//! - [`bench`](mod@bench): the reference benchmark ([`run_reference_benchmarks`]).
+//! - [`output`]: the solution file, written atomically.
+//!
+//! What `grainlaw solve-fc` does around them (read, solve, report, write) and the reference
+//! benchmark table are the command line's (`grainlaw::fc_cmd`, `grainlaw::fc_bench`).
 //!
 //! ```no_run
 //! use dem::fc::{read_problem, solve, FcOptions};
@@ -30,7 +31,7 @@
 //! # Speed
 //!
 //! Tolerance 1e-6 from `r = 0`, one core, the same session on a shared 2 vCPU Xeon
-//! (`cargo bench -p dem --bench fc_table`; Siconos 4.4 fc2d NSGS, see `datasets/fc-problems/README.md`):
+//! (`cargo bench --bench fc_table` in the root package; Siconos 4.4 fc2d NSGS, see `datasets/fc-problems/README.md`):
 //!
 //! | problem | contacts | Siconos its / s | dem::fc its / s | ratio |
 //! |---|---|---|---|---|
@@ -61,9 +62,7 @@
 //!   projecting the mixed iterate on the cones, restarting Anderson on a non-decreasing step.
 //! - Warm start ([`FcOptions::initial_guess`]) from a solution stops at once (0 sweeps).
 
-pub mod bench;
 pub mod block_csr;
-pub mod command;
 pub mod error;
 pub mod lemke;
 pub mod measure;
@@ -75,9 +74,7 @@ pub mod output;
 pub mod problem;
 pub mod reader;
 
-pub use bench::{run_reference_benchmarks, BenchRow};
 pub use block_csr::BlockCsr2;
-pub use command::{solve_fc, solve_file, SolveReport};
 pub use error::FcError;
 pub use measure::fc_error;
 pub use method::{solve_by, MethodReport, SolverMethod};

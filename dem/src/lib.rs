@@ -31,7 +31,6 @@
 pub mod anderson;
 pub mod assemble;
 pub mod atomic;
-pub mod bench;
 pub mod blocked;
 pub mod body;
 pub mod cell;
@@ -51,6 +50,7 @@ pub mod math;
 pub mod nlgs;
 pub mod parallel;
 pub mod serde_float;
+pub mod settle;
 pub mod snapshot;
 pub mod solver;
 pub mod stabilise;

@@ -1,10 +1,10 @@
-//! `dem::bench::settle`, the settling of the benchmark columns: rest is declared only after a
+//! `dem::settle::settle`, the settling of the benchmark columns: rest is declared only after a
 //! converged step.
 
 mod common;
 
 use common::{column, nlgs};
-use dem::bench::{energy_ratio, settle};
+use dem::settle::{energy_ratio, settle};
 
 /// Rest is declared only after a converged step. From rest, one sweep from zero impulses
 /// cannot balance the three contacts of a three-disk stack to 10⁻¹⁰, so its first step stops

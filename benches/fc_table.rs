@@ -1,4 +1,4 @@
-//! Prints the reference benchmark table (`cargo bench -p dem --bench fc_table [DIR]`): every
+//! Prints the reference benchmark table (`cargo bench --bench fc_table [DIR]`): every
 //! problem of `datasets/fc-problems/` solved at tolerance 1e-6 from r = 0, beside Siconos 4.4
 //! NSGS measured on the development machine.
 
@@ -10,10 +10,10 @@ fn main() {
         .find(|a| !a.starts_with("--"))
         .map(PathBuf::from)
         .unwrap_or_else(|| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../datasets/fc-problems")
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("datasets/fc-problems")
         });
-    match dem::fc::run_reference_benchmarks(&dir) {
-        Ok(rows) => print!("{}", dem::fc::bench::format_table(&rows)),
+    match grainlaw::fc_bench::run_reference_benchmarks(&dir) {
+        Ok(rows) => print!("{}", grainlaw::fc_bench::format_table(&rows)),
         Err(e) => {
             eprintln!("fc_table: {e}");
             std::process::exit(2);

@@ -1,12 +1,12 @@
-//! Reference benchmark: solve every problem of a folder (`datasets/fc-problems/`) at tolerance
-//! 1e-6 from `r = 0` and report iterations, error, seconds and the raw sweep throughput, beside
-//! Siconos 4.4 fc2d NSGS on the same problems.
+//! Reference benchmark of `grainlaw bench` (and `cargo bench --bench fc_table`): solve every
+//! problem of a folder (`datasets/fc-problems/`) with [`dem::fc`] at tolerance 1e-6 from `r = 0`
+//! and report iterations, error, seconds and the raw sweep throughput, beside Siconos 4.4 fc2d
+//! NSGS on the same problems.
 
 use std::path::{Path, PathBuf};
 
-use super::error::FcError;
-use super::nsgs::{solve, sweep_rate, FcOptions};
-use super::reader::read_problem;
+use dem::fc::nsgs::sweep_rate;
+use dem::fc::{read_problem, solve, FcError, FcOptions};
 
 /// One line of the benchmark table.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,8 +47,8 @@ impl BenchRow {
 /// in the same session as the `dem::fc` figures of `datasets/fc-problems/README.md`:
 /// (problem, iterations, seconds). Times below 10⁻⁴ s were not resolved (stored as 0).
 /// These are *quoted* figures: `grainlaw bench` prints them, labelled as quoted, only when
-/// Siconos is not installed; otherwise it measures Siconos in the same run (the root
-/// package's `siconos_peer` module; `dem` spawns no process).
+/// Siconos is not installed; otherwise it measures Siconos in the same run
+/// ([`crate::siconos_peer`]).
 pub const SICONOS_REFERENCE: &[(&str, usize, f64)] = &[
     ("large/pile_pert_10000", 5926, 14.67),
     ("piles/pile_pert_100", 118, 0.0022),

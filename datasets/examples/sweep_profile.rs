@@ -1,6 +1,6 @@
 //! Profile target: a settled 4000-grain deposit stepped at tight tolerance.
 fn main() {
-    let mut w = dem::bench::deposit_world(4000, 0.4, 1);
+    let mut w = datasets::benchmarks::deposit_world(4000, 0.4, 1);
     for _ in 0..800 {
         let _ = w.step();
     }
