@@ -9,9 +9,7 @@ fn main() {
         .skip(1)
         .find(|a| !a.starts_with("--"))
         .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("datasets/fc-problems")
-        });
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("datasets/fc-problems"));
     match grainlaw::fc_bench::run_reference_benchmarks(&dir) {
         Ok(rows) => print!("{}", grainlaw::fc_bench::format_table(&rows)),
         Err(e) => {

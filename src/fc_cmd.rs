@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use dem::fc::{
-    fc_error, read_problem, solve_by, write_solution, FcError, FcOptions, FcSolution,
-    MethodReport, NewtonParams, SolverMethod,
+    fc_error, read_problem, solve_by, write_solution, FcError, FcOptions, FcSolution, MethodReport,
+    NewtonParams, SolverMethod,
 };
 
 use crate::error::{CliError, Result};
@@ -184,8 +184,7 @@ mod tests {
         assert_eq!(report.contacts, 89);
         assert!(report.solution.converged && report.solution.error <= 1e-8);
         assert!(report.verified_error <= 1e-8, "{report}");
-        let v: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
         assert_eq!(
             v["iterations"].as_u64().unwrap() as usize,
             report.solution.iterations
