@@ -341,9 +341,9 @@ impl CellCoupling {
 
     /// One Gauss–Seidel sweep in colour order on all rayon threads with the cell's components
     /// kept current (module documentation, *Parallel sweeps*): the contacts not coupled to the
-    /// cell by [`coloured_sweep_where`] (blocks' interiors concurrently, then the colour
-    /// classes), then the coupled ones on the calling thread in slot order, each with the
-    /// current `δ`. The blocks must be [`CellCoupling::attach`]ed and `colouring` built from
+    /// cell by `crate::parallel::coloured_sweep_where` (blocks' interiors concurrently, then
+    /// the colour classes), then the coupled ones on the calling thread in slot order, each
+    /// with the current `δ`. The blocks must be [`CellCoupling::attach`]ed and `colouring` built from
     /// `rows` and `mobile`. Every contact is visited once in an order fixed by the colouring
     /// and the slots, so the impulses, velocities and `δ` have the same bits on any number of
     /// threads.
