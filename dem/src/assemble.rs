@@ -18,7 +18,7 @@
 use crate::cell_coupling::CellCoupling;
 use crate::contact::ContactRow;
 use crate::fc::block_csr::BlockCsr2;
-use crate::fc::problem::FcProblem;
+use crate::fc::problem::{FcProblem, LowRank};
 
 /// Row of contact `c` on the body of `side` (0: `a`, 1: `b`): `[n-row, t-row]`, each
 /// `(x, y, θ)`.
@@ -39,12 +39,8 @@ pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
 }
 
 /// [`delassus_matrix`] plus the term `m Σ_κ B_κ B_κᵀ` of a cell whose stress-controlled
-/// components are unknowns of the step ([`crate::cell_coupling`]).
-pub fn delassus_with(
-    rows: &[ContactRow],
-    inv: &[[f64; 3]],
-    cell: Option<&CellCoupling>,
-) -> BlockCsr2 {
+/// components are unknowns of the step ([`crate::cell_coupling`], [`CellCoupling::low_rank`]).
+pub fn delassus_with(rows: &[ContactRow], inv: &[[f64; 3]], cell: Option<&LowRank>) -> BlockCsr2 {
     // Body → (contact, side) adjacency in compressed form.
     let nb = inv.len();
     let mut count = vec![0usize; nb + 1];
@@ -88,7 +84,7 @@ pub fn delassus_with(
         }
     }
     if let Some(cell) = cell {
-        cell.add_to_delassus(&mut ri, &mut ci, &mut v);
+        cell.push_triplets(&mut ri, &mut ci, &mut v);
     }
     // Indices are in range and the values finite by construction.
     BlockCsr2::from_triplets(rows.len(), &ri, &ci, &v)
@@ -113,8 +109,9 @@ pub fn contact_problem_with(
     // Up to the global methods' limit the cell's term is folded into W as it is assembled
     // (the operator every method then sees); above it, it is kept apart (dense among all the
     // contacts when the grains follow the cell within the step).
-    let fold = cell.filter(|_| rows.len() <= crate::fc::LOW_RANK_EXPAND_MAX_CONTACTS);
-    let w = delassus_with(rows, inv, fold);
+    let low_rank = cell.map(CellCoupling::low_rank);
+    let fold = rows.len() <= crate::fc::LOW_RANK_EXPAND_MAX_CONTACTS;
+    let w = delassus_with(rows, inv, low_rank.as_ref().filter(|_| fold));
     let mut q = Vec::with_capacity(2 * rows.len());
     for (i, c) in rows.iter().enumerate() {
         let mut u = c.velocity(&v_free[c.a as usize], &v_free[c.b as usize]);
@@ -129,6 +126,6 @@ pub fn contact_problem_with(
         rows.iter().map(|c| c.mu).collect(),
         q,
         w,
-        cell.filter(|_| fold.is_none()).map(CellCoupling::low_rank),
+        low_rank.filter(|_| !fold),
     )
 }

@@ -315,8 +315,8 @@ pub struct CellControl {
     /// 9–10 steps) at the end of the step and by 0.1 % within it, and the largest overlap fell
     /// from 0.46 % to 0.026 % of the smallest radius; 2.5 mm grains sheared at I = 1, whose cell
     /// runs away at step 109 otherwise, run through. Gauss–Seidel converges more slowly on it
-    /// (200 grains, I = 0.04, to 10⁻⁴: 28 s against 3.9 s). The cell's term is then dense among all
-    /// contacts: the global methods fold it into `W` only up to
+    /// (200 grains, I = 0.04, to 10⁻⁴: 28 s against 3.9 s). The cell's term is then dense
+    /// among all contacts: the global methods fold it into `W` only up to
     /// [`crate::fc::LOW_RANK_EXPAND_MAX_CONTACTS`] contacts (Gauss–Seidel above).
     #[serde(default)]
     pub affine: bool,

@@ -343,8 +343,8 @@ impl CellCoupling {
     /// kept current (module documentation, *Parallel sweeps*): the contacts not coupled to the
     /// cell by `crate::parallel::coloured_sweep_where` (blocks' interiors concurrently, then
     /// the colour classes), then the coupled ones on the calling thread in slot order, each
-    /// with the current `δ`. The blocks must be [`CellCoupling::attach`]ed and `colouring` built from
-    /// `rows` and `mobile`. Every contact is visited once in an order fixed by the colouring
+    /// with the current `δ`. The blocks must be [`CellCoupling::attach`]ed and `colouring`
+    /// built from `rows` and `mobile`. Every contact is visited once in an order fixed by the colouring
     /// and the slots, so the impulses, velocities and `δ` have the same bits on any number of
     /// threads.
     #[allow(clippy::too_many_arguments)]
@@ -409,27 +409,6 @@ impl CellCoupling {
                 q
             }
             _ => [0.0; 2],
-        }
-    }
-
-    /// Appends the cell's term `m Σ_κ B_cκ B_c'κᵀ` of every pair of coupled contacts to the
-    /// triplets `(row, col, value)` of an assembled Delassus operator (scalar indices `2c + i`).
-    pub fn add_to_delassus(&self, ri: &mut Vec<usize>, ci: &mut Vec<usize>, v: &mut Vec<f64>) {
-        for (s, &a) in self.rows.iter().enumerate() {
-            for (t, &b) in self.rows.iter().enumerate() {
-                for i in 0..2 {
-                    for j in 0..2 {
-                        let x: f64 = (0..3)
-                            .map(|k| self.compliance[k] * self.coef[s][k][i] * self.coef[t][k][j])
-                            .sum();
-                        if x != 0.0 {
-                            ri.push(2 * a as usize + i);
-                            ci.push(2 * b as usize + j);
-                            v.push(x);
-                        }
-                    }
-                }
-            }
         }
     }
 

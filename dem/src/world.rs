@@ -1672,9 +1672,10 @@ impl World {
             }
         }
 
-        // A cell whose control ran away (an undamped cell ringing up, `CellControl::free_change`)
-        // makes the grains' velocities non-finite only here: the step fails, not the
-        // measurement after it.
+        // A cell whose control ran away (its rate ringing up against the packing, test
+        // `a_cell_control_that_runs_away_fails_its_run_at_the_step`) makes the grains'
+        // velocities non-finite only here, through the grains following it: the step fails,
+        // not the measurement after it.
         if let Some(cell) = &self.cell {
             if !cell.l.iter().chain(cell.h.iter()).all(|x| x.is_finite()) {
                 return Err(DemError::NonFiniteCell {

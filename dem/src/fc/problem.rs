@@ -59,6 +59,26 @@ impl LowRank {
         out
     }
 
+    /// Appends the term's non-zero entries `Σ_κ m_κ B_cκ B_c'κᵀ` of every pair of contacts it
+    /// reaches to the triplets `(row, col, value)` of an assembled operator (scalar indices
+    /// `2c + i`), the pairs in contact order: how `W` and the term are folded into one matrix.
+    pub fn push_triplets(&self, ri: &mut Vec<usize>, ci: &mut Vec<usize>, v: &mut Vec<f64>) {
+        let reached: Vec<usize> = (0..self.coef.len())
+            .filter(|&c| self.coef[c] != [[0.0; 2]; 3])
+            .collect();
+        for &i in &reached {
+            for &j in &reached {
+                for (k, x) in self.block(i, j).into_iter().enumerate() {
+                    if x != 0.0 {
+                        ri.push(2 * i + k / 2);
+                        ci.push(2 * j + k % 2);
+                        v.push(x);
+                    }
+                }
+            }
+        }
+    }
+
     /// `s_κ = b_κᵀ r` for impulses `r` (interleaved, length 2 nc).
     pub fn sums(&self, r: &[f64]) -> [f64; 3] {
         let mut s = [0.0; 3];
@@ -217,18 +237,7 @@ impl FcProblem {
                 }
             }
         }
-        let reached: Vec<usize> = (0..n).filter(|&c| l.coef[c] != [[0.0; 2]; 3]).collect();
-        for &i in &reached {
-            for &j in &reached {
-                for (k, x) in l.block(i, j).into_iter().enumerate() {
-                    if x != 0.0 {
-                        ri.push(2 * i + k / 2);
-                        ci.push(2 * j + k % 2);
-                        v.push(x);
-                    }
-                }
-            }
-        }
+        l.push_triplets(&mut ri, &mut ci, &mut v);
         let w = BlockCsr2::from_triplets(n, &ri, &ci, &v)?;
         Ok(Self::from_engine(self.mu.clone(), self.q.clone(), w))
     }
