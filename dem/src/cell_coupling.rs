@@ -110,6 +110,9 @@ pub struct CellCoupling {
     slot: Vec<u32>,
     /// Whether the rows' blocks are augmented now.
     attached: bool,
+    /// Whether some grains follow the cell's change within the step (their contacts are all
+    /// coupled, by their whole branch vectors).
+    within_step: bool,
 }
 
 impl CellCoupling {
@@ -150,6 +153,7 @@ impl CellCoupling {
             compliance,
             delta0,
             slot: vec![NONE; rows.len()],
+            within_step: follows.iter().any(|&f| f),
             ..CellCoupling::default()
         };
         for (i, (row, geo)) in rows.iter().zip(geometry).enumerate() {
@@ -193,6 +197,12 @@ impl CellCoupling {
     /// Number of contacts of the step the coupling was made for (coupled or not).
     pub fn row_count(&self) -> usize {
         self.slot.len()
+    }
+
+    /// Whether grains follow the cell's change within the step ([`crate::CellControl::affine`]):
+    /// then every contact between two of them is coupled.
+    pub fn within_step(&self) -> bool {
+        self.within_step
     }
 
     /// Number of contacts coupled to the cell.

@@ -11,8 +11,8 @@ use thiserror::Error;
 pub enum FcError {
     /// A global method (Newton, the active-set finish, Lemke) was asked to solve a problem with
     /// a low-rank term ([`super::LowRank`], a biperiodic cell's stress-controlled components)
-    /// too large to fold into `W` ([`super::FcProblem::expanded`]).
-    #[error("{contacts} contacts with a cell's low-rank term: more than the {limit} a global method folds into W")]
+    /// on more contacts than they take ([`super::FcProblem::check_global`]).
+    #[error("{contacts} contacts with a cell's low-rank term: more than the {limit} a global method takes")]
     LowRankTooLarge {
         /// Contacts of the problem.
         contacts: usize,
