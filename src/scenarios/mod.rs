@@ -12,6 +12,7 @@ pub mod janssen;
 pub mod phased;
 pub mod rheology_fit;
 pub mod rolling;
+pub mod rows;
 pub mod sensitivity;
 pub mod shear_cell;
 pub mod simple_shear;

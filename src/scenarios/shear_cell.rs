@@ -30,6 +30,7 @@ use super::common::{
     VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_rows, table_row, TableRow};
 use super::sensitivity::{record, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -172,20 +173,21 @@ pub(crate) fn point_verdict_code(v: Option<&Verdict>) -> f64 {
     }
 }
 
-/// Writes `rheology.csv`: `rows` under `headers` (whose last one is `point_verdict`, filled
-/// here from `point_verdicts`), the table's `description`, how to fit it again, the meaning of
+/// Writes `rheology.csv`: `rows` under their headers and a last column `point_verdict`, filled
+/// here from `point_verdicts`, the table's `description`, how to fit it again, the meaning of
 /// `point_verdict` and the grain's diameter and density as metadata (the fits' `d`, `ρ_s`).
-pub(crate) fn write_rheology_table(
+pub(crate) fn write_rheology_table<R: TableRow>(
     out: &mut OutputDir,
-    headers: &[&str],
-    rows: &[Vec<f64>],
+    rows: &[R],
     point_verdicts: &[Verdict],
     description: &str,
     grain: GrainScale,
 ) -> Result<()> {
-    let mut table = CsvTable::new(headers);
+    let mut headers = R::HEADERS.to_vec();
+    headers.push("point_verdict");
+    let mut table = CsvTable::new(&headers);
     for (k, r) in rows.iter().enumerate() {
-        let mut r = r.clone();
+        let mut r = r.to_values();
         r.push(point_verdict_code(point_verdicts.get(k)));
         table.push(r);
     }
@@ -276,13 +278,67 @@ struct MeanProfile {
     h: f64,
 }
 
+table_row! {
+    /// One shear run: a row of the shear cell's `rheology.csv` (without its `point_verdict`).
+    struct CellRow {
+        /// Target inertial number.
+        i_target: "I_target",
+        /// Bulk inertial number measured.
+        i: "I",
+        /// Bulk μ = |Σ_xy|/P.
+        mu: "mu",
+        /// Bulk solid fraction.
+        phi: "phi",
+        /// Bulk `P = −Σ_yy` (Pa).
+        p: "P_Pa",
+        /// Bulk shear rate (1/s).
+        shear_rate: "shear_rate_1_s",
+        /// Wall velocity V (m/s).
+        wall_velocity: "wall_velocity_m_s",
+        /// Gap H (m).
+        height: "height_m",
+        /// Time step (s).
+        dt: "dt_s",
+        /// Slip velocity at the bottom wall (m/s).
+        slip_bottom: "slip_velocity_bottom_m_s",
+        /// Effective friction of the bottom wall.
+        mu_eff_bottom: "mu_eff_bottom",
+        /// Slip velocity at the top wall (m/s).
+        slip_top: "slip_velocity_top_m_s",
+        /// Effective friction of the top wall.
+        mu_eff_top: "mu_eff_top",
+        /// Samples of the window.
+        samples: "samples",
+        /// V over the uniform-shear estimate γ̇_target H.
+        wall_velocity_over_uniform: "wall_velocity_over_uniform",
+        /// The solver's tolerance of the averaged stage.
+        solver_tolerance: "solver_tolerance",
+    }
+}
+
+table_row! {
+    /// One wall-velocity correction: a row of `lead_stages.csv`.
+    struct LeadRow {
+        /// Target inertial number.
+        i_target: "I_target",
+        /// The lead stage after which V was corrected.
+        lead_stage: "lead_stage",
+        /// Bulk I over the stage's second half.
+        i_measured: "I_measured",
+        /// Factor applied to V.
+        velocity_factor: "velocity_factor",
+        /// V over the uniform-shear estimate after it.
+        wall_velocity_over_uniform: "wall_velocity_over_uniform",
+    }
+}
+
 /// What the phases collect.
 #[derive(Serialize, Deserialize)]
 struct ShearState {
     all: PhaseStats,
     /// One row per run: `rheology.csv`.
-    #[serde(with = "crate::floats::table")]
-    rows: Vec<Vec<f64>>,
+    #[serde(with = "serde_rows")]
+    rows: Vec<CellRow>,
     profiles: Vec<MeanProfile>,
     run: ShearRun,
     acc: RunAverages,
@@ -296,8 +352,8 @@ struct ShearState {
     #[serde(default)]
     lead: LeadAverages,
     /// One row per wall-velocity correction: `lead_stages.csv`.
-    #[serde(default, with = "crate::floats::table")]
-    lead_rows: Vec<Vec<f64>>,
+    #[serde(default, with = "serde_rows")]
+    lead_rows: Vec<LeadRow>,
     /// The current lead stage's solver sensitivity (its second half's samples, re-solved).
     #[serde(default)]
     lead_sensitivity: Sensitivity,
@@ -444,8 +500,13 @@ impl PhasedRun for Shear<'_> {
         {
             let (i_measured, factor) = velocity_correction(i_target, &st.lead, d, c.grain.density);
             v *= factor;
-            st.lead_rows
-                .push(vec![i_target, j as f64, i_measured, factor, v / v_uniform]);
+            st.lead_rows.push(LeadRow {
+                i_target,
+                lead_stage: j as f64,
+                i_measured,
+                velocity_factor: factor,
+                wall_velocity_over_uniform: v / v_uniform,
+            });
             if factor != 1.0 {
                 info(
                     env.verbosity,
@@ -612,24 +673,24 @@ impl PhasedRun for Shear<'_> {
             mu: acc.mu_samples.clone(),
             phi: acc.phi_samples.clone(),
         });
-        st.rows.push(vec![
+        st.rows.push(CellRow {
             i_target,
-            i_meas,
+            i: i_meas,
             mu,
             phi,
             p,
-            gd,
-            v,
-            h,
+            shear_rate: gd,
+            wall_velocity: v,
+            height: h,
             dt,
-            vb,
-            mub,
-            vt,
-            mut_,
-            acc.samples as f64,
-            v / v_uniform,
-            world.params.solver.tolerance,
-        ]);
+            slip_bottom: vb,
+            mu_eff_bottom: mub,
+            slip_top: vt,
+            mu_eff_top: mut_,
+            samples: acc.samples as f64,
+            wall_velocity_over_uniform: v / v_uniform,
+            solver_tolerance: world.params.solver.tolerance,
+        });
         st.profiles.push(MeanProfile {
             i: i_meas,
             y: acc.profile.iter().map(|p| p.0).collect(),
@@ -704,58 +765,29 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     verdict.run.extend(&phi_checks);
     let d = mean_diameter(&world);
     VtkFrames::new(f64::INFINITY, 1).finish(&mut ctx.out, &world)?;
-    let headers = [
-        "I_target",
-        "I",
-        "mu",
-        "phi",
-        "P_Pa",
-        "shear_rate_1_s",
-        "wall_velocity_m_s",
-        "height_m",
-        "dt_s",
-        "slip_velocity_bottom_m_s",
-        "mu_eff_bottom",
-        "slip_velocity_top_m_s",
-        "mu_eff_top",
-        "samples",
-        "wall_velocity_over_uniform",
-        "solver_tolerance",
-        "point_verdict",
-    ];
     let grain = GrainScale {
         diameter_m: d,
         density_kg_m3: c.grain.density,
     };
     write_rheology_table(
         &mut ctx.out,
-        &headers,
         &rows,
         &point_verdicts,
         "steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip",
         grain,
     )?;
     if c.velocity_corrections > 0 {
-        let mut lead = CsvTable::new(&[
-            "I_target",
-            "lead_stage",
-            "I_measured",
-            "velocity_factor",
-            "wall_velocity_over_uniform",
-        ]);
+        let mut lead = rows::table(&lead_rows);
         lead.comments.push("wall-velocity corrections: bulk I over the second half of each correcting lead stage, the factor applied to V after it (1 within the dead band), and V over the uniform-shear estimate after it".into());
-        for r in lead_rows {
-            lead.push(r);
-        }
         lead.write(&mut ctx.out, "lead_stages.csv")?;
     }
 
     // Fits.
     let series = RheologySeries {
-        inertial_number: rows.iter().map(|r| r[1]).collect(),
-        mu: Some(rows.iter().map(|r| r[2]).collect()),
-        phi: Some(rows.iter().map(|r| r[3]).collect()),
-        pressure_pa: Some(rows.iter().map(|r| r[4]).collect()),
+        inertial_number: rows.iter().map(|r| r.i).collect(),
+        mu: Some(rows.iter().map(|r| r.mu).collect()),
+        phi: Some(rows.iter().map(|r| r.phi).collect()),
+        pressure_pa: Some(rows.iter().map(|r| r.p).collect()),
         // the wall-bounded cell measures no standard error per point: unweighted fits
         mu_std_error: None,
         phi_std_error: None,
@@ -768,10 +800,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         .num("pressure_Pa", c.pressure)
         .num("mean_diameter_m", d)
         .int("runs", rows.len() as u64)
-        .num("I_min", rows.iter().map(|r| r[1]).fold(f64::MAX, f64::min))
-        .num("I_max", rows.iter().map(|r| r[1]).fold(f64::MIN, f64::max));
+        .num("I_min", rows.iter().map(|r| r.i).fold(f64::MAX, f64::min))
+        .num("I_max", rows.iter().map(|r| r.i).fold(f64::MIN, f64::max));
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
-    let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+    let is: Vec<f64> = rows.iter().map(|r| r.i).collect();
     let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
         &mut ctx.out,
         &series,
@@ -796,7 +828,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     let mut vs = Vec::new();
     let mut mus = Vec::new();
     for r in &rows {
-        for (v, m) in [(r[9], r[10]), (r[11], r[12])] {
+        for (v, m) in [(r.slip_bottom, r.mu_eff_bottom), (r.slip_top, r.mu_eff_top)] {
             if v.is_finite() && m.is_finite() {
                 vs.push(v.abs());
                 mus.push(m);
