@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_csv_table, table_row};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -97,6 +98,22 @@ struct Flow<'a> {
     c: &'a InclinedFlowConfig,
 }
 
+table_row! {
+    /// One step of the flow: a row of `history.csv`.
+    struct FlowStep {
+        /// Time (s).
+        t: "time_s",
+        /// Mass-weighted mean velocity of the grains along the slope (m/s).
+        mean_velocity: "mean_velocity_m_s",
+        /// Kinetic energy (J).
+        kinetic_energy: "kinetic_energy_J",
+        /// Sweeps of the step's solve.
+        sweeps: "sweeps",
+        /// The solve's error.
+        solver_error: "solver_error",
+    }
+}
+
 /// What the flow phase collects.
 #[derive(Serialize, Deserialize)]
 struct FlowState {
@@ -104,7 +121,8 @@ struct FlowState {
     base: f64,
     prof: Profiles,
     /// One row per step: `history.csv`.
-    hist: CsvTable,
+    #[serde(with = "serde_csv_table")]
+    hist: Vec<FlowStep>,
     vtk: VtkFrames,
     /// Steps done.
     k: u64,
@@ -160,13 +178,13 @@ impl PhasedRun for Flow<'_> {
             mv += b.mass * b.velocity.x;
             m += b.mass;
         }
-        st.hist.push(vec![
-            w.time,
-            mv / m,
-            w.kinetic_energy(),
-            r.solver.iterations as f64,
-            r.solver.error,
-        ]);
+        st.hist.push(FlowStep {
+            t: w.time,
+            mean_velocity: mv / m,
+            kinetic_energy: w.kinetic_energy(),
+            sweeps: r.solver.iterations as f64,
+            solver_error: r.solver.error,
+        });
         if st.k > avg_from && st.k.is_multiple_of(sample_every) {
             st.prof.add(&w.snapshot(), st.base)?;
         }
@@ -217,13 +235,7 @@ pub fn run(
         let state = FlowState {
             base: c.grain.radius_mean, // top of the rough base (disks centred on y = 0)
             prof: Profiles::new(bins, 1.6 * h_est / bins as f64),
-            hist: CsvTable::new(&[
-                "time_s",
-                "mean_velocity_m_s",
-                "kinetic_energy_J",
-                "sweeps",
-                "solver_error",
-            ]),
+            hist: Vec::new(),
             vtk: VtkFrames::new(c.duration / c.vtk_frames.max(1) as f64, c.vtk_frames.max(1)),
             k: 0,
             stats: PhaseStats::default(),
@@ -288,7 +300,7 @@ pub fn run(
         c.average, prof.samples
     ));
     table.write(&mut ctx.out, "profiles.csv")?;
-    hist.write(&mut ctx.out, "history.csv")?;
+    rows::table(&hist).write(&mut ctx.out, "history.csv")?;
     // Flow height: where the time-averaged solid fraction falls below half its bulk value.
     let bulk = phi.iter().map(|p| p.0).fold(0.0, f64::max);
     let height = phi
@@ -296,7 +308,7 @@ pub fn run(
         .filter(|p| p.0 > 0.5 * bulk)
         .map(|p| p.1 + 0.5 * dy)
         .fold(0.0, f64::max);
-    let mean_v = hist.rows.last().map(|r| r[1]).unwrap_or(f64::NAN);
+    let mean_v = hist.last().map(|r| r.mean_velocity).unwrap_or(f64::NAN);
     let surface_v = vel
         .iter()
         .filter(|p| p.1 <= height)
@@ -330,9 +342,9 @@ pub fn run(
     let mut checks = Checks::new();
     checks.window("averaging window", &window);
     let avg_steps = window.steps as usize;
-    let v_window: Vec<f64> = hist.rows[hist.rows.len().saturating_sub(avg_steps)..]
+    let v_window: Vec<f64> = hist[hist.len().saturating_sub(avg_steps)..]
         .iter()
-        .map(|r| r[1])
+        .map(|r| r.mean_velocity)
         .collect();
     let v_mean = v_window.iter().sum::<f64>() / v_window.len().max(1) as f64;
     checks.steady(
@@ -427,7 +439,7 @@ pub fn run(
         "",
         Style::Thin,
         PALETTE[0],
-        hist.rows.iter().map(|r| (r[0], r[1])).collect(),
+        hist.iter().map(|r| (r.t, r.mean_velocity)).collect(),
     ));
     draw_xy(&mut ctx.out, "velocity_history.png", &ph)?;
 

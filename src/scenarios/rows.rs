@@ -98,6 +98,26 @@ pub mod serde_rows {
     }
 }
 
+/// Serde for `Vec<R>` of typed rows as the [`CsvTable`] of [`table`] (no comments or metadata),
+/// for a state that kept the table itself: its run checkpoints keep their format. Use with
+/// `#[serde(with = "crate::scenarios::rows::serde_csv_table")]`.
+pub mod serde_csv_table {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use super::{rows_of, table, TableRow};
+    use crate::output::CsvTable;
+
+    /// Serialise.
+    pub fn serialize<R: TableRow, S: Serializer>(v: &[R], s: S) -> Result<S::Ok, S::Error> {
+        table(v).serialize(s)
+    }
+
+    /// Deserialise.
+    pub fn deserialize<'de, R: TableRow, D: Deserializer<'de>>(d: D) -> Result<Vec<R>, D::Error> {
+        Ok(rows_of(&CsvTable::deserialize(d)?))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,5 +176,20 @@ mod tests {
         assert_eq!(json, serde_json::to_string(&plain).unwrap());
         let back: Typed = serde_json::from_str(&json).unwrap();
         assert_eq!(back.rows, typed.rows);
+        #[derive(serde::Serialize, serde::Deserialize)]
+        struct AsTable {
+            #[serde(with = "serde_csv_table")]
+            rows: Vec<Two>,
+        }
+        #[derive(serde::Serialize)]
+        struct Kept {
+            rows: CsvTable,
+        }
+        let mut kept = CsvTable::new(&["a_s", "b_Pa"]);
+        kept.push(vec![0.1, f64::INFINITY]);
+        let json = serde_json::to_string(&AsTable { rows: typed.rows }).unwrap();
+        assert_eq!(json, serde_json::to_string(&Kept { rows: kept }).unwrap());
+        let back: AsTable = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.rows[0].a, 0.1);
     }
 }

@@ -30,6 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_csv_table, table_row};
 use super::sensitivity::{resolve_last_step, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -64,6 +65,26 @@ struct Column<'a> {
     width: f64,
 }
 
+table_row! {
+    /// One step of the column's run: a row of `history.csv`.
+    pub(super) struct ColumnStep {
+        /// Time (s).
+        t: "time_s",
+        /// The phase: 0 deposit, 1 relax, 2 release, 3 measure.
+        phase: "phase_0deposit_1relax_2release_3measure",
+        /// Kinetic energy (J/m).
+        kinetic_energy: "kinetic_energy_J",
+        /// Active contacts.
+        contacts: "contacts",
+        /// Sweeps of the step's solve.
+        sweeps: "sweeps",
+        /// The solve's error.
+        solver_error: "solver_error",
+        /// Load on the floor over the grains' weight.
+        bottom_load: "bottom_load_over_weight",
+    }
+}
+
 /// What the column's phases collect.
 #[derive(Serialize, Deserialize)]
 struct ColumnState {
@@ -75,7 +96,8 @@ struct ColumnState {
     /// Weight of the grains Σ m g (N).
     weight: f64,
     /// One row per step: `history.csv`.
-    history: CsvTable,
+    #[serde(with = "serde_csv_table")]
+    history: Vec<ColumnStep>,
     /// VTK frames.
     vtk: VtkFrames,
     deposit: PhaseStats,
@@ -272,15 +294,15 @@ impl PhasedRun for Column<'_> {
         }
         st.last_step_index = r.step;
         let load = Self::floor_load(w, st);
-        st.history.push(vec![
-            w.time,
-            k as f64,
-            w.kinetic_energy(),
-            r.active_contacts as f64,
-            r.solver.iterations as f64,
-            r.solver.error,
-            load,
-        ]);
+        st.history.push(ColumnStep {
+            t: w.time,
+            phase: k as f64,
+            kinetic_energy: w.kinetic_energy(),
+            contacts: r.active_contacts as f64,
+            sweeps: r.solver.iterations as f64,
+            solver_error: r.solver.error,
+            bottom_load: load,
+        });
         st.vtk.maybe(out, w)
     }
 
@@ -341,15 +363,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             left: col.left,
             right: col.right,
             weight: grain_weight(&col.world),
-            history: CsvTable::new(&[
-                "time_s",
-                "phase_0deposit_1relax_2release_3measure",
-                "kinetic_energy_J",
-                "contacts",
-                "sweeps",
-                "solver_error",
-                "bottom_load_over_weight",
-            ]),
+            history: Vec::new(),
             vtk: VtkFrames::new(VTK_INTERVAL, c.analysis.vtk_frames.max(1)),
             deposit: PhaseStats::default(),
             relax: PhaseStats::default(),
@@ -620,7 +634,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     s.int("vtk_frames", frames as u64);
 
     // CSV: history and the fit-ready profile.
-    history.write(&mut ctx.out, "history.csv")?;
+    rows::table(&history).write(&mut ctx.out, "history.csv")?;
     // τ_w is named `tau_w_Pa` (read by `grainlaw fit janssen`) only when the fit used it.
     let uses_tau = fitted.as_ref().map(|o| o.uses_tau_w).unwrap_or(false);
     let tau_header = if uses_tau {
