@@ -23,7 +23,7 @@
 //! stress–dilatancy relation `sin φ_mob = sin φ_cv + β sin ψ` fitted over the hardening phase
 //! (dilatancy windows before the peak) of every pressure.
 
-use datasets::config::{BiaxialConfig, CellControlMode, Preparation};
+use datasets::config::{BiaxialConfig, Preparation};
 use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
@@ -35,9 +35,10 @@ use identify::mohr_coulomb::{fit_mohr_coulomb_supported, YieldData};
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
+use super::cell_base::{CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
 use super::common::{
-    fit_keys, implicit_cell_control, mean_diameter, parameter_lines, short_number, solver_keys,
-    strain_bins, Stop, VtkFrames,
+    fit_keys, mean_diameter, parameter_lines, short_number, solver_keys, strain_bins, Stop,
+    VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::rows::{self, serde_rows, table_row};
@@ -119,8 +120,6 @@ table_row! {
     }
 }
 
-/// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
-const GAIN_FRACTION: f64 = 0.3;
 /// Gain of the lateral control in the axial compression, as a fraction of `Δt/(ρ d²)`: lower
 /// than in the isotropic compression, so that the step-to-step noise of Σ_xx (tens of % of p₀
 /// for rigid grains) does not drive the lateral rate.
@@ -129,12 +128,6 @@ const AXIAL_GAIN_FRACTION: f64 = 0.05;
 const AXIAL_RATE_CAP: f64 = 3.0;
 /// Filter time of the lateral control in the axial compression, in time steps.
 const AXIAL_FILTER_STEPS: f64 = 10.0;
-/// Tolerance of the explicit law's correction of the cell control, as a fraction of p₀.
-const CONTROL_TOLERANCE: f64 = 0.5;
-/// Re-solves of a step at most by the implicit correction.
-const MAX_CORRECTIONS: usize = 8;
-/// Blocks of the block-averaged standard errors (at least).
-const MIN_BLOCKS: usize = 4;
 /// About this many axial steps per pressure, evenly spread, are solved again to
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] and the cell's stress taken both ways: the solver
 /// sensitivity of the axial compression ([`crate::verdict::Sensitivity`] with the axial
@@ -330,16 +323,14 @@ struct PressureCheck {
 /// What the phases collect.
 #[derive(Serialize, Deserialize)]
 struct State {
-    all: PhaseStats,
-    /// One row per finished pressure.
-    #[serde(with = "serde_rows")]
-    rows: Vec<PressureRow>,
+    /// Solver statistics, one row per finished pressure, the current axial compression's
+    /// history, the frames of the last pressure's sample, the numerics of the current axial
+    /// compression.
+    #[serde(flatten)]
+    cell: CellRecord<HistoryRow, PressureRow>,
     /// What the current pressure's isotropic compression reached, until its row is closed.
     #[serde(default)]
     compressed: Option<Compressed>,
-    /// The current axial compression's history.
-    #[serde(with = "serde_rows")]
-    history: Vec<HistoryRow>,
     /// The steps of the current isotropic compression.
     #[serde(with = "serde_rows")]
     compression: Vec<CompressionRow>,
@@ -351,8 +342,6 @@ struct State {
     #[serde(default, with = "serde_rows")]
     dilatancy: Vec<DilatancyRow>,
     run: RunPlan,
-    frames: VtkFrames,
-    window: WindowStats,
     checks: Vec<PressureCheck>,
     /// The imposed stress target of the current phase (Pa), after the outer correction.
     #[serde(with = "dem::serde_float")]
@@ -548,7 +537,7 @@ impl Biaxial<'_> {
     ) -> CellControl {
         let rho = self.c.grain.density;
         let cap = self.c.control_inertial_number * (p0 / rho).sqrt() / d;
-        let (yy, max_rate, gf, tau) = match axial_rate {
+        let (yy, max_rate, gain_fraction, filter_steps) = match axial_rate {
             None => (Imposed::Stress(target), cap, GAIN_FRACTION, 0.0),
             // the lateral expansion of a dilating sample runs at ε̇_a (1 + d), d ≲ 1
             Some(r) => (
@@ -558,35 +547,26 @@ impl Biaxial<'_> {
                 AXIAL_FILTER_STEPS,
             ),
         };
-        if self.c.cell_control == CellControlMode::Implicit {
-            return implicit_cell_control(
-                Imposed::Stress(target),
-                yy,
-                Imposed::Rate(0.0),
-                max_rate,
-                p0,
-                axial_rate.is_none(),
-            );
-        }
-        CellControl {
+        ControlPlan {
+            mode: self.c.cell_control,
             xx: Imposed::Stress(target),
             yy,
             xy: Imposed::Rate(0.0),
-            gain: gf * dt / (rho * d * d),
             max_rate,
-            relaxation: tau * dt,
-            tolerance: CONTROL_TOLERANCE * p0,
-            max_corrections: MAX_CORRECTIONS,
-            implicit: false,
+            pressure: p0,
+            compressing: axial_rate.is_none(),
+            gain_fraction,
+            filter_steps,
             affine: false,
         }
+        .control(dt, rho, d)
     }
 
     /// Closes an axial compression: the result row, the binned curves, the check data.
     fn close_axial(&self, i: usize, st: &mut State, world: &dem::World) -> Result<()> {
         let c = self.c;
         let p0 = self.pressures[i];
-        let h = &st.history;
+        let h = &st.cell.history;
         let bins = bin_history(h, c.bin_strain);
         // the peak: the largest bin mean of q/p
         let (kpeak, peak) =
@@ -659,7 +639,7 @@ impl Biaxial<'_> {
             phi: f64::NAN,
             z: f64::NAN,
         });
-        st.rows.push(PressureRow {
+        st.cell.rows.push(PressureRow {
             p0,
             sin_phi_peak: peak,
             axial_strain_peak: eps_peak,
@@ -693,7 +673,7 @@ impl Biaxial<'_> {
         });
         st.checks.push(PressureCheck {
             p0,
-            window: st.window,
+            window: st.cell.window,
             sin_phi: qa.iter().zip(col(|r| r.p)).map(|(q, p)| q / p).collect(),
             phi: col(|r| r.phi),
         });
@@ -813,8 +793,8 @@ impl PhasedRun for Biaxial<'_> {
                         h0: cell.h[(1, 1)],
                         v0: cell.volume(),
                     };
-                    st.history.clear();
-                    st.window.reset();
+                    st.cell.history.clear();
+                    st.cell.window.reset();
                 }
                 world.cell_control = Some(self.control(p0, target, dt, d, Some(rate)));
                 let steps = per.min(total.saturating_sub(st.run.n));
@@ -840,7 +820,7 @@ impl PhasedRun for Biaxial<'_> {
     ) -> Result<()> {
         let (i, part) = self.part(k);
         if i + 1 == self.pressures.len() && matches!(part, Part::Axial(_)) {
-            st.frames.maybe(out, w)?;
+            st.cell.frames.maybe(out, w)?;
         }
         let snap = w.snapshot();
         let cs = cell_state(&snap)?;
@@ -860,7 +840,7 @@ impl PhasedRun for Biaxial<'_> {
         }
         st.seg = (st.seg.0 + s[(0, 0)], st.seg.1 + s[(0, 0)], st.seg.2 + 1);
         st.run.n += 1;
-        st.window.step(true, w, r, &p.stats);
+        st.cell.window.step(true, w, r, &p.stats);
         if st
             .run
             .n
@@ -868,7 +848,7 @@ impl PhasedRun for Biaxial<'_> {
         {
             let resolved =
                 resolved_pair(w, |snap| Some(axial_pair(&cell_state(snap).ok()?.stress)));
-            record(&mut st.window.sensitivity, axial_pair(&s), resolved);
+            record(&mut st.cell.window.sensitivity, axial_pair(&s), resolved);
         }
         let Some(cell) = w.cell().copied() else {
             return Ok(());
@@ -883,7 +863,7 @@ impl PhasedRun for Biaxial<'_> {
         let f = cs.fabric;
         let aniso = 2.0 * ((f[(0, 0)] - f[(1, 1)]).powi(2) + 4.0 * f[(0, 1)].powi(2)).sqrt();
         let angle = 0.5 * (2.0 * f[(0, 1)]).atan2(f[(0, 0)] - f[(1, 1)]);
-        st.history.push(HistoryRow {
+        st.cell.history.push(HistoryRow {
             t: w.time,
             axial_strain: -(cell.h[(1, 1)] / st.run.h0).ln(),
             volumetric_strain: -(cell.volume() / st.run.v0).ln(),
@@ -916,7 +896,7 @@ impl PhasedRun for Biaxial<'_> {
         world: &mut dem::World,
         stats: &PhaseStats,
     ) -> Result<()> {
-        st.all.merge(stats);
+        st.cell.all.merge(stats);
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];
         match part {
@@ -954,7 +934,7 @@ impl PhasedRun for Biaxial<'_> {
                 if st.run.n < st.run.steps {
                     return Ok(());
                 }
-                let mut table = rows::table(&st.history);
+                let mut table = rows::table(&st.cell.history);
                 table.comments.push(format!(
                     "biaxial compression at confining pressure p0 = {p0} Pa ({} preparation), axial rate {:.6e} 1/s along y with sigma_xx = -p0 held: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s); compression positive for the strains: axial_strain = -ln(H/H0), volumetric_strain = -ln(V/V0) (positive in contraction); p = -tr(sigma)/2, q = sqrt(((sigma_xx - sigma_yy)/2)^2 + sigma_xy^2), sin_phi_mob = q/p of the step (noisy: the analysis uses means of the tensor), q_axial = (sigma_xx - sigma_yy)/2; phi solid fraction, Z coordination and fabric over force-carrying contacts, fabric_anisotropy a = 2 (F1 - F2) of the fabric tensor F (Rothenburg & Bathurst 1989), fabric_angle_deg its major direction from x; I = rate d / sqrt(p/rho); cell_corrections counts the re-solves of the step by the cell control; target_sigma_xx the imposed lateral stress after the outer correction",
                     self.c.preparation.as_str(),
@@ -979,17 +959,13 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         Ok((
             world,
             State {
-                all: PhaseStats::default(),
-                rows: Vec::new(),
+                // frames of the last (highest) pressure's sample
+                cell: CellRecord::new(VtkFrames::new(t_last / 40.0, 41)),
                 compressed: None,
-                history: Vec::new(),
                 compression: Vec::new(),
                 bins: Vec::new(),
                 dilatancy: Vec::new(),
                 run: RunPlan::default(),
-                // frames of the last (highest) pressure's sample
-                frames: VtkFrames::new(t_last / 40.0, 41),
-                window: WindowStats::default(),
                 checks: Vec::new(),
                 target: 0.0,
                 seg: (0.0, 0.0, 0),
@@ -998,11 +974,11 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     };
     let (world, state) = drive(ctx, ctl, &bx, fresh)?;
     let State {
-        all,
-        rows,
+        cell: CellRecord {
+            all, rows, frames, ..
+        },
         bins,
         dilatancy,
-        frames,
         checks,
         ..
     } = state;

@@ -4,6 +4,7 @@
 
 pub mod arrangements;
 pub mod biaxial;
+pub mod cell_base;
 pub mod column_collapse;
 pub mod common;
 pub mod dump;

@@ -11,7 +11,7 @@
 //! `I = γ̇ d / √(p_n/ρ)`. μ(I) and φ(I) are fitted by `identify::mu_i` (which refuses what the
 //! data cannot support).
 
-use datasets::config::{CellControlMode, SimpleShearConfig};
+use datasets::config::SimpleShearConfig;
 use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
@@ -21,11 +21,10 @@ use identify::mu_i::RheologySeries;
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{
-    implicit_cell_control, mean_diameter, solver_keys, strain_bins, Stop, VtkFrames,
-};
+use super::cell_base::{CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
+use super::common::{mean_diameter, solver_keys, strain_bins, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
-use super::rows::{self, serde_rows, table_row};
+use super::rows::{self, table_row};
 use super::sensitivity::{record, resolved_pair};
 use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
@@ -34,7 +33,7 @@ use crate::error::Result;
 use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::verdict::{max_solid_fraction, RunVerdict, WindowStats};
+use crate::verdict::{max_solid_fraction, RunVerdict};
 
 /// Re-solved samples of an averaging window, spread evenly over it (at least this many; every
 /// step of a shorter window): each such step is solved again to
@@ -94,15 +93,6 @@ table_row! {
         cell_corrections: "cell_corrections",
     }
 }
-
-/// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
-const GAIN_FRACTION: f64 = 0.3;
-/// Tolerance of the implicit correction of the cell control, as a fraction of P.
-const CONTROL_TOLERANCE: f64 = 0.5;
-/// Re-solves of a step at most by the implicit correction.
-const MAX_CORRECTIONS: usize = 8;
-/// Blocks of the block-averaged standard errors (at least).
-pub(crate) const MIN_BLOCKS: usize = 4;
 
 /// The samples of a biperiodic cell's state over an averaging window, one per step (this
 /// scenario) or per snapshot (another code's run, `grainlaw homogenise`): `−Σ_yy` and
@@ -268,20 +258,13 @@ struct RunPlan {
 /// What the phases collect.
 #[derive(Serialize, Deserialize)]
 struct State {
-    all: PhaseStats,
-    /// One row per run: `rheology.csv`.
-    #[serde(with = "serde_rows")]
-    rows: Vec<RheologyRow>,
-    /// The current run's history.
-    #[serde(with = "serde_rows")]
-    history: Vec<HistoryRow>,
+    /// Solver statistics, one row per run (`rheology.csv`), the current run's history, the
+    /// frames, the numerics of the current run's averaging window.
+    #[serde(flatten)]
+    cell: CellRecord<HistoryRow, RheologyRow>,
     /// Strain histories of μ of the finished runs, for the figure: (I, [(γ, μ)]).
     curves: Vec<(f64, Vec<(f64, f64)>)>,
     run: RunPlan,
-    frames: VtkFrames,
-    /// Numerics of the current run's averaging window.
-    #[serde(default)]
-    window: WindowStats,
     /// The checks of the finished runs (crate::verdict).
     #[serde(default)]
     checks: Vec<RunCheckData>,
@@ -325,29 +308,19 @@ impl Shear<'_> {
             // A sheared packing dilates at up to about γ̇: the cap must allow it.
             Some(g) => (Imposed::Rate(0.0), Imposed::Rate(g), rate_cap.max(g)),
         };
-        if c.cell_control == CellControlMode::Implicit {
-            return implicit_cell_control(
-                xx,
-                Imposed::Stress(-p),
-                xy,
-                max_rate,
-                p,
-                gamma_dot.is_none(),
-            )
-            .with_affine(c.cell_affine);
-        }
-        CellControl {
+        ControlPlan {
+            mode: c.cell_control,
             xx,
             yy: Imposed::Stress(-p),
             xy,
-            gain: GAIN_FRACTION * dt / (rho * d * d),
             max_rate,
-            relaxation: 0.0,
-            tolerance: CONTROL_TOLERANCE * p,
-            max_corrections: MAX_CORRECTIONS,
-            implicit: false,
-            affine: false,
+            pressure: p,
+            compressing: gamma_dot.is_none(),
+            gain_fraction: GAIN_FRACTION,
+            filter_steps: 0.0,
+            affine: c.cell_affine,
         }
+        .control(dt, rho, d)
     }
 }
 
@@ -396,8 +369,8 @@ impl PhasedRun for Shear<'_> {
             avg_steps,
             n: 0,
         };
-        st.history.clear();
-        st.window.reset();
+        st.cell.history.clear();
+        st.cell.window.reset();
         Ok(Some(PhasePlan {
             name: format!("I={i}"),
             stop: Stop::Steps(steps),
@@ -413,13 +386,13 @@ impl PhasedRun for Shear<'_> {
         r: &dem::StepReport,
         p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
-        st.frames.maybe(out, w)?;
+        st.cell.frames.maybe(out, w)?;
         if k == 0 {
             return Ok(());
         }
         st.run.n += 1;
         let averaged = st.run.n + st.run.avg_steps > st.run.steps;
-        st.window.step(averaged, w, r, &p.stats);
+        st.cell.window.step(averaged, w, r, &p.stats);
         let snap = w.snapshot();
         let cs = cell_state(&snap)?;
         let s = cs.stress;
@@ -433,7 +406,11 @@ impl PhasedRun for Shear<'_> {
                 let s = cell_state(snap).ok()?.stress;
                 Some([s[(0, 1)], s[(1, 1)]])
             });
-            record(&mut st.window.sensitivity, [s[(0, 1)], s[(1, 1)]], resolved);
+            record(
+                &mut st.cell.window.sensitivity,
+                [s[(0, 1)], s[(1, 1)]],
+                resolved,
+            );
         }
         let d = mean_diameter(w);
         let pn = -s[(1, 1)];
@@ -447,7 +424,7 @@ impl PhasedRun for Shear<'_> {
         } else {
             f64::NAN
         };
-        st.history.push(HistoryRow {
+        st.cell.history.push(HistoryRow {
             t: w.time,
             shear_strain: st.run.gamma_dot * st.run.dt * st.run.n as f64,
             sxx: s[(0, 0)],
@@ -478,18 +455,18 @@ impl PhasedRun for Shear<'_> {
         world: &mut dem::World,
         stats: &PhaseStats,
     ) -> Result<()> {
-        st.all.merge(stats);
+        st.cell.all.merge(stats);
         if k == 0 {
             return Ok(());
         }
         let target = self.targets[k - 1];
-        let mut table = rows::table(&st.history);
+        let mut table = rows::table(&st.cell.history);
         table.comments.push(format!(
             "simple shear at target I {target}: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s), p is -tr(sigma)/2, q, solid fraction, coordination Z and fabric over force-carrying contacts, I is gamma_dot d / sqrt(-sigma_yy/rho), mu is |sigma_xy|/(-sigma_yy), cell_corrections counts the re-solves of the step by the cell control"
         ));
         table.write(out, &format!("history_I{k}.csv"))?;
-        let tail =
-            &st.history[st.history.len() - (st.run.avg_steps as usize).min(st.history.len())..];
+        let tail = &st.cell.history
+            [st.cell.history.len() - (st.run.avg_steps as usize).min(st.cell.history.len())..];
         let col = |f: fn(&HistoryRow) -> f64| -> Vec<f64> { tail.iter().map(f).collect() };
         let samples = CellSamples {
             normal_stress: col(|r| r.syy).iter().map(|s| -s).collect(),
@@ -504,27 +481,28 @@ impl PhasedRun for Shear<'_> {
         let corrections: f64 = col(|r| r.cell_corrections).iter().sum();
         // what the solver's measured effect is judged against (0: not known)
         let known = |x: f64| if x.is_finite() { x } else { 0.0 };
-        st.window.statistical_errors = [known(point.mu_se), known(point.pn_se / point.pn)];
+        st.cell.window.statistical_errors = [known(point.mu_se), known(point.pn_se / point.pn)];
         st.checks.push(RunCheckData {
             i_target: target,
             i_measured: point.i,
-            window: st.window,
+            window: st.cell.window,
             mu: samples.mu,
             phi: samples.phi,
         });
-        st.rows.push(point.row(
+        st.cell.rows.push(point.row(
             target,
             gd,
             st.run.dt,
             tail.len(),
             corrections / tail.len().max(1) as f64,
         ));
-        st.peaks.push(peak_mu(&st.history));
+        st.peaks.push(peak_mu(&st.cell.history));
         st.curves.push((
             point.i,
-            st.history
+            st.cell
+                .history
                 .iter()
-                .step_by((st.history.len() / 200).max(1))
+                .step_by((st.cell.history.len() / 200).max(1))
                 .map(|r| (r.shear_strain, r.mu))
                 .collect(),
         ));
@@ -555,13 +533,9 @@ pub fn run(
         Ok((
             world,
             State {
-                all: PhaseStats::default(),
-                rows: Vec::new(),
-                history: Vec::new(),
+                cell: CellRecord::new(VtkFrames::new(t_total / 40.0, 41)),
                 curves: Vec::new(),
                 run: RunPlan::default(),
-                frames: VtkFrames::new(t_total / 40.0, 41),
-                window: WindowStats::default(),
                 checks: Vec::new(),
                 peaks: Vec::new(),
             },
@@ -569,10 +543,10 @@ pub fn run(
     };
     let (world, state) = drive(ctx, ctl, &shear, fresh)?;
     let State {
-        all,
-        rows,
+        cell: CellRecord {
+            all, rows, frames, ..
+        },
         curves,
-        frames,
         checks: run_checks,
         peaks,
         ..
