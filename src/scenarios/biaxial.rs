@@ -31,6 +31,7 @@ use homogenise::cell::cell_state;
 use identify::critical_state::{
     fit_critical_state, fit_stress_dilatancy, PlateauMeasure, StressDilatancyData,
 };
+use identify::law::Provenance;
 use identify::mohr_coulomb::{fit_mohr_coulomb_supported, YieldData};
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
@@ -1047,21 +1048,22 @@ fn judge_dilatancy(k: &mut Checks, label: &str, r: &PressureRow) {
     }
 }
 
-/// The checks, fits, laws, table, figures and summary of a finished run.
-#[allow(clippy::too_many_arguments)]
-fn analyse(
-    c: &BiaxialConfig,
-    pressures: &[f64],
-    ctx: &mut RunContext,
-    ctl: &RunControl,
-    world: &dem::World,
-    all: &PhaseStats,
-    rows: &[PressureRow],
-    bins: &[BinPoint],
-    dilatancy: &[DilatancyRow],
-    checks: &[PressureCheck],
-) -> Result<RunOutcome> {
-    // --- checks (crate::verdict) ---
+/// The checks of a finished run ([`judge`]): per law, the checks it is judged by.
+struct Judged {
+    /// The numerics and stresses of every pressure (all laws).
+    common: Checks,
+    /// `common` and the plateaus (the critical state).
+    critical: Checks,
+    /// `common` and the dilatancy (the stress–dilatancy relation).
+    dilat: Checks,
+    /// The run's own checks: the critical state's and the dilatancy's.
+    run: Checks,
+    /// The numerics of all axial compressions.
+    windows: WindowStats,
+}
+
+/// Stage "measure → verdict": the checks of every pressure (`crate::verdict`).
+fn judge(c: &BiaxialConfig, rows: &[PressureRow], checks: &[PressureCheck]) -> Judged {
     let mut common = Checks::new();
     let mut critical = Checks::new();
     let mut dilat = Checks::new();
@@ -1138,13 +1140,39 @@ fn analyse(
         k.extend(&dilat);
         k
     };
-    let mut verdict = RunVerdict {
+    Judged {
+        common,
+        critical,
+        dilat,
         run: run_checks,
-        allow_suspect: ctl.allow_suspect,
-        ..Default::default()
-    };
+        windows,
+    }
+}
 
-    // --- table ---
+/// What the fits of a finished run write into: the output directory, the summary, the
+/// headline and the verdict.
+struct Report<'a> {
+    out: &'a mut OutputDir,
+    s: Summary,
+    headline: Vec<String>,
+    verdict: RunVerdict,
+}
+
+/// Whether the plan leaves the law `law` out (said at the start).
+fn left_out(c: &BiaxialConfig, law: &str) -> bool {
+    c.leave_out.iter().any(|l| l == law)
+}
+
+/// Stage "report": `biaxial.csv` (one row per pressure) and `dilatancy.csv` (one row per
+/// dilatancy window), with `d` the mean grain diameter (m).
+fn write_tables(
+    c: &BiaxialConfig,
+    pressures: &[f64],
+    out: &mut OutputDir,
+    d: f64,
+    rows: &[PressureRow],
+    dilatancy: &[DilatancyRow],
+) -> Result<()> {
     let mut table = rows::table(rows);
     table.comments.push(format!(
         "biaxial compression ({} preparation) at each confining pressure p0: peak = largest mean of sin_phi_mob = q/p over axial-strain bins of {}, p and q at the peak (means over its bin); critical = means over the last {} of axial strain with block-averaged standard errors (of this sample alone: they understate the scatter between samples, summary.json gives the replica intervals); sin_psi = -rate_v/rate_gamma = tr D/(D1 - D2) of the mean strain rate D over consecutive windows of {} of axial strain (dilatancy.csv), empty where it is outside [-1, 1] (the cell contracted or dilated along both principal directions: no dilatancy angle), sin_psi_max the largest window with its block standard error, sin_psi_critical over the plateau; lateral_stress_error = |<sigma_xx> + p0|/p0 over the axial compression, compression_stress_error the largest of |<sigma_xx> + p0|/p0 and |<sigma_yy> + p0|/p0 over the last 20 % of the isotropic compression; I_mean = rate d / sqrt(<p>/rho) over the axial compression",
@@ -1153,13 +1181,12 @@ fn analyse(
         c.critical_strain,
         DILATANCY_WINDOW_BINS as f64 * c.bin_strain
     ));
-    let d = mean_diameter(world);
     table.metadata = vec![
         ("grain_diameter_m".into(), d),
         ("grain_density_kg_m3".into(), c.grain.density),
         ("grain_friction".into(), c.friction.grain_grain),
     ];
-    table.write(&mut ctx.out, "biaxial.csv")?;
+    table.write(out, "biaxial.csv")?;
     let with_p0: Vec<DilatancyRow> = dilatancy
         .iter()
         .map(|w| DilatancyRow {
@@ -1172,11 +1199,19 @@ fn analyse(
         "dilatancy of the axial compression over consecutive windows of {} of axial strain ({DILATANCY_WINDOW_BINS} bins): axial_strain at the window's centre, sin_phi_mob = q_a/p of its mean stresses, dilatancy_ratio = -rate_v/rate_gamma = tr D/(D1 - D2) of its mean strain rate D (tension positive), sin_psi the same where it lies in [-1, 1] (empty: the cell contracted or dilated along both principal directions, no dilatancy angle), with its block standard error; hardening = 1 for windows whose centre comes before the peak (the points of the stress-dilatancy fit)",
         DILATANCY_WINDOW_BINS as f64 * c.bin_strain
     ));
-    dt.write(&mut ctx.out, "dilatancy.csv")?;
+    dt.write(out, "dilatancy.csv")?;
+    Ok(())
+}
 
-    // --- summary: per pressure ---
+/// Stage "report": the summary keys and headline lines of the run and of each pressure.
+fn pressure_summary(
+    c: &BiaxialConfig,
+    d: f64,
+    rows: &[PressureRow],
+    report_dir: &std::path::Path,
+) -> (Summary, Vec<String>) {
     let mut s = Summary::new();
-    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
+    let mut headline = vec![format!("report: {}/", report_dir.display())];
     s.int("grains", c.grains as u64)
         .text("preparation", c.preparation.as_str())
         .text("cell_control", c.cell_control.as_str())
@@ -1276,10 +1311,23 @@ fn analyse(
             DILATANCY_WINDOW_BINS as f64 * c.bin_strain
         ));
     }
-    let provenance = crate::provenance::of_run(ctx, ctl, "biaxial", c.seed);
-    let out = &mut ctx.out;
+    (s, headline)
+}
 
-    // --- Mohr–Coulomb over the peaks ---
+/// Stage "fit": Mohr–Coulomb over the peak Mohr circles; the envelope `(φ, c)` when fitted.
+fn fit_peaks(
+    c: &BiaxialConfig,
+    rows: &[PressureRow],
+    common: &Checks,
+    provenance: &Provenance,
+    rep: &mut Report,
+) -> Result<Option<(f64, f64)>> {
+    let Report {
+        out,
+        s,
+        headline,
+        verdict,
+    } = rep;
     let n = rows.len();
     let peaks = YieldData::Circles {
         p_pa: rows.iter().map(|r| r.p_peak).collect(),
@@ -1287,7 +1335,7 @@ fn analyse(
     };
     // A free cohesion with 4 pressures or more, else (or when the data do not identify it:
     // rigid cohesionless grains have none) the envelope through the origin.
-    let left = |law: &str| c.leave_out.iter().any(|l| l == law);
+    let left = |law: &str| left_out(c, law);
     let fitted = fit_mohr_coulomb_supported(&peaks, 0.95).map(|(f, fixed, refusal)| {
         if let Some(e) = refusal {
             warn(&format!(
@@ -1302,9 +1350,9 @@ fn analyse(
         // left out by the plan (said at the start)
         None => remove_stale_law(out, "mohr_coulomb")?,
         Some(Ok((f, cohesion_fixed_zero))) => {
-            fit_keys(&mut s, "friction_peak", &f.report.parameters);
+            fit_keys(s, "friction_peak", &f.report.parameters);
             fit_keys(
-                &mut s,
+                s,
                 "friction_peak",
                 std::slice::from_ref(&f.friction_angle_deg),
             );
@@ -1314,7 +1362,7 @@ fn analyse(
                 .text("friction_peak_interval", "replicas");
             mc_line = Some((f.law.friction_angle_rad, f.law.cohesion_pa));
             let law = CalibratedLaw::from_mohr_coulomb(&f, provenance.clone());
-            let exported = export_law(out, &mut verdict, "mohr_coulomb", &law, common.clone())?;
+            let exported = export_law(out, verdict, "mohr_coulomb", &law, common.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "Mohr–Coulomb over the peaks, q = p sin φ + c cos φ",
@@ -1335,8 +1383,25 @@ fn analyse(
             );
         }
     }
+    Ok(mc_line)
+}
 
-    // --- the critical state ---
+/// Stage "fit": the critical state over the plateaus of the pressures (as replicas).
+fn fit_critical(
+    c: &BiaxialConfig,
+    rows: &[PressureRow],
+    critical: &Checks,
+    provenance: &Provenance,
+    rep: &mut Report,
+) -> Result<()> {
+    let Report {
+        out,
+        s,
+        headline,
+        verdict,
+    } = rep;
+    let n = rows.len();
+    let left = |law: &str| left_out(c, law);
     let plateaus: Vec<PlateauMeasure> = rows
         .iter()
         .map(|r| PlateauMeasure {
@@ -1352,7 +1417,7 @@ fn analyse(
         None => remove_stale_law(out, "critical_state")?,
         Some(Ok(f)) => {
             fit_keys(
-                &mut s,
+                s,
                 "friction_critical",
                 &[
                     f.friction_angle.clone(),
@@ -1361,7 +1426,7 @@ fn analyse(
                 ],
             );
             fit_keys(
-                &mut s,
+                s,
                 "solid_fraction_critical",
                 std::slice::from_ref(&f.solid_fraction),
             );
@@ -1398,7 +1463,7 @@ fn analyse(
                     );
             }
             let law = CalibratedLaw::from_critical_state(&f, provenance.clone());
-            let exported = export_law(out, &mut verdict, "critical_state", &law, critical.clone())?;
+            let exported = export_law(out, verdict, "critical_state", &law, critical.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 &format!(
@@ -1438,8 +1503,25 @@ fn analyse(
             );
         }
     }
+    Ok(())
+}
 
-    // --- stress–dilatancy over the hardening phases ---
+/// Stage "fit": the stress–dilatancy relation over the hardening windows of every pressure;
+/// its data and the line `(sin φ_cv, β)` when fitted.
+fn fit_dilatancy(
+    c: &BiaxialConfig,
+    dilatancy: &[DilatancyRow],
+    dilat: &Checks,
+    provenance: &Provenance,
+    rep: &mut Report,
+) -> Result<(StressDilatancyData, Option<(f64, f64)>)> {
+    let Report {
+        out,
+        s,
+        headline,
+        verdict,
+    } = rep;
+    let left = |law: &str| left_out(c, law);
     // the dilatancy windows of the hardening phases
     let hard: Vec<&DilatancyRow> = dilatancy
         .iter()
@@ -1457,7 +1539,7 @@ fn analyse(
     {
         None => remove_stale_law(out, "stress_dilatancy")?,
         Some(Ok(f)) => {
-            fit_keys(&mut s, "stress_dilatancy", &f.report.parameters);
+            fit_keys(s, "stress_dilatancy", &f.report.parameters);
             s.num("stress_dilatancy_r_squared", f.report.r_squared)
                 .int("stress_dilatancy_points", f.report.n as u64)
                 .int("stress_dilatancy_samples", f.samples as u64)
@@ -1469,7 +1551,7 @@ fn analyse(
                 );
             sd_line = Some((f.law.sin_phi_c, f.law.beta));
             let law = CalibratedLaw::from_stress_dilatancy(&f, provenance.clone());
-            let exported = export_law(out, &mut verdict, "stress_dilatancy", &law, dilat.clone())?;
+            let exported = export_law(out, verdict, "stress_dilatancy", &law, dilat.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "stress–dilatancy over the hardening phases, sin φ = sin φ_cv + β sin ψ",
@@ -1490,8 +1572,20 @@ fn analyse(
             );
         }
     }
+    Ok((sd_data, sd_line))
+}
 
-    // --- figures ---
+/// Stage "report": `biaxial.png` (the binned curves of every pressure) and `biaxial_fits.png`
+/// (the Mohr circles with the envelope, the stress–dilatancy points with the line).
+fn figures(
+    out: &mut OutputDir,
+    pressures: &[f64],
+    rows: &[PressureRow],
+    bins: &[BinPoint],
+    mc_line: Option<(f64, f64)>,
+    sd: (&StressDilatancyData, Option<(f64, f64)>),
+) -> Result<()> {
+    let (sd_data, sd_line) = sd;
     let mut pq = XyPlot::new(
         "Mobilised friction",
         Axis::new("axial strain ε_a"),
@@ -1566,8 +1660,50 @@ fn analyse(
     psd.legend = LegendAt::UpperLeft;
     draw_row(out, "biaxial.png", &[pq, pv], (1300, 650))?;
     draw_row(out, "biaxial_fits.png", &[pmc, psd], (1300, 650))?;
+    Ok(())
+}
+
+/// The checks, fits, laws, table, figures and summary of a finished run.
+#[allow(clippy::too_many_arguments)]
+fn analyse(
+    c: &BiaxialConfig,
+    pressures: &[f64],
+    ctx: &mut RunContext,
+    ctl: &RunControl,
+    world: &dem::World,
+    all: &PhaseStats,
+    rows: &[PressureRow],
+    bins: &[BinPoint],
+    dilatancy: &[DilatancyRow],
+    checks: &[PressureCheck],
+) -> Result<RunOutcome> {
+    let judged = judge(c, rows, checks);
+    let d = mean_diameter(world);
+    write_tables(c, pressures, &mut ctx.out, d, rows, dilatancy)?;
+    let (s, headline) = pressure_summary(c, d, rows, ctx.out.path());
+    let provenance = crate::provenance::of_run(ctx, ctl, "biaxial", c.seed);
+    let mut rep = Report {
+        out: &mut ctx.out,
+        s,
+        headline,
+        verdict: RunVerdict {
+            run: judged.run,
+            allow_suspect: ctl.allow_suspect,
+            ..Default::default()
+        },
+    };
+    let mc_line = fit_peaks(c, rows, &judged.common, &provenance, &mut rep)?;
+    fit_critical(c, rows, &judged.critical, &provenance, &mut rep)?;
+    let (sd_data, sd_line) = fit_dilatancy(c, dilatancy, &judged.dilat, &provenance, &mut rep)?;
+    figures(rep.out, pressures, rows, bins, mc_line, (&sd_data, sd_line))?;
+    let Report {
+        mut s,
+        headline,
+        verdict,
+        ..
+    } = rep;
     solver_keys(&mut s, all);
-    windows.keys(&mut s, "window");
+    judged.windows.keys(&mut s, "window");
     Ok(RunOutcome {
         summary: s,
         headline,
