@@ -706,8 +706,13 @@ impl PhasedRun for Shear<'_> {
     }
 }
 
-/// Runs the scenario.
-pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+/// Stages "build" and "run": the cell compressed, then sheared at each target inertial number
+/// (or resumed from a checkpoint).
+fn simulate(
+    c: &ShearCellConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<(dem::World, ShearState)> {
     let mut targets = c.inertial_numbers.clone();
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
@@ -729,6 +734,174 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         };
         Ok((world, state))
     };
+    drive(ctx, ctl, &shear, fresh)
+}
+
+/// Stage "fit": the wall law over the slip of both walls of every run (`rows`, `d` the mean
+/// diameter); the figure of the wall friction against the slip.
+#[allow(clippy::too_many_arguments)]
+fn fit_wall_law(
+    c: &ShearCellConfig,
+    rows: &[CellRow],
+    d: f64,
+    common: &Checks,
+    provenance: &identify::law::Provenance,
+    out: &mut OutputDir,
+    s: &mut Summary,
+    verdict: &mut RunVerdict,
+    headline: &mut Vec<String>,
+) -> Result<XyPlot> {
+    let opts = FitOptions::default();
+    let prov = || provenance.clone();
+    let mut vs = Vec::new();
+    let mut mus = Vec::new();
+    for r in rows {
+        for (v, m) in [(r.slip_bottom, r.mu_eff_bottom), (r.slip_top, r.mu_eff_top)] {
+            if v.is_finite() && m.is_finite() {
+                vs.push(v.abs());
+                mus.push(m);
+            }
+        }
+    }
+    let ws = WallSlipSeries::new(vs.clone(), mus.clone(), d);
+    let scale = (9.81 * d).sqrt();
+    let mut pw = XyPlot::new(
+        "Wall friction vs slip",
+        Axis::new("slip velocity V_s / √(g d)"),
+        Axis::new("μ_eff = τ_w / σ_w"),
+    );
+    pw.series.push(Series::new(
+        "DEM (both walls)",
+        Style::Points,
+        PALETTE[3],
+        vs.iter().zip(&mus).map(|(v, m)| (v / scale, *m)).collect(),
+    ));
+    let wall_left_out = c.leave_out.iter().any(|l| l == "wall-law");
+    match (!wall_left_out).then(|| select_wall_law(&ws, &opts)) {
+        // left out by the plan (said at the start)
+        None => crate::verdict::remove_stale_law(out, "wall")?,
+        Some(Ok(sel)) => {
+            let best = sel.best();
+            // over the measured slips only: the law is not drawn beyond its data
+            let (vmin, vmax) = super::rheology_fit::finite_range(vs.iter().map(|v| v / scale))
+                .unwrap_or((0.0, 0.0));
+            let vx = super::rheology_fit::curve_abscissae(vmin, vmax, false);
+            let p = best.report.values();
+            let form = best.form;
+            let band = delta_band(
+                &p,
+                &best.report.covariance,
+                best.report.t_critical,
+                &vx,
+                |p, v| {
+                    use identify::laws::wall_friction::WallFrictionLaw as W;
+                    let law = match form {
+                        identify::wall_law::WallLawForm::Exponential => W::Exponential {
+                            mu_0: p[0],
+                            mu_inf: p[1],
+                            v_star: p[2],
+                        },
+                        identify::wall_law::WallLawForm::Hyperbolic => W::Hyperbolic {
+                            mu_0: p[0],
+                            mu_inf: p[1],
+                            v_star: p[2],
+                        },
+                        identify::wall_law::WallLawForm::PowerLaw => W::PowerLaw {
+                            mu_0: p[0],
+                            k: p[1],
+                            n: p[2],
+                        },
+                    };
+                    law.mu_eff(v)
+                },
+            );
+            add_fitted_curve(
+                &mut pw,
+                &format!("{} (best AIC)", form.law_name()),
+                PALETTE[3],
+                PALETTE[1],
+                &band,
+            );
+            s.text("wall_law_form", form.law_name());
+            fit_keys(s, "wall_law", &best.report.parameters);
+            let law =
+                CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov());
+            let exported = export_law(out, verdict, "wall", &law, common.clone())?;
+            headline.extend(exported.heading(&law.law));
+            headline.extend(parameter_lines(
+                &format!("wall law: {} chosen by AIC", form.law_name()),
+                best.report.r_squared,
+                &best.report.parameters,
+            ));
+        }
+        Some(Err(e)) => {
+            warn(&format!("wall-law fit failed: {e}"));
+            s.text("wall_law_fit_error", &e.to_string());
+            headline.push(format!("wall law not identified: {e}"));
+            crate::verdict::remove_stale_law(out, "wall")?;
+            verdict.run.fail(
+                "shear_cell.wall_law_fit",
+                Verdict::Refused,
+                f64::NAN,
+                f64::NAN,
+                format!("no wall law could be fitted: {e}"),
+            );
+        }
+    }
+    pw.legend = LegendAt::LowerRight;
+    Ok(pw)
+}
+
+/// Stage "report": `velocity_profiles.png` (each run's mean profile, normalised) and
+/// `force_chains.png` (the last state, at the last inertial number of `is`).
+fn profile_figures(
+    out: &mut OutputDir,
+    world: &dem::World,
+    profiles: &[MeanProfile],
+    is: &[f64],
+) -> Result<()> {
+    let mut pv = XyPlot::new(
+        "Velocity profiles",
+        Axis::new("velocity / wall velocity v_x / V"),
+        Axis::new("height / gap y / H"),
+    );
+    for (k, mp) in profiles.iter().enumerate() {
+        pv.series.push(Series::new(
+            &format!("I = {:.3}", mp.i),
+            Style::LinePoints,
+            PALETTE[k % PALETTE.len()],
+            mp.y.iter()
+                .zip(&mp.velocity)
+                .filter(|p| p.1.is_finite())
+                .map(|(y, u)| (u / mp.v, y / mp.h))
+                .collect(),
+        ));
+    }
+    pv.legend = LegendAt::UpperLeft;
+    crate::plot::xy::draw_xy(out, "velocity_profiles.png", &pv)?;
+    let snap = world.snapshot();
+    draw_particles(
+        out,
+        "force_chains.png",
+        &ParticleView {
+            snap: &snap,
+            title: format!(
+                "Shear cell at I = {:.3}: normal forces",
+                is.last().copied().unwrap_or(0.0)
+            ),
+            fill: GrainFill::Plain,
+            forces: true,
+            axis_labels: ("x (m)".into(), "y (m)".into()),
+            width_px: 700,
+            overlays: Vec::new(),
+        },
+    )?;
+    Ok(())
+}
+
+/// Runs the scenario: build and run ([`simulate`]), verdict ([`judge_points`]), report and
+/// fits (μ(I), φ(I), [`fit_wall_law`]), figures ([`profile_figures`]).
+pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
     let (
         world,
         ShearState {
@@ -739,7 +912,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             lead_rows,
             ..
         },
-    ) = drive(ctx, ctl, &shear, fresh)?;
+    ) = simulate(c, ctx, ctl)?;
     // Checks (crate::verdict): per run, the numerics of its averaging window and the measured
     // I against its target (all laws); the steady state of μ (μ(I)) and of φ with its bound
     // (φ(I)).
@@ -792,7 +965,6 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         mu_std_error: None,
         phi_std_error: None,
     };
-    let opts = FitOptions::default();
     let provenance = crate::provenance::of_run(ctx, ctl, "shear-cell", c.seed);
     let prov = || provenance.clone();
     let mut s = Summary::new();
@@ -824,141 +996,19 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         &mut s,
         &mut headline,
     )?;
-    // Wall law from both walls.
-    let mut vs = Vec::new();
-    let mut mus = Vec::new();
-    for r in &rows {
-        for (v, m) in [(r.slip_bottom, r.mu_eff_bottom), (r.slip_top, r.mu_eff_top)] {
-            if v.is_finite() && m.is_finite() {
-                vs.push(v.abs());
-                mus.push(m);
-            }
-        }
-    }
-    let ws = WallSlipSeries::new(vs.clone(), mus.clone(), d);
-    let scale = (9.81 * d).sqrt();
-    let mut pw = XyPlot::new(
-        "Wall friction vs slip",
-        Axis::new("slip velocity V_s / √(g d)"),
-        Axis::new("μ_eff = τ_w / σ_w"),
-    );
-    pw.series.push(Series::new(
-        "DEM (both walls)",
-        Style::Points,
-        PALETTE[3],
-        vs.iter().zip(&mus).map(|(v, m)| (v / scale, *m)).collect(),
-    ));
-    let wall_left_out = c.leave_out.iter().any(|l| l == "wall-law");
-    match (!wall_left_out).then(|| select_wall_law(&ws, &opts)) {
-        // left out by the plan (said at the start)
-        None => crate::verdict::remove_stale_law(&ctx.out, "wall")?,
-        Some(Ok(sel)) => {
-            let best = sel.best();
-            // over the measured slips only: the law is not drawn beyond its data
-            let (vmin, vmax) = super::rheology_fit::finite_range(vs.iter().map(|v| v / scale))
-                .unwrap_or((0.0, 0.0));
-            let vx = super::rheology_fit::curve_abscissae(vmin, vmax, false);
-            let p = best.report.values();
-            let form = best.form;
-            let band = delta_band(
-                &p,
-                &best.report.covariance,
-                best.report.t_critical,
-                &vx,
-                |p, v| {
-                    use identify::laws::wall_friction::WallFrictionLaw as W;
-                    let law = match form {
-                        identify::wall_law::WallLawForm::Exponential => W::Exponential {
-                            mu_0: p[0],
-                            mu_inf: p[1],
-                            v_star: p[2],
-                        },
-                        identify::wall_law::WallLawForm::Hyperbolic => W::Hyperbolic {
-                            mu_0: p[0],
-                            mu_inf: p[1],
-                            v_star: p[2],
-                        },
-                        identify::wall_law::WallLawForm::PowerLaw => W::PowerLaw {
-                            mu_0: p[0],
-                            k: p[1],
-                            n: p[2],
-                        },
-                    };
-                    law.mu_eff(v)
-                },
-            );
-            add_fitted_curve(
-                &mut pw,
-                &format!("{} (best AIC)", form.law_name()),
-                PALETTE[3],
-                PALETTE[1],
-                &band,
-            );
-            s.text("wall_law_form", form.law_name());
-            fit_keys(&mut s, "wall_law", &best.report.parameters);
-            let law =
-                CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov());
-            let exported = export_law(&mut ctx.out, &mut verdict, "wall", &law, common.clone())?;
-            headline.extend(exported.heading(&law.law));
-            headline.extend(parameter_lines(
-                &format!("wall law: {} chosen by AIC", form.law_name()),
-                best.report.r_squared,
-                &best.report.parameters,
-            ));
-        }
-        Some(Err(e)) => {
-            warn(&format!("wall-law fit failed: {e}"));
-            s.text("wall_law_fit_error", &e.to_string());
-            headline.push(format!("wall law not identified: {e}"));
-            crate::verdict::remove_stale_law(&ctx.out, "wall")?;
-            verdict.run.fail(
-                "shear_cell.wall_law_fit",
-                Verdict::Refused,
-                f64::NAN,
-                f64::NAN,
-                format!("no wall law could be fitted: {e}"),
-            );
-        }
-    }
-    pw.legend = LegendAt::LowerRight;
-    draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, pw], (1950, 650))?;
-    // Velocity profiles, normalised.
-    let mut pv = XyPlot::new(
-        "Velocity profiles",
-        Axis::new("velocity / wall velocity v_x / V"),
-        Axis::new("height / gap y / H"),
-    );
-    for (k, mp) in profiles.iter().enumerate() {
-        pv.series.push(Series::new(
-            &format!("I = {:.3}", mp.i),
-            Style::LinePoints,
-            PALETTE[k % PALETTE.len()],
-            mp.y.iter()
-                .zip(&mp.velocity)
-                .filter(|p| p.1.is_finite())
-                .map(|(y, u)| (u / mp.v, y / mp.h))
-                .collect(),
-        ));
-    }
-    pv.legend = LegendAt::UpperLeft;
-    crate::plot::xy::draw_xy(&mut ctx.out, "velocity_profiles.png", &pv)?;
-    let snap = world.snapshot();
-    draw_particles(
+    let pw = fit_wall_law(
+        c,
+        &rows,
+        d,
+        &common,
+        &provenance,
         &mut ctx.out,
-        "force_chains.png",
-        &ParticleView {
-            snap: &snap,
-            title: format!(
-                "Shear cell at I = {:.3}: normal forces",
-                is.last().copied().unwrap_or(0.0)
-            ),
-            fill: GrainFill::Plain,
-            forces: true,
-            axis_labels: ("x (m)".into(), "y (m)".into()),
-            width_px: 700,
-            overlays: Vec::new(),
-        },
+        &mut s,
+        &mut verdict,
+        &mut headline,
     )?;
+    draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, pw], (1950, 650))?;
+    profile_figures(&mut ctx.out, &world, &profiles, &is)?;
     solver_keys(&mut s, &all);
     windows.keys(&mut s, "window");
     Ok(RunOutcome {
