@@ -211,13 +211,14 @@ fn disk_area_below(z: f64, r: f64) -> f64 {
     r * r * (t * (1.0 - t * t).sqrt() + t.asin() + std::f64::consts::FRAC_PI_2)
 }
 
-/// Runs the scenario.
-pub fn run(
+/// Stages "build" and "run": the layer on its rough base, flowing for `duration` (or resumed
+/// from a checkpoint); with the number of profile layers.
+fn simulate(
     c: &InclinedFlowConfig,
     ctx: &mut RunContext,
     ctl: &mut RunControl,
-) -> Result<RunOutcome> {
-    let length = c.cell_length_diameters * 2.0 * c.grain.radius_mean;
+    length: f64,
+) -> Result<(dem::World, FlowState, usize)> {
     // Layers are never thinner than a mean grain diameter: a thinner layer holds a fraction of
     // a grain and its averages are noise. Their number follows from the sample.
     let layer_height = |world: &dem::World| {
@@ -243,26 +244,23 @@ pub fn run(
         };
         Ok((world, state))
     };
-    let (
-        world,
-        FlowState {
-            prof,
-            hist,
-            vtk,
-            stats,
-            window,
-            ..
-        },
-    ) = drive(ctx, ctl, &Flow { c }, fresh)?;
-    let d = mean_diameter(&world);
-    let dy = prof.dy;
-    vtk.finish(&mut ctx.out, &world)?;
-    let snap = world.snapshot();
-    let gs = homogenise::grain_stresses(&snap)?;
-    let ratios = inertia_ratios(&gs);
-    let fluid = fluid_fraction(&ratios, c.fluid_threshold)?;
-    let values: Vec<f64> = ratios.iter().map(|r| r.ratio.unwrap_or(f64::NAN)).collect();
+    let (world, state) = drive(ctx, ctl, &Flow { c }, fresh)?;
+    Ok((world, state, bins))
+}
 
+/// A profile across the layer: `(value, height above the base)` per layer.
+type Profile = Vec<(f64, f64)>;
+
+/// Stage "measure": the time-averaged profiles of velocity, solid fraction and inertia ratio
+/// over `bins` layers of a cell of `length` (m), written to `profiles.csv`.
+fn layer_profiles(
+    out: &mut OutputDir,
+    c: &InclinedFlowConfig,
+    prof: &Profiles,
+    bins: usize,
+    length: f64,
+) -> Result<(Profile, Profile, Profile)> {
+    let dy = prof.dy;
     // Profiles.
     let mut table = CsvTable::new(&[
         "height_m",
@@ -299,7 +297,134 @@ pub fn run(
         "time averages over the last {} s ({} samples); height above the rough base (m)",
         c.average, prof.samples
     ));
-    table.write(&mut ctx.out, "profiles.csv")?;
+    table.write(out, "profiles.csv")?;
+    Ok((vel, phi, lr))
+}
+
+/// Stage "report": `inertia_ratio_map.png` (per grain, over the last state `snap` at
+/// `time`), `profiles.png` and `velocity_history.png`.
+fn figures(
+    out: &mut OutputDir,
+    c: &InclinedFlowConfig,
+    (snap, time): (&Snapshot, f64),
+    values: &[f64],
+    (vel, phi, lr): (&Profile, &Profile, Profile),
+    hist: &[FlowStep],
+) -> Result<()> {
+    // Colour range: the 2 % and 98 % quantiles, widened to whole decades.
+    let mut finite: Vec<f64> = values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    finite.sort_by(f64::total_cmp);
+    let (lo, hi) = if finite.len() >= 2 {
+        let q = |p: f64| finite[((finite.len() - 1) as f64 * p).round() as usize];
+        (q(0.02), q(0.98))
+    } else {
+        (1e-3, 1.0)
+    };
+    let lo = 10f64.powf(lo.log10().floor());
+    let hi = 10f64.powf(hi.log10().ceil()).max(lo * 10.0);
+    draw_particles(
+        out,
+        "inertia_ratio_map.png",
+        &ParticleView {
+            snap,
+            title: format!(
+                "‖Σ_inertia‖/‖Σ_contact‖ per grain, slope {}°, t = {:.2} s (white: no contact)",
+                c.slope_deg, time
+            ),
+            fill: GrainFill::Values {
+                values: values.to_vec(),
+                scale: Scale {
+                    min: lo,
+                    max: hi,
+                    log: true,
+                },
+                label: "‖Σ_i‖_F / ‖Σ_c‖_F".into(),
+            },
+            forces: false,
+            axis_labels: (
+                "x along the slope (m)".into(),
+                "y normal to the slope (m)".into(),
+            ),
+            width_px: 1300,
+            overlays: Vec::new(),
+        },
+    )?;
+    let mut pv = XyPlot::new(
+        &format!("Velocity profile (mean over the last {} s)", c.average),
+        Axis::new("velocity along the slope (m/s)"),
+        Axis::new("height above the base y (m)"),
+    );
+    pv.series.push(Series::new(
+        "DEM",
+        Style::LinePoints,
+        PALETTE[0],
+        vel.clone(),
+    ));
+    pv.legend = LegendAt::UpperLeft;
+    let mut pf = XyPlot::new(
+        "Solid fraction",
+        Axis::new("solid fraction φ"),
+        Axis::new("height above the base y (m)"),
+    );
+    pf.series
+        .push(Series::new("", Style::LinePoints, PALETTE[2], phi.clone()));
+    let mut pr = XyPlot::new(
+        "Inertia ratio across the layer",
+        Axis::new("mean log₁₀ ‖Σ_i‖/‖Σ_c‖"),
+        Axis::new("height above the base y (m)"),
+    );
+    pr.series
+        .push(Series::new("", Style::LinePoints, PALETTE[1], lr));
+    draw_row(out, "profiles.png", &[pv, pf, pr], (1800, 650))?;
+    let mut ph = XyPlot::new(
+        "Mean velocity of the layer",
+        Axis::new("time t (s)"),
+        Axis::new("mean velocity along the slope (m/s)"),
+    );
+    ph.series.push(Series::new(
+        "",
+        Style::Thin,
+        PALETTE[0],
+        hist.iter().map(|r| (r.t, r.mean_velocity)).collect(),
+    ));
+    draw_xy(out, "velocity_history.png", &ph)?;
+    Ok(())
+}
+
+/// Runs the scenario: build and run ([`simulate`]), measure ([`layer_profiles`], the inertia
+/// ratios), verdict, report ([`figures`]).
+pub fn run(
+    c: &InclinedFlowConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    let length = c.cell_length_diameters * 2.0 * c.grain.radius_mean;
+    let (
+        world,
+        FlowState {
+            prof,
+            hist,
+            vtk,
+            stats,
+            window,
+            ..
+        },
+        bins,
+    ) = simulate(c, ctx, ctl, length)?;
+    let d = mean_diameter(&world);
+    let dy = prof.dy;
+    vtk.finish(&mut ctx.out, &world)?;
+    let snap = world.snapshot();
+    let gs = homogenise::grain_stresses(&snap)?;
+    let ratios = inertia_ratios(&gs);
+    let fluid = fluid_fraction(&ratios, c.fluid_threshold)?;
+    let values: Vec<f64> = ratios.iter().map(|r| r.ratio.unwrap_or(f64::NAN)).collect();
+
+    let (vel, phi, lr) = layer_profiles(&mut ctx.out, c, &prof, bins, length)?;
     rows::table(&hist).write(&mut ctx.out, "history.csv")?;
     // Flow height: where the time-averaged solid fraction falls below half its bulk value.
     let bulk = phi.iter().map(|p| p.0).fold(0.0, f64::max);
@@ -360,88 +485,14 @@ pub fn run(
         max_solid_fraction(c.grain.radius_spread),
     );
 
-    // Figures.
-    // Colour range: the 2 % and 98 % quantiles, widened to whole decades.
-    let mut finite: Vec<f64> = values
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .collect();
-    finite.sort_by(f64::total_cmp);
-    let (lo, hi) = if finite.len() >= 2 {
-        let q = |p: f64| finite[((finite.len() - 1) as f64 * p).round() as usize];
-        (q(0.02), q(0.98))
-    } else {
-        (1e-3, 1.0)
-    };
-    let lo = 10f64.powf(lo.log10().floor());
-    let hi = 10f64.powf(hi.log10().ceil()).max(lo * 10.0);
-    draw_particles(
+    figures(
         &mut ctx.out,
-        "inertia_ratio_map.png",
-        &ParticleView {
-            snap: &snap,
-            title: format!(
-                "‖Σ_inertia‖/‖Σ_contact‖ per grain, slope {}°, t = {:.2} s (white: no contact)",
-                c.slope_deg, world.time
-            ),
-            fill: GrainFill::Values {
-                values: values.clone(),
-                scale: Scale {
-                    min: lo,
-                    max: hi,
-                    log: true,
-                },
-                label: "‖Σ_i‖_F / ‖Σ_c‖_F".into(),
-            },
-            forces: false,
-            axis_labels: (
-                "x along the slope (m)".into(),
-                "y normal to the slope (m)".into(),
-            ),
-            width_px: 1300,
-            overlays: Vec::new(),
-        },
+        c,
+        (&snap, world.time),
+        &values,
+        (&vel, &phi, lr),
+        &hist,
     )?;
-    let mut pv = XyPlot::new(
-        &format!("Velocity profile (mean over the last {} s)", c.average),
-        Axis::new("velocity along the slope (m/s)"),
-        Axis::new("height above the base y (m)"),
-    );
-    pv.series.push(Series::new(
-        "DEM",
-        Style::LinePoints,
-        PALETTE[0],
-        vel.clone(),
-    ));
-    pv.legend = LegendAt::UpperLeft;
-    let mut pf = XyPlot::new(
-        "Solid fraction",
-        Axis::new("solid fraction φ"),
-        Axis::new("height above the base y (m)"),
-    );
-    pf.series
-        .push(Series::new("", Style::LinePoints, PALETTE[2], phi.clone()));
-    let mut pr = XyPlot::new(
-        "Inertia ratio across the layer",
-        Axis::new("mean log₁₀ ‖Σ_i‖/‖Σ_c‖"),
-        Axis::new("height above the base y (m)"),
-    );
-    pr.series
-        .push(Series::new("", Style::LinePoints, PALETTE[1], lr));
-    draw_row(&mut ctx.out, "profiles.png", &[pv, pf, pr], (1800, 650))?;
-    let mut ph = XyPlot::new(
-        "Mean velocity of the layer",
-        Axis::new("time t (s)"),
-        Axis::new("mean velocity along the slope (m/s)"),
-    );
-    ph.series.push(Series::new(
-        "",
-        Style::Thin,
-        PALETTE[0],
-        hist.iter().map(|r| (r.t, r.mean_velocity)).collect(),
-    ));
-    draw_xy(&mut ctx.out, "velocity_history.png", &ph)?;
 
     let headline = vec![
         format!("report: {}/", ctx.out.path().display()),
