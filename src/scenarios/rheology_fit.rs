@@ -242,21 +242,18 @@ impl Shown {
     }
 }
 
-/// Fits μ(I) and φ(I) to `series` (those the plan does not leave out), writes the laws that
-/// pass (or their `.rejected.json`), records refusals in `verdict`, the keys in `s`, the printed
-/// lines in `headline`; returns the μ(I) and φ(I) figures ([`rheology_plot`]).
-pub(crate) fn fit_mu_phi(
+/// Stage "fit" of μ(I): the full law, or its linear form when the full one is refused or left
+/// out; the curve to draw (when one passed its fit) and the figure's notes.
+fn fit_mu(
     out: &mut OutputDir,
     series: &RheologySeries,
     inp: &RheologyFit<'_>,
     verdict: &mut RunVerdict,
     s: &mut Summary,
     headline: &mut Vec<String>,
-) -> Result<(XyPlot, XyPlot)> {
+) -> Result<(Option<FittedCurve>, Vec<String>)> {
     let opts = FitOptions::default();
-    let is = &series.inertial_number;
-    // every point enters the fits (a point failing its own checks makes the laws fail theirs)
-    let range = finite_range(is.iter().copied()).unwrap_or((0.0, 0.0));
+    let range = finite_range(series.inertial_number.iter().copied()).unwrap_or((0.0, 0.0));
     let mut mu_notes = Vec::new();
     let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
     // μ(I), or its linear form when μ(I) is refused or left out (`leave_out`)
@@ -367,6 +364,21 @@ pub(crate) fn fit_mu_phi(
             }
         }
     }
+    Ok((mu_curve, mu_notes))
+}
+
+/// Stage "fit" of φ(I); the curve to draw (when it passed its fit) and the figure's notes.
+fn fit_phi(
+    out: &mut OutputDir,
+    series: &RheologySeries,
+    inp: &RheologyFit<'_>,
+    verdict: &mut RunVerdict,
+    s: &mut Summary,
+    headline: &mut Vec<String>,
+) -> Result<(Option<FittedCurve>, Vec<String>)> {
+    let opts = FitOptions::default();
+    let range = finite_range(series.inertial_number.iter().copied()).unwrap_or((0.0, 0.0));
+    let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
     let mut phi_notes = Vec::new();
     let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, &opts)) {
         // left out by the plan (said at the start)
@@ -412,6 +424,24 @@ pub(crate) fn fit_mu_phi(
             None
         }
     };
+    Ok((phi_curve, phi_notes))
+}
+
+/// Fits μ(I) and φ(I) to `series` (those the plan does not leave out), writes the laws that
+/// pass (or their `.rejected.json`), records refusals in `verdict`, the keys in `s`, the printed
+/// lines in `headline`; returns the μ(I) and φ(I) figures ([`rheology_plot`]). Every point
+/// enters the fits (a point failing its own checks makes the laws fail theirs).
+pub(crate) fn fit_mu_phi(
+    out: &mut OutputDir,
+    series: &RheologySeries,
+    inp: &RheologyFit<'_>,
+    verdict: &mut RunVerdict,
+    s: &mut Summary,
+    headline: &mut Vec<String>,
+) -> Result<(XyPlot, XyPlot)> {
+    let is = &series.inertial_number;
+    let (mu_curve, mu_notes) = fit_mu(out, series, inp, verdict, s, headline)?;
+    let (phi_curve, phi_notes) = fit_phi(out, series, inp, verdict, s, headline)?;
     let points = |values: Option<&[f64]>, se: Option<&[f64]>| -> Vec<MeasuredPoint> {
         let Some(values) = values else {
             return Vec::new();
