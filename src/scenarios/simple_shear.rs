@@ -510,12 +510,13 @@ impl PhasedRun for Shear<'_> {
     }
 }
 
-/// Runs the scenario.
-pub fn run(
+/// Stages "build" and "run": the cell compressed, then sheared at each target inertial number
+/// (or resumed from a checkpoint).
+fn simulate(
     c: &SimpleShearConfig,
     ctx: &mut RunContext,
     ctl: &mut RunControl,
-) -> Result<RunOutcome> {
+) -> Result<(dem::World, State)> {
     let mut targets = c.inertial_numbers.clone();
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
@@ -541,7 +542,57 @@ pub fn run(
             },
         ))
     };
-    let (world, state) = drive(ctx, ctl, &shear, fresh)?;
+    drive(ctx, ctl, &shear, fresh)
+}
+
+/// Stage "report": the summary keys of the run and of each point (`rows`, with the peak
+/// stress ratio of each run in `peaks`), `d` the mean diameter (m).
+fn run_summary(c: &SimpleShearConfig, d: f64, rows: &[RheologyRow], peaks: &[f64]) -> Summary {
+    let is: Vec<f64> = rows.iter().map(|r| r.i).collect();
+    let mut s = Summary::new();
+    let imin = is.iter().cloned().fold(f64::MAX, f64::min);
+    let imax = is.iter().cloned().fold(f64::MIN, f64::max);
+    s.int("grains", c.grains as u64)
+        .text("cell_control", c.cell_control.as_str())
+        .num("pressure_Pa", c.pressure)
+        .num("mean_diameter_m", d)
+        .int("runs", rows.len() as u64)
+        .num("I_min", imin)
+        .num("I_max", imax)
+        .num(
+            "cell_corrections_per_step",
+            rows.iter().map(|r| r.corrections_per_step).sum::<f64>() / rows.len().max(1) as f64,
+        );
+    for (k, r) in rows.iter().enumerate() {
+        s.num(&format!("run{}_I", k + 1), r.i)
+            .num(&format!("run{}_mu", k + 1), r.mu)
+            .num(&format!("run{}_mu_std_error", k + 1), r.mu_se)
+            .num(&format!("run{}_phi", k + 1), r.phi)
+            .num(&format!("run{}_phi_std_error", k + 1), r.phi_se)
+            .num(&format!("run{}_P_Pa", k + 1), r.pn)
+            // the steady state of the run: its critical state at that I
+            .num(&format!("run{}_friction_critical_mu", k + 1), r.mu)
+            .num(&format!("run{}_solid_fraction_critical", k + 1), r.phi);
+        if let Some(&peak) = peaks.get(k) {
+            s.num(&format!("run{}_friction_peak_mu", k + 1), peak);
+        }
+    }
+    // The first run starts from the isotropically compressed sample: its transient peak is the
+    // sample's peak friction (the later runs start from the previous steady state).
+    if let Some(&peak) = peaks.first() {
+        s.num("friction_peak_mu", peak);
+    }
+    s
+}
+
+/// Runs the scenario: build and run ([`simulate`]), verdict ([`judge_points`]), report
+/// (`rheology.csv`, [`run_summary`]), fits (μ(I), φ(I)), figures.
+pub fn run(
+    c: &SimpleShearConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    let (world, state) = simulate(c, ctx, ctl)?;
     let State {
         cell: CellRecord {
             all, rows, frames, ..
@@ -607,40 +658,7 @@ pub fn run(
     };
     let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
     let prov = || provenance.clone();
-    let mut s = Summary::new();
-    let is: Vec<f64> = rows.iter().map(|r| r.i).collect();
-    let imin = is.iter().cloned().fold(f64::MAX, f64::min);
-    let imax = is.iter().cloned().fold(f64::MIN, f64::max);
-    s.int("grains", c.grains as u64)
-        .text("cell_control", c.cell_control.as_str())
-        .num("pressure_Pa", c.pressure)
-        .num("mean_diameter_m", d)
-        .int("runs", rows.len() as u64)
-        .num("I_min", imin)
-        .num("I_max", imax)
-        .num(
-            "cell_corrections_per_step",
-            rows.iter().map(|r| r.corrections_per_step).sum::<f64>() / rows.len().max(1) as f64,
-        );
-    for (k, r) in rows.iter().enumerate() {
-        s.num(&format!("run{}_I", k + 1), r.i)
-            .num(&format!("run{}_mu", k + 1), r.mu)
-            .num(&format!("run{}_mu_std_error", k + 1), r.mu_se)
-            .num(&format!("run{}_phi", k + 1), r.phi)
-            .num(&format!("run{}_phi_std_error", k + 1), r.phi_se)
-            .num(&format!("run{}_P_Pa", k + 1), r.pn)
-            // the steady state of the run: its critical state at that I
-            .num(&format!("run{}_friction_critical_mu", k + 1), r.mu)
-            .num(&format!("run{}_solid_fraction_critical", k + 1), r.phi);
-        if let Some(&peak) = peaks.get(k) {
-            s.num(&format!("run{}_friction_peak_mu", k + 1), peak);
-        }
-    }
-    // The first run starts from the isotropically compressed sample: its transient peak is the
-    // sample's peak friction (the later runs start from the previous steady state).
-    if let Some(&peak) = peaks.first() {
-        s.num("friction_peak_mu", peak);
-    }
+    let mut s = run_summary(c, d, &rows, &peaks);
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
     let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
         &mut ctx.out,
