@@ -1158,6 +1158,20 @@ struct Report<'a> {
     verdict: RunVerdict,
 }
 
+impl Report<'_> {
+    /// Its parts, borrowed apart: output directory, summary, headline, verdict.
+    fn parts(
+        &mut self,
+    ) -> (
+        &mut OutputDir,
+        &mut Summary,
+        &mut Vec<String>,
+        &mut RunVerdict,
+    ) {
+        (self.out, &mut self.s, &mut self.headline, &mut self.verdict)
+    }
+}
+
 /// Whether the plan leaves the law `law` out (said at the start).
 fn left_out(c: &BiaxialConfig, law: &str) -> bool {
     c.leave_out.iter().any(|l| l == law)
@@ -1322,12 +1336,7 @@ fn fit_peaks(
     provenance: &Provenance,
     rep: &mut Report,
 ) -> Result<Option<(f64, f64)>> {
-    let Report {
-        out,
-        s,
-        headline,
-        verdict,
-    } = rep;
+    let (out, s, headline, verdict) = rep.parts();
     let n = rows.len();
     let peaks = YieldData::Circles {
         p_pa: rows.iter().map(|r| r.p_peak).collect(),
@@ -1394,12 +1403,7 @@ fn fit_critical(
     provenance: &Provenance,
     rep: &mut Report,
 ) -> Result<()> {
-    let Report {
-        out,
-        s,
-        headline,
-        verdict,
-    } = rep;
+    let (out, s, headline, verdict) = rep.parts();
     let n = rows.len();
     let left = |law: &str| left_out(c, law);
     let plateaus: Vec<PlateauMeasure> = rows
@@ -1515,12 +1519,7 @@ fn fit_dilatancy(
     provenance: &Provenance,
     rep: &mut Report,
 ) -> Result<(StressDilatancyData, Option<(f64, f64)>)> {
-    let Report {
-        out,
-        s,
-        headline,
-        verdict,
-    } = rep;
+    let (out, s, headline, verdict) = rep.parts();
     let left = |law: &str| left_out(c, law);
     // the dilatancy windows of the hardening phases
     let hard: Vec<&DilatancyRow> = dilatancy

@@ -94,6 +94,25 @@ pub(crate) struct PointJudgement {
     pub(crate) windows: WindowStats,
 }
 
+impl PointJudgement {
+    /// The checks of the μ(I) and of the φ(I) law, each with the common ones, and the run's
+    /// verdict over the common checks and both laws' (`allow_suspect` as the run says).
+    pub(crate) fn law_checks(&self, allow_suspect: bool) -> (Checks, Checks, RunVerdict) {
+        let mut mu = self.mu.clone();
+        mu.extend(&self.common);
+        let mut phi = self.phi.clone();
+        phi.extend(&self.common);
+        let mut verdict = RunVerdict {
+            run: self.common.clone(),
+            allow_suspect,
+            ..Default::default()
+        };
+        verdict.run.extend(&mu);
+        verdict.run.extend(&phi);
+        (mu, phi, verdict)
+    }
+}
+
 /// Judges every point of a rheology ([`PointJudgement`]), its checks named after `scenario`. A
 /// point whose `i_target` is not finite (another code's run, which has none) skips the check of
 /// `I` against its target.
@@ -916,26 +935,18 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     // Checks (crate::verdict): per run, the numerics of its averaging window and the measured
     // I against its target (all laws); the steady state of μ (μ(I)) and of φ with its bound
     // (φ(I)).
-    let PointJudgement {
-        common,
-        mu: mut mu_checks,
-        phi: mut phi_checks,
-        points: point_verdicts,
-        windows,
-    } = judge_points(
+    let judged = judge_points(
         "shear_cell",
         &run_checks,
         max_solid_fraction(c.grain.radius_spread),
     );
-    mu_checks.extend(&common);
-    phi_checks.extend(&common);
-    let mut verdict = RunVerdict {
-        run: common.clone(),
-        allow_suspect: ctl.allow_suspect,
-        ..Default::default()
-    };
-    verdict.run.extend(&mu_checks);
-    verdict.run.extend(&phi_checks);
+    let (mu_checks, phi_checks, mut verdict) = judged.law_checks(ctl.allow_suspect);
+    let PointJudgement {
+        common,
+        points: point_verdicts,
+        windows,
+        ..
+    } = judged;
     let d = mean_diameter(&world);
     VtkFrames::new(f64::INFINITY, 1).finish(&mut ctx.out, &world)?;
     let grain = GrainScale {

@@ -33,7 +33,7 @@ use crate::error::Result;
 use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::verdict::{max_solid_fraction, RunVerdict};
+use crate::verdict::max_solid_fraction;
 
 /// Re-solved samples of an averaging window, spread evenly over it (at least this many; every
 /// step of a shorter window): each such step is solved again to
@@ -604,34 +604,17 @@ pub fn run(
     } = state;
     // Checks (crate::verdict), as in the shear cell: per point, the numerics of its averaging
     // window, I against its target, steady μ and φ, φ below its bound.
-    let PointJudgement {
-        common,
-        mu: mu_checks,
-        phi: phi_checks,
-        points: point_verdicts,
-        windows,
-    } = judge_points(
+    let judged = judge_points(
         "simple_shear",
         &run_checks,
         max_solid_fraction(c.grain.radius_spread),
     );
-    let mu_checks = {
-        let mut m = mu_checks;
-        m.extend(&common);
-        m
-    };
-    let phi_checks = {
-        let mut p = phi_checks;
-        p.extend(&common);
-        p
-    };
-    let mut verdict = RunVerdict {
-        run: common.clone(),
-        allow_suspect: ctl.allow_suspect,
-        ..Default::default()
-    };
-    verdict.run.extend(&mu_checks);
-    verdict.run.extend(&phi_checks);
+    let (mu_checks, phi_checks, mut verdict) = judged.law_checks(ctl.allow_suspect);
+    let PointJudgement {
+        points: point_verdicts,
+        windows,
+        ..
+    } = judged;
     frames.finish(&mut ctx.out, &world)?;
     let d = mean_diameter(&world);
     let grain = GrainScale {
