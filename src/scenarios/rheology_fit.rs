@@ -295,7 +295,7 @@ impl<'b> LawFits<'_, 'b> {
         let full = if left("mu-i") {
             None
         } else {
-            Some(fit_mu_i(series, &opts))
+            Some(fit_mu_i(series, opts))
         };
         let mut mu_curve = None;
         let linear_reason = match full {
@@ -361,7 +361,7 @@ impl<'b> LawFits<'_, 'b> {
             } else {
                 "μ_s + b I (the full μ(I) left out)"
             };
-            match fit_mu_i_linear(series, &opts) {
+            match fit_mu_i_linear(series, opts) {
                 Ok(f) => {
                     let shown = Shown {
                         key: "mu_i",
@@ -408,7 +408,7 @@ impl<'b> LawFits<'_, 'b> {
         let (series, inp, opts, range, out, verdict, s, headline) = self.parts();
         let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
         let mut phi_notes = Vec::new();
-        let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, &opts)) {
+        let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, opts)) {
             // left out by the plan (said at the start)
             None => {
                 crate::verdict::remove_stale_law(out, "phi_i")?;

@@ -472,7 +472,7 @@ fn solver_sensitivity(
     let resolved_profile = complete
         .then(|| resolved.profile(c.analysis.depth_bins).ok())
         .flatten();
-    let sensitivity = JanssenSensitivity {
+    JanssenSensitivity {
         resolved: resolved.samples,
         measured: measure_window.samples,
         failed: resolve_failed,
@@ -488,8 +488,7 @@ fn solver_sensitivity(
             (Ok(run), Some(p)) => p.negative_tau_w(window).is_empty() != run.uses_tau_w,
             _ => false,
         },
-    };
-    sensitivity
+    }
 }
 
 /// Stage "measure → verdict": the measured step's numerics, the force balance of the column
