@@ -395,8 +395,8 @@ fn figures(
     Ok(())
 }
 
-/// Runs the scenario: build and run ([`simulate`]), measure ([`layer_profiles`], the inertia
-/// ratios), verdict, report ([`figures`]).
+/// Runs the scenario: build and run (`simulate`), measure (`layer_profiles`, the inertia
+/// ratios), verdict, report (`figures`).
 pub fn run(
     c: &InclinedFlowConfig,
     ctx: &mut RunContext,

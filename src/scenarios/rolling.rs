@@ -381,7 +381,7 @@ fn motion_figures(
     Ok(())
 }
 
-/// Runs the scenario: build and run ([`simulate`]), measure (the acceleration, the stress
+/// Runs the scenario: build and run (`simulate`), measure (the acceleration, the stress
 /// at the end), compare with the exact answers, report.
 pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
     let phi = c.slope_deg.to_radians();

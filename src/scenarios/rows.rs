@@ -1,5 +1,5 @@
 //! Typed rows of the scenarios' CSV tables: one struct per table with a named field per column
-//! ([`table_row!`]), so that no runner reads a column by its position. The CSV text is still
+//! (`table_row!`), so that no runner reads a column by its position. The CSV text is still
 //! written by [`CsvTable`] (the same headers, `{:e}` numbers, NaN as an empty cell), so a
 //! table of typed rows is byte for byte the table of `Vec<f64>` rows it replaces; in a run
 //! checkpoint a `Vec` of rows is stored as the `Vec<Vec<f64>>` it was ([`serde_rows`]).

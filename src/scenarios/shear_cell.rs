@@ -918,8 +918,8 @@ fn profile_figures(
     Ok(())
 }
 
-/// Runs the scenario: build and run ([`simulate`]), verdict ([`judge_points`]), report and
-/// fits (μ(I), φ(I), [`fit_wall_law`]), figures ([`profile_figures`]).
+/// Runs the scenario: build and run (`simulate`), verdict (`judge_points`), report and
+/// fits (μ(I), φ(I), `fit_wall_law`), figures (`profile_figures`).
 pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
     let (
         world,

@@ -585,8 +585,8 @@ fn run_summary(c: &SimpleShearConfig, d: f64, rows: &[RheologyRow], peaks: &[f64
     s
 }
 
-/// Runs the scenario: build and run ([`simulate`]), verdict ([`judge_points`]), report
-/// (`rheology.csv`, [`run_summary`]), fits (μ(I), φ(I)), figures.
+/// Runs the scenario: build and run (`simulate`), verdict (`judge_points`), report
+/// (`rheology.csv`, `run_summary`), fits (μ(I), φ(I)), figures.
 pub fn run(
     c: &SimpleShearConfig,
     ctx: &mut RunContext,

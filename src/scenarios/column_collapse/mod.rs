@@ -804,8 +804,8 @@ fn headline(
     headline
 }
 
-/// Runs the scenario: config, build and run ([`simulate`]), measure ([`measure`]), the
-/// reference ([`compare_reference`]), verdict ([`judge`]), report.
+/// Runs the scenario: config, build and run (`simulate`), measure (`measure`), the
+/// reference (`compare_reference`), verdict (`judge`), report.
 pub fn run(
     c: &ColumnCollapseConfig,
     ctx: &mut RunContext,

@@ -731,8 +731,8 @@ fn write_profile(
     Ok(())
 }
 
-/// Runs the scenario: config, build and run ([`simulate`]), measure ([`homogenise`]), fit,
-/// verdict ([`judge`]), report.
+/// Runs the scenario: config, build and run (`simulate`), measure (`homogenise`), fit,
+/// verdict (`judge`), report.
 pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
     let width = datasets::build::column_width(&c.grain, c.grains, c.column_aspect);
     announce(c, ctx.verbosity, width);
