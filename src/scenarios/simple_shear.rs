@@ -209,8 +209,8 @@ impl RheologyPoint {
 }
 
 table_row! {
-    /// A point of the `rheology.csv` of a biperiodic cell ([`RheologyPoint::row`]; the table
-    /// adds the point's verdict, [`super::shear_cell::write_rheology_table`]).
+    /// A point of the `rheology.csv` of a biperiodic cell (`RheologyPoint::row`; the table
+    /// adds the point's verdict, `shear_cell::write_rheology_table`).
     pub struct RheologyRow {
         /// Target inertial number (NaN: none).
         i_target: "I_target",
