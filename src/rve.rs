@@ -24,8 +24,9 @@ use identify::law::GrainScale;
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
 use crate::readers::{ExternalSnapshot, GradientSource};
+use crate::scenarios::rows::TableRow;
 use crate::scenarios::shear_cell::{judge_points, write_rheology_table, RunCheckData};
-use crate::scenarios::simple_shear::{CellSamples, RheologyPoint, RHEOLOGY_HEADERS};
+use crate::scenarios::simple_shear::{CellSamples, RheologyPoint, RheologyRow};
 use crate::verdict::{max_solid_fraction, Checks, Verdict, WindowStats};
 
 /// The point of a series of snapshots of a sheared biperiodic cell (module documentation).
@@ -33,7 +34,7 @@ use crate::verdict::{max_solid_fraction, Checks, Verdict, WindowStats};
 pub struct RvePoint {
     /// The row of `rheology.csv` (the columns of the `simple-shear` scenario's, `I_target` and
     /// `cell_corrections_per_step` NaN), without its verdict.
-    pub row: Vec<f64>,
+    pub row: RheologyRow,
     /// The point's verdict.
     pub verdict: Verdict,
     /// The failed checks.
@@ -140,11 +141,10 @@ pub fn rve_point(snaps: &[ExternalSnapshot]) -> Result<Option<RvePoint>> {
 impl RvePoint {
     /// Column `name` of [`RvePoint::row`].
     pub fn value(&self, name: &str) -> f64 {
-        RHEOLOGY_HEADERS
+        RheologyRow::HEADERS
             .iter()
             .position(|h| *h == name)
-            .and_then(|k| self.row.get(k))
-            .copied()
+            .and_then(|k| self.row.to_values().get(k).copied())
             .unwrap_or(f64::NAN)
     }
 
@@ -153,7 +153,6 @@ impl RvePoint {
     pub fn write(&self, out: &mut OutputDir) -> Result<()> {
         write_rheology_table(
             out,
-            &RHEOLOGY_HEADERS,
             std::slice::from_ref(&self.row),
             &[self.verdict],
             &format!(

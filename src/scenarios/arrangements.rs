@@ -13,10 +13,11 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_csv_table, table_row};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, OutputDir, Summary};
+use crate::output::{OutputDir, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 
 /// One phase per arrangement (rectangular, triangular, cannonball), each settling its own
@@ -31,7 +32,8 @@ struct StacksState {
     /// Summary entries so far.
     s: Summary,
     /// One row per arrangement: `wall_loads.csv`.
-    table: CsvTable,
+    #[serde(with = "serde_csv_table")]
+    table: Vec<WallLoadRow>,
     headline: Vec<String>,
     all: PhaseStats,
     /// VTK frames of the current arrangement.
@@ -119,17 +121,17 @@ impl PhasedRun for Stacks<'_> {
                 0.5 * (-left.x + right.x),
             )
             .flag(&format!("at_rest_{name}"), stats.at_rest);
-        st.table.push(vec![
-            k as f64,
-            (snap.bodies.len() - 4) as f64,
+        st.table.push(WallLoadRow {
+            arrangement: k as f64,
+            grains: (snap.bodies.len() - 4) as f64,
             weight,
             bottom_load,
-            -left.x,
-            right.x,
-            -left.y,
-            -right.y,
-            top.y,
-        ]);
+            left_normal: -left.x,
+            right_normal: right.x,
+            left_friction_up: -left.y,
+            right_friction_up: -right.y,
+            top_load: top.y,
+        });
         st.headline.push(format!(
             "{name:<12}: bottom load / weight = {ratio:.3}, side walls carry {:.3} of the weight",
             -(left.y + right.y) / weight
@@ -152,6 +154,31 @@ impl PhasedRun for Stacks<'_> {
     }
 }
 
+table_row! {
+    /// One arrangement at rest: a row of `wall_loads.csv`, the forces of the grains on the
+    /// walls (N per metre of thickness).
+    struct WallLoadRow {
+        /// The arrangement: 0 rectangular, 1 triangular, 2 cannonball.
+        arrangement: "arrangement_0rect_1tri_2cannon",
+        /// Grains of the stack.
+        grains: "grains",
+        /// Their weight (N).
+        weight: "weight_N",
+        /// Load on the floor, downward (N).
+        bottom_load: "bottom_load_N",
+        /// Normal force on the left wall (N).
+        left_normal: "left_wall_normal_N",
+        /// Normal force on the right wall (N).
+        right_normal: "right_wall_normal_N",
+        /// Friction carried up by the left wall (N).
+        left_friction_up: "left_wall_friction_up_N",
+        /// Friction carried up by the right wall (N).
+        right_friction_up: "right_wall_friction_up_N",
+        /// Load on the top wall (N).
+        top_load: "top_load_N",
+    }
+}
+
 /// Runs the scenario.
 pub fn run(
     c: &ArrangementsConfig,
@@ -166,17 +193,7 @@ pub fn run(
         .num("wall_friction", c.friction.grain_wall);
     let state = StacksState {
         s,
-        table: CsvTable::new(&[
-            "arrangement_0rect_1tri_2cannon",
-            "grains",
-            "weight_N",
-            "bottom_load_N",
-            "left_wall_normal_N",
-            "right_wall_normal_N",
-            "left_wall_friction_up_N",
-            "right_wall_friction_up_N",
-            "top_load_N",
-        ]),
+        table: Vec::new(),
         headline: vec![format!("report: {}/", ctx.out.path().display())],
         all: PhaseStats::default(),
         vtk: VtkFrames::new(f64::INFINITY, 1),
@@ -187,7 +204,7 @@ pub fn run(
     let (_, st) = drive(ctx, ctl, &Stacks { c }, || Ok((empty, state)))?;
     let StacksState {
         mut s,
-        mut table,
+        table,
         headline,
         all,
         ..
@@ -196,9 +213,11 @@ pub fn run(
     // Verdict: each stack at rest carries its weight exactly: floor + side-wall friction − top
     // load = weight (crate::verdict).
     let mut checks = crate::verdict::Checks::new();
-    for (k, r) in table.rows.iter().enumerate() {
+    for (k, r) in table.iter().enumerate() {
         let name = Arrangement::ALL[k].name();
-        let balance = (r[3] + r[6] + r[7] - r[8]) / r[2] - 1.0;
+        let balance = (r.bottom_load + r.left_friction_up + r.right_friction_up - r.top_load)
+            / r.weight
+            - 1.0;
         checks.at_most(
             &format!("arrangements.force_balance_{name}"),
             balance.abs(),
@@ -222,6 +241,7 @@ pub fn run(
             );
         }
     }
+    let mut table = rows::table(&table);
     table.comments.push("one row per arrangement; forces of the grains on the walls at rest (N per metre of thickness)".into());
     table.write(&mut ctx.out, "wall_loads.csv")?;
     Ok(RunOutcome {

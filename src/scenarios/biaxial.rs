@@ -23,7 +23,7 @@
 //! stress–dilatancy relation `sin φ_mob = sin φ_cv + β sin ψ` fitted over the hardening phase
 //! (dilatancy windows before the peak) of every pressure.
 
-use datasets::config::{BiaxialConfig, CellControlMode, Preparation};
+use datasets::config::{BiaxialConfig, Preparation};
 use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
@@ -31,20 +31,23 @@ use homogenise::cell::cell_state;
 use identify::critical_state::{
     fit_critical_state, fit_stress_dilatancy, PlateauMeasure, StressDilatancyData,
 };
+use identify::law::Provenance;
 use identify::mohr_coulomb::{fit_mohr_coulomb_supported, YieldData};
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
+use super::cell_base::{CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
 use super::common::{
-    fit_keys, implicit_cell_control, mean_diameter, parameter_lines, short_number, solver_keys,
-    strain_bins, Stop, VtkFrames,
+    fit_keys, mean_diameter, parameter_lines, short_number, solver_keys, strain_bins, Stop,
+    VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_rows, table_row};
 use super::sensitivity::{record, resolved_pair};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, OutputDir, Summary};
+use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::warn;
@@ -52,56 +55,72 @@ use crate::verdict::{
     export_law, max_solid_fraction, remove_stale_law, Checks, RunVerdict, Verdict, WindowStats,
 };
 
-/// Columns of `history_p{k}.csv`.
-const HISTORY: [&str; 20] = [
-    "t_s",
-    "axial_strain",
-    "volumetric_strain",
-    "sigma_xx_Pa",
-    "sigma_yy_Pa",
-    "sigma_xy_Pa",
-    "D_xx_1_s",
-    "D_yy_1_s",
-    "D_xy_1_s",
-    "p_Pa",
-    "q_Pa",
-    "sin_phi_mob",
-    "phi",
-    "Z",
-    "fabric_anisotropy",
-    "I",
-    "cell_corrections",
-    "fabric_angle_deg",
-    "q_axial_Pa",
-    "target_sigma_xx_Pa",
-];
-/// Columns of `compression_p{k}.csv`.
-const COMPRESSION: [&str; 7] = [
-    "t_s",
-    "sigma_xx_Pa",
-    "sigma_yy_Pa",
-    "phi",
-    "Z",
-    "cell_corrections",
-    "target_sigma_Pa",
-];
-/// Column indices of [`HISTORY`].
-const EA: usize = 1;
-const EV: usize = 2;
-const SXX: usize = 3;
-const SYY: usize = 4;
-const DXX: usize = 6;
-const DYY: usize = 7;
-const DXY: usize = 8;
-const P: usize = 9;
-const PHI: usize = 12;
-const Z: usize = 13;
-const ANISO: usize = 14;
-const INERTIAL: usize = 15;
-const CORRECTIONS: usize = 16;
+table_row! {
+    /// One step of the axial compression: a row of `history_p{k}.csv`.
+    struct HistoryRow {
+        /// Time (s).
+        t: "t_s",
+        /// `ε_a = −ln(H/H₀)` (compression positive).
+        axial_strain: "axial_strain",
+        /// `ε_v = −ln(V/V₀)` (positive in contraction).
+        volumetric_strain: "volumetric_strain",
+        /// Whole-cell mean stress Σ_xx (Pa, tension positive).
+        sxx: "sigma_xx_Pa",
+        /// Σ_yy (Pa).
+        syy: "sigma_yy_Pa",
+        /// Σ_xy (Pa).
+        sxy: "sigma_xy_Pa",
+        /// Strain rate of the cell D_xx (1/s).
+        dxx: "D_xx_1_s",
+        /// D_yy (1/s).
+        dyy: "D_yy_1_s",
+        /// D_xy (1/s).
+        dxy: "D_xy_1_s",
+        /// Mean pressure `p = −tr Σ/2` (Pa).
+        p: "p_Pa",
+        /// Deviator q (Pa).
+        q: "q_Pa",
+        /// q/p of the step.
+        sin_phi_mob: "sin_phi_mob",
+        /// Solid fraction.
+        phi: "phi",
+        /// Coordination over force-carrying contacts.
+        z: "Z",
+        /// Fabric anisotropy `a = 2 (F₁ − F₂)`.
+        fabric_anisotropy: "fabric_anisotropy",
+        /// Inertial number of the step (NaN without pressure).
+        inertial: "I",
+        /// Re-solves of the step by the cell control.
+        cell_corrections: "cell_corrections",
+        /// Major direction of the fabric from x (degrees).
+        fabric_angle_deg: "fabric_angle_deg",
+        /// `q_a = (Σ_xx − Σ_yy)/2` (Pa).
+        q_axial: "q_axial_Pa",
+        /// The imposed lateral stress after the outer correction (Pa).
+        target_sxx: "target_sigma_xx_Pa",
+    }
+}
 
-/// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
-const GAIN_FRACTION: f64 = 0.3;
+table_row! {
+    /// One step of the isotropic compression: a row of `compression_p{k}.csv`.
+    struct CompressionRow {
+        /// Time (s).
+        t: "t_s",
+        /// Σ_xx (Pa, tension positive).
+        sxx: "sigma_xx_Pa",
+        /// Σ_yy (Pa).
+        syy: "sigma_yy_Pa",
+        /// Solid fraction.
+        phi: "phi",
+        /// Coordination.
+        z: "Z",
+        /// Re-solves of the step by the cell control.
+        cell_corrections: "cell_corrections",
+        /// The imposed target (Pa).
+        target: "target_sigma_Pa",
+    }
+}
+
 /// Gain of the lateral control in the axial compression, as a fraction of `Δt/(ρ d²)`: lower
 /// than in the isotropic compression, so that the step-to-step noise of Σ_xx (tens of % of p₀
 /// for rigid grains) does not drive the lateral rate.
@@ -110,12 +129,6 @@ const AXIAL_GAIN_FRACTION: f64 = 0.05;
 const AXIAL_RATE_CAP: f64 = 3.0;
 /// Filter time of the lateral control in the axial compression, in time steps.
 const AXIAL_FILTER_STEPS: f64 = 10.0;
-/// Tolerance of the explicit law's correction of the cell control, as a fraction of p₀.
-const CONTROL_TOLERANCE: f64 = 0.5;
-/// Re-solves of a step at most by the implicit correction.
-const MAX_CORRECTIONS: usize = 8;
-/// Blocks of the block-averaged standard errors (at least).
-const MIN_BLOCKS: usize = 4;
 /// About this many axial steps per pressure, evenly spread, are solved again to
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] and the cell's stress taken both ways: the solver
 /// sensitivity of the axial compression ([`crate::verdict::Sensitivity`] with the axial
@@ -163,50 +176,120 @@ pub const STEADY_SIN_PHI_TOLERANCE: f64 = 0.02;
 /// Difference of the plateau halves of φ that matters (absolute).
 pub const STEADY_PHI_TOLERANCE: f64 = 0.005;
 
-/// Columns of `dilatancy.csv`: one row per dilatancy window ([`dilatancy_windows`]).
-const DILATANCY: [&str; 7] = [
-    "p0_Pa",
-    "axial_strain",
-    "sin_phi_mob",
-    "sin_psi",
-    "sin_psi_std_error",
-    "dilatancy_ratio",
-    "hardening",
-];
+table_row! {
+    /// One dilatancy window ([`dilatancy_windows`]): a row of `dilatancy.csv`.
+    struct DilatancyRow {
+        /// p₀ (Pa) in the CSV; the pressure's index while the run collects them.
+        p0: "p0_Pa",
+        /// ε_a at the window's centre.
+        axial_strain: "axial_strain",
+        /// `q_a/p` of the window's mean stresses.
+        sin_phi_mob: "sin_phi_mob",
+        /// `sin ψ` (NaN outside [−1, 1]).
+        sin_psi: "sin_psi",
+        /// Its block standard error.
+        sin_psi_std_error: "sin_psi_std_error",
+        /// `−ε̇_v/ε̇_γ`, in range or not.
+        dilatancy_ratio: "dilatancy_ratio",
+        /// 1 for a window whose centre comes before the peak, else 0.
+        hardening: "hardening",
+    }
+}
 
-/// Columns of a per-pressure result row ([`State::rows`], `biaxial.csv`).
-const ROW: [&str; 30] = [
-    "p0_Pa",
-    "sin_phi_peak",
-    "axial_strain_peak",
-    "p_peak_Pa",
-    "q_peak_Pa",
-    "sin_phi_critical",
-    "sin_phi_critical_std_error",
-    "phi_critical",
-    "phi_critical_std_error",
-    "p_critical_Pa",
-    "Z_critical",
-    "sin_psi_max",
-    "axial_strain_psi_max",
-    "sin_psi_critical",
-    "lateral_stress_error",
-    "I_mean",
-    "compression_stress_error",
-    "phi_compressed",
-    "Z_compressed",
-    "axial_rate_1_s",
-    "dt_s",
-    "critical_samples",
-    "cell_corrections_per_step",
-    "fabric_anisotropy_critical",
-    "phi_initial_axial",
-    "sin_psi_max_std_error",
-    "sin_psi_critical_std_error",
-    "dilatancy_ratio_critical",
-    "dilatancy_windows",
-    "dilatancy_undefined_windows",
-];
+table_row! {
+    /// The result of one pressure ([`State::rows`], `biaxial.csv`).
+    struct PressureRow {
+        /// Confining pressure (Pa).
+        p0: "p0_Pa",
+        /// Largest bin mean of q/p.
+        sin_phi_peak: "sin_phi_peak",
+        /// ε_a of the peak bin.
+        axial_strain_peak: "axial_strain_peak",
+        /// p at the peak (Pa).
+        p_peak: "p_peak_Pa",
+        /// q_a at the peak (Pa).
+        q_peak: "q_peak_Pa",
+        /// Plateau q/p (ratio of means).
+        sin_phi_critical: "sin_phi_critical",
+        /// Its block standard error.
+        sin_phi_critical_se: "sin_phi_critical_std_error",
+        /// Plateau solid fraction.
+        phi_critical: "phi_critical",
+        /// Its block standard error.
+        phi_critical_se: "phi_critical_std_error",
+        /// Plateau pressure (Pa).
+        p_critical: "p_critical_Pa",
+        /// Plateau coordination.
+        z_critical: "Z_critical",
+        /// Largest window `sin ψ`.
+        sin_psi_max: "sin_psi_max",
+        /// ε_a of that window.
+        axial_strain_psi_max: "axial_strain_psi_max",
+        /// The plateau's `sin ψ`.
+        sin_psi_critical: "sin_psi_critical",
+        /// `|⟨Σ_xx⟩ + p₀|/p₀` over the axial compression.
+        lateral_stress_error: "lateral_stress_error",
+        /// Inertial number with the mean pressure of the axial compression.
+        i_mean: "I_mean",
+        /// Error of the stress reached by the isotropic compression.
+        compression_stress_error: "compression_stress_error",
+        /// Solid fraction reached by the isotropic compression.
+        phi_compressed: "phi_compressed",
+        /// Coordination reached by the isotropic compression.
+        z_compressed: "Z_compressed",
+        /// ε̇_a (1/s).
+        axial_rate: "axial_rate_1_s",
+        /// Time step (s).
+        dt: "dt_s",
+        /// Steps of the plateau.
+        critical_samples: "critical_samples",
+        /// Mean re-solves per axial step.
+        cell_corrections_per_step: "cell_corrections_per_step",
+        /// Plateau fabric anisotropy.
+        fabric_anisotropy_critical: "fabric_anisotropy_critical",
+        /// Solid fraction at the first axial step.
+        phi_initial_axial: "phi_initial_axial",
+        /// Block standard error of [`Self::sin_psi_max`].
+        sin_psi_max_se: "sin_psi_max_std_error",
+        /// Block standard error of [`Self::sin_psi_critical`].
+        sin_psi_critical_se: "sin_psi_critical_std_error",
+        /// The plateau's `−ε̇_v/ε̇_γ`, in range or not.
+        dilatancy_ratio_critical: "dilatancy_ratio_critical",
+        /// Dilatancy windows.
+        dilatancy_windows: "dilatancy_windows",
+        /// Windows without a dilatancy angle.
+        dilatancy_undefined_windows: "dilatancy_undefined_windows",
+    }
+}
+
+table_row! {
+    /// A point of a finished pressure's binned curves ([`bin_history`]), kept for the figures.
+    struct BinPoint {
+        /// Index of the pressure.
+        pressure: "pressure_index",
+        /// ε_a (bin mean).
+        axial_strain: "axial_strain",
+        /// `q_a/p` of the bin's mean stresses.
+        sin_phi: "sin_phi",
+        /// ε_v (bin mean).
+        volumetric_strain: "volumetric_strain",
+    }
+}
+
+/// What the isotropic compression reached (means over its last [`COMPRESSION_TAIL`]), kept
+/// until the axial compression closes the pressure's row.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+struct Compressed {
+    /// `max(|⟨Σ_xx⟩ + p₀|, |⟨Σ_yy⟩ + p₀|)/p₀`.
+    #[serde(with = "dem::serde_float")]
+    error: f64,
+    /// Solid fraction.
+    #[serde(with = "dem::serde_float")]
+    phi: f64,
+    /// Coordination.
+    #[serde(with = "dem::serde_float")]
+    z: f64,
+}
 
 /// The plan of the current phase.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
@@ -241,27 +324,25 @@ struct PressureCheck {
 /// What the phases collect.
 #[derive(Serialize, Deserialize)]
 struct State {
-    all: PhaseStats,
-    /// One row per pressure ([`ROW`]).
-    #[serde(with = "crate::floats::table")]
-    rows: Vec<Vec<f64>>,
-    /// The current axial compression's history ([`HISTORY`]).
-    #[serde(with = "crate::floats::table")]
-    history: Vec<Vec<f64>>,
-    /// t, Σ_xx, Σ_yy, φ, Z, cell corrections of the steps of the current isotropic compression
-    /// ([`COMPRESSION`]).
-    #[serde(with = "crate::floats::table")]
-    compression: Vec<Vec<f64>>,
-    /// Binned curves of the finished pressures: rows (pressure index, ε_a, sin φ, ε_v).
-    #[serde(with = "crate::floats::table")]
-    bins: Vec<Vec<f64>>,
-    /// Dilatancy windows of the finished pressures ([`dilatancy_windows`]): rows ([`DILATANCY`]
-    /// but the pressure's index in place of p₀).
-    #[serde(default, with = "crate::floats::table")]
-    dilatancy: Vec<Vec<f64>>,
+    /// Solver statistics, one row per finished pressure, the current axial compression's
+    /// history, the frames of the last pressure's sample, the numerics of the current axial
+    /// compression.
+    #[serde(flatten)]
+    cell: CellRecord<HistoryRow, PressureRow>,
+    /// What the current pressure's isotropic compression reached, until its row is closed.
+    #[serde(default)]
+    compressed: Option<Compressed>,
+    /// The steps of the current isotropic compression.
+    #[serde(with = "serde_rows")]
+    compression: Vec<CompressionRow>,
+    /// Binned curves of the finished pressures.
+    #[serde(with = "serde_rows")]
+    bins: Vec<BinPoint>,
+    /// Dilatancy windows of the finished pressures ([`dilatancy_windows`]), with the
+    /// pressure's index in place of p₀.
+    #[serde(default, with = "serde_rows")]
+    dilatancy: Vec<DilatancyRow>,
     run: RunPlan,
-    frames: VtkFrames,
-    window: WindowStats,
     checks: Vec<PressureCheck>,
     /// The imposed stress target of the current phase (Pa), after the outer correction.
     #[serde(with = "dem::serde_float")]
@@ -278,21 +359,54 @@ fn axial_pair(s: &Mat) -> [f64; 2] {
     [0.5 * (s[(0, 0)] - s[(1, 1)]), 0.5 * (s[(0, 0)] + s[(1, 1)])]
 }
 
+/// One bin of a history ([`bin_history`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Bin {
+    /// Mean ε_a.
+    axial_strain: f64,
+    /// `q_a/p` of the mean stresses.
+    sin_phi: f64,
+    /// Mean ε_v.
+    volumetric_strain: f64,
+    /// Mean p (Pa).
+    p: f64,
+    /// `q_a = (⟨Σ_xx⟩ − ⟨Σ_yy⟩)/2` (Pa).
+    q_axial: f64,
+}
+
 /// Bins of a history: per bin of `width` in ε_a (the first starting at ε_a = 0, bins with at
 /// least one sample), the means of ε_a, ε_v, I, Σ_xx, Σ_yy, p, and from the mean tensor the
 /// mobilised friction `sin φ = q_a/p`, `q_a = (⟨Σ_xx⟩ − ⟨Σ_yy⟩)/2` (σ₁ axial, σ₃ lateral, the
-/// shear stress averaging 0 under L_xy = 0): `[ε_a, sin φ, ε_v, I, p, q_a]`. The mean of the
-/// tensor, not of the step's q/p, which the noise of the step biases upward.
-fn bin_history(history: &[Vec<f64>], width: f64) -> Vec<[f64; 6]> {
-    let cols = [EA, EV, INERTIAL, SXX, SYY, P];
-    strain_bins(history, EA, width, &cols, |r| r[INERTIAL].is_finite())
-        .into_iter()
-        .map(|m| {
-            // m: ε_a, ε_v, I, Σ_xx, Σ_yy, p
-            let qa = 0.5 * (m[3] - m[4]);
-            [m[0], qa / m[5], m[1], m[2], m[5], qa]
-        })
-        .collect()
+/// shear stress averaging 0 under L_xy = 0). The mean of the tensor, not of the step's q/p,
+/// which the noise of the step biases upward.
+fn bin_history(history: &[HistoryRow], width: f64) -> Vec<Bin> {
+    let cols: [fn(&HistoryRow) -> f64; 6] = [
+        |r| r.axial_strain,
+        |r| r.volumetric_strain,
+        |r| r.inertial,
+        |r| r.sxx,
+        |r| r.syy,
+        |r| r.p,
+    ];
+    strain_bins(
+        history,
+        |r| r.axial_strain,
+        width,
+        cols,
+        |r| r.inertial.is_finite(),
+    )
+    .into_iter()
+    .map(|[ea, ev, _inertial, sxx, syy, p]| {
+        let qa = 0.5 * (sxx - syy);
+        Bin {
+            axial_strain: ea,
+            sin_phi: qa / p,
+            volumetric_strain: ev,
+            p,
+            q_axial: qa,
+        }
+    })
+    .collect()
 }
 
 /// Mean of `num/den` as the ratio of the means `⟨num⟩/⟨den⟩`, with its block-averaged standard
@@ -352,7 +466,7 @@ struct Dilatancy {
 /// their `−Δ ln V`), with the block-averaged standard error of the ratio of means
 /// ([`ratio_of_means`] with `tr D_t` over the shear rate of step `t` along `D̄`'s principal
 /// axes, `((D_xx − D_yy)(D̄_xx − D̄_yy) + 4 D_xy D̄_xy)/ε̇_γ`, whose mean is `ε̇_γ`).
-fn dilatancy_over(rows: &[&Vec<f64>]) -> Dilatancy {
+fn dilatancy_over(rows: &[&HistoryRow]) -> Dilatancy {
     let nan = Dilatancy {
         sin_psi: f64::NAN,
         std_error: f64::NAN,
@@ -362,17 +476,17 @@ fn dilatancy_over(rows: &[&Vec<f64>]) -> Dilatancy {
         return nan;
     }
     let n = rows.len() as f64;
-    let mean = |j: usize| rows.iter().map(|r| r[j]).sum::<f64>() / n;
-    let (a, b, c) = (mean(DXX), mean(DYY), mean(DXY));
+    let mean = |f: fn(&HistoryRow) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+    let (a, b, c) = (mean(|r| r.dxx), mean(|r| r.dyy), mean(|r| r.dxy));
     let ratio = dilatancy_ratio([a, b, c]);
     let g = ((a - b).powi(2) + 4.0 * c * c).sqrt();
     if !ratio.is_finite() {
         return nan;
     }
-    let num: Vec<f64> = rows.iter().map(|r| r[DXX] + r[DYY]).collect();
+    let num: Vec<f64> = rows.iter().map(|r| r.dxx + r.dyy).collect();
     let den: Vec<f64> = rows
         .iter()
-        .map(|r| ((r[DXX] - r[DYY]) * (a - b) + 4.0 * r[DXY] * c) / g)
+        .map(|r| ((r.dxx - r.dyy) * (a - b) + 4.0 * r.dxy * c) / g)
         .collect();
     let (_, se) = ratio_of_means(&num, &den);
     Dilatancy {
@@ -385,20 +499,20 @@ fn dilatancy_over(rows: &[&Vec<f64>]) -> Dilatancy {
 /// The dilatancy windows of a history: consecutive windows of `width` of axial strain from
 /// ε_a = 0, each with at least one step, the last one only if whole: `(ε_a at its centre, sin φ
 /// as the ratio of its mean stresses, its dilatancy)`.
-fn dilatancy_windows(history: &[Vec<f64>], width: f64) -> Vec<(f64, f64, Dilatancy)> {
-    let end = history.last().map_or(0.0, |r| r[EA]);
+fn dilatancy_windows(history: &[HistoryRow], width: f64) -> Vec<(f64, f64, Dilatancy)> {
+    let end = history.last().map_or(0.0, |r| r.axial_strain);
     let mut out = Vec::new();
     let mut k = 0.0;
     while (k + 1.0) * width <= end * (1.0 + 1e-9) {
         let (lo, hi) = (k * width, (k + 1.0) * width);
-        let rows: Vec<&Vec<f64>> = history
+        let rows: Vec<&HistoryRow> = history
             .iter()
-            .filter(|r| r[EA] >= lo && r[EA] < hi && r[INERTIAL].is_finite())
+            .filter(|r| r.axial_strain >= lo && r.axial_strain < hi && r.inertial.is_finite())
             .collect();
         if !rows.is_empty() {
             let n = rows.len() as f64;
-            let m = |j: usize| rows.iter().map(|r| r[j]).sum::<f64>() / n;
-            let sin_phi = 0.5 * (m(SXX) - m(SYY)) / m(P);
+            let m = |f: fn(&HistoryRow) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+            let sin_phi = 0.5 * (m(|r| r.sxx) - m(|r| r.syy)) / m(|r| r.p);
             out.push((0.5 * (lo + hi), sin_phi, dilatancy_over(&rows)));
         }
         k += 1.0;
@@ -424,7 +538,7 @@ impl Biaxial<'_> {
     ) -> CellControl {
         let rho = self.c.grain.density;
         let cap = self.c.control_inertial_number * (p0 / rho).sqrt() / d;
-        let (yy, max_rate, gf, tau) = match axial_rate {
+        let (yy, max_rate, gain_fraction, filter_steps) = match axial_rate {
             None => (Imposed::Stress(target), cap, GAIN_FRACTION, 0.0),
             // the lateral expansion of a dilating sample runs at ε̇_a (1 + d), d ≲ 1
             Some(r) => (
@@ -434,52 +548,49 @@ impl Biaxial<'_> {
                 AXIAL_FILTER_STEPS,
             ),
         };
-        if self.c.cell_control == CellControlMode::Implicit {
-            return implicit_cell_control(
-                Imposed::Stress(target),
-                yy,
-                Imposed::Rate(0.0),
-                max_rate,
-                p0,
-                axial_rate.is_none(),
-            );
-        }
-        CellControl {
+        ControlPlan {
+            mode: self.c.cell_control,
             xx: Imposed::Stress(target),
             yy,
             xy: Imposed::Rate(0.0),
-            gain: gf * dt / (rho * d * d),
             max_rate,
-            relaxation: tau * dt,
-            tolerance: CONTROL_TOLERANCE * p0,
-            max_corrections: MAX_CORRECTIONS,
-            implicit: false,
+            pressure: p0,
+            compressing: axial_rate.is_none(),
+            gain_fraction,
+            filter_steps,
             affine: false,
         }
+        .control(dt, rho, d)
     }
 
     /// Closes an axial compression: the result row, the binned curves, the check data.
     fn close_axial(&self, i: usize, st: &mut State, world: &dem::World) -> Result<()> {
         let c = self.c;
         let p0 = self.pressures[i];
-        let h = &st.history;
+        let h = &st.cell.history;
         let bins = bin_history(h, c.bin_strain);
         // the peak: the largest bin mean of q/p
         let (kpeak, peak) =
             bins.iter()
                 .enumerate()
                 .fold((0, f64::NEG_INFINITY), |(k, m), (j, b)| {
-                    if b[1] > m {
-                        (j, b[1])
+                    if b.sin_phi > m {
+                        (j, b.sin_phi)
                     } else {
                         (k, m)
                     }
                 });
-        let (eps_peak, p_peak, q_peak) = bins
-            .get(kpeak)
-            .map_or((f64::NAN, f64::NAN, f64::NAN), |b| (b[0], b[4], b[5]));
+        let (eps_peak, p_peak, q_peak) =
+            bins.get(kpeak).map_or((f64::NAN, f64::NAN, f64::NAN), |b| {
+                (b.axial_strain, b.p, b.q_axial)
+            });
         for b in &bins {
-            st.bins.push(vec![i as f64, b[0], b[1], b[2]]);
+            st.bins.push(BinPoint {
+                pressure: i as f64,
+                axial_strain: b.axial_strain,
+                sin_phi: b.sin_phi,
+                volumetric_strain: b.volumetric_strain,
+            });
         }
         // dilatancy over windows of DILATANCY_WINDOW_BINS bins; the largest defined one
         let windows = dilatancy_windows(h, DILATANCY_WINDOW_BINS as f64 * c.bin_strain);
@@ -493,75 +604,79 @@ impl Biaxial<'_> {
                 psi_max = (dl.sin_psi, *x, dl.std_error);
             }
             // the hardening phase: windows whose centre comes before the peak
-            st.dilatancy.push(vec![
-                i as f64,
-                *x,
-                *sin_phi,
-                dl.sin_psi,
-                dl.std_error,
-                dl.ratio,
-                if *x <= eps_peak { 1.0 } else { 0.0 },
-            ]);
+            st.dilatancy.push(DilatancyRow {
+                p0: i as f64,
+                axial_strain: *x,
+                sin_phi_mob: *sin_phi,
+                sin_psi: dl.sin_psi,
+                sin_psi_std_error: dl.std_error,
+                dilatancy_ratio: dl.ratio,
+                hardening: if *x <= eps_peak { 1.0 } else { 0.0 },
+            });
         }
-        let p_mean = h.iter().map(|r| r[P]).sum::<f64>() / h.len().max(1) as f64;
+        let p_mean = h.iter().map(|r| r.p).sum::<f64>() / h.len().max(1) as f64;
         let i_mean = st.run.rate * mean_diameter(world) / (p_mean / c.grain.density).sqrt();
         // the critical-state plateau
         let start = c.max_axial_strain - c.critical_strain;
-        let tail: Vec<&Vec<f64>> = h.iter().filter(|r| r[EA] >= start).collect();
-        let col = |j: usize| -> Vec<f64> { tail.iter().map(|r| r[j]).collect() };
-        let avg = |j: usize| -> (f64, f64) {
-            block_average(&col(j), MIN_BLOCKS)
+        let tail: Vec<&HistoryRow> = h.iter().filter(|r| r.axial_strain >= start).collect();
+        let col = |f: fn(&HistoryRow) -> f64| -> Vec<f64> { tail.iter().map(|r| f(r)).collect() };
+        let avg = |f: fn(&HistoryRow) -> f64| -> (f64, f64) {
+            block_average(&col(f), MIN_BLOCKS)
                 .map_or((f64::NAN, f64::NAN), |a| (a.mean, a.std_error))
         };
-        let qa: Vec<f64> = tail.iter().map(|r| 0.5 * (r[SXX] - r[SYY])).collect();
-        let (sphi, sphi_se) = ratio_of_means(&qa, &col(P));
-        let (phi, phi_se) = avg(PHI);
-        let (pc, _) = avg(P);
-        let (zc, _) = avg(Z);
-        let (ac, _) = avg(ANISO);
+        let qa: Vec<f64> = tail.iter().map(|r| 0.5 * (r.sxx - r.syy)).collect();
+        let (sphi, sphi_se) = ratio_of_means(&qa, &col(|r| r.p));
+        let (phi, phi_se) = avg(|r| r.phi);
+        let (pc, _) = avg(|r| r.p);
+        let (zc, _) = avg(|r| r.z);
+        let (ac, _) = avg(|r| r.fabric_anisotropy);
         // the dilatancy of the plateau, from its mean strain rate
         let psi_c = dilatancy_over(&tail);
-        let sxx_mean = h.iter().map(|r| r[SXX]).sum::<f64>() / h.len().max(1) as f64;
+        let sxx_mean = h.iter().map(|r| r.sxx).sum::<f64>() / h.len().max(1) as f64;
         let lateral = (sxx_mean + p0).abs() / p0;
-        let corr = h.iter().map(|r| r[CORRECTIONS]).sum::<f64>() / h.len().max(1) as f64;
-        let comp = st.rows.pop().unwrap_or_else(|| vec![f64::NAN; 3]);
-        st.rows.push(vec![
+        let corr = h.iter().map(|r| r.cell_corrections).sum::<f64>() / h.len().max(1) as f64;
+        let comp = st.compressed.take().unwrap_or(Compressed {
+            error: f64::NAN,
+            phi: f64::NAN,
+            z: f64::NAN,
+        });
+        st.cell.rows.push(PressureRow {
             p0,
-            peak,
-            eps_peak,
+            sin_phi_peak: peak,
+            axial_strain_peak: eps_peak,
             p_peak,
             q_peak,
-            sphi,
-            sphi_se,
-            phi,
-            phi_se,
-            pc,
-            zc,
-            psi_max.0,
-            psi_max.1,
-            psi_c.sin_psi,
-            lateral,
+            sin_phi_critical: sphi,
+            sin_phi_critical_se: sphi_se,
+            phi_critical: phi,
+            phi_critical_se: phi_se,
+            p_critical: pc,
+            z_critical: zc,
+            sin_psi_max: psi_max.0,
+            axial_strain_psi_max: psi_max.1,
+            sin_psi_critical: psi_c.sin_psi,
+            lateral_stress_error: lateral,
             i_mean,
-            comp[0],
-            comp[1],
-            comp[2],
-            st.run.rate,
-            st.run.dt,
-            tail.len() as f64,
-            corr,
-            ac,
-            h.first().map_or(f64::NAN, |r| r[PHI]),
-            psi_max.2,
-            psi_c.std_error,
-            psi_c.ratio,
-            windows.len() as f64,
-            undefined as f64,
-        ]);
+            compression_stress_error: comp.error,
+            phi_compressed: comp.phi,
+            z_compressed: comp.z,
+            axial_rate: st.run.rate,
+            dt: st.run.dt,
+            critical_samples: tail.len() as f64,
+            cell_corrections_per_step: corr,
+            fabric_anisotropy_critical: ac,
+            phi_initial_axial: h.first().map_or(f64::NAN, |r| r.phi),
+            sin_psi_max_se: psi_max.2,
+            sin_psi_critical_se: psi_c.std_error,
+            dilatancy_ratio_critical: psi_c.ratio,
+            dilatancy_windows: windows.len() as f64,
+            dilatancy_undefined_windows: undefined as f64,
+        });
         st.checks.push(PressureCheck {
             p0,
-            window: st.window,
-            sin_phi: qa.iter().zip(col(P)).map(|(q, p)| q / p).collect(),
-            phi: col(PHI),
+            window: st.cell.window,
+            sin_phi: qa.iter().zip(col(|r| r.p)).map(|(q, p)| q / p).collect(),
+            phi: col(|r| r.phi),
         });
         Ok(())
     }
@@ -679,8 +794,8 @@ impl PhasedRun for Biaxial<'_> {
                         h0: cell.h[(1, 1)],
                         v0: cell.volume(),
                     };
-                    st.history.clear();
-                    st.window.reset();
+                    st.cell.history.clear();
+                    st.cell.window.reset();
                 }
                 world.cell_control = Some(self.control(p0, target, dt, d, Some(rate)));
                 let steps = per.min(total.saturating_sub(st.run.n));
@@ -706,27 +821,27 @@ impl PhasedRun for Biaxial<'_> {
     ) -> Result<()> {
         let (i, part) = self.part(k);
         if i + 1 == self.pressures.len() && matches!(part, Part::Axial(_)) {
-            st.frames.maybe(out, w)?;
+            st.cell.frames.maybe(out, w)?;
         }
         let snap = w.snapshot();
         let cs = cell_state(&snap)?;
         let s = cs.stress;
         if !matches!(part, Part::Axial(_)) {
             st.seg = (st.seg.0 + s[(0, 0)], st.seg.1 + s[(1, 1)], st.seg.2 + 1);
-            st.compression.push(vec![
-                w.time,
-                s[(0, 0)],
-                s[(1, 1)],
-                cs.solid_fraction,
-                cs.coordination,
-                r.cell_corrections as f64,
-                st.target,
-            ]);
+            st.compression.push(CompressionRow {
+                t: w.time,
+                sxx: s[(0, 0)],
+                syy: s[(1, 1)],
+                phi: cs.solid_fraction,
+                z: cs.coordination,
+                cell_corrections: r.cell_corrections as f64,
+                target: st.target,
+            });
             return Ok(());
         }
         st.seg = (st.seg.0 + s[(0, 0)], st.seg.1 + s[(0, 0)], st.seg.2 + 1);
         st.run.n += 1;
-        st.window.step(true, w, r, &p.stats);
+        st.cell.window.step(true, w, r, &p.stats);
         if st
             .run
             .n
@@ -734,7 +849,7 @@ impl PhasedRun for Biaxial<'_> {
         {
             let resolved =
                 resolved_pair(w, |snap| Some(axial_pair(&cell_state(snap).ok()?.stress)));
-            record(&mut st.window.sensitivity, axial_pair(&s), resolved);
+            record(&mut st.cell.window.sensitivity, axial_pair(&s), resolved);
         }
         let Some(cell) = w.cell().copied() else {
             return Ok(());
@@ -749,28 +864,28 @@ impl PhasedRun for Biaxial<'_> {
         let f = cs.fabric;
         let aniso = 2.0 * ((f[(0, 0)] - f[(1, 1)]).powi(2) + 4.0 * f[(0, 1)].powi(2)).sqrt();
         let angle = 0.5 * (2.0 * f[(0, 1)]).atan2(f[(0, 0)] - f[(1, 1)]);
-        st.history.push(vec![
-            w.time,
-            -(cell.h[(1, 1)] / st.run.h0).ln(),
-            -(cell.volume() / st.run.v0).ln(),
-            s[(0, 0)],
-            s[(1, 1)],
-            s[(0, 1)],
-            cs.strain_rate[(0, 0)],
-            cs.strain_rate[(1, 1)],
-            cs.strain_rate[(0, 1)],
-            pm,
-            cs.deviator,
-            if pm > 0.0 { cs.deviator / pm } else { f64::NAN },
-            cs.solid_fraction,
-            cs.coordination,
-            aniso,
+        st.cell.history.push(HistoryRow {
+            t: w.time,
+            axial_strain: -(cell.h[(1, 1)] / st.run.h0).ln(),
+            volumetric_strain: -(cell.volume() / st.run.v0).ln(),
+            sxx: s[(0, 0)],
+            syy: s[(1, 1)],
+            sxy: s[(0, 1)],
+            dxx: cs.strain_rate[(0, 0)],
+            dyy: cs.strain_rate[(1, 1)],
+            dxy: cs.strain_rate[(0, 1)],
+            p: pm,
+            q: cs.deviator,
+            sin_phi_mob: if pm > 0.0 { cs.deviator / pm } else { f64::NAN },
+            phi: cs.solid_fraction,
+            z: cs.coordination,
+            fabric_anisotropy: aniso,
             inertial,
-            r.cell_corrections as f64,
-            angle.to_degrees(),
-            0.5 * (s[(0, 0)] - s[(1, 1)]),
-            st.target,
-        ]);
+            cell_corrections: r.cell_corrections as f64,
+            fabric_angle_deg: angle.to_degrees(),
+            q_axial: 0.5 * (s[(0, 0)] - s[(1, 1)]),
+            target_sxx: st.target,
+        });
         Ok(())
     }
 
@@ -782,7 +897,7 @@ impl PhasedRun for Biaxial<'_> {
         world: &mut dem::World,
         stats: &PhaseStats,
     ) -> Result<()> {
-        st.all.merge(stats);
+        st.cell.all.merge(stats);
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];
         match part {
@@ -791,15 +906,20 @@ impl PhasedRun for Biaxial<'_> {
                 let n = st.compression.len();
                 let m = ((n as f64 * COMPRESSION_TAIL).ceil() as usize).clamp(1, n.max(1));
                 let tail = &st.compression[n.saturating_sub(m)..];
-                let mean =
-                    |j: usize| tail.iter().map(|r| r[j]).sum::<f64>() / tail.len().max(1) as f64;
-                let err = (mean(1) + p0).abs().max((mean(2) + p0).abs()) / p0;
+                let mean = |f: fn(&CompressionRow) -> f64| {
+                    tail.iter().map(f).sum::<f64>() / tail.len().max(1) as f64
+                };
+                let err = (mean(|r| r.sxx) + p0)
+                    .abs()
+                    .max((mean(|r| r.syy) + p0).abs())
+                    / p0;
                 // kept until the axial compression closes the row
-                st.rows.push(vec![err, mean(3), mean(4)]);
-                let mut table = CsvTable::new(&COMPRESSION);
-                for row in &st.compression {
-                    table.push(row.clone());
-                }
+                st.compressed = Some(Compressed {
+                    error: err,
+                    phi: mean(|r| r.phi),
+                    z: mean(|r| r.z),
+                });
+                let mut table = rows::table(&st.compression);
                 table.comments.push(format!(
                     "isotropic compression to p0 = {p0} Pa ({} preparation: grain friction {} during it): whole-cell mean stress (tension positive), solid fraction, coordination over force-carrying contacts, re-solves of the step by the cell control, the imposed target",
                     self.c.preparation.as_str(),
@@ -815,10 +935,7 @@ impl PhasedRun for Biaxial<'_> {
                 if st.run.n < st.run.steps {
                     return Ok(());
                 }
-                let mut table = CsvTable::new(&HISTORY);
-                for row in &st.history {
-                    table.push(row.clone());
-                }
+                let mut table = rows::table(&st.cell.history);
                 table.comments.push(format!(
                     "biaxial compression at confining pressure p0 = {p0} Pa ({} preparation), axial rate {:.6e} 1/s along y with sigma_xx = -p0 held: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s); compression positive for the strains: axial_strain = -ln(H/H0), volumetric_strain = -ln(V/V0) (positive in contraction); p = -tr(sigma)/2, q = sqrt(((sigma_xx - sigma_yy)/2)^2 + sigma_xy^2), sin_phi_mob = q/p of the step (noisy: the analysis uses means of the tensor), q_axial = (sigma_xx - sigma_yy)/2; phi solid fraction, Z coordination and fabric over force-carrying contacts, fabric_anisotropy a = 2 (F1 - F2) of the fabric tensor F (Rothenburg & Bathurst 1989), fabric_angle_deg its major direction from x; I = rate d / sqrt(p/rho); cell_corrections counts the re-solves of the step by the cell control; target_sigma_xx the imposed lateral stress after the outer correction",
                     self.c.preparation.as_str(),
@@ -843,16 +960,13 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         Ok((
             world,
             State {
-                all: PhaseStats::default(),
-                rows: Vec::new(),
-                history: Vec::new(),
+                // frames of the last (highest) pressure's sample
+                cell: CellRecord::new(VtkFrames::new(t_last / 40.0, 41)),
+                compressed: None,
                 compression: Vec::new(),
                 bins: Vec::new(),
                 dilatancy: Vec::new(),
                 run: RunPlan::default(),
-                // frames of the last (highest) pressure's sample
-                frames: VtkFrames::new(t_last / 40.0, 41),
-                window: WindowStats::default(),
                 checks: Vec::new(),
                 target: 0.0,
                 seg: (0.0, 0.0, 0),
@@ -861,11 +975,11 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     };
     let (world, state) = drive(ctx, ctl, &bx, fresh)?;
     let State {
-        all,
-        rows,
+        cell: CellRecord {
+            all, rows, frames, ..
+        },
         bins,
         dilatancy,
-        frames,
         checks,
         ..
     } = state;
@@ -889,9 +1003,15 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
 /// error at most [`DILATANCY_SE_SUSPECT`]); the plateau's must be an angle (its mean strain
 /// rate shears the cell). Suspect otherwise: the value is then not reported (NaN), never a
 /// `sin ψ` outside [−1, 1].
-fn judge_dilatancy(k: &mut Checks, label: &str, r: &[f64]) {
-    let (max, max_se, crit, crit_ratio, windows, undefined) =
-        (r[11], r[25], r[13], r[27], r[28], r[29]);
+fn judge_dilatancy(k: &mut Checks, label: &str, r: &PressureRow) {
+    let (max, max_se, crit, crit_ratio, windows, undefined) = (
+        r.sin_psi_max,
+        r.sin_psi_max_se,
+        r.sin_psi_critical,
+        r.dilatancy_ratio_critical,
+        r.dilatancy_windows,
+        r.dilatancy_undefined_windows,
+    );
     if max.is_nan() {
         k.fail(
             "biaxial.dilatancy_undefined",
@@ -928,21 +1048,22 @@ fn judge_dilatancy(k: &mut Checks, label: &str, r: &[f64]) {
     }
 }
 
-/// The checks, fits, laws, table, figures and summary of a finished run.
-#[allow(clippy::too_many_arguments)]
-fn analyse(
-    c: &BiaxialConfig,
-    pressures: &[f64],
-    ctx: &mut RunContext,
-    ctl: &RunControl,
-    world: &dem::World,
-    all: &PhaseStats,
-    rows: &[Vec<f64>],
-    bins: &[Vec<f64>],
-    dilatancy: &[Vec<f64>],
-    checks: &[PressureCheck],
-) -> Result<RunOutcome> {
-    // --- checks (crate::verdict) ---
+/// The checks of a finished run ([`judge`]): per law, the checks it is judged by.
+struct Judged {
+    /// The numerics and stresses of every pressure (all laws).
+    common: Checks,
+    /// `common` and the plateaus (the critical state).
+    critical: Checks,
+    /// `common` and the dilatancy (the stress–dilatancy relation).
+    dilat: Checks,
+    /// The run's own checks: the critical state's and the dilatancy's.
+    run: Checks,
+    /// The numerics of all axial compressions.
+    windows: WindowStats,
+}
+
+/// Stage "measure → verdict": the checks of every pressure (`crate::verdict`).
+fn judge(c: &BiaxialConfig, rows: &[PressureRow], checks: &[PressureCheck]) -> Judged {
     let mut common = Checks::new();
     let mut critical = Checks::new();
     let mut dilat = Checks::new();
@@ -954,13 +1075,13 @@ fn analyse(
         windows.merge(&pc.window);
         common.at_most(
             "biaxial.compression_stress_error",
-            r[16],
+            r.compression_stress_error,
             COMPRESSION_ERROR_SUSPECT,
             Some(COMPRESSION_ERROR_REFUSED),
             |t| {
                 format!(
                     "{label}: the isotropic compression ended {:.2} % away from -p0 (means over its last {:.0} %; limit {:.0} %)",
-                    100.0 * r[16],
+                    100.0 * r.compression_stress_error,
                     100.0 * COMPRESSION_TAIL,
                     100.0 * t
                 )
@@ -968,26 +1089,26 @@ fn analyse(
         );
         common.at_most(
             "biaxial.lateral_stress_error",
-            r[14],
+            r.lateral_stress_error,
             LATERAL_ERROR_SUSPECT,
             Some(LATERAL_ERROR_REFUSED),
             |t| {
                 format!(
                     "{label}: the mean lateral stress of the axial compression is {:.2} % away from -p0 (limit {:.0} %)",
-                    100.0 * r[14],
+                    100.0 * r.lateral_stress_error,
                     100.0 * t
                 )
             },
         );
         common.at_most(
             "biaxial.quasi_static",
-            r[15],
+            r.i_mean,
             QUASI_STATIC_I,
             Some(QUASI_STATIC_I_REFUSED),
             |t| {
                 format!(
                     "{label}: the inertial number of the axial compression is {:.2e} (with its mean pressure; limit {t:.0e})",
-                    r[15]
+                    r.i_mean
                 )
             },
         );
@@ -1003,7 +1124,7 @@ fn analyse(
             &pc.phi,
             STEADY_PHI_TOLERANCE,
         );
-        critical.solid_fraction("biaxial.solid_fraction", &label, r[7], phi_bound);
+        critical.solid_fraction("biaxial.solid_fraction", &label, r.phi_critical, phi_bound);
         judge_dilatancy(&mut dilat, &label, r);
     }
     let critical = {
@@ -1019,17 +1140,54 @@ fn analyse(
         k.extend(&dilat);
         k
     };
-    let mut verdict = RunVerdict {
+    Judged {
+        common,
+        critical,
+        dilat,
         run: run_checks,
-        allow_suspect: ctl.allow_suspect,
-        ..Default::default()
-    };
-
-    // --- table ---
-    let mut table = CsvTable::new(&ROW);
-    for r in rows {
-        table.push(r.clone());
+        windows,
     }
+}
+
+/// What the fits of a finished run write into: the output directory, the summary, the
+/// headline and the verdict.
+struct Report<'a> {
+    out: &'a mut OutputDir,
+    s: Summary,
+    headline: Vec<String>,
+    verdict: RunVerdict,
+}
+
+impl Report<'_> {
+    /// Its parts, borrowed apart: output directory, summary, headline, verdict.
+    fn parts(
+        &mut self,
+    ) -> (
+        &mut OutputDir,
+        &mut Summary,
+        &mut Vec<String>,
+        &mut RunVerdict,
+    ) {
+        (self.out, &mut self.s, &mut self.headline, &mut self.verdict)
+    }
+}
+
+/// Whether the plan leaves the law `law` out (said at the start).
+fn left_out(c: &BiaxialConfig, law: &str) -> bool {
+    c.leave_out.iter().any(|l| l == law)
+}
+
+/// Stage "report": `biaxial.csv` (one row per pressure) and `dilatancy.csv` (one row per
+/// dilatancy window), with `d` the mean grain diameter (m).
+fn write_tables(
+    c: &BiaxialConfig,
+    pressures: &[f64],
+    out: &mut OutputDir,
+    d: f64,
+    rows: &[PressureRow],
+    dilatancy: &[DilatancyRow],
+) -> Result<()> {
+    let mut table = rows::table(rows);
     table.comments.push(format!(
         "biaxial compression ({} preparation) at each confining pressure p0: peak = largest mean of sin_phi_mob = q/p over axial-strain bins of {}, p and q at the peak (means over its bin); critical = means over the last {} of axial strain with block-averaged standard errors (of this sample alone: they understate the scatter between samples, summary.json gives the replica intervals); sin_psi = -rate_v/rate_gamma = tr D/(D1 - D2) of the mean strain rate D over consecutive windows of {} of axial strain (dilatancy.csv), empty where it is outside [-1, 1] (the cell contracted or dilated along both principal directions: no dilatancy angle), sin_psi_max the largest window with its block standard error, sin_psi_critical over the plateau; lateral_stress_error = |<sigma_xx> + p0|/p0 over the axial compression, compression_stress_error the largest of |<sigma_xx> + p0|/p0 and |<sigma_yy> + p0|/p0 over the last 20 % of the isotropic compression; I_mean = rate d / sqrt(<p>/rho) over the axial compression",
         c.preparation.as_str(),
@@ -1037,28 +1195,37 @@ fn analyse(
         c.critical_strain,
         DILATANCY_WINDOW_BINS as f64 * c.bin_strain
     ));
-    let d = mean_diameter(world);
     table.metadata = vec![
         ("grain_diameter_m".into(), d),
         ("grain_density_kg_m3".into(), c.grain.density),
         ("grain_friction".into(), c.friction.grain_grain),
     ];
-    table.write(&mut ctx.out, "biaxial.csv")?;
-    let mut dt = CsvTable::new(&DILATANCY);
-    for w in dilatancy {
-        let mut row = w.clone();
-        row[0] = pressures.get(w[0] as usize).copied().unwrap_or(f64::NAN);
-        dt.push(row);
-    }
+    table.write(out, "biaxial.csv")?;
+    let with_p0: Vec<DilatancyRow> = dilatancy
+        .iter()
+        .map(|w| DilatancyRow {
+            p0: pressures.get(w.p0 as usize).copied().unwrap_or(f64::NAN),
+            ..*w
+        })
+        .collect();
+    let mut dt = rows::table(&with_p0);
     dt.comments.push(format!(
         "dilatancy of the axial compression over consecutive windows of {} of axial strain ({DILATANCY_WINDOW_BINS} bins): axial_strain at the window's centre, sin_phi_mob = q_a/p of its mean stresses, dilatancy_ratio = -rate_v/rate_gamma = tr D/(D1 - D2) of its mean strain rate D (tension positive), sin_psi the same where it lies in [-1, 1] (empty: the cell contracted or dilated along both principal directions, no dilatancy angle), with its block standard error; hardening = 1 for windows whose centre comes before the peak (the points of the stress-dilatancy fit)",
         DILATANCY_WINDOW_BINS as f64 * c.bin_strain
     ));
-    dt.write(&mut ctx.out, "dilatancy.csv")?;
+    dt.write(out, "dilatancy.csv")?;
+    Ok(())
+}
 
-    // --- summary: per pressure ---
+/// Stage "report": the summary keys and headline lines of the run and of each pressure.
+fn pressure_summary(
+    c: &BiaxialConfig,
+    d: f64,
+    rows: &[PressureRow],
+    report_dir: &std::path::Path,
+) -> (Summary, Vec<String>) {
     let mut s = Summary::new();
-    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
+    let mut headline = vec![format!("report: {}/", report_dir.display())];
     s.int("grains", c.grains as u64)
         .text("preparation", c.preparation.as_str())
         .text("cell_control", c.cell_control.as_str())
@@ -1070,61 +1237,114 @@ fn analyse(
     let deg = |x: f64| x.asin().to_degrees();
     for (k, r) in rows.iter().enumerate() {
         let pre = format!("p{}", k + 1);
-        s.num(&format!("{pre}_confining_pressure_Pa"), r[0])
-            .num(&format!("{pre}_compression_stress_error"), r[16])
-            .num(&format!("{pre}_phi_compressed"), r[17])
-            .num(&format!("{pre}_Z_compressed"), r[18])
-            .num(&format!("{pre}_friction_peak_sin_phi"), r[1])
-            .num(&format!("{pre}_friction_peak_angle_deg"), deg(r[1]))
-            .num(&format!("{pre}_axial_strain_peak"), r[2])
-            .num(&format!("{pre}_friction_critical_sin_phi"), r[5])
-            .num(&format!("{pre}_friction_critical_sin_phi_std_error"), r[6])
-            .num(&format!("{pre}_friction_critical_angle_deg"), deg(r[5]))
-            .num(&format!("{pre}_solid_fraction_critical"), r[7])
-            .num(&format!("{pre}_solid_fraction_critical_std_error"), r[8])
-            .num(&format!("{pre}_Z_critical"), r[10])
-            .num(&format!("{pre}_fabric_anisotropy_critical"), r[23])
-            .num(&format!("{pre}_dilatancy_max_sin_psi"), r[11])
-            .num(&format!("{pre}_dilatancy_max_sin_psi_std_error"), r[25])
-            .num(&format!("{pre}_dilatancy_max_angle_deg"), deg(r[11]))
-            .num(&format!("{pre}_axial_strain_dilatancy_max"), r[12])
-            .num(&format!("{pre}_dilatancy_critical_sin_psi"), r[13])
+        s.num(&format!("{pre}_confining_pressure_Pa"), r.p0)
+            .num(
+                &format!("{pre}_compression_stress_error"),
+                r.compression_stress_error,
+            )
+            .num(&format!("{pre}_phi_compressed"), r.phi_compressed)
+            .num(&format!("{pre}_Z_compressed"), r.z_compressed)
+            .num(&format!("{pre}_friction_peak_sin_phi"), r.sin_phi_peak)
+            .num(
+                &format!("{pre}_friction_peak_angle_deg"),
+                deg(r.sin_phi_peak),
+            )
+            .num(&format!("{pre}_axial_strain_peak"), r.axial_strain_peak)
+            .num(
+                &format!("{pre}_friction_critical_sin_phi"),
+                r.sin_phi_critical,
+            )
+            .num(
+                &format!("{pre}_friction_critical_sin_phi_std_error"),
+                r.sin_phi_critical_se,
+            )
+            .num(
+                &format!("{pre}_friction_critical_angle_deg"),
+                deg(r.sin_phi_critical),
+            )
+            .num(&format!("{pre}_solid_fraction_critical"), r.phi_critical)
+            .num(
+                &format!("{pre}_solid_fraction_critical_std_error"),
+                r.phi_critical_se,
+            )
+            .num(&format!("{pre}_Z_critical"), r.z_critical)
+            .num(
+                &format!("{pre}_fabric_anisotropy_critical"),
+                r.fabric_anisotropy_critical,
+            )
+            .num(&format!("{pre}_dilatancy_max_sin_psi"), r.sin_psi_max)
+            .num(
+                &format!("{pre}_dilatancy_max_sin_psi_std_error"),
+                r.sin_psi_max_se,
+            )
+            .num(
+                &format!("{pre}_dilatancy_max_angle_deg"),
+                deg(r.sin_psi_max),
+            )
+            .num(
+                &format!("{pre}_axial_strain_dilatancy_max"),
+                r.axial_strain_psi_max,
+            )
+            .num(
+                &format!("{pre}_dilatancy_critical_sin_psi"),
+                r.sin_psi_critical,
+            )
             .num(
                 &format!("{pre}_dilatancy_critical_sin_psi_std_error"),
-                r[26],
+                r.sin_psi_critical_se,
             )
-            .num(&format!("{pre}_dilatancy_critical_ratio"), r[27])
-            .int(&format!("{pre}_dilatancy_windows"), r[28] as u64)
-            .int(&format!("{pre}_dilatancy_undefined_windows"), r[29] as u64)
-            .num(&format!("{pre}_lateral_stress_error"), r[14])
-            .num(&format!("{pre}_I"), r[15])
-            .num(&format!("{pre}_axial_rate_1_s"), r[19]);
+            .num(
+                &format!("{pre}_dilatancy_critical_ratio"),
+                r.dilatancy_ratio_critical,
+            )
+            .int(
+                &format!("{pre}_dilatancy_windows"),
+                r.dilatancy_windows as u64,
+            )
+            .int(
+                &format!("{pre}_dilatancy_undefined_windows"),
+                r.dilatancy_undefined_windows as u64,
+            )
+            .num(
+                &format!("{pre}_lateral_stress_error"),
+                r.lateral_stress_error,
+            )
+            .num(&format!("{pre}_I"), r.i_mean)
+            .num(&format!("{pre}_axial_rate_1_s"), r.axial_rate);
         headline.push(format!(
             "p0 = {} Pa: peak sin φ = {:.4} at ε_a = {:.3}; critical sin φ = {:.4} ± {:.4}, φ = {:.4} ± {:.4} (block s.e. of this sample alone); max sin ψ = {} ± {} (block s.e., windows of {} of ε_a)",
-            r[0],
-            r[1],
-            r[2],
-            r[5],
-            r[6],
-            r[7],
-            r[8],
-            short_number(r[11]),
-            short_number(r[25]),
+            r.p0,
+            r.sin_phi_peak,
+            r.axial_strain_peak,
+            r.sin_phi_critical,
+            r.sin_phi_critical_se,
+            r.phi_critical,
+            r.phi_critical_se,
+            short_number(r.sin_psi_max),
+            short_number(r.sin_psi_max_se),
             DILATANCY_WINDOW_BINS as f64 * c.bin_strain
         ));
     }
-    let provenance = crate::provenance::of_run(ctx, ctl, "biaxial", c.seed);
-    let out = &mut ctx.out;
+    (s, headline)
+}
 
-    // --- Mohr–Coulomb over the peaks ---
+/// Stage "fit": Mohr–Coulomb over the peak Mohr circles; the envelope `(φ, c)` when fitted.
+fn fit_peaks(
+    c: &BiaxialConfig,
+    rows: &[PressureRow],
+    common: &Checks,
+    provenance: &Provenance,
+    rep: &mut Report,
+) -> Result<Option<(f64, f64)>> {
+    let (out, s, headline, verdict) = rep.parts();
     let n = rows.len();
     let peaks = YieldData::Circles {
-        p_pa: rows.iter().map(|r| r[3]).collect(),
-        q_pa: rows.iter().map(|r| r[4]).collect(),
+        p_pa: rows.iter().map(|r| r.p_peak).collect(),
+        q_pa: rows.iter().map(|r| r.q_peak).collect(),
     };
     // A free cohesion with 4 pressures or more, else (or when the data do not identify it:
     // rigid cohesionless grains have none) the envelope through the origin.
-    let left = |law: &str| c.leave_out.iter().any(|l| l == law);
+    let left = |law: &str| left_out(c, law);
     let fitted = fit_mohr_coulomb_supported(&peaks, 0.95).map(|(f, fixed, refusal)| {
         if let Some(e) = refusal {
             warn(&format!(
@@ -1139,9 +1359,9 @@ fn analyse(
         // left out by the plan (said at the start)
         None => remove_stale_law(out, "mohr_coulomb")?,
         Some(Ok((f, cohesion_fixed_zero))) => {
-            fit_keys(&mut s, "friction_peak", &f.report.parameters);
+            fit_keys(s, "friction_peak", &f.report.parameters);
             fit_keys(
-                &mut s,
+                s,
                 "friction_peak",
                 std::slice::from_ref(&f.friction_angle_deg),
             );
@@ -1151,7 +1371,7 @@ fn analyse(
                 .text("friction_peak_interval", "replicas");
             mc_line = Some((f.law.friction_angle_rad, f.law.cohesion_pa));
             let law = CalibratedLaw::from_mohr_coulomb(&f, provenance.clone());
-            let exported = export_law(out, &mut verdict, "mohr_coulomb", &law, common.clone())?;
+            let exported = export_law(out, verdict, "mohr_coulomb", &law, common.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "Mohr–Coulomb over the peaks, q = p sin φ + c cos φ",
@@ -1172,16 +1392,28 @@ fn analyse(
             );
         }
     }
+    Ok(mc_line)
+}
 
-    // --- the critical state ---
+/// Stage "fit": the critical state over the plateaus of the pressures (as replicas).
+fn fit_critical(
+    c: &BiaxialConfig,
+    rows: &[PressureRow],
+    critical: &Checks,
+    provenance: &Provenance,
+    rep: &mut Report,
+) -> Result<()> {
+    let (out, s, headline, verdict) = rep.parts();
+    let n = rows.len();
+    let left = |law: &str| left_out(c, law);
     let plateaus: Vec<PlateauMeasure> = rows
         .iter()
         .map(|r| PlateauMeasure {
-            pressure_pa: r[9],
-            sin_phi: r[5],
-            sin_phi_std_error: r[6],
-            solid_fraction: r[7],
-            solid_fraction_std_error: r[8],
+            pressure_pa: r.p_critical,
+            sin_phi: r.sin_phi_critical,
+            sin_phi_std_error: r.sin_phi_critical_se,
+            solid_fraction: r.phi_critical,
+            solid_fraction_std_error: r.phi_critical_se,
             blocks: MIN_BLOCKS,
         })
         .collect();
@@ -1189,7 +1421,7 @@ fn analyse(
         None => remove_stale_law(out, "critical_state")?,
         Some(Ok(f)) => {
             fit_keys(
-                &mut s,
+                s,
                 "friction_critical",
                 &[
                     f.friction_angle.clone(),
@@ -1198,7 +1430,7 @@ fn analyse(
                 ],
             );
             fit_keys(
-                &mut s,
+                s,
                 "solid_fraction_critical",
                 std::slice::from_ref(&f.solid_fraction),
             );
@@ -1218,7 +1450,7 @@ fn analyse(
             // each pressure's plateau value with the interval of one sample among replicas
             for (k, r) in rows.iter().enumerate() {
                 let pre = format!("p{}", k + 1);
-                let (lo, hi) = f.sample_interval(r[5], f.sin_phi_replica_sd);
+                let (lo, hi) = f.sample_interval(r.sin_phi_critical, f.sin_phi_replica_sd);
                 s.num(
                     &format!("{pre}_friction_critical_sin_phi_replica_ci_low"),
                     lo,
@@ -1227,7 +1459,7 @@ fn analyse(
                     &format!("{pre}_friction_critical_sin_phi_replica_ci_high"),
                     hi,
                 );
-                let (lo, hi) = f.sample_interval(r[7], f.solid_fraction_replica_sd);
+                let (lo, hi) = f.sample_interval(r.phi_critical, f.solid_fraction_replica_sd);
                 s.num(&format!("{pre}_solid_fraction_critical_replica_ci_low"), lo)
                     .num(
                         &format!("{pre}_solid_fraction_critical_replica_ci_high"),
@@ -1235,7 +1467,7 @@ fn analyse(
                     );
             }
             let law = CalibratedLaw::from_critical_state(&f, provenance.clone());
-            let exported = export_law(out, &mut verdict, "critical_state", &law, critical.clone())?;
+            let exported = export_law(out, verdict, "critical_state", &law, critical.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 &format!(
@@ -1275,18 +1507,30 @@ fn analyse(
             );
         }
     }
+    Ok(())
+}
 
-    // --- stress–dilatancy over the hardening phases ---
-    // the dilatancy windows of the hardening phases (columns of DILATANCY)
-    let hard: Vec<&Vec<f64>> = dilatancy
+/// Stage "fit": the stress–dilatancy relation over the hardening windows of every pressure;
+/// its data and the line `(sin φ_cv, β)` when fitted.
+fn fit_dilatancy(
+    c: &BiaxialConfig,
+    dilatancy: &[DilatancyRow],
+    dilat: &Checks,
+    provenance: &Provenance,
+    rep: &mut Report,
+) -> Result<(StressDilatancyData, Option<(f64, f64)>)> {
+    let (out, s, headline, verdict) = rep.parts();
+    let left = |law: &str| left_out(c, law);
+    // the dilatancy windows of the hardening phases
+    let hard: Vec<&DilatancyRow> = dilatancy
         .iter()
-        .filter(|w| w[6] > 0.5 && w[3].is_finite() && w[2].is_finite())
+        .filter(|w| w.hardening > 0.5 && w.sin_psi.is_finite() && w.sin_phi_mob.is_finite())
         .collect();
     let sd_data = StressDilatancyData {
-        sin_psi: hard.iter().map(|w| w[3]).collect(),
-        sin_phi: hard.iter().map(|w| w[2]).collect(),
+        sin_psi: hard.iter().map(|w| w.sin_psi).collect(),
+        sin_phi: hard.iter().map(|w| w.sin_phi_mob).collect(),
         // each pressure's test is an independent sample: intervals over them
-        sample: Some(hard.iter().map(|w| w[0] as usize).collect()),
+        sample: Some(hard.iter().map(|w| w.p0 as usize).collect()),
     };
     let mut sd_line = None;
     match (!left("stress-dilatancy"))
@@ -1294,7 +1538,7 @@ fn analyse(
     {
         None => remove_stale_law(out, "stress_dilatancy")?,
         Some(Ok(f)) => {
-            fit_keys(&mut s, "stress_dilatancy", &f.report.parameters);
+            fit_keys(s, "stress_dilatancy", &f.report.parameters);
             s.num("stress_dilatancy_r_squared", f.report.r_squared)
                 .int("stress_dilatancy_points", f.report.n as u64)
                 .int("stress_dilatancy_samples", f.samples as u64)
@@ -1306,7 +1550,7 @@ fn analyse(
                 );
             sd_line = Some((f.law.sin_phi_c, f.law.beta));
             let law = CalibratedLaw::from_stress_dilatancy(&f, provenance.clone());
-            let exported = export_law(out, &mut verdict, "stress_dilatancy", &law, dilat.clone())?;
+            let exported = export_law(out, verdict, "stress_dilatancy", &law, dilat.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 "stress–dilatancy over the hardening phases, sin φ = sin φ_cv + β sin ψ",
@@ -1327,8 +1571,20 @@ fn analyse(
             );
         }
     }
+    Ok((sd_data, sd_line))
+}
 
-    // --- figures ---
+/// Stage "report": `biaxial.png` (the binned curves of every pressure) and `biaxial_fits.png`
+/// (the Mohr circles with the envelope, the stress–dilatancy points with the line).
+fn figures(
+    out: &mut OutputDir,
+    pressures: &[f64],
+    rows: &[PressureRow],
+    bins: &[BinPoint],
+    mc_line: Option<(f64, f64)>,
+    sd: (&StressDilatancyData, Option<(f64, f64)>),
+) -> Result<()> {
+    let (sd_data, sd_line) = sd;
     let mut pq = XyPlot::new(
         "Mobilised friction",
         Axis::new("axial strain ε_a"),
@@ -1340,10 +1596,10 @@ fn analyse(
         Axis::new("ε_v = −ln(V/V₀)"),
     );
     for (k, p0) in pressures.iter().enumerate().take(rows.len()) {
-        let pts = |j: usize| -> Vec<(f64, f64)> {
+        let pts = |f: fn(&BinPoint) -> f64| -> Vec<(f64, f64)> {
             bins.iter()
-                .filter(|b| b[0] as usize == k && b[j].is_finite())
-                .map(|b| (b[1], b[j]))
+                .filter(|b| b.pressure as usize == k && f(b).is_finite())
+                .map(|b| (b.axial_strain, f(b)))
                 .collect()
         };
         let colour = PALETTE[k % PALETTE.len()];
@@ -1351,13 +1607,13 @@ fn analyse(
             &format!("p₀ = {p0} Pa"),
             Style::Line,
             colour,
-            pts(2),
+            pts(|b| b.sin_phi),
         ));
         pv.series.push(Series::new(
             &format!("p₀ = {p0} Pa"),
             Style::Line,
             colour,
-            pts(3),
+            pts(|b| b.volumetric_strain),
         ));
     }
     pq.legend = LegendAt::LowerRight;
@@ -1365,7 +1621,7 @@ fn analyse(
     let circles: Vec<(f64, f64, f64)> = pressures
         .iter()
         .zip(rows.iter())
-        .map(|(p0, r)| (*p0, r[3], r[4]))
+        .map(|(p0, r)| (*p0, r.p_peak, r.q_peak))
         .collect();
     let pmc = mohr_plot(&circles, mc_line);
     let mut psd = XyPlot::new(
@@ -1403,8 +1659,50 @@ fn analyse(
     psd.legend = LegendAt::UpperLeft;
     draw_row(out, "biaxial.png", &[pq, pv], (1300, 650))?;
     draw_row(out, "biaxial_fits.png", &[pmc, psd], (1300, 650))?;
+    Ok(())
+}
+
+/// The checks, fits, laws, table, figures and summary of a finished run.
+#[allow(clippy::too_many_arguments)]
+fn analyse(
+    c: &BiaxialConfig,
+    pressures: &[f64],
+    ctx: &mut RunContext,
+    ctl: &RunControl,
+    world: &dem::World,
+    all: &PhaseStats,
+    rows: &[PressureRow],
+    bins: &[BinPoint],
+    dilatancy: &[DilatancyRow],
+    checks: &[PressureCheck],
+) -> Result<RunOutcome> {
+    let judged = judge(c, rows, checks);
+    let d = mean_diameter(world);
+    write_tables(c, pressures, &mut ctx.out, d, rows, dilatancy)?;
+    let (s, headline) = pressure_summary(c, d, rows, ctx.out.path());
+    let provenance = crate::provenance::of_run(ctx, ctl, "biaxial", c.seed);
+    let mut rep = Report {
+        out: &mut ctx.out,
+        s,
+        headline,
+        verdict: RunVerdict {
+            run: judged.run,
+            allow_suspect: ctl.allow_suspect,
+            ..Default::default()
+        },
+    };
+    let mc_line = fit_peaks(c, rows, &judged.common, &provenance, &mut rep)?;
+    fit_critical(c, rows, &judged.critical, &provenance, &mut rep)?;
+    let (sd_data, sd_line) = fit_dilatancy(c, dilatancy, &judged.dilat, &provenance, &mut rep)?;
+    figures(rep.out, pressures, rows, bins, mc_line, (&sd_data, sd_line))?;
+    let Report {
+        mut s,
+        headline,
+        verdict,
+        ..
+    } = rep;
     solver_keys(&mut s, all);
-    windows.keys(&mut s, "window");
+    judged.windows.keys(&mut s, "window");
     Ok(RunOutcome {
         summary: s,
         headline,

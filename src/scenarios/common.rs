@@ -409,37 +409,38 @@ pub fn add_fitted_curve(
     ));
 }
 
-/// Means of the columns `cols` of a history over consecutive bins of `width` of its column
-/// `axis` (a strain growing along the rows; the first bin starts at 0): one row of means per bin
-/// with at least one row that `keep` accepts, in the order of `cols`. The means are of the step
-/// values; what is derived from them (a stress ratio of mean stresses, a peak) is the caller's.
-pub fn strain_bins(
-    history: &[Vec<f64>],
-    axis: usize,
+/// Means of the columns `cols` of a history (typed rows, [`super::rows`]) over consecutive bins
+/// of `width` of its column `axis` (a strain growing along the rows; the first bin starts at 0):
+/// one array of means per bin with at least one row that `keep` accepts, in the order of `cols`.
+/// The means are of the step values; what is derived from them (a stress ratio of mean
+/// stresses, a peak) is the caller's.
+pub fn strain_bins<R, const N: usize>(
+    history: &[R],
+    axis: impl Fn(&R) -> f64,
     width: f64,
-    cols: &[usize],
-    keep: impl Fn(&[f64]) -> bool,
-) -> Vec<Vec<f64>> {
+    cols: [fn(&R) -> f64; N],
+    keep: impl Fn(&R) -> bool,
+) -> Vec<[f64; N]> {
     let mut out = Vec::new();
-    let mut acc = vec![0.0; cols.len()];
+    let mut acc = [0.0; N];
     let mut n = 0usize;
     let mut current = 0i64;
-    let mut flush = |acc: &mut Vec<f64>, n: &mut usize| {
+    let mut flush = |acc: &mut [f64; N], n: &mut usize| {
         if *n > 0 {
-            out.push(acc.iter().map(|v| v / *n as f64).collect());
+            out.push(acc.map(|v| v / *n as f64));
         }
         acc.iter_mut().for_each(|v| *v = 0.0);
         *n = 0;
     };
     for r in history {
-        let b = (r[axis] / width).floor() as i64;
+        let b = (axis(r) / width).floor() as i64;
         if b != current {
             flush(&mut acc, &mut n);
             current = b;
         }
         if keep(r) {
-            for (a, &j) in acc.iter_mut().zip(cols) {
-                *a += r[j];
+            for (a, col) in acc.iter_mut().zip(cols) {
+                *a += col(r);
             }
             n += 1;
         }

@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_csv_table, table_row};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -97,6 +98,22 @@ struct Flow<'a> {
     c: &'a InclinedFlowConfig,
 }
 
+table_row! {
+    /// One step of the flow: a row of `history.csv`.
+    struct FlowStep {
+        /// Time (s).
+        t: "time_s",
+        /// Mass-weighted mean velocity of the grains along the slope (m/s).
+        mean_velocity: "mean_velocity_m_s",
+        /// Kinetic energy (J).
+        kinetic_energy: "kinetic_energy_J",
+        /// Sweeps of the step's solve.
+        sweeps: "sweeps",
+        /// The solve's error.
+        solver_error: "solver_error",
+    }
+}
+
 /// What the flow phase collects.
 #[derive(Serialize, Deserialize)]
 struct FlowState {
@@ -104,7 +121,8 @@ struct FlowState {
     base: f64,
     prof: Profiles,
     /// One row per step: `history.csv`.
-    hist: CsvTable,
+    #[serde(with = "serde_csv_table")]
+    hist: Vec<FlowStep>,
     vtk: VtkFrames,
     /// Steps done.
     k: u64,
@@ -160,13 +178,13 @@ impl PhasedRun for Flow<'_> {
             mv += b.mass * b.velocity.x;
             m += b.mass;
         }
-        st.hist.push(vec![
-            w.time,
-            mv / m,
-            w.kinetic_energy(),
-            r.solver.iterations as f64,
-            r.solver.error,
-        ]);
+        st.hist.push(FlowStep {
+            t: w.time,
+            mean_velocity: mv / m,
+            kinetic_energy: w.kinetic_energy(),
+            sweeps: r.solver.iterations as f64,
+            solver_error: r.solver.error,
+        });
         if st.k > avg_from && st.k.is_multiple_of(sample_every) {
             st.prof.add(&w.snapshot(), st.base)?;
         }
@@ -193,13 +211,14 @@ fn disk_area_below(z: f64, r: f64) -> f64 {
     r * r * (t * (1.0 - t * t).sqrt() + t.asin() + std::f64::consts::FRAC_PI_2)
 }
 
-/// Runs the scenario.
-pub fn run(
+/// Stages "build" and "run": the layer on its rough base, flowing for `duration` (or resumed
+/// from a checkpoint); with the number of profile layers.
+fn simulate(
     c: &InclinedFlowConfig,
     ctx: &mut RunContext,
     ctl: &mut RunControl,
-) -> Result<RunOutcome> {
-    let length = c.cell_length_diameters * 2.0 * c.grain.radius_mean;
+    length: f64,
+) -> Result<(dem::World, FlowState, usize)> {
     // Layers are never thinner than a mean grain diameter: a thinner layer holds a fraction of
     // a grain and its averages are noise. Their number follows from the sample.
     let layer_height = |world: &dem::World| {
@@ -217,13 +236,7 @@ pub fn run(
         let state = FlowState {
             base: c.grain.radius_mean, // top of the rough base (disks centred on y = 0)
             prof: Profiles::new(bins, 1.6 * h_est / bins as f64),
-            hist: CsvTable::new(&[
-                "time_s",
-                "mean_velocity_m_s",
-                "kinetic_energy_J",
-                "sweeps",
-                "solver_error",
-            ]),
+            hist: Vec::new(),
             vtk: VtkFrames::new(c.duration / c.vtk_frames.max(1) as f64, c.vtk_frames.max(1)),
             k: 0,
             stats: PhaseStats::default(),
@@ -231,26 +244,23 @@ pub fn run(
         };
         Ok((world, state))
     };
-    let (
-        world,
-        FlowState {
-            prof,
-            hist,
-            vtk,
-            stats,
-            window,
-            ..
-        },
-    ) = drive(ctx, ctl, &Flow { c }, fresh)?;
-    let d = mean_diameter(&world);
-    let dy = prof.dy;
-    vtk.finish(&mut ctx.out, &world)?;
-    let snap = world.snapshot();
-    let gs = homogenise::grain_stresses(&snap)?;
-    let ratios = inertia_ratios(&gs);
-    let fluid = fluid_fraction(&ratios, c.fluid_threshold)?;
-    let values: Vec<f64> = ratios.iter().map(|r| r.ratio.unwrap_or(f64::NAN)).collect();
+    let (world, state) = drive(ctx, ctl, &Flow { c }, fresh)?;
+    Ok((world, state, bins))
+}
 
+/// A profile across the layer: `(value, height above the base)` per layer.
+type Profile = Vec<(f64, f64)>;
+
+/// Stage "measure": the time-averaged profiles of velocity, solid fraction and inertia ratio
+/// over `bins` layers of a cell of `length` (m), written to `profiles.csv`.
+fn layer_profiles(
+    out: &mut OutputDir,
+    c: &InclinedFlowConfig,
+    prof: &Profiles,
+    bins: usize,
+    length: f64,
+) -> Result<(Profile, Profile, Profile)> {
+    let dy = prof.dy;
     // Profiles.
     let mut table = CsvTable::new(&[
         "height_m",
@@ -287,68 +297,20 @@ pub fn run(
         "time averages over the last {} s ({} samples); height above the rough base (m)",
         c.average, prof.samples
     ));
-    table.write(&mut ctx.out, "profiles.csv")?;
-    hist.write(&mut ctx.out, "history.csv")?;
-    // Flow height: where the time-averaged solid fraction falls below half its bulk value.
-    let bulk = phi.iter().map(|p| p.0).fold(0.0, f64::max);
-    let height = phi
-        .iter()
-        .filter(|p| p.0 > 0.5 * bulk)
-        .map(|p| p.1 + 0.5 * dy)
-        .fold(0.0, f64::max);
-    let mean_v = hist.rows.last().map(|r| r[1]).unwrap_or(f64::NAN);
-    let surface_v = vel
-        .iter()
-        .filter(|p| p.1 <= height)
-        .map(|p| p.0)
-        .fold(f64::NAN, f64::max);
-    let n_contactless = ratios.iter().filter(|r| r.ratio.is_none()).count();
+    table.write(out, "profiles.csv")?;
+    Ok((vel, phi, lr))
+}
 
-    let mut s = Summary::new();
-    s.int("grains", c.grains as u64)
-        .num("slope_deg", c.slope_deg)
-        .num("friction", c.friction.grain_grain)
-        .num("cell_length_m", length)
-        .num("mean_diameter_m", d)
-        .num("mean_velocity_m_s", mean_v)
-        .num("surface_velocity_m_s", surface_v)
-        .num("flow_height_m", height)
-        .num("flow_height_diameters", height / d)
-        .num(
-            "froude_number",
-            mean_v / (9.81 * c.slope_deg.to_radians().cos() * height).sqrt(),
-        )
-        .num("fluid_fraction", fluid)
-        .num("fluid_threshold", c.fluid_threshold)
-        .int("grains_without_contact", n_contactless as u64)
-        .num("max_solid_fraction", bulk);
-    solver_keys(&mut s, &stats);
-    window.keys(&mut s, "window");
-
-    // Checks (crate::verdict): the numerics of the averaging window, the steady state of the
-    // mean velocity over it, the layer solid fractions.
-    let mut checks = Checks::new();
-    checks.window("averaging window", &window);
-    let avg_steps = window.steps as usize;
-    let v_window: Vec<f64> = hist.rows[hist.rows.len().saturating_sub(avg_steps)..]
-        .iter()
-        .map(|r| r[1])
-        .collect();
-    let v_mean = v_window.iter().sum::<f64>() / v_window.len().max(1) as f64;
-    checks.steady(
-        "inclined_flow.steady_velocity",
-        "the mean velocity (m/s)",
-        &v_window,
-        STEADY_VELOCITY_TOLERANCE * v_mean.abs(),
-    );
-    checks.solid_fraction(
-        "inclined_flow.solid_fraction",
-        "the densest layer",
-        bulk,
-        max_solid_fraction(c.grain.radius_spread),
-    );
-
-    // Figures.
+/// Stage "report": `inertia_ratio_map.png` (per grain, over the last state `snap` at
+/// `time`), `profiles.png` and `velocity_history.png`.
+fn figures(
+    out: &mut OutputDir,
+    c: &InclinedFlowConfig,
+    (snap, time): (&Snapshot, f64),
+    values: &[f64],
+    (vel, phi, lr): (&Profile, &Profile, Profile),
+    hist: &[FlowStep],
+) -> Result<()> {
     // Colour range: the 2 % and 98 % quantiles, widened to whole decades.
     let mut finite: Vec<f64> = values
         .iter()
@@ -365,16 +327,16 @@ pub fn run(
     let lo = 10f64.powf(lo.log10().floor());
     let hi = 10f64.powf(hi.log10().ceil()).max(lo * 10.0);
     draw_particles(
-        &mut ctx.out,
+        out,
         "inertia_ratio_map.png",
         &ParticleView {
-            snap: &snap,
+            snap,
             title: format!(
                 "‖Σ_inertia‖/‖Σ_contact‖ per grain, slope {}°, t = {:.2} s (white: no contact)",
-                c.slope_deg, world.time
+                c.slope_deg, time
             ),
             fill: GrainFill::Values {
-                values: values.clone(),
+                values: values.to_vec(),
                 scale: Scale {
                     min: lo,
                     max: hi,
@@ -417,7 +379,7 @@ pub fn run(
     );
     pr.series
         .push(Series::new("", Style::LinePoints, PALETTE[1], lr));
-    draw_row(&mut ctx.out, "profiles.png", &[pv, pf, pr], (1800, 650))?;
+    draw_row(out, "profiles.png", &[pv, pf, pr], (1800, 650))?;
     let mut ph = XyPlot::new(
         "Mean velocity of the layer",
         Axis::new("time t (s)"),
@@ -427,9 +389,110 @@ pub fn run(
         "",
         Style::Thin,
         PALETTE[0],
-        hist.rows.iter().map(|r| (r[0], r[1])).collect(),
+        hist.iter().map(|r| (r.t, r.mean_velocity)).collect(),
     ));
-    draw_xy(&mut ctx.out, "velocity_history.png", &ph)?;
+    draw_xy(out, "velocity_history.png", &ph)?;
+    Ok(())
+}
+
+/// Runs the scenario: build and run (`simulate`), measure (`layer_profiles`, the inertia
+/// ratios), verdict, report (`figures`).
+pub fn run(
+    c: &InclinedFlowConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    let length = c.cell_length_diameters * 2.0 * c.grain.radius_mean;
+    let (
+        world,
+        FlowState {
+            prof,
+            hist,
+            vtk,
+            stats,
+            window,
+            ..
+        },
+        bins,
+    ) = simulate(c, ctx, ctl, length)?;
+    let d = mean_diameter(&world);
+    let dy = prof.dy;
+    vtk.finish(&mut ctx.out, &world)?;
+    let snap = world.snapshot();
+    let gs = homogenise::grain_stresses(&snap)?;
+    let ratios = inertia_ratios(&gs);
+    let fluid = fluid_fraction(&ratios, c.fluid_threshold)?;
+    let values: Vec<f64> = ratios.iter().map(|r| r.ratio.unwrap_or(f64::NAN)).collect();
+
+    let (vel, phi, lr) = layer_profiles(&mut ctx.out, c, &prof, bins, length)?;
+    rows::table(&hist).write(&mut ctx.out, "history.csv")?;
+    // Flow height: where the time-averaged solid fraction falls below half its bulk value.
+    let bulk = phi.iter().map(|p| p.0).fold(0.0, f64::max);
+    let height = phi
+        .iter()
+        .filter(|p| p.0 > 0.5 * bulk)
+        .map(|p| p.1 + 0.5 * dy)
+        .fold(0.0, f64::max);
+    let mean_v = hist.last().map(|r| r.mean_velocity).unwrap_or(f64::NAN);
+    let surface_v = vel
+        .iter()
+        .filter(|p| p.1 <= height)
+        .map(|p| p.0)
+        .fold(f64::NAN, f64::max);
+    let n_contactless = ratios.iter().filter(|r| r.ratio.is_none()).count();
+
+    let mut s = Summary::new();
+    s.int("grains", c.grains as u64)
+        .num("slope_deg", c.slope_deg)
+        .num("friction", c.friction.grain_grain)
+        .num("cell_length_m", length)
+        .num("mean_diameter_m", d)
+        .num("mean_velocity_m_s", mean_v)
+        .num("surface_velocity_m_s", surface_v)
+        .num("flow_height_m", height)
+        .num("flow_height_diameters", height / d)
+        .num(
+            "froude_number",
+            mean_v / (9.81 * c.slope_deg.to_radians().cos() * height).sqrt(),
+        )
+        .num("fluid_fraction", fluid)
+        .num("fluid_threshold", c.fluid_threshold)
+        .int("grains_without_contact", n_contactless as u64)
+        .num("max_solid_fraction", bulk);
+    solver_keys(&mut s, &stats);
+    window.keys(&mut s, "window");
+
+    // Checks (crate::verdict): the numerics of the averaging window, the steady state of the
+    // mean velocity over it, the layer solid fractions.
+    let mut checks = Checks::new();
+    checks.window("averaging window", &window);
+    let avg_steps = window.steps as usize;
+    let v_window: Vec<f64> = hist[hist.len().saturating_sub(avg_steps)..]
+        .iter()
+        .map(|r| r.mean_velocity)
+        .collect();
+    let v_mean = v_window.iter().sum::<f64>() / v_window.len().max(1) as f64;
+    checks.steady(
+        "inclined_flow.steady_velocity",
+        "the mean velocity (m/s)",
+        &v_window,
+        STEADY_VELOCITY_TOLERANCE * v_mean.abs(),
+    );
+    checks.solid_fraction(
+        "inclined_flow.solid_fraction",
+        "the densest layer",
+        bulk,
+        max_solid_fraction(c.grain.radius_spread),
+    );
+
+    figures(
+        &mut ctx.out,
+        c,
+        (&snap, world.time),
+        &values,
+        (&vel, &phi, lr),
+        &hist,
+    )?;
 
     let headline = vec![
         format!("report: {}/", ctx.out.path().display()),

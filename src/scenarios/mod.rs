@@ -4,6 +4,7 @@
 
 pub mod arrangements;
 pub mod biaxial;
+pub mod cell_base;
 pub mod column_collapse;
 pub mod common;
 pub mod dump;
@@ -12,6 +13,7 @@ pub mod janssen;
 pub mod phased;
 pub mod rheology_fit;
 pub mod rolling;
+pub mod rows;
 pub mod sensitivity;
 pub mod shear_cell;
 pub mod simple_shear;

@@ -242,104 +242,73 @@ impl Shown {
     }
 }
 
-/// Fits μ(I) and φ(I) to `series` (those the plan does not leave out), writes the laws that
-/// pass (or their `.rejected.json`), records refusals in `verdict`, the keys in `s`, the printed
-/// lines in `headline`; returns the μ(I) and φ(I) figures ([`rheology_plot`]).
-pub(crate) fn fit_mu_phi(
-    out: &mut OutputDir,
-    series: &RheologySeries,
-    inp: &RheologyFit<'_>,
-    verdict: &mut RunVerdict,
-    s: &mut Summary,
-    headline: &mut Vec<String>,
-) -> Result<(XyPlot, XyPlot)> {
-    let opts = FitOptions::default();
-    let is = &series.inertial_number;
-    // every point enters the fits (a point failing its own checks makes the laws fail theirs)
-    let range = finite_range(is.iter().copied()).unwrap_or((0.0, 0.0));
-    let mut mu_notes = Vec::new();
-    let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
-    // μ(I), or its linear form when μ(I) is refused or left out (`leave_out`)
-    let full = if left("mu-i") {
-        None
-    } else {
-        Some(fit_mu_i(series, &opts))
-    };
-    let mut mu_curve = None;
-    let linear_reason = match full {
-        Some(Ok(f)) => {
-            let shown = Shown {
-                key: "mu_i",
-                form: Some("mu-i"),
-                formula: "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                title: "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
-                linear: false,
-                file: "mu_i",
-            };
-            let law = CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone());
-            mu_curve = Some(shown.record(
-                out,
-                verdict,
-                &law,
-                inp.mu_checks.clone(),
-                range,
-                &f.report,
-                s,
-                headline,
-                |p, i| {
-                    identify::laws::mu_i::MuILaw {
-                        mu_s: p[0],
-                        mu_2: p[1],
-                        i0: p[2],
-                    }
-                    .mu(i)
-                },
-            )?);
+/// The fits of μ(I) and φ(I) of one series ([`fit_mu_phi`]): their input and where they write.
+struct LawFits<'a, 'b> {
+    out: &'a mut OutputDir,
+    series: &'a RheologySeries,
+    inp: &'a RheologyFit<'b>,
+    verdict: &'a mut RunVerdict,
+    s: &'a mut Summary,
+    headline: &'a mut Vec<String>,
+    opts: FitOptions,
+    /// The range of the inertial numbers, over which the curves are drawn.
+    range: (f64, f64),
+}
+
+/// The curve a fit draws (when its law passed) and the notes of its figure.
+type LawCurve = (Option<FittedCurve>, Vec<String>);
+
+/// The parts of [`LawFits`] a fit uses, borrowed apart.
+type Parts<'c, 'b> = (
+    &'c RheologySeries,
+    &'c RheologyFit<'b>,
+    &'c FitOptions,
+    (f64, f64),
+    &'c mut OutputDir,
+    &'c mut RunVerdict,
+    &'c mut Summary,
+    &'c mut Vec<String>,
+);
+
+impl<'b> LawFits<'_, 'b> {
+    /// Its parts: series, input, options, range, output directory, verdict, summary, headline.
+    fn parts(&mut self) -> Parts<'_, 'b> {
+        (
+            self.series,
+            self.inp,
+            &self.opts,
+            self.range,
+            self.out,
+            self.verdict,
+            self.s,
+            self.headline,
+        )
+    }
+
+    /// Stage "fit" of μ(I): the full law, or its linear form when the full one is refused or
+    /// left out.
+    fn mu(&mut self) -> Result<LawCurve> {
+        let (series, inp, opts, range, out, verdict, s, headline) = self.parts();
+        let mut mu_notes = Vec::new();
+        let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
+        // μ(I), or its linear form when μ(I) is refused or left out (`leave_out`)
+        let full = if left("mu-i") {
             None
-        }
-        Some(Err(e)) => {
-            s.text("mu_i_fit_error", &e.to_string());
-            Some(e.to_string())
-        }
-        None => None,
-    };
-    let try_linear = linear_reason.is_some() || left("mu-i");
-    if try_linear && left("mu-i-linear") {
-        // neither form is fitted: the plan said so at the start
-        crate::verdict::remove_stale_law(out, "mu_i")?;
-        mu_notes.push("no μ(I) law fitted (left out by the plan)".into());
-        if let Some(e) = linear_reason {
-            warn(&format!(
-                "μ(I) fit failed ({e}); its linear form is left out (leave_out)"
-            ));
-            verdict.run.fail(
-                &format!("{}.mu_i_fit", inp.check_prefix),
-                Verdict::Refused,
-                f64::NAN,
-                f64::NAN,
-                format!("no μ(I) law could be fitted: {e}"),
-            );
-        }
-    } else if try_linear {
-        let formula = if let Some(e) = &linear_reason {
-            warn(&format!(
-                "μ(I) fit failed ({e}); fitting the linear form μ_s + b I"
-            ));
-            "μ_s + b I (the full μ(I) refused)"
         } else {
-            "μ_s + b I (the full μ(I) left out)"
+            Some(fit_mu_i(series, opts))
         };
-        match fit_mu_i_linear(series, &opts) {
-            Ok(f) => {
+        let mut mu_curve = None;
+        let linear_reason = match full {
+            Some(Ok(f)) => {
                 let shown = Shown {
                     key: "mu_i",
-                    form: Some("mu-i-linear"),
-                    formula,
-                    title: "μ(I) = μ_s + b I (linear form)",
-                    linear: true,
+                    form: Some("mu-i"),
+                    formula: "μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                    title: "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
+                    linear: false,
                     file: "mu_i",
                 };
-                let law = CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone());
+                let law = CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone());
                 mu_curve = Some(shown.record(
                     out,
                     verdict,
@@ -349,69 +318,169 @@ pub(crate) fn fit_mu_phi(
                     &f.report,
                     s,
                     headline,
-                    |p, i| p[0] + p[1] * i,
+                    |p, i| {
+                        identify::laws::mu_i::MuILaw {
+                            mu_s: p[0],
+                            mu_2: p[1],
+                            i0: p[2],
+                        }
+                        .mu(i)
+                    },
                 )?);
+                None
             }
-            Err(e2) => {
-                warn(&format!("linear μ(I) fit failed too: {e2}"));
-                s.text("mu_i_linear_fit_error", &e2.to_string());
-                crate::verdict::remove_stale_law(out, "mu_i")?;
+            Some(Err(e)) => {
+                s.text("mu_i_fit_error", &e.to_string());
+                Some(e.to_string())
+            }
+            None => None,
+        };
+        let try_linear = linear_reason.is_some() || left("mu-i");
+        if try_linear && left("mu-i-linear") {
+            // neither form is fitted: the plan said so at the start
+            crate::verdict::remove_stale_law(out, "mu_i")?;
+            mu_notes.push("no μ(I) law fitted (left out by the plan)".into());
+            if let Some(e) = linear_reason {
+                warn(&format!(
+                    "μ(I) fit failed ({e}); its linear form is left out (leave_out)"
+                ));
                 verdict.run.fail(
                     &format!("{}.mu_i_fit", inp.check_prefix),
                     Verdict::Refused,
                     f64::NAN,
                     f64::NAN,
-                    format!("no μ(I) law could be fitted: {e2}"),
+                    format!("no μ(I) law could be fitted: {e}"),
                 );
-                mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
+            }
+        } else if try_linear {
+            let formula = if let Some(e) = &linear_reason {
+                warn(&format!(
+                    "μ(I) fit failed ({e}); fitting the linear form μ_s + b I"
+                ));
+                "μ_s + b I (the full μ(I) refused)"
+            } else {
+                "μ_s + b I (the full μ(I) left out)"
+            };
+            match fit_mu_i_linear(series, opts) {
+                Ok(f) => {
+                    let shown = Shown {
+                        key: "mu_i",
+                        form: Some("mu-i-linear"),
+                        formula,
+                        title: "μ(I) = μ_s + b I (linear form)",
+                        linear: true,
+                        file: "mu_i",
+                    };
+                    let law =
+                        CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone());
+                    mu_curve = Some(shown.record(
+                        out,
+                        verdict,
+                        &law,
+                        inp.mu_checks.clone(),
+                        range,
+                        &f.report,
+                        s,
+                        headline,
+                        |p, i| p[0] + p[1] * i,
+                    )?);
+                }
+                Err(e2) => {
+                    warn(&format!("linear μ(I) fit failed too: {e2}"));
+                    s.text("mu_i_linear_fit_error", &e2.to_string());
+                    crate::verdict::remove_stale_law(out, "mu_i")?;
+                    verdict.run.fail(
+                        &format!("{}.mu_i_fit", inp.check_prefix),
+                        Verdict::Refused,
+                        f64::NAN,
+                        f64::NAN,
+                        format!("no μ(I) law could be fitted: {e2}"),
+                    );
+                    mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
+                }
             }
         }
+        Ok((mu_curve, mu_notes))
     }
-    let mut phi_notes = Vec::new();
-    let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, &opts)) {
-        // left out by the plan (said at the start)
-        None => {
-            crate::verdict::remove_stale_law(out, "phi_i")?;
-            phi_notes.push("no φ(I) law fitted (left out by the plan)".into());
-            None
-        }
-        Some(Ok(f)) => {
-            let shown = Shown {
-                key: "phi_i",
-                form: None,
-                formula: "φ_max − a I",
-                title: "φ(I) = φ_max − a I",
-                linear: true,
-                file: "phi_i",
-            };
-            let law = CalibratedLaw::from_phi_i(&f, inp.grain, inp.provenance.clone());
-            Some(shown.record(
-                out,
-                verdict,
-                &law,
-                inp.phi_checks.clone(),
-                range,
-                &f.report,
-                s,
-                headline,
-                |p, i| p[0] - p[1] * i,
-            )?)
-        }
-        Some(Err(e)) => {
-            warn(&format!("φ(I) fit failed: {e}"));
-            s.text("phi_i_fit_error", &e.to_string());
-            crate::verdict::remove_stale_law(out, "phi_i")?;
-            verdict.run.fail(
-                &format!("{}.phi_i_fit", inp.check_prefix),
-                Verdict::Refused,
-                f64::NAN,
-                f64::NAN,
-                format!("the φ(I) fit failed: {e}"),
-            );
-            phi_notes.push("no φ(I) law fitted (phi_i_fit_error)".into());
-            None
-        }
+
+    /// Stage "fit" of φ(I).
+    fn phi(&mut self) -> Result<LawCurve> {
+        let (series, inp, opts, range, out, verdict, s, headline) = self.parts();
+        let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
+        let mut phi_notes = Vec::new();
+        let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, opts)) {
+            // left out by the plan (said at the start)
+            None => {
+                crate::verdict::remove_stale_law(out, "phi_i")?;
+                phi_notes.push("no φ(I) law fitted (left out by the plan)".into());
+                None
+            }
+            Some(Ok(f)) => {
+                let shown = Shown {
+                    key: "phi_i",
+                    form: None,
+                    formula: "φ_max − a I",
+                    title: "φ(I) = φ_max − a I",
+                    linear: true,
+                    file: "phi_i",
+                };
+                let law = CalibratedLaw::from_phi_i(&f, inp.grain, inp.provenance.clone());
+                Some(shown.record(
+                    out,
+                    verdict,
+                    &law,
+                    inp.phi_checks.clone(),
+                    range,
+                    &f.report,
+                    s,
+                    headline,
+                    |p, i| p[0] - p[1] * i,
+                )?)
+            }
+            Some(Err(e)) => {
+                warn(&format!("φ(I) fit failed: {e}"));
+                s.text("phi_i_fit_error", &e.to_string());
+                crate::verdict::remove_stale_law(out, "phi_i")?;
+                verdict.run.fail(
+                    &format!("{}.phi_i_fit", inp.check_prefix),
+                    Verdict::Refused,
+                    f64::NAN,
+                    f64::NAN,
+                    format!("the φ(I) fit failed: {e}"),
+                );
+                phi_notes.push("no φ(I) law fitted (phi_i_fit_error)".into());
+                None
+            }
+        };
+        Ok((phi_curve, phi_notes))
+    }
+}
+
+/// Fits μ(I) and φ(I) to `series` (those the plan does not leave out), writes the laws that
+/// pass (or their `.rejected.json`), records refusals in `verdict`, the keys in `s`, the printed
+/// lines in `headline`; returns the μ(I) and φ(I) figures ([`rheology_plot`]). Every point
+/// enters the fits (a point failing its own checks makes the laws fail theirs).
+pub(crate) fn fit_mu_phi(
+    out: &mut OutputDir,
+    series: &RheologySeries,
+    inp: &RheologyFit<'_>,
+    verdict: &mut RunVerdict,
+    s: &mut Summary,
+    headline: &mut Vec<String>,
+) -> Result<(XyPlot, XyPlot)> {
+    let is = &series.inertial_number;
+    let mut fits = LawFits {
+        out,
+        series,
+        inp,
+        verdict,
+        s,
+        headline,
+        opts: FitOptions::default(),
+        range: finite_range(is.iter().copied()).unwrap_or((0.0, 0.0)),
     };
+    let (mu_curve, mu_notes) = fits.mu()?;
+    let (phi_curve, phi_notes) = fits.phi()?;
     let points = |values: Option<&[f64]>, se: Option<&[f64]>| -> Vec<MeasuredPoint> {
         let Some(values) = values else {
             return Vec::new();

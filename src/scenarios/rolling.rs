@@ -20,10 +20,11 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_csv_table, table_row};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::{CliError, Result};
-use crate::output::{CsvTable, OutputDir, Summary};
+use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 
@@ -78,9 +79,54 @@ struct RollState {
     /// Initial centre (m).
     c0: Vector2<f64>,
     /// One row per step: `history.csv`.
-    hist: CsvTable,
+    #[serde(with = "serde_csv_table")]
+    hist: Vec<RollStep>,
     vtk: VtkFrames,
     stats: PhaseStats,
+}
+
+table_row! {
+    /// One step of the rolling disk: a row of `history.csv` (slope frame).
+    struct RollStep {
+        /// Time (s).
+        t: "time_s",
+        /// Distance travelled down the slope L (m).
+        travelled: "travelled_m",
+        /// Velocity down the slope (m/s).
+        velocity: "velocity_m_s",
+        /// Angular velocity (rad/s, counter-clockwise).
+        omega: "omega_rad_s",
+        /// Slip velocity of the contact point `v + ω a` (m/s).
+        slip: "slip_velocity_m_s",
+        /// Mean stress with inertia Σ_p, xx (Pa).
+        sxx: "stress_xx_Pa",
+        /// Σ_p, xy (Pa).
+        sxy: "stress_xy_Pa",
+        /// Σ_p, yx (Pa).
+        syx: "stress_yx_Pa",
+        /// Σ_p, yy (Pa).
+        syy: "stress_yy_Pa",
+        /// Contact part Σ_c, xx (Pa).
+        cxx: "contact_stress_xx_Pa",
+        /// Σ_c, xy (Pa).
+        cxy: "contact_stress_xy_Pa",
+        /// Σ_c, yx (Pa).
+        cyx: "contact_stress_yx_Pa",
+        /// Σ_c, yy (Pa).
+        cyy: "contact_stress_yy_Pa",
+    }
+}
+
+impl RollStep {
+    /// The mean stress with inertia Σ_p (slope frame, Pa).
+    fn total(&self) -> Tensor2 {
+        Tensor2::new(self.sxx, self.sxy, self.syx, self.syy)
+    }
+
+    /// The contact part Σ_c (slope frame, Pa).
+    fn contact(&self) -> Tensor2 {
+        Tensor2::new(self.cxx, self.cxy, self.cyx, self.cyy)
+    }
 }
 
 impl PhasedRun for Roll<'_> {
@@ -127,21 +173,21 @@ impl PhasedRun for Roll<'_> {
         // Slip velocity of the contact point along e₁: v + ω a (ω counter-clockwise, the
         // contact point is at −a e₂ from the centre: ω e_z × (−a e₂) = ω a e₁).
         let slip = v + b.omega * self.c.radius;
-        st.hist.push(vec![
-            w.time,
-            (b.position - st.c0).dot(&e1),
-            v,
-            b.omega,
+        st.hist.push(RollStep {
+            t: w.time,
+            travelled: (b.position - st.c0).dot(&e1),
+            velocity: v,
+            omega: b.omega,
             slip,
-            tot[(0, 0)],
-            tot[(0, 1)],
-            tot[(1, 0)],
-            tot[(1, 1)],
-            con[(0, 0)],
-            con[(0, 1)],
-            con[(1, 0)],
-            con[(1, 1)],
-        ]);
+            sxx: tot[(0, 0)],
+            sxy: tot[(0, 1)],
+            syx: tot[(1, 0)],
+            syy: tot[(1, 1)],
+            cxx: con[(0, 0)],
+            cxy: con[(0, 1)],
+            cyx: con[(1, 0)],
+            cyy: con[(1, 1)],
+        });
         st.vtk.maybe(out, w)
     }
 
@@ -158,9 +204,12 @@ impl PhasedRun for Roll<'_> {
     }
 }
 
-/// Runs the scenario.
-pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
-    let phi = c.slope_deg.to_radians();
+/// Stages "build" and "run": the disk released on the slope (or resumed from a checkpoint).
+fn simulate(
+    c: &RollingConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<(dem::World, RollState)> {
     let fresh = || -> Result<(dem::World, RollState)> {
         let (world, e1, e2) = datasets::build::rolling(c)?;
         let c0 = world.bodies[1].position;
@@ -168,40 +217,187 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             e1,
             e2,
             c0,
-            hist: CsvTable::new(&[
-                "time_s",
-                "travelled_m",
-                "velocity_m_s",
-                "omega_rad_s",
-                "slip_velocity_m_s",
-                "stress_xx_Pa",
-                "stress_xy_Pa",
-                "stress_yx_Pa",
-                "stress_yy_Pa",
-                "contact_stress_xx_Pa",
-                "contact_stress_xy_Pa",
-                "contact_stress_yx_Pa",
-                "contact_stress_yy_Pa",
-            ]),
+            hist: Vec::new(),
             vtk: VtkFrames::new(c.duration / 20.0, 21),
             stats: PhaseStats::default(),
         };
         Ok((world, state))
     };
+    drive(ctx, ctl, &Roll { c }, fresh)
+}
+
+/// The exact answers the figures compare with ([`exact_motion`]).
+#[derive(Debug, Clone, Copy)]
+struct Exact {
+    /// Acceleration down the slope (m/s²).
+    a_exact: f64,
+    /// Friction force over the disk's weight term of the contact stress.
+    f: f64,
+    /// Whether the disk rolls without slipping.
+    rolls: bool,
+}
+
+/// Stage "report": `stress_vs_travel.png`, the stress components against the distance
+/// travelled `l` (m), DEM against the exact formulas, on a slope of `phi` (rad) under gravity
+/// `g` (m/s²).
+fn stress_figures(
+    out: &mut OutputDir,
+    c: &RollingConfig,
+    hist: &[RollStep],
+    (g, phi, l): (f64, f64, f64),
+    exact: Exact,
+) -> Result<()> {
+    let Exact { f, rolls, .. } = exact;
+    let rho_g_a = c.density * g * c.radius;
+    let mut p1 = XyPlot::new(
+        "Mean stress with inertia Σ_p (slope frame)",
+        Axis::new("distance travelled L (m)"),
+        Axis::new("stress / (ρ g a)"),
+    );
+    let mut p2 = XyPlot::new(
+        "Contact part alone Σ_c (not symmetric)",
+        Axis::new("distance travelled L (m)"),
+        Axis::new("stress / (ρ g a)"),
+    );
+    let every = (hist.len() / 25).max(1);
+    let pts = |tensor: fn(&RollStep) -> Tensor2, ij: (usize, usize)| -> Vec<(f64, f64)> {
+        hist.iter()
+            .step_by(every)
+            .map(|r| (r.travelled, tensor(r)[ij] / rho_g_a))
+            .collect()
+    };
+    let components = [(0, 0), (0, 1), (1, 0), (1, 1)];
+    let lmax = l.max(1e-12);
+    let line = |v0: f64, slope: f64| vec![(0.0, v0), (lmax, v0 + slope * lmax)];
+    let (sn, cs) = (phi.sin(), phi.cos());
+    let iso = if rolls {
+        sn / (3.0 * c.radius)
+    } else {
+        f64::NAN
+    };
+    let fxy = f;
+    let names = ["xx", "xy", "yx", "yy"];
+    let exact_total = [(0.0, iso), (fxy / 2.0, 0.0), (fxy / 2.0, 0.0), (-cs, iso)];
+    let exact_contact = [(0.0, 0.0), (fxy, 0.0), (0.0, 0.0), (-cs, 0.0)];
+    for (k, name) in names.iter().enumerate() {
+        let col = PALETTE[k];
+        p1.series.push(Series::new(
+            &format!("Σ_{name} exact"),
+            Style::Line,
+            col,
+            line(exact_total[k].0, if rolls { exact_total[k].1 } else { 0.0 }),
+        ));
+        p1.series.push(Series::new(
+            &format!("Σ_{name} DEM"),
+            if k == 2 {
+                Style::Circles
+            } else {
+                Style::Points
+            },
+            col,
+            pts(RollStep::total, components[k]),
+        ));
+        p2.series.push(Series::new(
+            &format!("Σc_{name} exact"),
+            Style::Line,
+            col,
+            line(exact_contact[k].0, 0.0),
+        ));
+        p2.series.push(Series::new(
+            &format!("Σc_{name} DEM"),
+            if k == 2 {
+                Style::Circles
+            } else {
+                Style::Points
+            },
+            col,
+            pts(RollStep::contact, components[k]),
+        ));
+    }
+    p1.legend = LegendAt::MiddleRight;
+    p2.legend = LegendAt::MiddleRight;
+    if !rolls {
+        p1.notes
+            .push("μ < tan φ/3: rolls while sliding (isotropic term from ω² only)".into());
+    }
+    draw_row(out, "stress_vs_travel.png", &[p1, p2], (1800, 700))?;
+    Ok(())
+}
+
+/// Stage "report": `motion.png`, the distance travelled against the exact motion and the slip
+/// velocity of the contact point.
+fn motion_figures(
+    out: &mut OutputDir,
+    c: &RollingConfig,
+    hist: &[RollStep],
+    exact: Exact,
+) -> Result<()> {
+    let Exact { a_exact, rolls, .. } = exact;
+    let every = (hist.len() / 25).max(1);
+    let mut m = XyPlot::new(
+        "Motion of the centre",
+        Axis::new("time t (s)"),
+        Axis::new("distance travelled L (m)"),
+    );
+    m.series.push(Series::new(
+        &format!("exact ½ a t², a = {a_exact:.4} m/s²"),
+        Style::Line,
+        PALETTE[1],
+        (0..=50)
+            .map(|k| {
+                let t = c.duration * k as f64 / 50.0;
+                (t, 0.5 * a_exact * t * t)
+            })
+            .collect(),
+    ));
+    m.series.push(Series::new(
+        "DEM",
+        Style::Points,
+        PALETTE[0],
+        hist.iter()
+            .step_by(every)
+            .map(|r| (r.t, r.travelled))
+            .collect(),
+    ));
+    m.legend = LegendAt::UpperLeft;
+    // Rolling without slipping: the slip is round-off (1e-16 m/s); show it on a ±1 μm/s scale.
+    let slip_axis = if rolls {
+        Axis::new("slip velocity v + ω a (m/s)").range(-1e-6, 1e-6)
+    } else {
+        Axis::new("slip velocity v + ω a (m/s)")
+    };
+    let mut sv = XyPlot::new(
+        "Slip velocity of the contact point",
+        Axis::new("time t (s)"),
+        slip_axis,
+    );
+    sv.series.push(Series::new(
+        "DEM",
+        Style::Line,
+        PALETTE[2],
+        hist.iter().map(|r| (r.t, r.slip)).collect(),
+    ));
+    draw_row(out, "motion.png", &[m, sv], (1600, 600))?;
+    Ok(())
+}
+
+/// Runs the scenario: build and run (`simulate`), measure (the acceleration, the stress
+/// at the end), compare with the exact answers, report.
+pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    let phi = c.slope_deg.to_radians();
     let (
         world,
         RollState {
             hist, vtk, stats, ..
         },
-    ) = drive(ctx, ctl, &Roll { c }, fresh)?;
+    ) = simulate(c, ctx, ctl)?;
     let g = world.params.gravity.norm();
     let frames = vtk.finish(&mut ctx.out, &world)?;
-    let last = hist.rows.last().cloned().unwrap_or_default();
+    let last = hist.last().copied().unwrap_or_default();
     // Measured acceleration: least squares of v(t) = a t.
-    let (svt, stt) = hist
-        .rows
-        .iter()
-        .fold((0.0, 0.0), |(a, b), r| (a + r[2] * r[0], b + r[0] * r[0]));
+    let (svt, stt) = hist.iter().fold((0.0, 0.0), |(a, b), r| {
+        (a + r.velocity * r.t, b + r.t * r.t)
+    });
     let accel = svt / stt;
     let (a_exact, f, rolls) = exact_motion(phi, c.friction, g);
     let b = &world.bodies[1];
@@ -214,9 +410,9 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         b.omega,
         b.angular_acceleration,
     );
-    let tot = Tensor2::new(last[5], last[6], last[7], last[8]);
-    let con = Tensor2::new(last[9], last[10], last[11], last[12]);
-    let l = last[1];
+    let tot = last.total();
+    let con = last.contact();
+    let l = last.travelled;
     let paper = Tensor2::new(0.0, phi.sin() / 6.0, phi.sin() / 6.0, -phi.cos())
         * (c.density * g * c.radius)
         + Tensor2::identity() * (c.density * g * l * phi.sin() / 3.0);
@@ -271,127 +467,11 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     .num("contact_stress_skew_ratio", skew_ratio(&con))
     .int("vtk_frames", frames as u64);
     solver_keys(&mut s, &stats);
-    hist.write(&mut ctx.out, "history.csv")?;
+    rows::table(&hist).write(&mut ctx.out, "history.csv")?;
 
-    // Figures: stress components vs travelled distance, DEM against the exact formulas.
-    let rho_g_a = c.density * g * c.radius;
-    let mut p1 = XyPlot::new(
-        "Mean stress with inertia Σ_p (slope frame)",
-        Axis::new("distance travelled L (m)"),
-        Axis::new("stress / (ρ g a)"),
-    );
-    let mut p2 = XyPlot::new(
-        "Contact part alone Σ_c (not symmetric)",
-        Axis::new("distance travelled L (m)"),
-        Axis::new("stress / (ρ g a)"),
-    );
-    let every = (hist.rows.len() / 25).max(1);
-    let pts = |col: usize| -> Vec<(f64, f64)> {
-        hist.rows
-            .iter()
-            .step_by(every)
-            .map(|r| (r[1], r[col] / rho_g_a))
-            .collect()
-    };
-    let lmax = l.max(1e-12);
-    let line = |v0: f64, slope: f64| vec![(0.0, v0), (lmax, v0 + slope * lmax)];
-    let (sn, cs) = (phi.sin(), phi.cos());
-    let iso = if rolls {
-        sn / (3.0 * c.radius)
-    } else {
-        f64::NAN
-    };
-    let fxy = f;
-    let names = ["xx", "xy", "yx", "yy"];
-    let exact_total = [(0.0, iso), (fxy / 2.0, 0.0), (fxy / 2.0, 0.0), (-cs, iso)];
-    let exact_contact = [(0.0, 0.0), (fxy, 0.0), (0.0, 0.0), (-cs, 0.0)];
-    for (k, name) in names.iter().enumerate() {
-        let col = PALETTE[k];
-        p1.series.push(Series::new(
-            &format!("Σ_{name} exact"),
-            Style::Line,
-            col,
-            line(exact_total[k].0, if rolls { exact_total[k].1 } else { 0.0 }),
-        ));
-        p1.series.push(Series::new(
-            &format!("Σ_{name} DEM"),
-            if k == 2 {
-                Style::Circles
-            } else {
-                Style::Points
-            },
-            col,
-            pts(5 + k),
-        ));
-        p2.series.push(Series::new(
-            &format!("Σc_{name} exact"),
-            Style::Line,
-            col,
-            line(exact_contact[k].0, 0.0),
-        ));
-        p2.series.push(Series::new(
-            &format!("Σc_{name} DEM"),
-            if k == 2 {
-                Style::Circles
-            } else {
-                Style::Points
-            },
-            col,
-            pts(9 + k),
-        ));
-    }
-    p1.legend = LegendAt::MiddleRight;
-    p2.legend = LegendAt::MiddleRight;
-    if !rolls {
-        p1.notes
-            .push("μ < tan φ/3: rolls while sliding (isotropic term from ω² only)".into());
-    }
-    draw_row(&mut ctx.out, "stress_vs_travel.png", &[p1, p2], (1800, 700))?;
-    let mut m = XyPlot::new(
-        "Motion of the centre",
-        Axis::new("time t (s)"),
-        Axis::new("distance travelled L (m)"),
-    );
-    m.series.push(Series::new(
-        &format!("exact ½ a t², a = {a_exact:.4} m/s²"),
-        Style::Line,
-        PALETTE[1],
-        (0..=50)
-            .map(|k| {
-                let t = c.duration * k as f64 / 50.0;
-                (t, 0.5 * a_exact * t * t)
-            })
-            .collect(),
-    ));
-    m.series.push(Series::new(
-        "DEM",
-        Style::Points,
-        PALETTE[0],
-        hist.rows
-            .iter()
-            .step_by(every)
-            .map(|r| (r[0], r[1]))
-            .collect(),
-    ));
-    m.legend = LegendAt::UpperLeft;
-    // Rolling without slipping: the slip is round-off (1e-16 m/s); show it on a ±1 μm/s scale.
-    let slip_axis = if rolls {
-        Axis::new("slip velocity v + ω a (m/s)").range(-1e-6, 1e-6)
-    } else {
-        Axis::new("slip velocity v + ω a (m/s)")
-    };
-    let mut sv = XyPlot::new(
-        "Slip velocity of the contact point",
-        Axis::new("time t (s)"),
-        slip_axis,
-    );
-    sv.series.push(Series::new(
-        "DEM",
-        Style::Line,
-        PALETTE[2],
-        hist.rows.iter().map(|r| (r[0], r[4])).collect(),
-    ));
-    draw_row(&mut ctx.out, "motion.png", &[m, sv], (1600, 600))?;
+    let exact = Exact { a_exact, f, rolls };
+    stress_figures(&mut ctx.out, c, &hist, (g, phi, l), exact)?;
+    motion_figures(&mut ctx.out, c, &hist, exact)?;
 
     let headline = vec![
         format!("report: {}/", ctx.out.path().display()),

@@ -30,6 +30,7 @@ use super::common::{
     VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_rows, table_row, TableRow};
 use super::sensitivity::{record, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -91,6 +92,25 @@ pub(crate) struct PointJudgement {
     pub(crate) phi: Checks,
     pub(crate) points: Vec<Verdict>,
     pub(crate) windows: WindowStats,
+}
+
+impl PointJudgement {
+    /// The checks of the μ(I) and of the φ(I) law, each with the common ones, and the run's
+    /// verdict over the common checks and both laws' (`allow_suspect` as the run says).
+    pub(crate) fn law_checks(&self, allow_suspect: bool) -> (Checks, Checks, RunVerdict) {
+        let mut mu = self.mu.clone();
+        mu.extend(&self.common);
+        let mut phi = self.phi.clone();
+        phi.extend(&self.common);
+        let mut verdict = RunVerdict {
+            run: self.common.clone(),
+            allow_suspect,
+            ..Default::default()
+        };
+        verdict.run.extend(&mu);
+        verdict.run.extend(&phi);
+        (mu, phi, verdict)
+    }
 }
 
 /// Judges every point of a rheology ([`PointJudgement`]), its checks named after `scenario`. A
@@ -172,20 +192,21 @@ pub(crate) fn point_verdict_code(v: Option<&Verdict>) -> f64 {
     }
 }
 
-/// Writes `rheology.csv`: `rows` under `headers` (whose last one is `point_verdict`, filled
-/// here from `point_verdicts`), the table's `description`, how to fit it again, the meaning of
+/// Writes `rheology.csv`: `rows` under their headers and a last column `point_verdict`, filled
+/// here from `point_verdicts`, the table's `description`, how to fit it again, the meaning of
 /// `point_verdict` and the grain's diameter and density as metadata (the fits' `d`, `ρ_s`).
-pub(crate) fn write_rheology_table(
+pub(crate) fn write_rheology_table<R: TableRow>(
     out: &mut OutputDir,
-    headers: &[&str],
-    rows: &[Vec<f64>],
+    rows: &[R],
     point_verdicts: &[Verdict],
     description: &str,
     grain: GrainScale,
 ) -> Result<()> {
-    let mut table = CsvTable::new(headers);
+    let mut headers = R::HEADERS.to_vec();
+    headers.push("point_verdict");
+    let mut table = CsvTable::new(&headers);
     for (k, r) in rows.iter().enumerate() {
-        let mut r = r.clone();
+        let mut r = r.to_values();
         r.push(point_verdict_code(point_verdicts.get(k)));
         table.push(r);
     }
@@ -276,13 +297,67 @@ struct MeanProfile {
     h: f64,
 }
 
+table_row! {
+    /// One shear run: a row of the shear cell's `rheology.csv` (without its `point_verdict`).
+    struct CellRow {
+        /// Target inertial number.
+        i_target: "I_target",
+        /// Bulk inertial number measured.
+        i: "I",
+        /// Bulk μ = |Σ_xy|/P.
+        mu: "mu",
+        /// Bulk solid fraction.
+        phi: "phi",
+        /// Bulk `P = −Σ_yy` (Pa).
+        p: "P_Pa",
+        /// Bulk shear rate (1/s).
+        shear_rate: "shear_rate_1_s",
+        /// Wall velocity V (m/s).
+        wall_velocity: "wall_velocity_m_s",
+        /// Gap H (m).
+        height: "height_m",
+        /// Time step (s).
+        dt: "dt_s",
+        /// Slip velocity at the bottom wall (m/s).
+        slip_bottom: "slip_velocity_bottom_m_s",
+        /// Effective friction of the bottom wall.
+        mu_eff_bottom: "mu_eff_bottom",
+        /// Slip velocity at the top wall (m/s).
+        slip_top: "slip_velocity_top_m_s",
+        /// Effective friction of the top wall.
+        mu_eff_top: "mu_eff_top",
+        /// Samples of the window.
+        samples: "samples",
+        /// V over the uniform-shear estimate γ̇_target H.
+        wall_velocity_over_uniform: "wall_velocity_over_uniform",
+        /// The solver's tolerance of the averaged stage.
+        solver_tolerance: "solver_tolerance",
+    }
+}
+
+table_row! {
+    /// One wall-velocity correction: a row of `lead_stages.csv`.
+    struct LeadRow {
+        /// Target inertial number.
+        i_target: "I_target",
+        /// The lead stage after which V was corrected.
+        lead_stage: "lead_stage",
+        /// Bulk I over the stage's second half.
+        i_measured: "I_measured",
+        /// Factor applied to V.
+        velocity_factor: "velocity_factor",
+        /// V over the uniform-shear estimate after it.
+        wall_velocity_over_uniform: "wall_velocity_over_uniform",
+    }
+}
+
 /// What the phases collect.
 #[derive(Serialize, Deserialize)]
 struct ShearState {
     all: PhaseStats,
     /// One row per run: `rheology.csv`.
-    #[serde(with = "crate::floats::table")]
-    rows: Vec<Vec<f64>>,
+    #[serde(with = "serde_rows")]
+    rows: Vec<CellRow>,
     profiles: Vec<MeanProfile>,
     run: ShearRun,
     acc: RunAverages,
@@ -296,8 +371,8 @@ struct ShearState {
     #[serde(default)]
     lead: LeadAverages,
     /// One row per wall-velocity correction: `lead_stages.csv`.
-    #[serde(default, with = "crate::floats::table")]
-    lead_rows: Vec<Vec<f64>>,
+    #[serde(default, with = "serde_rows")]
+    lead_rows: Vec<LeadRow>,
     /// The current lead stage's solver sensitivity (its second half's samples, re-solved).
     #[serde(default)]
     lead_sensitivity: Sensitivity,
@@ -444,8 +519,13 @@ impl PhasedRun for Shear<'_> {
         {
             let (i_measured, factor) = velocity_correction(i_target, &st.lead, d, c.grain.density);
             v *= factor;
-            st.lead_rows
-                .push(vec![i_target, j as f64, i_measured, factor, v / v_uniform]);
+            st.lead_rows.push(LeadRow {
+                i_target,
+                lead_stage: j as f64,
+                i_measured,
+                velocity_factor: factor,
+                wall_velocity_over_uniform: v / v_uniform,
+            });
             if factor != 1.0 {
                 info(
                     env.verbosity,
@@ -612,24 +692,24 @@ impl PhasedRun for Shear<'_> {
             mu: acc.mu_samples.clone(),
             phi: acc.phi_samples.clone(),
         });
-        st.rows.push(vec![
+        st.rows.push(CellRow {
             i_target,
-            i_meas,
+            i: i_meas,
             mu,
             phi,
             p,
-            gd,
-            v,
-            h,
+            shear_rate: gd,
+            wall_velocity: v,
+            height: h,
             dt,
-            vb,
-            mub,
-            vt,
-            mut_,
-            acc.samples as f64,
-            v / v_uniform,
-            world.params.solver.tolerance,
-        ]);
+            slip_bottom: vb,
+            mu_eff_bottom: mub,
+            slip_top: vt,
+            mu_eff_top: mut_,
+            samples: acc.samples as f64,
+            wall_velocity_over_uniform: v / v_uniform,
+            solver_tolerance: world.params.solver.tolerance,
+        });
         st.profiles.push(MeanProfile {
             i: i_meas,
             y: acc.profile.iter().map(|p| p.0).collect(),
@@ -645,8 +725,13 @@ impl PhasedRun for Shear<'_> {
     }
 }
 
-/// Runs the scenario.
-pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+/// Stages "build" and "run": the cell compressed, then sheared at each target inertial number
+/// (or resumed from a checkpoint).
+fn simulate(
+    c: &ShearCellConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<(dem::World, ShearState)> {
     let mut targets = c.inertial_numbers.clone();
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
@@ -668,135 +753,29 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         };
         Ok((world, state))
     };
-    let (
-        world,
-        ShearState {
-            all,
-            rows,
-            profiles,
-            checks: run_checks,
-            lead_rows,
-            ..
-        },
-    ) = drive(ctx, ctl, &shear, fresh)?;
-    // Checks (crate::verdict): per run, the numerics of its averaging window and the measured
-    // I against its target (all laws); the steady state of μ (μ(I)) and of φ with its bound
-    // (φ(I)).
-    let PointJudgement {
-        common,
-        mu: mut mu_checks,
-        phi: mut phi_checks,
-        points: point_verdicts,
-        windows,
-    } = judge_points(
-        "shear_cell",
-        &run_checks,
-        max_solid_fraction(c.grain.radius_spread),
-    );
-    mu_checks.extend(&common);
-    phi_checks.extend(&common);
-    let mut verdict = RunVerdict {
-        run: common.clone(),
-        allow_suspect: ctl.allow_suspect,
-        ..Default::default()
-    };
-    verdict.run.extend(&mu_checks);
-    verdict.run.extend(&phi_checks);
-    let d = mean_diameter(&world);
-    VtkFrames::new(f64::INFINITY, 1).finish(&mut ctx.out, &world)?;
-    let headers = [
-        "I_target",
-        "I",
-        "mu",
-        "phi",
-        "P_Pa",
-        "shear_rate_1_s",
-        "wall_velocity_m_s",
-        "height_m",
-        "dt_s",
-        "slip_velocity_bottom_m_s",
-        "mu_eff_bottom",
-        "slip_velocity_top_m_s",
-        "mu_eff_top",
-        "samples",
-        "wall_velocity_over_uniform",
-        "solver_tolerance",
-        "point_verdict",
-    ];
-    let grain = GrainScale {
-        diameter_m: d,
-        density_kg_m3: c.grain.density,
-    };
-    write_rheology_table(
-        &mut ctx.out,
-        &headers,
-        &rows,
-        &point_verdicts,
-        "steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip",
-        grain,
-    )?;
-    if c.velocity_corrections > 0 {
-        let mut lead = CsvTable::new(&[
-            "I_target",
-            "lead_stage",
-            "I_measured",
-            "velocity_factor",
-            "wall_velocity_over_uniform",
-        ]);
-        lead.comments.push("wall-velocity corrections: bulk I over the second half of each correcting lead stage, the factor applied to V after it (1 within the dead band), and V over the uniform-shear estimate after it".into());
-        for r in lead_rows {
-            lead.push(r);
-        }
-        lead.write(&mut ctx.out, "lead_stages.csv")?;
-    }
+    drive(ctx, ctl, &shear, fresh)
+}
 
-    // Fits.
-    let series = RheologySeries {
-        inertial_number: rows.iter().map(|r| r[1]).collect(),
-        mu: Some(rows.iter().map(|r| r[2]).collect()),
-        phi: Some(rows.iter().map(|r| r[3]).collect()),
-        pressure_pa: Some(rows.iter().map(|r| r[4]).collect()),
-        // the wall-bounded cell measures no standard error per point: unweighted fits
-        mu_std_error: None,
-        phi_std_error: None,
-    };
+/// Stage "fit": the wall law over the slip of both walls of every run (`rows`, `d` the mean
+/// diameter); the figure of the wall friction against the slip.
+#[allow(clippy::too_many_arguments)]
+fn fit_wall_law(
+    c: &ShearCellConfig,
+    rows: &[CellRow],
+    d: f64,
+    common: &Checks,
+    provenance: &identify::law::Provenance,
+    out: &mut OutputDir,
+    s: &mut Summary,
+    verdict: &mut RunVerdict,
+    headline: &mut Vec<String>,
+) -> Result<XyPlot> {
     let opts = FitOptions::default();
-    let provenance = crate::provenance::of_run(ctx, ctl, "shear-cell", c.seed);
     let prov = || provenance.clone();
-    let mut s = Summary::new();
-    s.int("grains", c.grains as u64)
-        .num("pressure_Pa", c.pressure)
-        .num("mean_diameter_m", d)
-        .int("runs", rows.len() as u64)
-        .num("I_min", rows.iter().map(|r| r[1]).fold(f64::MAX, f64::min))
-        .num("I_max", rows.iter().map(|r| r[1]).fold(f64::MIN, f64::max));
-    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
-    let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
-    let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
-        &mut ctx.out,
-        &series,
-        &super::rheology_fit::RheologyFit {
-            check_prefix: "shear_cell",
-            title_suffix: "",
-            dem_label: "DEM",
-            grain,
-            provenance: prov(),
-            mu_checks: mu_checks.clone(),
-            phi_checks: phi_checks.clone(),
-            // the wall-bounded cell measures no standard error per point
-            std_errors: Default::default(),
-            point_verdicts: &point_verdicts,
-            leave_out: &c.leave_out,
-        },
-        &mut verdict,
-        &mut s,
-        &mut headline,
-    )?;
-    // Wall law from both walls.
     let mut vs = Vec::new();
     let mut mus = Vec::new();
-    for r in &rows {
-        for (v, m) in [(r[9], r[10]), (r[11], r[12])] {
+    for r in rows {
+        for (v, m) in [(r.slip_bottom, r.mu_eff_bottom), (r.slip_top, r.mu_eff_top)] {
             if v.is_finite() && m.is_finite() {
                 vs.push(v.abs());
                 mus.push(m);
@@ -819,7 +798,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     let wall_left_out = c.leave_out.iter().any(|l| l == "wall-law");
     match (!wall_left_out).then(|| select_wall_law(&ws, &opts)) {
         // left out by the plan (said at the start)
-        None => crate::verdict::remove_stale_law(&ctx.out, "wall")?,
+        None => crate::verdict::remove_stale_law(out, "wall")?,
         Some(Ok(sel)) => {
             let best = sel.best();
             // over the measured slips only: the law is not drawn beyond its data
@@ -863,10 +842,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
                 &band,
             );
             s.text("wall_law_form", form.law_name());
-            fit_keys(&mut s, "wall_law", &best.report.parameters);
+            fit_keys(s, "wall_law", &best.report.parameters);
             let law =
                 CalibratedLaw::from_wall_law(best, d, 9.81, Some(sel.comparison.clone()), prov());
-            let exported = export_law(&mut ctx.out, &mut verdict, "wall", &law, common.clone())?;
+            let exported = export_law(out, verdict, "wall", &law, common.clone())?;
             headline.extend(exported.heading(&law.law));
             headline.extend(parameter_lines(
                 &format!("wall law: {} chosen by AIC", form.law_name()),
@@ -878,7 +857,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             warn(&format!("wall-law fit failed: {e}"));
             s.text("wall_law_fit_error", &e.to_string());
             headline.push(format!("wall law not identified: {e}"));
-            crate::verdict::remove_stale_law(&ctx.out, "wall")?;
+            crate::verdict::remove_stale_law(out, "wall")?;
             verdict.run.fail(
                 "shear_cell.wall_law_fit",
                 Verdict::Refused,
@@ -889,8 +868,17 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         }
     }
     pw.legend = LegendAt::LowerRight;
-    draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, pw], (1950, 650))?;
-    // Velocity profiles, normalised.
+    Ok(pw)
+}
+
+/// Stage "report": `velocity_profiles.png` (each run's mean profile, normalised) and
+/// `force_chains.png` (the last state, at the last inertial number of `is`).
+fn profile_figures(
+    out: &mut OutputDir,
+    world: &dem::World,
+    profiles: &[MeanProfile],
+    is: &[f64],
+) -> Result<()> {
     let mut pv = XyPlot::new(
         "Velocity profiles",
         Axis::new("velocity / wall velocity v_x / V"),
@@ -909,10 +897,10 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         ));
     }
     pv.legend = LegendAt::UpperLeft;
-    crate::plot::xy::draw_xy(&mut ctx.out, "velocity_profiles.png", &pv)?;
+    crate::plot::xy::draw_xy(out, "velocity_profiles.png", &pv)?;
     let snap = world.snapshot();
     draw_particles(
-        &mut ctx.out,
+        out,
         "force_chains.png",
         &ParticleView {
             snap: &snap,
@@ -927,6 +915,111 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             overlays: Vec::new(),
         },
     )?;
+    Ok(())
+}
+
+/// Runs the scenario: build and run (`simulate`), verdict (`judge_points`), report and
+/// fits (μ(I), φ(I), `fit_wall_law`), figures (`profile_figures`).
+pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    let (
+        world,
+        ShearState {
+            all,
+            rows,
+            profiles,
+            checks: run_checks,
+            lead_rows,
+            ..
+        },
+    ) = simulate(c, ctx, ctl)?;
+    // Checks (crate::verdict): per run, the numerics of its averaging window and the measured
+    // I against its target (all laws); the steady state of μ (μ(I)) and of φ with its bound
+    // (φ(I)).
+    let judged = judge_points(
+        "shear_cell",
+        &run_checks,
+        max_solid_fraction(c.grain.radius_spread),
+    );
+    let (mu_checks, phi_checks, mut verdict) = judged.law_checks(ctl.allow_suspect);
+    let PointJudgement {
+        common,
+        points: point_verdicts,
+        windows,
+        ..
+    } = judged;
+    let d = mean_diameter(&world);
+    VtkFrames::new(f64::INFINITY, 1).finish(&mut ctx.out, &world)?;
+    let grain = GrainScale {
+        diameter_m: d,
+        density_kg_m3: c.grain.density,
+    };
+    write_rheology_table(
+        &mut ctx.out,
+        &rows,
+        &point_verdicts,
+        "steady plane shear: bulk averages per run (I, mu = |sigma_xy|/P, phi, P) and wall slip",
+        grain,
+    )?;
+    if c.velocity_corrections > 0 {
+        let mut lead = rows::table(&lead_rows);
+        lead.comments.push("wall-velocity corrections: bulk I over the second half of each correcting lead stage, the factor applied to V after it (1 within the dead band), and V over the uniform-shear estimate after it".into());
+        lead.write(&mut ctx.out, "lead_stages.csv")?;
+    }
+
+    // Fits.
+    let series = RheologySeries {
+        inertial_number: rows.iter().map(|r| r.i).collect(),
+        mu: Some(rows.iter().map(|r| r.mu).collect()),
+        phi: Some(rows.iter().map(|r| r.phi).collect()),
+        pressure_pa: Some(rows.iter().map(|r| r.p).collect()),
+        // the wall-bounded cell measures no standard error per point: unweighted fits
+        mu_std_error: None,
+        phi_std_error: None,
+    };
+    let provenance = crate::provenance::of_run(ctx, ctl, "shear-cell", c.seed);
+    let prov = || provenance.clone();
+    let mut s = Summary::new();
+    s.int("grains", c.grains as u64)
+        .num("pressure_Pa", c.pressure)
+        .num("mean_diameter_m", d)
+        .int("runs", rows.len() as u64)
+        .num("I_min", rows.iter().map(|r| r.i).fold(f64::MAX, f64::min))
+        .num("I_max", rows.iter().map(|r| r.i).fold(f64::MIN, f64::max));
+    let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
+    let is: Vec<f64> = rows.iter().map(|r| r.i).collect();
+    let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
+        &mut ctx.out,
+        &series,
+        &super::rheology_fit::RheologyFit {
+            check_prefix: "shear_cell",
+            title_suffix: "",
+            dem_label: "DEM",
+            grain,
+            provenance: prov(),
+            mu_checks: mu_checks.clone(),
+            phi_checks: phi_checks.clone(),
+            // the wall-bounded cell measures no standard error per point
+            std_errors: Default::default(),
+            point_verdicts: &point_verdicts,
+            leave_out: &c.leave_out,
+        },
+        &mut verdict,
+        &mut s,
+        &mut headline,
+    )?;
+    let pw = fit_wall_law(
+        c,
+        &rows,
+        d,
+        &common,
+        &provenance,
+        &mut ctx.out,
+        &mut s,
+        &mut verdict,
+        &mut headline,
+    )?;
+    draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, pw], (1950, 650))?;
+    profile_figures(&mut ctx.out, &world, &profiles, &is)?;
     solver_keys(&mut s, &all);
     windows.keys(&mut s, "window");
     Ok(RunOutcome {

@@ -11,7 +11,7 @@
 //! `I = γ̇ d / √(p_n/ρ)`. μ(I) and φ(I) are fitted by `identify::mu_i` (which refuses what the
 //! data cannot support).
 
-use datasets::config::{CellControlMode, SimpleShearConfig};
+use datasets::config::SimpleShearConfig;
 use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed, Mat};
 use homogenise::averaging::block_average;
@@ -21,19 +21,19 @@ use identify::mu_i::RheologySeries;
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{
-    implicit_cell_control, mean_diameter, solver_keys, strain_bins, Stop, VtkFrames,
-};
+use super::cell_base::{CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
+use super::common::{mean_diameter, solver_keys, strain_bins, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, table_row};
 use super::sensitivity::{record, resolved_pair};
 use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, OutputDir, Summary};
+use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::verdict::{max_solid_fraction, RunVerdict, WindowStats};
+use crate::verdict::max_solid_fraction;
 
 /// Re-solved samples of an averaging window, spread evenly over it (at least this many; every
 /// step of a shorter window): each such step is solved again to
@@ -52,36 +52,47 @@ fn resolves(j: u64, len: u64) -> bool {
     j % every == every - 1
 }
 
-/// Columns of `history_I{k}.csv`.
-const HISTORY: [&str; 18] = [
-    "t_s",
-    "shear_strain",
-    "sigma_xx_Pa",
-    "sigma_yy_Pa",
-    "sigma_xy_Pa",
-    "D_xx_1_s",
-    "D_yy_1_s",
-    "D_xy_1_s",
-    "p_Pa",
-    "q_Pa",
-    "phi",
-    "Z",
-    "fabric_xx",
-    "fabric_yy",
-    "fabric_xy",
-    "I",
-    "mu",
-    "cell_corrections",
-];
-
-/// Gain of the cell control as a fraction of its stability limit `Δt/(ρ d²)` (`dem::cell`).
-const GAIN_FRACTION: f64 = 0.3;
-/// Tolerance of the implicit correction of the cell control, as a fraction of P.
-const CONTROL_TOLERANCE: f64 = 0.5;
-/// Re-solves of a step at most by the implicit correction.
-const MAX_CORRECTIONS: usize = 8;
-/// Blocks of the block-averaged standard errors (at least).
-pub(crate) const MIN_BLOCKS: usize = 4;
+table_row! {
+    /// One step of a shear run: a row of `history_I{k}.csv`.
+    struct HistoryRow {
+        /// Time (s).
+        t: "t_s",
+        /// Shear strain γ of the run.
+        shear_strain: "shear_strain",
+        /// Whole-cell mean stress Σ_xx (Pa, tension positive).
+        sxx: "sigma_xx_Pa",
+        /// Σ_yy (Pa).
+        syy: "sigma_yy_Pa",
+        /// Σ_xy (Pa).
+        sxy: "sigma_xy_Pa",
+        /// Strain rate of the cell D_xx (1/s).
+        dxx: "D_xx_1_s",
+        /// D_yy (1/s).
+        dyy: "D_yy_1_s",
+        /// D_xy (1/s).
+        dxy: "D_xy_1_s",
+        /// `−tr Σ/2` (Pa).
+        p: "p_Pa",
+        /// Deviator (Pa).
+        q: "q_Pa",
+        /// Solid fraction.
+        phi: "phi",
+        /// Coordination.
+        z: "Z",
+        /// Fabric F_xx.
+        fabric_xx: "fabric_xx",
+        /// Fabric F_yy.
+        fabric_yy: "fabric_yy",
+        /// Fabric F_xy.
+        fabric_xy: "fabric_xy",
+        /// `γ̇ d / √(−Σ_yy/ρ)` (NaN without normal stress).
+        inertial: "I",
+        /// `|Σ_xy|/(−Σ_yy)`.
+        mu: "mu",
+        /// Re-solves of the step by the cell control.
+        cell_corrections: "cell_corrections",
+    }
+}
 
 /// The samples of a biperiodic cell's state over an averaging window, one per step (this
 /// scenario) or per snapshot (another code's run, `grainlaw homogenise`): `−Σ_yy` and
@@ -168,7 +179,7 @@ impl RheologyPoint {
         })
     }
 
-    /// The row of `rheology.csv` ([`RHEOLOGY_HEADERS`] but `point_verdict`).
+    /// The row of `rheology.csv` (without its `point_verdict`).
     pub(crate) fn row(
         &self,
         i_target: f64,
@@ -176,47 +187,63 @@ impl RheologyPoint {
         dt: f64,
         samples: usize,
         corrections_per_step: f64,
-    ) -> Vec<f64> {
-        vec![
+    ) -> RheologyRow {
+        RheologyRow {
             i_target,
-            self.i,
-            self.i_se,
-            self.mu,
-            self.mu_se,
-            self.phi,
-            self.phi_se,
-            self.pn,
-            self.pn_se,
-            self.p,
-            self.z,
-            gamma_dot,
+            i: self.i,
+            i_se: self.i_se,
+            mu: self.mu,
+            mu_se: self.mu_se,
+            phi: self.phi,
+            phi_se: self.phi_se,
+            pn: self.pn,
+            pn_se: self.pn_se,
+            p: self.p,
+            z: self.z,
+            shear_rate: gamma_dot,
             dt,
-            samples as f64,
+            samples: samples as f64,
             corrections_per_step,
-        ]
+        }
     }
 }
 
-/// Columns of the `rheology.csv` of a biperiodic cell ([`RheologyPoint::row`], then the
-/// point's verdict).
-pub(crate) const RHEOLOGY_HEADERS: [&str; 16] = [
-    "I_target",
-    "I",
-    "I_std_error",
-    "mu",
-    "mu_std_error",
-    "phi",
-    "phi_std_error",
-    "P_Pa",
-    "P_std_error_Pa",
-    "p_mean_Pa",
-    "Z",
-    "shear_rate_1_s",
-    "dt_s",
-    "samples",
-    "cell_corrections_per_step",
-    "point_verdict",
-];
+table_row! {
+    /// A point of the `rheology.csv` of a biperiodic cell (`RheologyPoint::row`; the table
+    /// adds the point's verdict, `shear_cell::write_rheology_table`).
+    pub struct RheologyRow {
+        /// Target inertial number (NaN: none).
+        i_target: "I_target",
+        /// Measured I.
+        i: "I",
+        /// Its standard error.
+        i_se: "I_std_error",
+        /// μ = |Σ_xy|/P.
+        mu: "mu",
+        /// Its block standard error.
+        mu_se: "mu_std_error",
+        /// Solid fraction.
+        phi: "phi",
+        /// Its block standard error.
+        phi_se: "phi_std_error",
+        /// `P = ⟨−Σ_yy⟩` (Pa).
+        pn: "P_Pa",
+        /// Its block standard error (Pa).
+        pn_se: "P_std_error_Pa",
+        /// Mean pressure `−tr Σ/2` (Pa).
+        p: "p_mean_Pa",
+        /// Coordination.
+        z: "Z",
+        /// Shear rate γ̇ (1/s).
+        shear_rate: "shear_rate_1_s",
+        /// Time step (s).
+        dt: "dt_s",
+        /// Samples of the window.
+        samples: "samples",
+        /// Mean re-solves per step by the cell control (NaN: not known).
+        corrections_per_step: "cell_corrections_per_step",
+    }
+}
 
 /// The plan of the current shear run.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
@@ -231,20 +258,13 @@ struct RunPlan {
 /// What the phases collect.
 #[derive(Serialize, Deserialize)]
 struct State {
-    all: PhaseStats,
-    /// One row per run: `rheology.csv`.
-    #[serde(with = "crate::floats::table")]
-    rows: Vec<Vec<f64>>,
-    /// The current run's history.
-    #[serde(with = "crate::floats::table")]
-    history: Vec<Vec<f64>>,
+    /// Solver statistics, one row per run (`rheology.csv`), the current run's history, the
+    /// frames, the numerics of the current run's averaging window.
+    #[serde(flatten)]
+    cell: CellRecord<HistoryRow, RheologyRow>,
     /// Strain histories of μ of the finished runs, for the figure: (I, [(γ, μ)]).
     curves: Vec<(f64, Vec<(f64, f64)>)>,
     run: RunPlan,
-    frames: VtkFrames,
-    /// Numerics of the current run's averaging window.
-    #[serde(default)]
-    window: WindowStats,
     /// The checks of the finished runs (crate::verdict).
     #[serde(default)]
     checks: Vec<RunCheckData>,
@@ -256,15 +276,18 @@ struct State {
 /// Width of the shear-strain bins of the peak stress ratio of a run.
 const PEAK_BIN_STRAIN: f64 = 0.1;
 
-/// The peak stress ratio of a run's history (rows with the shear strain in column `strain` and
-/// μ in column `mu`): the largest mean of μ over bins of [`PEAK_BIN_STRAIN`] of shear strain
-/// ([`strain_bins`]; NaN without data).
-fn peak_mu(history: &[Vec<f64>], strain: usize, mu: usize) -> f64 {
-    strain_bins(history, strain, PEAK_BIN_STRAIN, &[mu], |r| {
-        r[mu].is_finite() && r[strain].is_finite()
-    })
+/// The peak stress ratio of a run's history: the largest mean of μ over bins of
+/// [`PEAK_BIN_STRAIN`] of shear strain ([`strain_bins`]; NaN without data).
+fn peak_mu(history: &[HistoryRow]) -> f64 {
+    strain_bins(
+        history,
+        |r| r.shear_strain,
+        PEAK_BIN_STRAIN,
+        [|r: &HistoryRow| r.mu],
+        |r| r.mu.is_finite() && r.shear_strain.is_finite(),
+    )
     .iter()
-    .map(|m| m[0])
+    .map(|[mu]| *mu)
     .fold(f64::NAN, f64::max)
 }
 
@@ -285,29 +308,19 @@ impl Shear<'_> {
             // A sheared packing dilates at up to about γ̇: the cap must allow it.
             Some(g) => (Imposed::Rate(0.0), Imposed::Rate(g), rate_cap.max(g)),
         };
-        if c.cell_control == CellControlMode::Implicit {
-            return implicit_cell_control(
-                xx,
-                Imposed::Stress(-p),
-                xy,
-                max_rate,
-                p,
-                gamma_dot.is_none(),
-            )
-            .with_affine(c.cell_affine);
-        }
-        CellControl {
+        ControlPlan {
+            mode: c.cell_control,
             xx,
             yy: Imposed::Stress(-p),
             xy,
-            gain: GAIN_FRACTION * dt / (rho * d * d),
             max_rate,
-            relaxation: 0.0,
-            tolerance: CONTROL_TOLERANCE * p,
-            max_corrections: MAX_CORRECTIONS,
-            implicit: false,
-            affine: false,
+            pressure: p,
+            compressing: gamma_dot.is_none(),
+            gain_fraction: GAIN_FRACTION,
+            filter_steps: 0.0,
+            affine: c.cell_affine,
         }
+        .control(dt, rho, d)
     }
 }
 
@@ -356,8 +369,8 @@ impl PhasedRun for Shear<'_> {
             avg_steps,
             n: 0,
         };
-        st.history.clear();
-        st.window.reset();
+        st.cell.history.clear();
+        st.cell.window.reset();
         Ok(Some(PhasePlan {
             name: format!("I={i}"),
             stop: Stop::Steps(steps),
@@ -373,13 +386,13 @@ impl PhasedRun for Shear<'_> {
         r: &dem::StepReport,
         p: &datasets::phases::PhaseProgress,
     ) -> Result<()> {
-        st.frames.maybe(out, w)?;
+        st.cell.frames.maybe(out, w)?;
         if k == 0 {
             return Ok(());
         }
         st.run.n += 1;
         let averaged = st.run.n + st.run.avg_steps > st.run.steps;
-        st.window.step(averaged, w, r, &p.stats);
+        st.cell.window.step(averaged, w, r, &p.stats);
         let snap = w.snapshot();
         let cs = cell_state(&snap)?;
         let s = cs.stress;
@@ -393,7 +406,11 @@ impl PhasedRun for Shear<'_> {
                 let s = cell_state(snap).ok()?.stress;
                 Some([s[(0, 1)], s[(1, 1)]])
             });
-            record(&mut st.window.sensitivity, [s[(0, 1)], s[(1, 1)]], resolved);
+            record(
+                &mut st.cell.window.sensitivity,
+                [s[(0, 1)], s[(1, 1)]],
+                resolved,
+            );
         }
         let d = mean_diameter(w);
         let pn = -s[(1, 1)];
@@ -407,26 +424,26 @@ impl PhasedRun for Shear<'_> {
         } else {
             f64::NAN
         };
-        st.history.push(vec![
-            w.time,
-            st.run.gamma_dot * st.run.dt * st.run.n as f64,
-            s[(0, 0)],
-            s[(1, 1)],
-            s[(0, 1)],
-            cs.strain_rate[(0, 0)],
-            cs.strain_rate[(1, 1)],
-            cs.strain_rate[(0, 1)],
-            cs.pressure,
-            cs.deviator,
-            cs.solid_fraction,
-            cs.coordination,
-            cs.fabric[(0, 0)],
-            cs.fabric[(1, 1)],
-            cs.fabric[(0, 1)],
-            i,
+        st.cell.history.push(HistoryRow {
+            t: w.time,
+            shear_strain: st.run.gamma_dot * st.run.dt * st.run.n as f64,
+            sxx: s[(0, 0)],
+            syy: s[(1, 1)],
+            sxy: s[(0, 1)],
+            dxx: cs.strain_rate[(0, 0)],
+            dyy: cs.strain_rate[(1, 1)],
+            dxy: cs.strain_rate[(0, 1)],
+            p: cs.pressure,
+            q: cs.deviator,
+            phi: cs.solid_fraction,
+            z: cs.coordination,
+            fabric_xx: cs.fabric[(0, 0)],
+            fabric_yy: cs.fabric[(1, 1)],
+            fabric_xy: cs.fabric[(0, 1)],
+            inertial: i,
             mu,
-            r.cell_corrections as f64,
-        ]);
+            cell_corrections: r.cell_corrections as f64,
+        });
         Ok(())
     }
 
@@ -438,69 +455,68 @@ impl PhasedRun for Shear<'_> {
         world: &mut dem::World,
         stats: &PhaseStats,
     ) -> Result<()> {
-        st.all.merge(stats);
+        st.cell.all.merge(stats);
         if k == 0 {
             return Ok(());
         }
         let target = self.targets[k - 1];
-        let mut table = CsvTable::new(&HISTORY);
-        for row in &st.history {
-            table.push(row.clone());
-        }
+        let mut table = rows::table(&st.cell.history);
         table.comments.push(format!(
             "simple shear at target I {target}: whole-cell mean stress (tension positive, kinetic stress of the fluctuations included), strain rate D of the cell (1/s), p is -tr(sigma)/2, q, solid fraction, coordination Z and fabric over force-carrying contacts, I is gamma_dot d / sqrt(-sigma_yy/rho), mu is |sigma_xy|/(-sigma_yy), cell_corrections counts the re-solves of the step by the cell control"
         ));
         table.write(out, &format!("history_I{k}.csv"))?;
-        let tail =
-            &st.history[st.history.len() - (st.run.avg_steps as usize).min(st.history.len())..];
-        let col = |j: usize| -> Vec<f64> { tail.iter().map(|r| r[j]).collect() };
+        let tail = &st.cell.history
+            [st.cell.history.len() - (st.run.avg_steps as usize).min(st.cell.history.len())..];
+        let col = |f: fn(&HistoryRow) -> f64| -> Vec<f64> { tail.iter().map(f).collect() };
         let samples = CellSamples {
-            normal_stress: col(3).iter().map(|s| -s).collect(),
-            mu: col(16),
-            phi: col(10),
-            pressure: col(8),
-            coordination: col(11),
+            normal_stress: col(|r| r.syy).iter().map(|s| -s).collect(),
+            mu: col(|r| r.mu),
+            phi: col(|r| r.phi),
+            pressure: col(|r| r.p),
+            coordination: col(|r| r.z),
         };
         let d = mean_diameter(world);
         let gd = st.run.gamma_dot;
         let point = RheologyPoint::of(&samples, gd, d, self.c.grain.density)?;
-        let corrections: f64 = col(17).iter().sum();
+        let corrections: f64 = col(|r| r.cell_corrections).iter().sum();
         // what the solver's measured effect is judged against (0: not known)
         let known = |x: f64| if x.is_finite() { x } else { 0.0 };
-        st.window.statistical_errors = [known(point.mu_se), known(point.pn_se / point.pn)];
+        st.cell.window.statistical_errors = [known(point.mu_se), known(point.pn_se / point.pn)];
         st.checks.push(RunCheckData {
             i_target: target,
             i_measured: point.i,
-            window: st.window,
+            window: st.cell.window,
             mu: samples.mu,
             phi: samples.phi,
         });
-        st.rows.push(point.row(
+        st.cell.rows.push(point.row(
             target,
             gd,
             st.run.dt,
             tail.len(),
             corrections / tail.len().max(1) as f64,
         ));
-        st.peaks.push(peak_mu(&st.history, 1, 16));
+        st.peaks.push(peak_mu(&st.cell.history));
         st.curves.push((
             point.i,
-            st.history
+            st.cell
+                .history
                 .iter()
-                .step_by((st.history.len() / 200).max(1))
-                .map(|r| (r[1], r[16]))
+                .step_by((st.cell.history.len() / 200).max(1))
+                .map(|r| (r.shear_strain, r.mu))
                 .collect(),
         ));
         Ok(())
     }
 }
 
-/// Runs the scenario.
-pub fn run(
+/// Stages "build" and "run": the cell compressed, then sheared at each target inertial number
+/// (or resumed from a checkpoint).
+fn simulate(
     c: &SimpleShearConfig,
     ctx: &mut RunContext,
     ctl: &mut RunControl,
-) -> Result<RunOutcome> {
+) -> Result<(dem::World, State)> {
     let mut targets = c.inertial_numbers.clone();
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
@@ -518,88 +534,22 @@ pub fn run(
         Ok((
             world,
             State {
-                all: PhaseStats::default(),
-                rows: Vec::new(),
-                history: Vec::new(),
+                cell: CellRecord::new(VtkFrames::new(t_total / 40.0, 41)),
                 curves: Vec::new(),
                 run: RunPlan::default(),
-                frames: VtkFrames::new(t_total / 40.0, 41),
-                window: WindowStats::default(),
                 checks: Vec::new(),
                 peaks: Vec::new(),
             },
         ))
     };
-    let (world, state) = drive(ctx, ctl, &shear, fresh)?;
-    let State {
-        all,
-        rows,
-        curves,
-        frames,
-        checks: run_checks,
-        peaks,
-        ..
-    } = state;
-    // Checks (crate::verdict), as in the shear cell: per point, the numerics of its averaging
-    // window, I against its target, steady μ and φ, φ below its bound.
-    let PointJudgement {
-        common,
-        mu: mu_checks,
-        phi: phi_checks,
-        points: point_verdicts,
-        windows,
-    } = judge_points(
-        "simple_shear",
-        &run_checks,
-        max_solid_fraction(c.grain.radius_spread),
-    );
-    let mu_checks = {
-        let mut m = mu_checks;
-        m.extend(&common);
-        m
-    };
-    let phi_checks = {
-        let mut p = phi_checks;
-        p.extend(&common);
-        p
-    };
-    let mut verdict = RunVerdict {
-        run: common.clone(),
-        allow_suspect: ctl.allow_suspect,
-        ..Default::default()
-    };
-    verdict.run.extend(&mu_checks);
-    verdict.run.extend(&phi_checks);
-    frames.finish(&mut ctx.out, &world)?;
-    let d = mean_diameter(&world);
-    let headers = RHEOLOGY_HEADERS;
-    let grain = GrainScale {
-        diameter_m: d,
-        density_kg_m3: c.grain.density,
-    };
-    super::shear_cell::write_rheology_table(
-        &mut ctx.out,
-        &headers,
-        &rows,
-        &point_verdicts,
-        "Lees-Edwards simple shear at imposed normal stress: means over the last average_strain with block-averaged standard errors; P is -sigma_yy, I is gamma_dot d / sqrt(P/rho), mu is |sigma_xy|/P",
-        grain,
-    )?;
+    drive(ctx, ctl, &shear, fresh)
+}
 
-    let series = RheologySeries {
-        inertial_number: rows.iter().map(|r| r[1]).collect(),
-        mu: Some(rows.iter().map(|r| r[3]).collect()),
-        phi: Some(rows.iter().map(|r| r[5]).collect()),
-        pressure_pa: Some(rows.iter().map(|r| r[7]).collect()),
-        // each point weighted by its block-averaged standard error (unweighted when one is
-        // not a positive number, e.g. a window too short for its blocks)
-        mu_std_error: weights_if_usable(rows.iter().map(|r| r[4]).collect()),
-        phi_std_error: weights_if_usable(rows.iter().map(|r| r[6]).collect()),
-    };
-    let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
-    let prov = || provenance.clone();
+/// Stage "report": the summary keys of the run and of each point (`rows`, with the peak
+/// stress ratio of each run in `peaks`), `d` the mean diameter (m).
+fn run_summary(c: &SimpleShearConfig, d: f64, rows: &[RheologyRow], peaks: &[f64]) -> Summary {
+    let is: Vec<f64> = rows.iter().map(|r| r.i).collect();
     let mut s = Summary::new();
-    let is: Vec<f64> = rows.iter().map(|r| r[1]).collect();
     let imin = is.iter().cloned().fold(f64::MAX, f64::min);
     let imax = is.iter().cloned().fold(f64::MIN, f64::max);
     s.int("grains", c.grains as u64)
@@ -611,18 +561,18 @@ pub fn run(
         .num("I_max", imax)
         .num(
             "cell_corrections_per_step",
-            rows.iter().map(|r| r[14]).sum::<f64>() / rows.len().max(1) as f64,
+            rows.iter().map(|r| r.corrections_per_step).sum::<f64>() / rows.len().max(1) as f64,
         );
     for (k, r) in rows.iter().enumerate() {
-        s.num(&format!("run{}_I", k + 1), r[1])
-            .num(&format!("run{}_mu", k + 1), r[3])
-            .num(&format!("run{}_mu_std_error", k + 1), r[4])
-            .num(&format!("run{}_phi", k + 1), r[5])
-            .num(&format!("run{}_phi_std_error", k + 1), r[6])
-            .num(&format!("run{}_P_Pa", k + 1), r[7])
+        s.num(&format!("run{}_I", k + 1), r.i)
+            .num(&format!("run{}_mu", k + 1), r.mu)
+            .num(&format!("run{}_mu_std_error", k + 1), r.mu_se)
+            .num(&format!("run{}_phi", k + 1), r.phi)
+            .num(&format!("run{}_phi_std_error", k + 1), r.phi_se)
+            .num(&format!("run{}_P_Pa", k + 1), r.pn)
             // the steady state of the run: its critical state at that I
-            .num(&format!("run{}_friction_critical_mu", k + 1), r[3])
-            .num(&format!("run{}_solid_fraction_critical", k + 1), r[5]);
+            .num(&format!("run{}_friction_critical_mu", k + 1), r.mu)
+            .num(&format!("run{}_solid_fraction_critical", k + 1), r.phi);
         if let Some(&peak) = peaks.get(k) {
             s.num(&format!("run{}_friction_peak_mu", k + 1), peak);
         }
@@ -632,6 +582,66 @@ pub fn run(
     if let Some(&peak) = peaks.first() {
         s.num("friction_peak_mu", peak);
     }
+    s
+}
+
+/// Runs the scenario: build and run (`simulate`), verdict (`judge_points`), report
+/// (`rheology.csv`, `run_summary`), fits (μ(I), φ(I)), figures.
+pub fn run(
+    c: &SimpleShearConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    let (world, state) = simulate(c, ctx, ctl)?;
+    let State {
+        cell: CellRecord {
+            all, rows, frames, ..
+        },
+        curves,
+        checks: run_checks,
+        peaks,
+        ..
+    } = state;
+    // Checks (crate::verdict), as in the shear cell: per point, the numerics of its averaging
+    // window, I against its target, steady μ and φ, φ below its bound.
+    let judged = judge_points(
+        "simple_shear",
+        &run_checks,
+        max_solid_fraction(c.grain.radius_spread),
+    );
+    let (mu_checks, phi_checks, mut verdict) = judged.law_checks(ctl.allow_suspect);
+    let PointJudgement {
+        points: point_verdicts,
+        windows,
+        ..
+    } = judged;
+    frames.finish(&mut ctx.out, &world)?;
+    let d = mean_diameter(&world);
+    let grain = GrainScale {
+        diameter_m: d,
+        density_kg_m3: c.grain.density,
+    };
+    super::shear_cell::write_rheology_table(
+        &mut ctx.out,
+        &rows,
+        &point_verdicts,
+        "Lees-Edwards simple shear at imposed normal stress: means over the last average_strain with block-averaged standard errors; P is -sigma_yy, I is gamma_dot d / sqrt(P/rho), mu is |sigma_xy|/P",
+        grain,
+    )?;
+
+    let series = RheologySeries {
+        inertial_number: rows.iter().map(|r| r.i).collect(),
+        mu: Some(rows.iter().map(|r| r.mu).collect()),
+        phi: Some(rows.iter().map(|r| r.phi).collect()),
+        pressure_pa: Some(rows.iter().map(|r| r.pn).collect()),
+        // each point weighted by its block-averaged standard error (unweighted when one is
+        // not a positive number, e.g. a window too short for its blocks)
+        mu_std_error: weights_if_usable(rows.iter().map(|r| r.mu_se).collect()),
+        phi_std_error: weights_if_usable(rows.iter().map(|r| r.phi_se).collect()),
+    };
+    let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
+    let prov = || provenance.clone();
+    let mut s = run_summary(c, d, &rows, &peaks);
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
     let (pmu, pphi) = super::rheology_fit::fit_mu_phi(
         &mut ctx.out,
@@ -645,9 +655,9 @@ pub fn run(
             mu_checks: mu_checks.clone(),
             phi_checks: phi_checks.clone(),
             std_errors: super::rheology_fit::PointStdErrors {
-                i: Some(rows.iter().map(|r| r[2]).collect()),
-                mu: Some(rows.iter().map(|r| r[4]).collect()),
-                phi: Some(rows.iter().map(|r| r[6]).collect()),
+                i: Some(rows.iter().map(|r| r.i_se).collect()),
+                mu: Some(rows.iter().map(|r| r.mu_se).collect()),
+                phi: Some(rows.iter().map(|r| r.phi_se).collect()),
             },
             point_verdicts: &point_verdicts,
             leave_out: &c.leave_out,
@@ -703,11 +713,19 @@ mod tests {
                 25 => 1.0,
                 _ => 0.4,
             };
-            h.push(vec![g, mu]);
+            h.push(HistoryRow {
+                shear_strain: g,
+                mu,
+                ..Default::default()
+            });
         }
-        h.push(vec![0.5, f64::NAN]);
-        let p = peak_mu(&h, 0, 1);
+        h.push(HistoryRow {
+            shear_strain: 0.5,
+            mu: f64::NAN,
+            ..Default::default()
+        });
+        let p = peak_mu(&h);
         assert!((p - 0.8).abs() < 1e-12, "{p}");
-        assert!(peak_mu(&[], 0, 1).is_nan());
+        assert!(peak_mu(&[]).is_nan());
     }
 }

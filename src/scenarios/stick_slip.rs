@@ -13,10 +13,11 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_csv_table, table_row};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{CsvTable, OutputDir, Summary};
+use crate::output::{OutputDir, Summary};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_column, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
@@ -41,7 +42,8 @@ struct PushState {
     /// Summary entries so far.
     s: Summary,
     /// Force on the moving wall per step and case: `wall_force.csv`.
-    table: CsvTable,
+    #[serde(with = "serde_csv_table")]
+    table: Vec<WallForceRow>,
     headline: Vec<String>,
     all: PhaseStats,
     /// Weight of each case's grains (N).
@@ -60,6 +62,38 @@ struct PushState {
     /// Those of each finished push, in case order (the verdict judges them).
     #[serde(default)]
     windows: Vec<WindowStats>,
+}
+
+table_row! {
+    /// One step of the pushes: a row of `wall_force.csv`, the force on the moving wall (N per
+    /// metre of thickness) of each case (NaN until its push ran).
+    struct WallForceRow {
+        /// Time since the start of the push (s).
+        t: "time_s",
+        /// The frictionless case.
+        frictionless: "force_frictionless_N",
+        /// Friction at the walls only.
+        walls_only: "force_walls_only_N",
+        /// Friction at the walls and between the grains.
+        walls_and_grains: "force_walls_and_grains_N",
+    }
+}
+
+impl WallForceRow {
+    /// The force of case `case` of `StickSlipCases::list` (its order: frictionless, walls
+    /// only, walls and grains).
+    fn case_mut(&mut self, case: usize) -> &mut f64 {
+        match case {
+            0 => &mut self.frictionless,
+            1 => &mut self.walls_only,
+            _ => &mut self.walls_and_grains,
+        }
+    }
+
+    /// The same, read.
+    fn case(mut self, case: usize) -> f64 {
+        *self.case_mut(case)
+    }
 }
 
 impl Push<'_> {
@@ -161,7 +195,7 @@ impl PhasedRun for Push<'_> {
         st.windows.push(st.window);
         let force = std::mem::take(&mut st.force);
         for (i, f) in force.iter().enumerate() {
-            st.table.rows[i][case + 1] = *f;
+            *st.table[i].case_mut(case) = *f;
         }
         // Statistics over the second half (after the start-up transient).
         let half = &force[force.len() / 2..];
@@ -217,15 +251,14 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         .num("box_width_m", width)
         .num("push_velocity", c.push_velocity)
         .num("push_duration", c.push_duration);
-    let mut table = CsvTable::new(&[
-        "time_s",
-        "force_frictionless_N",
-        "force_walls_only_N",
-        "force_walls_and_grains_N",
-    ]);
-    for k in 0..steps {
-        table.push(vec![(k + 1) as f64 * c.dt, f64::NAN, f64::NAN, f64::NAN]);
-    }
+    let table: Vec<WallForceRow> = (0..steps)
+        .map(|k| WallForceRow {
+            t: (k + 1) as f64 * c.dt,
+            frictionless: f64::NAN,
+            walls_only: f64::NAN,
+            walls_and_grains: f64::NAN,
+        })
+        .collect();
     let state = PushState {
         s,
         table,
@@ -243,7 +276,7 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     let (_, st) = drive(ctx, ctl, &Push { c }, || Ok((empty, state)))?;
     let PushState {
         mut s,
-        mut table,
+        table,
         headline,
         all,
         weights,
@@ -274,16 +307,16 @@ pub fn run(c: &StickSlipConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
             Style::Thin,
             PALETTE[k],
             table
-                .rows
                 .iter()
                 .enumerate()
-                .map(|(i, r)| ((i + 1) as f64 * c.dt, r[k + 1]))
+                .map(|(i, r)| ((i + 1) as f64 * c.dt, r.case(k)))
                 .collect(),
         ));
         p.legend = LegendAt::UpperRight;
         plots.push(p);
     }
     solver_keys(&mut s, &all);
+    let mut table = rows::table(&table);
     table.comments.push(
         "force received by the moving bottom wall from the grains, per metre of thickness".into(),
     );

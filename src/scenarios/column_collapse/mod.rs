@@ -358,15 +358,11 @@ fn front_at(front: &[FrontSample], t: f64) -> f64 {
     }
 }
 
-/// Runs the scenario.
-pub fn run(
-    c: &ColumnCollapseConfig,
-    ctx: &mut RunContext,
-    ctl: &mut RunControl,
-) -> Result<RunOutcome> {
-    let (r0, h0, ts) = (c.half_width(), c.height(), c.time_scale());
+/// Stage "config": says what is about to run.
+fn announce(c: &ColumnCollapseConfig, verbosity: crate::progress::Verbosity) {
+    let (r0, h0) = (c.half_width(), c.height());
     info(
-        ctx.verbosity,
+        verbosity,
         &format!(
             "column-collapse: a = {}, R0 = {:.4} m ({} mean diameters), H0 = {:.4} m, {} grains poured, radius {:.2} ± {:.2} mm, μ = {} / {} / {} (grains / floor / wall)",
             c.aspect_ratio,
@@ -381,6 +377,16 @@ pub fn run(
             c.friction.wall
         ),
     );
+}
+
+/// Stages "build" and "run": the column deposited behind its gate, then released (or resumed
+/// from a checkpoint).
+fn simulate(
+    c: &ColumnCollapseConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<(dem::World, CollapseState)> {
+    let ts = c.time_scale();
     let run = Collapse { c };
     let fresh = || -> Result<(dem::World, CollapseState)> {
         let col = datasets::build::column_collapse_deposit(c)?;
@@ -408,11 +414,38 @@ pub fn run(
         };
         Ok((col.world, state))
     };
-    let (world, st) = drive(ctx, ctl, &run, fresh)?;
-    let world = &world;
+    drive(ctx, ctl, &run, fresh)
+}
+
+/// What the end state of a collapse gives ([`measure`]).
+#[derive(Debug, Clone, Copy)]
+struct Measured {
+    /// Runout, final height at the wall and initial surface height (m).
+    runout: f64,
+    final_height: f64,
+    initial_height: f64,
+    /// Front of the initial column (m).
+    initial_front: f64,
+    /// Time of rest and end of the run (s).
+    rest_time: f64,
+    end_time: f64,
+    /// Recession of the front below its running maximum (m).
+    recession: f64,
+    /// End of the rough floor (m), grains off it, their mass (kg/m), their reach (m).
+    floor_end: f64,
+    escaped: usize,
+    mass_end: f64,
+    reach: f64,
+    /// Energy dissipated and potential energy released over the collapse (J/m), growth of the
+    /// mechanical energy over the load energy.
+    dissipated: f64,
+    released: f64,
+    gain: f64,
+}
+
+/// Stage "measure": runout, heights, mass and energy balance of the deposit at the end.
+fn measure(c: &ColumnCollapseConfig, world: &dem::World, st: &CollapseState) -> Result<Measured> {
     let d = st.d;
-    let frames = st.vtk.clone().finish(&mut ctx.out, world)?;
-    let at_rest = st.collapse.at_rest;
     let rest = st
         .profiles
         .iter()
@@ -466,7 +499,36 @@ pub fn run(
     let dissipated = st.e_start - e_end + st.collapse.position_correction_energy;
     let released = st.e_pot_start - world.potential_energy();
     let gain = (-dissipated).max(0.0) / st.e_load;
+    Ok(Measured {
+        runout,
+        final_height,
+        initial_height,
+        initial_front: initial.profile.front(d),
+        rest_time,
+        end_time,
+        recession,
+        floor_end,
+        escaped,
+        mass_end,
+        reach,
+        dissipated,
+        released,
+        gain,
+    })
+}
 
+/// The front against the contact-dynamics reference (a = 6.26, [`reference_front`]): the
+/// reference, `(t*, x_f/R₀ measured, x_f/R₀ reference)` at its instants, the worst relative
+/// difference.
+struct ReferenceComparison {
+    reference: Option<Vec<(f64, f64)>>,
+    comparison: Vec<(f64, f64, f64)>,
+    worst_reference: f64,
+}
+
+/// Stage "fit": the front against the reference when the case is the reference's.
+fn compare_reference(c: &ColumnCollapseConfig, st: &CollapseState) -> Result<ReferenceComparison> {
+    let (r0, ts) = (c.half_width(), c.time_scale());
     // Reference comparison (a = 6.26).
     let reference = if is_reference_case(c) {
         Some(reference_front()?)
@@ -486,7 +548,26 @@ pub fn run(
             f64::NAN,
             |a: f64, b| if a.is_nan() || b > a { b } else { a },
         );
+    Ok(ReferenceComparison {
+        reference,
+        comparison,
+        worst_reference,
+    })
+}
 
+/// Stage "measure → verdict": at rest, mass conserved, on the floor, energy dissipated.
+fn judge(c: &ColumnCollapseConfig, st: &CollapseState, m: &Measured) -> Checks {
+    let (r0, ts, d) = (c.half_width(), c.time_scale(), st.d);
+    let at_rest = st.collapse.at_rest;
+    let Measured {
+        end_time,
+        escaped,
+        mass_end,
+        floor_end,
+        reach,
+        gain,
+        ..
+    } = *m;
     // Checks.
     let mut checks = Checks::new();
     checks.window("collapse", &st.window);
@@ -554,14 +635,12 @@ pub fn run(
             )
         },
     );
-    let verdict = RunVerdict {
-        run: checks,
-        ..Default::default()
-    };
-    if !at_rest {
-        warn("column-collapse: the deposit did not come to rest within collapse.max_time");
-    }
+    checks
+}
 
+/// Stage "report": the contract's tables, `front.csv`, `profiles.csv` and `history.csv`.
+fn write_tables(ctx: &mut RunContext, c: &ColumnCollapseConfig, st: &CollapseState) -> Result<()> {
+    let ts = c.time_scale();
     // Outputs: the contract's files.
     let mut front = CsvTable::new(&["t_s", "t_star", "x_f_m"]);
     // no comment line: the contract's header is the file's first line
@@ -590,6 +669,34 @@ pub fn run(
     }
     history.write(&mut ctx.out, "history.csv")?;
 
+    Ok(())
+}
+
+/// Stage "report": the summary keys (`column` the contract's, then the run's).
+fn summary(
+    c: &ColumnCollapseConfig,
+    world: &dem::World,
+    st: &CollapseState,
+    m: &Measured,
+    r: &ReferenceComparison,
+    frames: usize,
+) -> Summary {
+    let (r0, h0, ts, d) = (c.half_width(), c.height(), c.time_scale(), st.d);
+    let at_rest = st.collapse.at_rest;
+    let Measured {
+        runout,
+        final_height,
+        initial_height,
+        rest_time,
+        end_time,
+        recession,
+        escaped,
+        dissipated,
+        released,
+        gain,
+        ..
+    } = *m;
+    let (comparison, worst_reference) = (&r.comparison, r.worst_reference);
     let mut s = Summary::new();
     s.set(
         "column",
@@ -617,7 +724,7 @@ pub fn run(
         .num("restitution", c.restitution)
         .num("time_scale_s", ts)
         .num("initial_surface_height_m", initial_height)
-        .num("initial_front_m", initial.profile.front(d))
+        .num("initial_front_m", m.initial_front)
         .num("runout_over_r0", runout / r0)
         .num("normalised_runout", (runout - r0) / r0)
         .num(
@@ -636,7 +743,7 @@ pub fn run(
         .num("load_energy_J", st.e_load);
     if is_reference_case(c) {
         s.num("reference_front_worst_relative_error", worst_reference);
-        for (t, dem, cd) in &comparison {
+        for (t, dem, cd) in comparison {
             s.num(&format!("front_over_r0_{}", instant_label(*t)), *dem)
                 .num(
                     &format!("reference_front_over_r0_{}", instant_label(*t)),
@@ -654,21 +761,24 @@ pub fn run(
         .num("collapse_worst_error", st.collapse.worst_error);
     st.window.keys(&mut s, "collapse");
     s.int("vtk_frames", frames as u64);
+    s
+}
 
-    figures::draw(
-        ctx,
-        &figures::Inputs {
-            c,
-            profiles: &st.profiles,
-            frames: &st.frames,
-            front: &st.front,
-            history: &st.history,
-            reference: reference.as_deref(),
-            runout,
-            d,
-        },
-    )?;
-
+/// Stage "report": the headline lines.
+fn headline(
+    ctx: &RunContext,
+    c: &ColumnCollapseConfig,
+    m: &Measured,
+    r: &ReferenceComparison,
+) -> Vec<String> {
+    let (r0, h0, ts) = (c.half_width(), c.height(), c.time_scale());
+    let Measured {
+        runout,
+        final_height,
+        rest_time,
+        ..
+    } = *m;
+    let (comparison, worst_reference) = (&r.comparison, r.worst_reference);
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];
     headline.push(format!(
         "runout r_inf = {:.4} m = {:.2} R0 ((r_inf − R0)/R0 = {:.2}; Lube et al. 2005 2D: {:.2}), final height {:.4} m = {:.3} H0, at rest at t* = {:.2}",
@@ -691,6 +801,45 @@ pub fn run(
             100.0 * worst_reference
         ));
     }
+    headline
+}
+
+/// Runs the scenario: config, build and run (`simulate`), measure (`measure`), the
+/// reference (`compare_reference`), verdict (`judge`), report.
+pub fn run(
+    c: &ColumnCollapseConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+) -> Result<RunOutcome> {
+    announce(c, ctx.verbosity);
+    let (world, st) = simulate(c, ctx, ctl)?;
+    let world = &world;
+    let frames = st.vtk.clone().finish(&mut ctx.out, world)?;
+    let m = measure(c, world, &st)?;
+    let r = compare_reference(c, &st)?;
+    let verdict = RunVerdict {
+        run: judge(c, &st, &m),
+        ..Default::default()
+    };
+    if !st.collapse.at_rest {
+        warn("column-collapse: the deposit did not come to rest within collapse.max_time");
+    }
+    write_tables(ctx, c, &st)?;
+    let s = summary(c, world, &st, &m, &r, frames);
+    figures::draw(
+        ctx,
+        &figures::Inputs {
+            c,
+            profiles: &st.profiles,
+            frames: &st.frames,
+            front: &st.front,
+            history: &st.history,
+            reference: r.reference.as_deref(),
+            runout: m.runout,
+            d: st.d,
+        },
+    )?;
+    let headline = headline(ctx, c, &m, &r);
     Ok(RunOutcome {
         summary: s,
         headline,

@@ -9,7 +9,6 @@ use super::fit::{fit_band, JanssenOutcome};
 use super::measure::ColumnProfile;
 use super::RunContext;
 use crate::error::Result;
-use crate::output::CsvTable;
 use crate::plot::histogram::{draw_histogram, HistogramPlot};
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, Band, LegendAt, Series, Style, XyPlot};
@@ -40,7 +39,7 @@ pub(super) struct Inputs<'a> {
     /// Number of grains.
     pub grains: usize,
     /// `history.csv`.
-    pub history: &'a CsvTable,
+    pub history: &'a [super::ColumnStep],
     /// Simulated time at the end (s).
     pub end_time: f64,
 }
@@ -93,8 +92,8 @@ pub(super) fn draw(ctx: &mut RunContext, f: &Inputs) -> Result<()> {
             overlays: Vec::new(),
         },
     )?;
-    let t: Vec<(f64, f64)> = f.history.rows.iter().map(|r| (r[0], r[2])).collect();
-    let l: Vec<(f64, f64)> = f.history.rows.iter().map(|r| (r[0], r[6])).collect();
+    let t: Vec<(f64, f64)> = f.history.iter().map(|r| (r.t, r.kinetic_energy)).collect();
+    let l: Vec<(f64, f64)> = f.history.iter().map(|r| (r.t, r.bottom_load)).collect();
     let mut ke = XyPlot::new(
         "Kinetic energy",
         Axis::new("time t (s)"),
@@ -118,13 +117,12 @@ pub(super) fn draw(ctx: &mut RunContext, f: &Inputs) -> Result<()> {
         PALETTE[6],
         vec![(0.0, 1.0), (f.end_time, 1.0)],
     ));
-    // Phase boundaries (history column 1 holds the phase code).
+    // Phase boundaries: (the new phase's code, the time of the step before it).
     let starts: Vec<(f64, f64)> = f
         .history
-        .rows
         .windows(2)
-        .filter(|w| w[1][1] != w[0][1])
-        .map(|w| (w[1][1], w[0][0]))
+        .filter(|w| w[1].phase != w[0].phase)
+        .map(|w| (w[1].phase, w[0].t))
         .collect();
     let names = ["deposit", "relax", "release", "measure"];
     let mut note = String::from("phases: deposit from 0 s");
@@ -191,12 +189,18 @@ pub(super) fn profile_plot(
         plot.bands.push(Band::between_x(
             "95 % band of σ_v",
             PALETTE[0],
-            &band.iter().map(|r| (r[0], r[2], r[3])).collect::<Vec<_>>(),
+            &band
+                .iter()
+                .map(|b| (b.z, b.sigma_v_lo, b.sigma_v_hi))
+                .collect::<Vec<_>>(),
         ));
         plot.bands.push(Band::between_x(
             "95 % band of σ_h",
             PALETTE[1],
-            &band.iter().map(|r| (r[0], r[5], r[6])).collect::<Vec<_>>(),
+            &band
+                .iter()
+                .map(|b| (b.z, b.sigma_h_lo, b.sigma_h_hi))
+                .collect::<Vec<_>>(),
         ));
     }
     plot.series.push(Series::new(

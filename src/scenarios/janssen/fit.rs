@@ -95,9 +95,28 @@ pub fn fit_profile(
     }
 }
 
-/// 95 % band of `σ_v(z)` and `σ_h(z)` of a fit by the delta method on (K, μ_w):
-/// rows `(z, σ_v, σ_v lo, σ_v hi, σ_h, σ_h lo, σ_h hi)`.
-pub fn fit_band(fit: &JanssenFit, zs: &[f64]) -> Vec<[f64; 7]> {
+/// A point of the 95 % band of a Janssen fit ([`fit_band`]): stresses in Pa at depth `z` (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BandPoint {
+    /// Depth below the free surface (m).
+    pub z: f64,
+    /// σ_v of the fitted law.
+    pub sigma_v: f64,
+    /// Lower end of σ_v's band.
+    pub sigma_v_lo: f64,
+    /// Upper end of σ_v's band.
+    pub sigma_v_hi: f64,
+    /// σ_h of the fitted law.
+    pub sigma_h: f64,
+    /// Lower end of σ_h's band.
+    pub sigma_h_lo: f64,
+    /// Upper end of σ_h's band.
+    pub sigma_h_hi: f64,
+}
+
+/// 95 % band of `σ_v(z)` and `σ_h(z)` of a fit by the delta method on (K, μ_w), at each depth
+/// of `zs`.
+pub fn fit_band(fit: &JanssenFit, zs: &[f64]) -> Vec<BandPoint> {
     let law = fit.law;
     let cov = &fit.report.covariance;
     let t = fit.report.t_critical;
@@ -123,7 +142,15 @@ pub fn fit_band(fit: &JanssenFit, zs: &[f64]) -> Vec<[f64; 7]> {
                 v.max(0.0)
             };
             let (ev, eh) = (t * var(gv).sqrt(), t * var(gh).sqrt());
-            [z, sv, sv - ev, sv + ev, sh, sh - eh, sh + eh]
+            BandPoint {
+                z,
+                sigma_v: sv,
+                sigma_v_lo: sv - ev,
+                sigma_v_hi: sv + ev,
+                sigma_h: sh,
+                sigma_h_lo: sh - eh,
+                sigma_h_hi: sh + eh,
+            }
         })
         .collect()
 }

@@ -30,6 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
+use super::rows::{self, serde_csv_table, table_row};
 use super::sensitivity::{resolve_last_step, Resolved};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -64,6 +65,26 @@ struct Column<'a> {
     width: f64,
 }
 
+table_row! {
+    /// One step of the column's run: a row of `history.csv`.
+    pub(super) struct ColumnStep {
+        /// Time (s).
+        t: "time_s",
+        /// The phase: 0 deposit, 1 relax, 2 release, 3 measure.
+        phase: "phase_0deposit_1relax_2release_3measure",
+        /// Kinetic energy (J/m).
+        kinetic_energy: "kinetic_energy_J",
+        /// Active contacts.
+        contacts: "contacts",
+        /// Sweeps of the step's solve.
+        sweeps: "sweeps",
+        /// The solve's error.
+        solver_error: "solver_error",
+        /// Load on the floor over the grains' weight.
+        bottom_load: "bottom_load_over_weight",
+    }
+}
+
 /// What the column's phases collect.
 #[derive(Serialize, Deserialize)]
 struct ColumnState {
@@ -75,7 +96,8 @@ struct ColumnState {
     /// Weight of the grains Σ m g (N).
     weight: f64,
     /// One row per step: `history.csv`.
-    history: CsvTable,
+    #[serde(with = "serde_csv_table")]
+    history: Vec<ColumnStep>,
     /// VTK frames.
     vtk: VtkFrames,
     deposit: PhaseStats,
@@ -272,15 +294,15 @@ impl PhasedRun for Column<'_> {
         }
         st.last_step_index = r.step;
         let load = Self::floor_load(w, st);
-        st.history.push(vec![
-            w.time,
-            k as f64,
-            w.kinetic_energy(),
-            r.active_contacts as f64,
-            r.solver.iterations as f64,
-            r.solver.error,
-            load,
-        ]);
+        st.history.push(ColumnStep {
+            t: w.time,
+            phase: k as f64,
+            kinetic_energy: w.kinetic_energy(),
+            contacts: r.active_contacts as f64,
+            sweeps: r.solver.iterations as f64,
+            solver_error: r.solver.error,
+            bottom_load: load,
+        });
         st.vtk.maybe(out, w)
     }
 
@@ -311,11 +333,10 @@ impl PhasedRun for Column<'_> {
     }
 }
 
-/// Runs the scenario.
-pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
-    let width = datasets::build::column_width(&c.grain, c.grains, c.column_aspect);
+/// Stage "config": says what is about to run.
+fn announce(c: &JanssenConfig, verbosity: crate::progress::Verbosity, width: f64) {
     info(
-        ctx.verbosity,
+        verbosity,
         &format!(
             "janssen: {} grains, radius {:.2} ± {:.2} mm, box {:.1} mm wide ({:.1} mean diameters), μ = {} / {} (grain / wall)",
             c.grains,
@@ -327,6 +348,16 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             c.friction.grain_wall
         ),
     );
+}
+
+/// Stages "build" and "run": the column of `width` (m) deposited, relaxed, released and
+/// measured (or resumed from a checkpoint).
+fn simulate(
+    c: &JanssenConfig,
+    ctx: &mut RunContext,
+    ctl: &mut RunControl,
+    width: f64,
+) -> Result<(dem::World, ColumnState)> {
     let fresh = || -> Result<(dem::World, ColumnState)> {
         let col = datasets::build::column(
             &c.grain,
@@ -341,15 +372,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             left: col.left,
             right: col.right,
             weight: grain_weight(&col.world),
-            history: CsvTable::new(&[
-                "time_s",
-                "phase_0deposit_1relax_2release_3measure",
-                "kinetic_energy_J",
-                "contacts",
-                "sweeps",
-                "solver_error",
-                "bottom_load_over_weight",
-            ]),
+            history: Vec::new(),
             vtk: VtkFrames::new(VTK_INTERVAL, c.analysis.vtk_frames.max(1)),
             deposit: PhaseStats::default(),
             relax: PhaseStats::default(),
@@ -367,85 +390,119 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         };
         Ok((col.world, state))
     };
-    let (world, st) = drive(ctx, ctl, &Column { c, width }, fresh)?;
-    let world = &world;
-    let ColumnState {
-        weight,
-        history,
-        vtk,
-        deposit,
-        relax,
-        release,
-        deposit_load,
-        relaxed_load,
-        measured,
-        window: measure_window,
-        measured_substeps,
-        resolved,
-        resolve_failed,
-        resolve_unavailable,
-        resolve_near,
-        ..
-    } = st;
-    let final_report = world.last_report();
-    if measured.unconverged > 0 {
-        warn(&format!(
-            "{} of the {} measured steps did not converge: worst error {:.2e} > {:.0e}",
-            measured.unconverged, measured.steps, measured.worst_error, c.relax.solver.tolerance
-        ));
-    }
-    let snap = world.snapshot();
-    let frames = vtk.finish(&mut ctx.out, world)?;
+    drive(ctx, ctl, &Column { c, width }, fresh)
+}
 
-    // 3. Homogenisation.
+/// What the homogenisation of the measurement window gives ([`homogenise`]).
+struct Homogenised {
+    /// Mean grain diameter (m).
+    d: f64,
+    /// The wall stress profile.
+    profile: ColumnProfile,
+    /// Loads on the floor and the side walls (N per metre).
+    loads: ColumnLoads,
+    /// Solid fraction of the column away from its ends.
+    phi: f64,
+    /// Bulk density (kg/m²).
+    rho_b: f64,
+    /// Gravity (m/s²).
+    g: f64,
+    /// Share of the wall contacts at the Coulomb limit.
+    sliding: f64,
+    /// Mean mobilisation of the wall contacts.
+    mean_mob: f64,
+    /// Depth left out at the top of the column (m).
+    top_skip: f64,
+    /// Height left out at the bottom of the column (m).
+    bottom_skip: f64,
+}
+
+/// Stage "measure": the profile, loads, solid fraction and wall mobilisation of the
+/// measurement window `measure_window` of the column of `width` (m).
+fn homogenise(
+    c: &JanssenConfig,
+    world: &dem::World,
+    snap: &dem::snapshot::Snapshot,
+    width: f64,
+    measure_window: &MeasureWindow,
+) -> Result<Homogenised> {
     let d = mean_diameter(world);
     let profile = measure_window.profile(c.analysis.depth_bins)?;
     let loads = measure_window.loads();
-    let bottom_load = loads.floor;
     let top_skip = c.analysis.skip_top_diameters * d;
     let bottom_skip = c.analysis.skip_bottom_diameters * d;
     let phi_region = Region::Rectangle {
         min: Vector2::new(0.0, bottom_skip),
         max: Vector2::new(width, (profile.surface - top_skip).max(bottom_skip + d)),
     };
-    let phi = solid_fraction(&snap, &phi_region)?;
+    let phi = solid_fraction(snap, &phi_region)?;
     let rho_b = phi * c.grain.density;
     let g = world.params.gravity.norm();
     let (sliding, mean_mob) = measure_window.sliding();
+    Ok(Homogenised {
+        d,
+        profile,
+        loads,
+        phi,
+        rho_b,
+        g,
+        sliding,
+        mean_mob,
+        top_skip,
+        bottom_skip,
+    })
+}
 
-    // 4. Fit.
-    let setup = JanssenSetup {
-        width_m: width,
-        bulk_density_kg_m3: rho_b,
-        gravity_m_s2: g,
-        wall_friction: c.friction.grain_wall,
-    };
-    let window = (top_skip, profile.surface - bottom_skip);
-    let fitted = fit_profile(&profile, &setup, window);
+/// A Janssen fit or why it failed.
+type Fitted = std::result::Result<JanssenOutcome, identify::IdentifyError>;
 
-    // The solver's effect on the fit: the measured steps solved again to 1e-8, fitted alike.
+/// Stage "fit": the solver's effect on the fit, the measured steps solved again to 1e-8 and
+/// fitted alike.
+fn solver_sensitivity(
+    c: &JanssenConfig,
+    st: &ColumnState,
+    fitted: &Fitted,
+    setup: &JanssenSetup,
+    window: (f64, f64),
+) -> JanssenSensitivity {
+    let (resolved, measure_window) = (&st.resolved, &st.window);
+    let (resolve_failed, resolve_unavailable, resolve_near) =
+        (st.resolve_failed, st.resolve_unavailable, st.resolve_near);
     let complete = resolved.samples > 0 && resolved.samples == measure_window.samples;
     let resolved_profile = complete
         .then(|| resolved.profile(c.analysis.depth_bins).ok())
         .flatten();
-    let sensitivity = JanssenSensitivity {
+    JanssenSensitivity {
         resolved: resolved.samples,
         measured: measure_window.samples,
         failed: resolve_failed,
         unavailable: resolve_unavailable,
         near: resolve_near,
-        fit: match (&fitted, &resolved_profile) {
+        fit: match (fitted, &resolved_profile) {
             (Ok(run), Some(p)) => {
-                Some(fit_profile_like(p, &setup, window, run).map_err(|e| e.to_string()))
+                Some(fit_profile_like(p, setup, window, run).map_err(|e| e.to_string()))
             }
             _ => None,
         },
-        tau_w_flipped: match (&fitted, &resolved_profile) {
+        tau_w_flipped: match (fitted, &resolved_profile) {
             (Ok(run), Some(p)) => p.negative_tau_w(window).is_empty() != run.uses_tau_w,
             _ => false,
         },
-    };
+    }
+}
 
+/// Stage "measure → verdict": the measured step's numerics, the force balance of the column
+/// (`balance`, the relative residual of the loads against the weight), the solid fraction,
+/// the depth bins (`bin` thick, m), the fit's solver sensitivity.
+fn judge(
+    c: &JanssenConfig,
+    measured: &WindowStats,
+    h: &Homogenised,
+    sensitivity: &JanssenSensitivity,
+    fitted: &Fitted,
+    (balance, bin): (f64, f64),
+) -> Checks {
+    let (phi, d) = (h.phi, h.d);
     // 5. Checks (crate::verdict): the measured step's numerics, the force balance of the
     // column, the solid fraction, the depth bins.
     let mut checks = Checks::new();
@@ -453,9 +510,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     // when it passes, it stands in for the window's loaded-contacts proxy.
     let mut sensitivity_checks = Checks::new();
     let sensitivity_passed = sensitivity.check(&mut sensitivity_checks, fitted.as_ref().ok());
-    checks.window_measured("measurement window", &measured, sensitivity_passed);
-    let wall_load = loads.walls;
-    let balance = (bottom_load + wall_load) / weight - 1.0;
+    checks.window_measured("measurement window", measured, sensitivity_passed);
     checks.at_most(
         "janssen.force_balance",
         balance.abs(),
@@ -475,7 +530,6 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         phi,
         max_solid_fraction(c.grain.radius_spread),
     );
-    let bin = profile.surface / c.analysis.depth_bins as f64;
     checks.at_most("janssen.bin_thickness", d / bin, 1.0, None, |_| {
         format!(
             "depth bins {:.2} mm thick, thinner than a mean diameter ({:.2} mm): lower analysis.depth_bins",
@@ -484,31 +538,24 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         )
     });
     checks.extend(&sensitivity_checks);
-    let mut verdict = RunVerdict {
-        run: checks.clone(),
-        ..Default::default()
-    };
-    verdict.allow_suspect = ctl.allow_suspect;
+    checks
+}
 
-    // 6. Outputs.
-    let mut s = Summary::new();
-    s.int("grains", c.grains as u64)
-        .num("box_width_m", width)
-        .num("column_height_m", profile.surface)
-        .num("column_height_over_width", profile.surface / width)
-        .num("mean_diameter_m", d)
-        .num("solid_fraction", phi)
-        .num("bulk_density_kg_m3", rho_b)
-        .num("weight_N", weight)
-        .num("bottom_load_N", bottom_load)
-        .num("bottom_load_over_weight", bottom_load / weight)
-        .num("wall_load_N", wall_load)
-        .num("force_balance_residual", balance)
-        .num("depth_bin_thickness_m", bin)
-        .num("wall_friction", c.friction.grain_wall)
-        .num("grain_friction", c.friction.grain_grain);
+/// Stage "report": the fit's summary keys, law file and headline lines (or its refusal).
+#[allow(clippy::too_many_arguments)]
+fn report_fit(
+    c: &JanssenConfig,
+    ctx: &mut RunContext,
+    ctl: &RunControl,
+    fitted: &Fitted,
+    profile: &ColumnProfile,
+    window: (f64, f64),
+    checks: &Checks,
+    s: &mut Summary,
+    verdict: &mut RunVerdict,
+) -> Result<Vec<String>> {
     let mut headline = Vec::new();
-    match &fitted {
+    match fitted {
         Ok(o) => {
             let f = &o.fit;
             for (k, v) in f.summary_entries() {
@@ -524,7 +571,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 f,
                 crate::provenance::of_run(ctx, ctl, "janssen", c.seed),
             );
-            let exported = export_law(&mut ctx.out, &mut verdict, "janssen", &law, checks.clone())?;
+            let exported = export_law(&mut ctx.out, verdict, "janssen", &law, checks.clone())?;
             headline.extend(exported.heading("janssen"));
             headline.push(format!(
                 "K    = {:.3}  (95 % CI {:.3} … {:.3})",
@@ -545,7 +592,7 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
                 "K μ_w = {:.3}  (95 % CI {:.3} … {:.3}), R² = {:.3}",
                 f.k_mu_w.value, f.k_mu_w.ci_low, f.k_mu_w.ci_high, f.report.r_squared
             ));
-            headline.push(fit_data_line(&profile, window, o.uses_tau_w));
+            headline.push(fit_data_line(profile, window, o.uses_tau_w));
         }
         Err(e) => {
             warn(&format!("Janssen fit failed: {e}"));
@@ -566,18 +613,24 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             );
         }
     }
-    s.num("wall_sliding_fraction", sliding)
-        .num("wall_mean_mobilisation", mean_mob)
-        .num("wall_contacts", measure_window.wall_contacts());
-    headline.push(format!(
-        "bottom load / weight = {:.3}, wall contacts at the Coulomb limit: {:.0} %",
-        bottom_load / weight,
-        100.0 * sliding
-    ));
+    Ok(headline)
+}
+
+/// Stage "report": the summary keys of each phase (deposit, relaxation, release and
+/// measurement) and of the last step.
+fn phase_keys(
+    s: &mut Summary,
+    c: &JanssenConfig,
+    st: &ColumnState,
+    final_report: &dem::StepReport,
+) {
+    let (deposit, relax, release) = (st.deposit, st.relax, st.release);
+    let (deposit_load, relaxed_load) = (st.deposit_load, st.relaxed_load);
+    let (measure_window, measured_substeps) = (&st.window, st.measured_substeps);
     let mut all = deposit;
     all.merge(&release);
     all.merge(&relax);
-    solver_keys(&mut s, &all);
+    solver_keys(s, &all);
     s.int("deposit_steps", deposit.steps)
         .num("deposit_dt_s", c.dt / c.deposit.substeps as f64)
         .num("deposit_time_s", deposit.simulated_time)
@@ -615,12 +668,19 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         .flag("final_solver_converged", final_report.solver.converged)
         .int("measure_steps", measure_window.samples)
         .int("measured_max_substeps", measured_substeps);
-    measured.keys(&mut s, "measured");
-    sensitivity.keys(&mut s, fitted.as_ref().ok());
-    s.int("vtk_frames", frames as u64);
+}
 
-    // CSV: history and the fit-ready profile.
-    history.write(&mut ctx.out, "history.csv")?;
+/// Stage "report": `wall_profile.csv`, the fit-ready profile with the fitted law and the
+/// hydrostatic line.
+fn write_profile(
+    out: &mut OutputDir,
+    c: &JanssenConfig,
+    h: &Homogenised,
+    fitted: &Fitted,
+    width: f64,
+    window: (f64, f64),
+) -> Result<()> {
+    let (profile, rho_b, g) = (&h.profile, h.rho_b, h.g);
     // τ_w is named `tau_w_Pa` (read by `grainlaw fit janssen`) only when the fit used it.
     let uses_tau = fitted.as_ref().map(|o| o.uses_tau_w).unwrap_or(false);
     let tau_header = if uses_tau {
@@ -646,13 +706,13 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
         ("depth_min_m".into(), window.0),
         ("depth_max_m".into(), window.1),
     ];
-    if let Ok(o) = &fitted {
+    if let Ok(o) = fitted {
         if o.mode == "full_mobilisation" {
             prof.metadata.push(("full_mobilisation".into(), 1.0));
         }
     }
     for (i, &z) in profile.z.iter().enumerate() {
-        let (jv, jh) = match &fitted {
+        let (jv, jh) = match fitted {
             Ok(o) => (o.fit.law.sigma_v(z), o.fit.law.sigma_h(z)),
             Err(_) => (f64::NAN, f64::NAN),
         };
@@ -666,13 +726,101 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             rho_b * g * z,
         ]);
     }
-    prof.write(&mut ctx.out, "wall_profile.csv")?;
+    prof.write(out, "wall_profile.csv")?;
 
-    // Figures.
+    Ok(())
+}
+
+/// Runs the scenario: config, build and run (`simulate`), measure (`homogenise`), fit,
+/// verdict (`judge`), report.
+pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
+    let width = datasets::build::column_width(&c.grain, c.grains, c.column_aspect);
+    announce(c, ctx.verbosity, width);
+    let (world, st) = simulate(c, ctx, ctl, width)?;
+    let world = &world;
+    let (weight, measured) = (st.weight, st.measured);
+    let final_report = world.last_report();
+    if measured.unconverged > 0 {
+        warn(&format!(
+            "{} of the {} measured steps did not converge: worst error {:.2e} > {:.0e}",
+            measured.unconverged, measured.steps, measured.worst_error, c.relax.solver.tolerance
+        ));
+    }
+    let snap = world.snapshot();
+    let frames = st.vtk.clone().finish(&mut ctx.out, world)?;
+    let measure_window = &st.window;
+    let h = homogenise(c, world, &snap, width, measure_window)?;
+    let (d, profile, rho_b, g) = (h.d, &h.profile, h.rho_b, h.g);
+    let bottom_load = h.loads.floor;
+    let wall_load = h.loads.walls;
+
+    let setup = JanssenSetup {
+        width_m: width,
+        bulk_density_kg_m3: rho_b,
+        gravity_m_s2: g,
+        wall_friction: c.friction.grain_wall,
+    };
+    let window = (h.top_skip, profile.surface - h.bottom_skip);
+    let fitted = fit_profile(profile, &setup, window);
+    let sensitivity = solver_sensitivity(c, &st, &fitted, &setup, window);
+
+    let balance = (bottom_load + wall_load) / weight - 1.0;
+    let bin = profile.surface / c.analysis.depth_bins as f64;
+    let checks = judge(c, &measured, &h, &sensitivity, &fitted, (balance, bin));
+    let mut verdict = RunVerdict {
+        run: checks.clone(),
+        ..Default::default()
+    };
+    verdict.allow_suspect = ctl.allow_suspect;
+
+    let mut s = Summary::new();
+    s.int("grains", c.grains as u64)
+        .num("box_width_m", width)
+        .num("column_height_m", profile.surface)
+        .num("column_height_over_width", profile.surface / width)
+        .num("mean_diameter_m", d)
+        .num("solid_fraction", h.phi)
+        .num("bulk_density_kg_m3", rho_b)
+        .num("weight_N", weight)
+        .num("bottom_load_N", bottom_load)
+        .num("bottom_load_over_weight", bottom_load / weight)
+        .num("wall_load_N", wall_load)
+        .num("force_balance_residual", balance)
+        .num("depth_bin_thickness_m", bin)
+        .num("wall_friction", c.friction.grain_wall)
+        .num("grain_friction", c.friction.grain_grain);
+    let mut headline = report_fit(
+        c,
+        ctx,
+        ctl,
+        &fitted,
+        profile,
+        window,
+        &checks,
+        &mut s,
+        &mut verdict,
+    )?;
+    s.num("wall_sliding_fraction", h.sliding)
+        .num("wall_mean_mobilisation", h.mean_mob)
+        .num("wall_contacts", measure_window.wall_contacts());
+    headline.push(format!(
+        "bottom load / weight = {:.3}, wall contacts at the Coulomb limit: {:.0} %",
+        bottom_load / weight,
+        100.0 * h.sliding
+    ));
+    phase_keys(&mut s, c, &st, &final_report);
+    measured.keys(&mut s, "measured");
+    sensitivity.keys(&mut s, fitted.as_ref().ok());
+    s.int("vtk_frames", frames as u64);
+
+    // CSV: history and the fit-ready profile.
+    rows::table(&st.history).write(&mut ctx.out, "history.csv")?;
+    write_profile(&mut ctx.out, c, &h, &fitted, width, window)?;
+
     figures::draw(
         ctx,
         &figures::Inputs {
-            profile: &profile,
+            profile,
             fitted: &fitted,
             rho_b,
             g,
@@ -680,11 +828,11 @@ pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             mu_wall: c.friction.grain_wall,
             mobilisations: measure_window.mobilisations(),
             samples: measure_window.samples,
-            sliding,
-            mean_mob,
+            sliding: h.sliding,
+            mean_mob: h.mean_mob,
             snap: &snap,
             grains: c.grains,
-            history: &history,
+            history: &st.history,
             end_time: world.time,
         },
     )?;

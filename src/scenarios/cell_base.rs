@@ -1,0 +1,116 @@
+//! The shared base of the cell scenarios, `biaxial` and `simple-shear`: a biperiodic
+//! deformable cell (`dem::cell`) driven by a stress or rate on each component of the velocity
+//! gradient. Both build their cell control from a [`ControlPlan`] (explicit law with the gains
+//! and tolerances below, or the implicit law of [`implicit_cell_control`]), keep what every
+//! phase collects in a [`CellRecord`], and take block-averaged standard errors over at least
+//! [`MIN_BLOCKS`] blocks.
+
+use datasets::config::CellControlMode;
+use datasets::phases::PhaseStats;
+use dem::cell::{CellControl, Imposed};
+use serde::{Deserialize, Serialize};
+
+use super::common::{implicit_cell_control, VtkFrames};
+use super::rows::{serde_rows, TableRow};
+use crate::verdict::WindowStats;
+
+/// Gain of the explicit cell control as a fraction of its stability limit `Δt/(ρ d²)`
+/// (`dem::cell`).
+pub const GAIN_FRACTION: f64 = 0.3;
+/// Tolerance of the explicit law's correction of the cell control, as a fraction of the
+/// scenario's pressure.
+pub const CONTROL_TOLERANCE: f64 = 0.5;
+/// Re-solves of a step at most by the correction.
+pub const MAX_CORRECTIONS: usize = 8;
+/// Blocks of the block-averaged standard errors (at least).
+pub const MIN_BLOCKS: usize = 4;
+
+/// What a cell scenario imposes on its cell in a phase: the three components of the velocity
+/// gradient and the control's scales.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlPlan {
+    /// Explicit or implicit law.
+    pub mode: CellControlMode,
+    /// What is imposed on xx, yy, xy.
+    pub xx: Imposed,
+    pub yy: Imposed,
+    pub xy: Imposed,
+    /// Cap of a controlled rate (1/s).
+    pub max_rate: f64,
+    /// The pressure the control's tolerance and implicit gain scale with (Pa, positive).
+    pub pressure: f64,
+    /// An isotropic compression of a loose packing (the implicit law caps its reference
+    /// rate, [`implicit_cell_control`]).
+    pub compressing: bool,
+    /// Gain of the explicit law as a fraction of `Δt/(ρ d²)` ([`GAIN_FRACTION`] unless the
+    /// phase needs a gentler one).
+    pub gain_fraction: f64,
+    /// Filter time of the explicit law, in time steps (0: none).
+    pub filter_steps: f64,
+    /// Whether the implicit law moves the grains with the cell's change (`dem::cell`).
+    pub affine: bool,
+}
+
+impl ControlPlan {
+    /// The cell control of the plan at time step `dt` (s), grain density `rho` (kg/m³) and mean
+    /// diameter `d` (m).
+    pub fn control(&self, dt: f64, rho: f64, d: f64) -> CellControl {
+        if self.mode == CellControlMode::Implicit {
+            return implicit_cell_control(
+                self.xx,
+                self.yy,
+                self.xy,
+                self.max_rate,
+                self.pressure,
+                self.compressing,
+            )
+            .with_affine(self.affine);
+        }
+        CellControl {
+            xx: self.xx,
+            yy: self.yy,
+            xy: self.xy,
+            gain: self.gain_fraction * dt / (rho * d * d),
+            max_rate: self.max_rate,
+            relaxation: self.filter_steps * dt,
+            tolerance: CONTROL_TOLERANCE * self.pressure,
+            max_corrections: MAX_CORRECTIONS,
+            implicit: false,
+            affine: false,
+        }
+    }
+}
+
+/// What the phases of a cell scenario collect in common (flattened into the scenario's
+/// state, so a checkpoint stores the same keys as before): the solver statistics of all
+/// phases, one result row `R` per finished run, the current run's history of rows `H`, the VTK
+/// frames and the numerics of the current window.
+#[derive(Serialize, Deserialize)]
+pub struct CellRecord<H: TableRow, R: TableRow> {
+    /// Solver statistics of all phases.
+    pub all: PhaseStats,
+    /// One row per finished run (pressure, inertial number).
+    #[serde(with = "serde_rows")]
+    pub rows: Vec<R>,
+    /// The current run's history, one row per step.
+    #[serde(with = "serde_rows")]
+    pub history: Vec<H>,
+    /// VTK frames.
+    pub frames: VtkFrames,
+    /// Numerics of the current window.
+    #[serde(default)]
+    pub window: WindowStats,
+}
+
+impl<H: TableRow, R: TableRow> CellRecord<H, R> {
+    /// An empty record with these frames.
+    pub fn new(frames: VtkFrames) -> Self {
+        Self {
+            all: PhaseStats::default(),
+            rows: Vec::new(),
+            history: Vec::new(),
+            frames,
+            window: WindowStats::default(),
+        }
+    }
+}
