@@ -10,6 +10,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 cargo test --release --workspace
+# The compile-only 3D skeleton behind dem's `dim3` feature (its cone, frame and sphere tests).
+cargo test --release -p dem --features dim3 --lib dim3
 
 # The CLI the Python tests compare with (same seed, same summary.json).
 cargo build --release --bin grainlaw

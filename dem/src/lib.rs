@@ -38,8 +38,11 @@ pub mod cell_coupling;
 pub mod checkpoint;
 pub mod collider;
 pub mod colouring;
+pub mod cone;
 pub mod contact;
 pub mod detection;
+#[cfg(feature = "dim3")]
+pub mod dim3;
 pub mod energy;
 pub mod error;
 pub mod fc;

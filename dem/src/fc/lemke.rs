@@ -1,5 +1,10 @@
 //! Lemke's complementary pivoting method on the 2D frictional-contact problem.
 //!
+//! **2D only, by algorithm.** It is exact because the plane cone is polyhedral (two faces); the
+//! circular cone of a 3D contact (`crate::cone::FrictionCone`, the `dim3` skeleton) is not, and
+//! a 3D problem has no such LCP without faceting the cone. It therefore takes the plane cone's
+//! data directly, not the cone interface.
+//!
 //! In 2D the Coulomb cone `|r_t| ≤ μ r_n` is a polyhedron, and the contact problem of a step
 //! (`u = W r + q`, Coulomb's law with De Saxcé's modified velocity, `docs/physics.md` §3) is
 //! the linear complementarity problem of Stewart & Trinkle (1996). Per contact α, with

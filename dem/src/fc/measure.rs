@@ -9,7 +9,8 @@
 //! `max(‖q‖, ‖r‖, ‖u‖)` is not above machine epsilon the absolute residual is returned.
 
 use super::problem::FcProblem;
-use crate::local::natural_map_residual;
+use crate::cone::natural_map_error;
+use crate::local::Coulomb2;
 
 /// The error measure `e` and the velocity `u = W r + q` at impulses `r` (length 2 nc).
 ///
@@ -26,23 +27,7 @@ pub fn fc_error(problem: &FcProblem, r: &[f64]) -> f64 {
 }
 
 /// The error measure from `μ`, `q`, `r` and an already computed `u = W r + q` (all interleaved
-/// `(n, t)` per contact).
+/// `(n, t)` per contact): [`natural_map_error`] on the plane cones.
 pub fn error_given_velocity(mu: &[f64], q: &[f64], r: &[f64], u: &[f64]) -> f64 {
-    let mut res2 = 0.0;
-    for (a, &m) in mu.iter().enumerate() {
-        let e = natural_map_residual([r[2 * a], r[2 * a + 1]], [u[2 * a], u[2 * a + 1]], m);
-        res2 += e[0] * e[0] + e[1] * e[1];
-    }
-    let scale = norm(q).max(norm(r)).max(norm(u));
-    let res = res2.sqrt();
-    if scale > f64::EPSILON {
-        res / scale
-    } else {
-        res
-    }
-}
-
-/// Euclidean norm.
-pub(crate) fn norm(x: &[f64]) -> f64 {
-    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+    natural_map_error(mu.len(), |a| Coulomb2 { mu: mu[a] }, q, r, u)
 }
