@@ -137,6 +137,26 @@ pub(crate) fn judge_points(
             format!("I = {:.4e} (measured)", rc.i_measured)
         };
         let (mut pc, mut pm, mut pp) = (Checks::new(), Checks::new(), Checks::new());
+        // A sample that is not a number (μ of a cell whose σ_yy went tensile: the grains lost
+        // contact) leaves the point without a mean: refused, not an input error.
+        let bad = rc
+            .mu
+            .iter()
+            .chain(&rc.phi)
+            .filter(|x| !x.is_finite())
+            .count();
+        if bad > 0 {
+            pc.fail(
+                &format!("{scenario}.finite_samples"),
+                Verdict::Refused,
+                bad as f64,
+                0.0,
+                format!(
+                    "{label}: {bad} of the averaging window's {} samples of μ and φ are not finite (a tensile or vanishing σ_yy: the packing lost its contacts)",
+                    rc.mu.len() + rc.phi.len()
+                ),
+            );
+        }
         pc.window(&format!("{label}, averaging window"), &rc.window);
         j.windows.merge(&rc.window);
         if rc.i_target.is_finite() {

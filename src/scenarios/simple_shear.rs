@@ -179,6 +179,37 @@ impl RheologyPoint {
         })
     }
 
+    /// [`RheologyPoint::of`] for grainlaw's own run: a window with a sample that is not
+    /// finite gives a point of NaN means and errors (its verdict refuses it:
+    /// `simple_shear.finite_samples`), not an error of the run.
+    pub(crate) fn of_run(s: &CellSamples, gamma_dot: f64, d: f64, rho: f64) -> Result<Self> {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if [
+            &s.normal_stress,
+            &s.mu,
+            &s.phi,
+            &s.pressure,
+            &s.coordination,
+        ]
+        .iter()
+        .all(|v| finite(v))
+        {
+            return Self::of(s, gamma_dot, d, rho);
+        }
+        Ok(RheologyPoint {
+            i: f64::NAN,
+            i_se: f64::NAN,
+            mu: f64::NAN,
+            mu_se: f64::NAN,
+            phi: f64::NAN,
+            phi_se: f64::NAN,
+            pn: f64::NAN,
+            pn_se: f64::NAN,
+            p: f64::NAN,
+            z: f64::NAN,
+        })
+    }
+
     /// The row of `rheology.csv` (without its `point_verdict`).
     pub(crate) fn row(
         &self,
@@ -477,7 +508,7 @@ impl PhasedRun for Shear<'_> {
         };
         let d = mean_diameter(world);
         let gd = st.run.gamma_dot;
-        let point = RheologyPoint::of(&samples, gd, d, self.c.grain.density)?;
+        let point = RheologyPoint::of_run(&samples, gd, d, self.c.grain.density)?;
         let corrections: f64 = col(|r| r.cell_corrections).iter().sum();
         // what the solver's measured effect is judged against (0: not known)
         let known = |x: f64| if x.is_finite() { x } else { 0.0 };
@@ -629,15 +660,27 @@ pub fn run(
         grain,
     )?;
 
+    // The points the laws are fitted to: those with a mean (a window with a sample that is
+    // not finite has none, and is refused by its own checks: simple_shear.finite_samples).
+    let kept: Vec<usize> = (0..rows.len())
+        .filter(|&k| {
+            [rows[k].i, rows[k].mu, rows[k].phi]
+                .iter()
+                .all(|x| x.is_finite())
+        })
+        .collect();
+    let fit_verdicts: Vec<_> = kept.iter().map(|&k| point_verdicts[k]).collect();
+    let fit =
+        |f: fn(&RheologyRow) -> f64| -> Vec<f64> { kept.iter().map(|&k| f(&rows[k])).collect() };
     let series = RheologySeries {
-        inertial_number: rows.iter().map(|r| r.i).collect(),
-        mu: Some(rows.iter().map(|r| r.mu).collect()),
-        phi: Some(rows.iter().map(|r| r.phi).collect()),
-        pressure_pa: Some(rows.iter().map(|r| r.pn).collect()),
+        inertial_number: fit(|r| r.i),
+        mu: Some(fit(|r| r.mu)),
+        phi: Some(fit(|r| r.phi)),
+        pressure_pa: Some(fit(|r| r.pn)),
         // each point weighted by its block-averaged standard error (unweighted when one is
         // not a positive number, e.g. a window too short for its blocks)
-        mu_std_error: weights_if_usable(rows.iter().map(|r| r.mu_se).collect()),
-        phi_std_error: weights_if_usable(rows.iter().map(|r| r.phi_se).collect()),
+        mu_std_error: weights_if_usable(fit(|r| r.mu_se)),
+        phi_std_error: weights_if_usable(fit(|r| r.phi_se)),
     };
     let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
     let prov = || provenance.clone();
@@ -655,11 +698,11 @@ pub fn run(
             mu_checks: mu_checks.clone(),
             phi_checks: phi_checks.clone(),
             std_errors: super::rheology_fit::PointStdErrors {
-                i: Some(rows.iter().map(|r| r.i_se).collect()),
-                mu: Some(rows.iter().map(|r| r.mu_se).collect()),
-                phi: Some(rows.iter().map(|r| r.phi_se).collect()),
+                i: Some(fit(|r| r.i_se)),
+                mu: Some(fit(|r| r.mu_se)),
+                phi: Some(fit(|r| r.phi_se)),
             },
-            point_verdicts: &point_verdicts,
+            point_verdicts: &fit_verdicts,
             leave_out: &c.leave_out,
         },
         &mut verdict,
@@ -698,6 +741,7 @@ fn weights_if_usable(se: Vec<f64>) -> Option<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::verdict::{Verdict, WindowStats};
 
     /// A history whose μ is 0.6 over the first bin of shear strain, 0.8 over the second and
     /// 0.4 after (steps every 0.01 of strain), with a non-finite row: the peak is the second
@@ -727,5 +771,54 @@ mod tests {
         let p = peak_mu(&h);
         assert!((p - 0.8).abs() < 1e-12, "{p}");
         assert!(peak_mu(&[]).is_nan());
+    }
+
+    /// A window with a sample that is not finite (μ of a step whose σ_yy went tensile) is a
+    /// refused point of NaN means, not an error of the run (before: "homogenise: invalid
+    /// parameter `series`: sample N is not finite", exit 2); the same window read from another
+    /// code (`RheologyPoint::of`) is still an input error.
+    #[test]
+    fn a_window_with_a_sample_that_is_not_finite_is_a_refused_point() {
+        let n = 40;
+        let mut samples = CellSamples {
+            normal_stress: vec![1000.0; n],
+            mu: (0..n).map(|k| 0.3 + 0.001 * (k % 3) as f64).collect(),
+            phi: vec![0.8; n],
+            pressure: vec![1000.0; n],
+            coordination: vec![3.5; n],
+        };
+        let good = RheologyPoint::of_run(&samples, 2.0, 3e-3, 2500.0).unwrap();
+        assert!((good.mu - 0.301).abs() < 1e-3, "{}", good.mu);
+        samples.mu[15] = f64::NAN;
+        assert!(RheologyPoint::of(&samples, 2.0, 3e-3, 2500.0).is_err());
+        let bad = RheologyPoint::of_run(&samples, 2.0, 3e-3, 2500.0).unwrap();
+        assert!(bad.mu.is_nan() && bad.i.is_nan());
+        let check = |mu: Vec<f64>| RunCheckData {
+            i_target: 0.01,
+            i_measured: 0.01,
+            window: WindowStats::default(),
+            mu,
+            phi: samples.phi.clone(),
+        };
+        let fine = judge_points("simple_shear", &[check(good_mu(n))], 0.9);
+        assert_eq!(fine.points, vec![Verdict::Ok]);
+        let j = judge_points("simple_shear", &[check(samples.mu.clone())], 0.9);
+        assert_eq!(j.points, vec![Verdict::Refused]);
+        let r = j
+            .common
+            .reasons
+            .iter()
+            .find(|r| r.check == "simple_shear.finite_samples")
+            .expect("the finite-samples reason");
+        assert_eq!(r.value, 1.0);
+        assert!(
+            r.message.contains("1 of the averaging window's 80 samples"),
+            "{}",
+            r.message
+        );
+    }
+
+    fn good_mu(n: usize) -> Vec<f64> {
+        (0..n).map(|k| 0.3 + 0.001 * (k % 3) as f64).collect()
     }
 }
