@@ -44,6 +44,7 @@
 //! wall-clock limit (`timer timeout`). Whether the column settled is decided here from the
 //! ratio LAMMPS prints at the end, not from how the run stopped.
 
+use dem::math::Vector;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -206,7 +207,7 @@ impl PeerColumn {
                     }
                 }
                 (Shape::Disk { offset, .. }, BodyKind::Grain)
-                    if *offset == nalgebra::Vector2::zeros() =>
+                    if *offset == Vector::zeros() =>
                 {
                     if grain_mat
                         .replace(c.material)

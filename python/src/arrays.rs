@@ -2,6 +2,7 @@
 //! through `numpy.asarray(x, dtype=float64)`), checked for shape and finiteness with the
 //! argument's name in the message; float64 arrays out.
 
+use dem::math::Tensor;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -94,7 +95,7 @@ pub fn out2<'py, const K: usize>(py: Python<'py>, rows: &[[f64; K]]) -> Bound<'p
 /// 2×2 tensors as an `(n, 2, 2)` float64 array, `a[k, i, j] = T_k[i, j]`.
 pub fn out_tensors<'py>(
     py: Python<'py>,
-    ts: &[nalgebra::Matrix2<f64>],
+    ts: &[Tensor],
 ) -> PyResult<Bound<'py, PyAny>> {
     let flat: Vec<f64> = ts
         .iter()
@@ -106,6 +107,6 @@ pub fn out_tensors<'py>(
 }
 
 /// One 2×2 tensor as a `(2, 2)` float64 array.
-pub fn out_tensor<'py>(py: Python<'py>, t: &nalgebra::Matrix2<f64>) -> PyResult<Bound<'py, PyAny>> {
+pub fn out_tensor<'py>(py: Python<'py>, t: &Tensor) -> PyResult<Bound<'py, PyAny>> {
     out_tensors(py, std::slice::from_ref(t))?.get_item(0)
 }

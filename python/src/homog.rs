@@ -2,7 +2,7 @@
 //! stress with its contact and inertia parts, solid fraction, coordination, fabric. Stresses in
 //! Pa, tension positive, tensors as (2, 2) arrays `[[xx, xy], [yx, yy]]`.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -23,8 +23,8 @@ fn region_of(
     match (region, y_slice) {
         (None, None) => Ok(Region::Whole),
         (Some((x0, y0, x1, y1)), None) => Ok(Region::Rectangle {
-            min: Vector2::new(x0, y0),
-            max: Vector2::new(x1, y1),
+            min: Vector::new(x0, y0),
+            max: Vector::new(x1, y1),
         }),
         (None, Some((y_min, y_max))) => Ok(Region::Slice { y_min, y_max }),
         (Some(_), Some(_)) => Err(input("give `region` or `y_slice`, not both")),

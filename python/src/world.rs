@@ -1,6 +1,6 @@
 //! `grainlaw.World` and `grainlaw.Snapshot`: the engine (`dem::World`) from Python.
 
-use nalgebra::Vector2;
+use dem::math::Vector;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -24,9 +24,9 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
     }
 }
 
-fn pair(v: (f64, f64), name: &str) -> PyResult<Vector2<f64>> {
+fn pair(v: (f64, f64), name: &str) -> PyResult<Vector> {
     if v.0.is_finite() && v.1.is_finite() {
-        Ok(Vector2::new(v.0, v.1))
+        Ok(Vector::new(v.0, v.1))
     } else {
         Err(input(format!("`{name}` is not finite ({}, {})", v.0, v.1)))
     }
@@ -294,14 +294,14 @@ impl World {
         let mut ids = Vec::with_capacity(n);
         for i in 0..n {
             let b = self.world.add_grain_with_thickness(
-                Vector2::new(x[i][0], x[i][1]),
+                Vector::new(x[i][0], x[i][1]),
                 r[i],
                 rho[i],
                 t,
                 mat,
             );
             if let Some(v) = &v {
-                self.world.bodies[b as usize].velocity = Vector2::new(v[i][0], v[i][1]);
+                self.world.bodies[b as usize].velocity = Vector::new(v[i][0], v[i][1]);
             }
             ids.push(i64::from(b));
         }
@@ -392,7 +392,7 @@ impl World {
             .map(|&i| self.grain_id(i))
             .collect::<PyResult<Vec<_>>>()?;
         for (k, &i) in idx.iter().enumerate() {
-            self.world.bodies[i].velocity = Vector2::new(v[k][0], v[k][1]);
+            self.world.bodies[i].velocity = Vector::new(v[k][0], v[k][1]);
             if let Some(w) = &w {
                 self.world.bodies[i].omega = w[k];
             }

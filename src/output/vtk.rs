@@ -36,11 +36,11 @@ use std::io::Write as _;
 use base64::engine::general_purpose::STANDARD as BASE64;
 use base64::Engine as _;
 use dem::local::ContactStatus;
+use dem::math::Vector;
 use dem::snapshot::{BodyKind, Snapshot, WallGeometry};
 use flate2::write::ZlibEncoder;
 use flate2::Compression;
 use homogenise::tensor::frobenius;
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
@@ -127,7 +127,7 @@ fn header(nverts: usize, nlines: usize, npoints: usize) -> String {
 
 const FOOTER: &str = "    </Piece>\n  </PolyData>\n</VTKFile>\n";
 
-fn points(s: &mut String, p: &[Vector2<f64>]) {
+fn points(s: &mut String, p: &[Vector]) {
     s.push_str("      <Points>\n");
     data_array(s, "Points", 3, p.iter().flat_map(|p| [p.x, p.y, 0.0]));
     s.push_str("      </Points>\n");
@@ -224,7 +224,7 @@ pub fn grains_vtp(snap: &Snapshot) -> Result<String> {
 
 /// Ends of the branch of a contact: body a's end (its centre, or the contact point for a
 /// wall) and body b's centre, both as seen from b (periodic images handled by the levers).
-pub fn branch(snap: &Snapshot, c: &dem::snapshot::ContactState) -> (Vector2<f64>, Vector2<f64>) {
+pub fn branch(snap: &Snapshot, c: &dem::snapshot::ContactState) -> (Vector, Vector) {
     let a = &snap.bodies[c.body_a as usize];
     let pa = if a.kind == BodyKind::Grain {
         c.point - c.lever_a
@@ -281,7 +281,7 @@ pub fn contacts_vtp(snap: &Snapshot) -> String {
         cs.iter().map(|c| c.mobilisation().unwrap_or(0.0)),
     );
     s.push_str("      </CellData>\n");
-    let pts: Vec<Vector2<f64>> = cs
+    let pts: Vec<Vector> = cs
         .iter()
         .flat_map(|c| {
             let (a, b) = branch(snap, c);
@@ -322,12 +322,8 @@ pub fn grain_extent(snap: &Snapshot) -> (f64, f64, f64, f64) {
 }
 
 /// Clips the infinite line through `p` with normal `n` to the box `(x0, x1, y0, y1)`.
-pub fn clip_line(
-    p: Vector2<f64>,
-    n: Vector2<f64>,
-    e: (f64, f64, f64, f64),
-) -> Option<(Vector2<f64>, Vector2<f64>)> {
-    let d = Vector2::new(-n.y, n.x);
+pub fn clip_line(p: Vector, n: Vector, e: (f64, f64, f64, f64)) -> Option<(Vector, Vector)> {
+    let d = Vector::new(-n.y, n.x);
     let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
     for (pc, dc, lo, hi) in [(p.x, d.x, e.0, e.1), (p.y, d.y, e.2, e.3)] {
         if dc.abs() < 1e-14 {
@@ -381,7 +377,7 @@ pub fn walls_vtp(snap: &Snapshot) -> String {
     if let Some(cell) = &snap.cell {
         // The biperiodic cell's four edges.
         let (a1, a2) = (cell.h.column(0).into_owned(), cell.h.column(1).into_owned());
-        let corners = [Vector2::zeros(), a1, a1 + a2, a2];
+        let corners = [Vector::zeros(), a1, a1 + a2, a2];
         for k in 0..4 {
             lines.push(pts.len());
             pts.push(corners[k]);

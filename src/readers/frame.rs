@@ -30,10 +30,10 @@ use std::collections::HashMap;
 
 use dem::cell::{Cell, Mat};
 use dem::local::ContactStatus;
+use dem::math::Vector;
 use dem::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
 use homogenise::kinematics::{velocity_gradient, VelocityWeight};
 use homogenise::Region;
-use nalgebra::Vector2;
 
 use super::{AccelerationSource, ExternalSnapshot, GradientSource, ReadError, ReadOptions};
 
@@ -43,11 +43,11 @@ pub struct GrainRecord {
     /// The code's id.
     pub id: u64,
     /// Centre (m).
-    pub position: Vector2<f64>,
+    pub position: Vector,
     /// Rotation angle (rad), 0 when the file has none.
     pub angle: f64,
     /// Velocity (m/s).
-    pub velocity: Vector2<f64>,
+    pub velocity: Vector,
     /// Angular velocity (rad/s).
     pub omega: f64,
     /// Radius (m).
@@ -58,7 +58,7 @@ pub struct GrainRecord {
     pub inertia: f64,
     /// Acceleration and angular acceleration when the file gives them (or forces and torques
     /// that give them).
-    pub acceleration: Option<(Vector2<f64>, f64)>,
+    pub acceleration: Option<(Vector, f64)>,
 }
 
 /// A wall: a line through `point` with unit `normal` pointing to the grains, or a segment.
@@ -69,9 +69,9 @@ pub struct WallRecord {
     /// Geometry.
     pub geometry: WallGeometry,
     /// Reference point (m): the body's centre, where its lever arms start.
-    pub position: Vector2<f64>,
+    pub position: Vector,
     /// Velocity (m/s).
-    pub velocity: Vector2<f64>,
+    pub velocity: Vector,
 }
 
 /// The other body of a contact.
@@ -91,11 +91,11 @@ pub struct ContactRecord {
     /// Grain `b`, by id.
     pub b: u64,
     /// Force on `b` (N); `a` receives the opposite.
-    pub force: Vector2<f64>,
+    pub force: Vector,
     /// Contact point (m) when the file gives it.
-    pub point: Option<Vector2<f64>>,
+    pub point: Option<Vector>,
     /// Unit normal from `a` to `b` when the file gives it (else from the geometry).
-    pub normal: Option<Vector2<f64>>,
+    pub normal: Option<Vector>,
 }
 
 /// The periodic cell of a frame, as LAMMPS describes its box: the parallelogram with corner
@@ -104,7 +104,7 @@ pub struct ContactRecord {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrameCell {
     /// Corner `(x_lo, y_lo)` (m).
-    pub origin: Vector2<f64>,
+    pub origin: Vector,
     /// Length along x `l_x = x_hi − x_lo` (m).
     pub lx: f64,
     /// Height `l_y = y_hi − y_lo` (m).
@@ -161,7 +161,7 @@ enum Images {
     /// Along x with this period (m).
     X(f64),
     /// Along the edge `a₂` (m) alone.
-    Edge(Vector2<f64>),
+    Edge(Vector),
     /// Biperiodic cell.
     Cell(Cell),
 }
@@ -171,7 +171,7 @@ impl Images {
         Ok(match (f.cell, f.periodic_x) {
             (Some(c), _) if c.biperiodic() => Images::Cell(cell_of(f, &c, Mat::zeros())?),
             (Some(c), _) if c.periodic[0] => Images::X(c.lx),
-            (Some(c), _) if c.periodic[1] => Images::Edge(Vector2::new(c.xy, c.ly)),
+            (Some(c), _) if c.periodic[1] => Images::Edge(Vector::new(c.xy, c.ly)),
             (Some(_), _) => Images::None,
             (None, Some([a, b])) => Images::X(b - a),
             (None, None) => Images::None,
@@ -179,7 +179,7 @@ impl Images {
     }
 
     /// `d` mapped to its shortest periodic image.
-    fn min(&self, mut d: Vector2<f64>) -> Vector2<f64> {
+    fn min(&self, mut d: Vector) -> Vector {
         match self {
             Images::None => d,
             Images::X(l) => {
@@ -198,7 +198,7 @@ fn cell_of(f: &Frame, c: &FrameCell, l: Mat) -> Result<Cell, ReadError> {
 }
 
 /// Per grain, the acceleration (m/s²) and angular acceleration (rad/s²).
-type Accelerations = Vec<(Vector2<f64>, f64)>;
+type Accelerations = Vec<(Vector, f64)>;
 
 /// The time of each frame: the file's, else `step · dt`.
 fn times(frames: &[Frame], opts: &ReadOptions) -> Result<Vec<Option<f64>>, ReadError> {
@@ -235,7 +235,7 @@ pub fn build_snapshots(
         }
         if n < 2 {
             acc.push((
-                vec![(Vector2::zeros(), 0.0); f.grains.len()],
+                vec![(Vector::zeros(), 0.0); f.grains.len()],
                 AccelerationSource::Zero,
             ));
             continue;
@@ -281,7 +281,7 @@ pub fn build_snapshots(
         }
         if k == 0 {
             // forward difference: a of frame 1 computed above, keyed by frame 1's order
-            let by_id: HashMap<u64, (Vector2<f64>, f64)> = frames[1]
+            let by_id: HashMap<u64, (Vector, f64)> = frames[1]
                 .grains
                 .iter()
                 .zip(&a)
@@ -390,7 +390,7 @@ fn to_cell_frame(f: &mut Frame, c: &FrameCell) -> Result<(), ReadError> {
 
 fn build_one(
     mut f: Frame,
-    acc: Vec<(Vector2<f64>, f64)>,
+    acc: Vec<(Vector, f64)>,
     src: AccelerationSource,
     time: Option<f64>,
     dt: Option<f64>,
@@ -449,7 +449,7 @@ fn build_one(
             angle: 0.0,
             velocity: w.velocity,
             omega: 0.0,
-            acceleration: Vector2::zeros(),
+            acceleration: Vector::zeros(),
             angular_acceleration: 0.0,
             mass: f64::INFINITY,
             inertia: f64::INFINITY,
@@ -461,7 +461,7 @@ fn build_one(
     let mu = opts.mu.unwrap_or(0.0);
     let wall_mu = opts.wall_mu.or(opts.mu).unwrap_or(0.0);
     let mut contacts = Vec::with_capacity(f.contacts.len());
-    let mut wall_force = vec![(Vector2::zeros(), 0.0); f.walls.len()];
+    let mut wall_force = vec![(Vector::zeros(), 0.0); f.walls.len()];
     for c in &f.contacts {
         let ib = *index.get(&c.b).ok_or_else(|| {
             content(
@@ -548,7 +548,7 @@ fn build_one(
                 format!("contact on grain {}: the normal is not a unit vector", c.b),
             ));
         }
-        let t = Vector2::new(-normal.y, normal.x);
+        let t = Vector::new(-normal.y, normal.x);
         let (fn_, ft) = (c.force.dot(&normal), c.force.dot(&t));
         let ca = bodies[ia as usize].position;
         let lever_a = images.min(point - ca);
@@ -608,7 +608,7 @@ fn build_one(
         step: f.step,
         time: time.unwrap_or(f.step as f64),
         dt: dt.filter(|d| *d > 0.0 && d.is_finite()).unwrap_or(1.0),
-        gravity: Vector2::new(opts.gravity[0], opts.gravity[1]),
+        gravity: Vector::new(opts.gravity[0], opts.gravity[1]),
         periodic_x,
         cell,
         bodies,

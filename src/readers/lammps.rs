@@ -32,8 +32,8 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
+use dem::math::Vector;
 use dem::snapshot::WallGeometry;
-use nalgebra::Vector2;
 
 use super::frame::{ContactRecord, Frame, FrameCell, GrainRecord, Other, WallRecord};
 use super::{build_snapshots, number, read_text, ExternalSnapshot, ReadError, ReadOptions};
@@ -204,7 +204,7 @@ fn parse_box<'a>(
     }
     Ok(DumpBox {
         cell: FrameCell {
-            origin: Vector2::new(xlo, ylo),
+            origin: Vector::new(xlo, ylo),
             lx,
             ly,
             xy,
@@ -413,9 +413,9 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
         source: path.display().to_string(),
         ..Default::default()
     };
-    let mut wall_acc: Vec<(Vector2<f64>, Vector2<f64>, usize)> =
-        vec![(Vector2::zeros(), Vector2::zeros(), 0); walls.len()];
-    let mut wall_contacts: Vec<(usize, u64, Vector2<f64>, Vector2<f64>)> = Vec::new();
+    let mut wall_acc: Vec<(Vector, Vector, usize)> =
+        vec![(Vector::zeros(), Vector::zeros(), 0); walls.len()];
+    let mut wall_contacts: Vec<(usize, u64, Vector, Vector)> = Vec::new();
     for row in 0..b.rows() {
         let v = &b.values[row * b.cols..(row + 1) * b.cols];
         let line = b.first_line + row;
@@ -436,25 +436,25 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
             ));
         }
         let inertia = k * mass * radius * radius;
-        let pos = Vector2::new(v[x], v[y]);
+        let pos = Vector::new(v[x], v[y]);
         frame.grains.push(GrainRecord {
             id: gid as u64,
             position: pos,
             angle: 0.0,
-            velocity: Vector2::new(v[vx], v[vy]),
+            velocity: Vector::new(v[vx], v[vy]),
             omega: v[om],
             radius,
             mass,
             inertia,
             acceleration: forces
-                .map(|(fx, fy, tq)| (Vector2::new(v[fx], v[fy]) / mass, v[tq] / inertia)),
+                .map(|(fx, fy, tq)| (Vector::new(v[fx], v[fy]) / mass, v[tq] / inertia)),
         });
         for (w, (_, c)) in walls.iter().enumerate() {
             let col = |k: usize| c[k].map_or(0.0, |i| v[i]);
             if col(0) == 0.0 {
                 continue;
             }
-            let p = Vector2::new(col(4), col(5));
+            let p = Vector::new(col(4), col(5));
             let d = pos - p;
             if d.norm() == 0.0 {
                 return Err(ReadError::parse(
@@ -463,7 +463,7 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
                     format!("atom {gid}: its centre is on wall `{}`", walls[w].0),
                 ));
             }
-            let f = Vector2::new(col(1), col(2));
+            let f = Vector::new(col(1), col(2));
             wall_acc[w].0 += p;
             wall_acc[w].1 += d / d.norm();
             wall_acc[w].2 += 1;
@@ -478,13 +478,13 @@ fn atoms_frame(path: &Path, b: &Block, opts: &ReadOptions) -> Result<Frame, Read
             continue;
         }
         let point = ps / count as f64;
-        let normal = ns.try_normalize(0.0).unwrap_or(Vector2::new(0.0, 1.0));
+        let normal = ns.try_normalize(0.0).unwrap_or(Vector::new(0.0, 1.0));
         wall_index[w] = Some(frame.walls.len());
         frame.walls.push(WallRecord {
             name: name.clone(),
             geometry: WallGeometry::Line { point, normal },
             position: point,
-            velocity: Vector2::zeros(),
+            velocity: Vector::zeros(),
         });
     }
     for (w, gid, f, n) in wall_contacts {
@@ -576,7 +576,7 @@ fn add_pairs(
     let get = |v: &[f64], k: &str| c.get(k).map_or(0.0, |&i| v[i]);
     for row in 0..b.rows() {
         let v = &b.values[row * b.cols..(row + 1) * b.cols];
-        let f = Vector2::new(get(v, "fx") + get(v, "ftx"), get(v, "fy") + get(v, "fty"));
+        let f = Vector::new(get(v, "fx") + get(v, "ftx"), get(v, "fy") + get(v, "fty"));
         if f.x == 0.0 && f.y == 0.0 {
             continue;
         }
@@ -594,7 +594,7 @@ fn add_pairs(
             force: f,
             point: c
                 .contains_key("cx")
-                .then(|| Vector2::new(get(v, "cx"), get(v, "cy"))),
+                .then(|| Vector::new(get(v, "cx"), get(v, "cy"))),
             normal: None,
         });
     }
@@ -603,11 +603,7 @@ fn add_pairs(
 
 /// Per wall id: the sums of the contact points and of the unit normals, and the contacts
 /// (particle id, force on it, contact point, unit normal).
-type WallSums = (
-    Vector2<f64>,
-    Vector2<f64>,
-    Vec<(u64, Vector2<f64>, Vector2<f64>, Vector2<f64>)>,
-);
+type WallSums = (Vector, Vector, Vec<(u64, Vector, Vector, Vector)>);
 
 /// Whether a local block holds wall contacts (a `wall.wall` column by name or by mapping).
 fn is_wall_block(b: &Block, opts: &ReadOptions) -> bool {
@@ -641,8 +637,7 @@ fn add_walls(
             "wall.cy",
         ],
     )?;
-    let centre: HashMap<u64, Vector2<f64>> =
-        frame.grains.iter().map(|g| (g.id, g.position)).collect();
+    let centre: HashMap<u64, Vector> = frame.grains.iter().map(|g| (g.id, g.position)).collect();
     let mut walls: BTreeMap<i64, WallSums> = BTreeMap::new();
     for row in 0..b.rows() {
         let v = &b.values[row * b.cols..(row + 1) * b.cols];
@@ -655,7 +650,7 @@ fn add_walls(
                 "wall and particle ids must be integers",
             ));
         }
-        let x = Vector2::new(v[c["wall.cx"]], v[c["wall.cy"]]);
+        let x = Vector::new(v[c["wall.cx"]], v[c["wall.cy"]]);
         let cp = *centre.get(&(id as u64)).ok_or_else(|| {
             ReadError::parse(
                 path,
@@ -677,12 +672,12 @@ fn add_walls(
         let n = d / d.norm();
         let e = walls
             .entry(w as i64)
-            .or_insert((Vector2::zeros(), Vector2::zeros(), Vec::new()));
+            .or_insert((Vector::zeros(), Vector::zeros(), Vec::new()));
         e.0 += x;
         e.1 += n;
         e.2.push((
             id as u64,
-            Vector2::new(v[c["wall.fx"]], v[c["wall.fy"]]),
+            Vector::new(v[c["wall.fx"]], v[c["wall.fy"]]),
             x,
             n,
         ));
@@ -694,10 +689,10 @@ fn add_walls(
             name: format!("wall{w}"),
             geometry: WallGeometry::Line {
                 point,
-                normal: ns.try_normalize(0.0).unwrap_or(Vector2::new(0.0, 1.0)),
+                normal: ns.try_normalize(0.0).unwrap_or(Vector::new(0.0, 1.0)),
             },
             position: point,
-            velocity: Vector2::zeros(),
+            velocity: Vector::zeros(),
         });
         for (id, f, x, n) in contacts {
             frame.contacts.push(ContactRecord {

@@ -25,8 +25,8 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
+use dem::math::Vector;
 use dem::snapshot::WallGeometry;
-use nalgebra::Vector2;
 
 use super::frame::{ContactRecord, Frame, GrainRecord, Other, WallRecord};
 use super::{build_snapshots, number, read_text, ExternalSnapshot, ReadError, ReadOptions};
@@ -235,8 +235,8 @@ struct LmgcContact {
     antagonist_is_wall: bool,
     rt: f64,
     rn: f64,
-    n: Vector2<f64>,
-    point: Vector2<f64>,
+    n: Vector,
+    point: Vector,
 }
 
 fn parse_vloc(path: &Path, text: &str) -> Result<Vec<(u64, Vec<LmgcContact>)>, ReadError> {
@@ -310,8 +310,8 @@ fn parse_vloc(path: &Path, text: &str) -> Result<Vec<(u64, Vec<LmgcContact>)>, R
                 antagonist_is_wall: kind == "DKJCx",
                 rt: get(&["rlt/H", "rlt  "])?,
                 rn: get(&["rln/H", "rln  "])?,
-                n: Vector2::new(get(&["n(1)="])?, get(&["n(2)="])?),
-                point: Vector2::new(get(&["coo1="])?, get(&["coo2="])?),
+                n: Vector::new(get(&["n(1)="])?, get(&["n(2)="])?),
+                point: Vector::new(get(&["coo1="])?, get(&["coo2="])?),
             };
             if let Some(o) = out.last_mut() {
                 o.1.push(contact);
@@ -385,7 +385,7 @@ pub fn read_lmgc90(
         let mut wall_of: HashMap<u64, usize> = HashMap::new();
         for (id, b) in &bodies {
             let (x, v) = dof.get(id).copied().unwrap_or(([0.0; 3], [0.0; 3]));
-            let c = Vector2::new(b.cooref[0] + x[0], b.cooref[1] + x[1]);
+            let c = Vector::new(b.cooref[0] + x[0], b.cooref[1] + x[1]);
             match b.tactor {
                 Some(Tactor::Disk { radius }) => {
                     let mass = density * std::f64::consts::PI * b.avrd * b.avrd;
@@ -393,7 +393,7 @@ pub fn read_lmgc90(
                         id: *id,
                         position: c,
                         angle: x[2],
-                        velocity: Vector2::new(v[0], v[1]),
+                        velocity: Vector::new(v[0], v[1]),
                         omega: v[2],
                         radius,
                         mass,
@@ -402,7 +402,7 @@ pub fn read_lmgc90(
                     });
                 }
                 Some(Tactor::Jonc { ax1 }) => {
-                    let e = Vector2::new(x[2].cos(), x[2].sin());
+                    let e = Vector::new(x[2].cos(), x[2].sin());
                     wall_of.insert(*id, frame.walls.len());
                     frame.walls.push(WallRecord {
                         name: format!("body{id}"),
@@ -411,7 +411,7 @@ pub fn read_lmgc90(
                             b: c + e * ax1,
                         },
                         position: c,
-                        velocity: Vector2::new(v[0], v[1]),
+                        velocity: Vector::new(v[0], v[1]),
                     });
                 }
                 None => {
@@ -438,7 +438,7 @@ pub fn read_lmgc90(
                 } else {
                     Other::Grain(c.antagonist)
                 };
-                let t = Vector2::new(c.n.y, -c.n.x);
+                let t = Vector::new(c.n.y, -c.n.x);
                 frame.contacts.push(ContactRecord {
                     a,
                     b: c.candidate,

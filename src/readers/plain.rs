@@ -5,8 +5,8 @@
 
 use std::path::PathBuf;
 
+use dem::math::Vector;
 use dem::snapshot::WallGeometry;
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use super::frame::{ContactRecord, Frame, GrainRecord, Other, WallRecord};
@@ -106,8 +106,8 @@ pub struct PlainContact {
     pub point: Option<[f64; 2]>,
 }
 
-fn v2(a: [f64; 2]) -> Vector2<f64> {
-    Vector2::new(a[0], a[1])
+fn v2(a: [f64; 2]) -> Vector {
+    Vector::new(a[0], a[1])
 }
 
 /// Reads plain snapshots, one JSON file each (plain or `.gz`).
@@ -145,14 +145,14 @@ pub fn read_plain(
         for g in &p.grains {
             frame.grains.push(GrainRecord {
                 id: g.id,
-                position: Vector2::new(g.x, g.y),
+                position: Vector::new(g.x, g.y),
                 angle: 0.0,
-                velocity: Vector2::new(g.vx, g.vy),
+                velocity: Vector::new(g.vx, g.vy),
                 omega: g.omega,
                 radius: g.radius,
                 mass: g.mass,
                 inertia: g.inertia.unwrap_or(0.5 * g.mass * g.radius * g.radius),
-                acceleration: g.acceleration.map(|a| (Vector2::new(a[0], a[1]), a[2])),
+                acceleration: g.acceleration.map(|a| (Vector::new(a[0], a[1]), a[2])),
             });
         }
         for w in &p.walls {
@@ -184,13 +184,13 @@ pub fn read_plain(
             let position = match &geometry {
                 WallGeometry::Line { point, .. } => *point,
                 WallGeometry::Segment { a, b } => (a + b) * 0.5,
-                WallGeometry::Clump { .. } => Vector2::zeros(),
+                WallGeometry::Clump { .. } => Vector::zeros(),
             };
             frame.walls.push(WallRecord {
                 name: w.name.clone(),
                 geometry,
                 position,
-                velocity: Vector2::zeros(),
+                velocity: Vector::zeros(),
             });
         }
         for (k, c) in p.contacts.iter().enumerate() {

@@ -12,8 +12,8 @@
 //! then follows from the same formula with the friction force μ m g cos φ (also reported).
 
 use datasets::config::RollingConfig;
+use dem::math::Vector;
 use homogenise::tensor::{frobenius, in_frame, skew_ratio, Tensor2};
-use nalgebra::Vector2;
 
 use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
@@ -74,10 +74,10 @@ struct Roll<'a> {
 #[derive(Serialize, Deserialize)]
 struct RollState {
     /// Slope frame: down the slope, outward normal.
-    e1: Vector2<f64>,
-    e2: Vector2<f64>,
+    e1: Vector,
+    e2: Vector,
     /// Initial centre (m).
-    c0: Vector2<f64>,
+    c0: Vector,
     /// One row per step: `history.csv`.
     #[serde(with = "serde_csv_table")]
     hist: Vec<RollStep>,

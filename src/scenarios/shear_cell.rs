@@ -11,6 +11,7 @@
 //! best of three forms by AIC).
 
 use datasets::config::ShearCellConfig;
+use dem::math::{Tensor, Vector};
 use dem::snapshot::Snapshot;
 use homogenise::kinematics::{velocity_gradient, VelocityWeight};
 use homogenise::state::solid_fraction;
@@ -20,7 +21,6 @@ use identify::law::GrainScale;
 use identify::mu_i::RheologySeries;
 use identify::wall_law::{select_wall_law, WallSlipSeries};
 use identify::{CalibratedLaw, FitOptions};
-use nalgebra::Vector2;
 
 use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
@@ -1060,7 +1060,7 @@ fn bulk_region(w: &dem::World, r: f64, d: f64) -> Region {
 }
 
 /// Symmetric mean stress of the bulk (Pa, tension positive, inertia included).
-fn bulk_stress(snap: &Snapshot, region: &Region) -> Result<nalgebra::Matrix2<f64>> {
+fn bulk_stress(snap: &Snapshot, region: &Region) -> Result<Tensor> {
     let gs = homogenise::grain_stresses(snap)?;
     let st = homogenise::mean_stress(snap, &gs, region)?;
     Ok((st.total + st.total.transpose()) * 0.5)
@@ -1069,7 +1069,7 @@ fn bulk_stress(snap: &Snapshot, region: &Region) -> Result<nalgebra::Matrix2<f64
 /// The bulk shear rate `γ̇ = ∂v_x/∂y` (1/s, mass-weighted affine fit of the grain velocities)
 /// and symmetric stress (Pa) of one state: what the wall-velocity correction measures
 /// (`P = −σ_yy`).
-fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, nalgebra::Matrix2<f64>)> {
+fn bulk_shear(w: &dem::World, r: f64, d: f64) -> Result<(f64, Tensor)> {
     let snap = w.snapshot();
     let region = bulk_region(w, r, d);
     let sym = bulk_stress(&snap, &region)?;
@@ -1105,8 +1105,8 @@ fn sample(w: &dem::World, acc: &mut RunAverages, r: f64, d: f64) -> Result<(f64,
         let h = top_y - 2.0 * r;
         let spec = NearWallSpec {
             wall: wall.to_string(),
-            flow_direction: Vector2::new(1.0, 0.0),
-            normal: Some(Vector2::new(0.0, if j == 0 { 1.0 } else { -1.0 })),
+            flow_direction: Vector::new(1.0, 0.0),
+            normal: Some(Vector::new(0.0, if j == 0 { 1.0 } else { -1.0 })),
             bin_width: 0.5 * d,
             bins: ((h / (0.5 * d)).ceil() as usize).max(1),
             first_layer: d,

@@ -6,7 +6,7 @@
 
 use datasets::config::StickSlipConfig;
 use datasets::phases::RunUntilRest;
-use nalgebra::Vector2;
+use dem::math::Vector;
 
 use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
@@ -145,7 +145,7 @@ impl PhasedRun for Push<'_> {
         } else {
             world.params.dt = c.dt;
             c.solver.apply(&mut world.params);
-            world.bodies[st.bottom].velocity = Vector2::new(0.0, c.push_velocity);
+            world.bodies[st.bottom].velocity = Vector::new(0.0, c.push_velocity);
             st.force = Vec::with_capacity(self.steps() as usize);
             st.window.reset();
             st.vtk = VtkFrames::with_prefix(&format!("{name}_"), c.push_duration / 20.0, 21);

@@ -19,12 +19,12 @@
 //! vertical loads, and the mobilisation `|f_t|/(μ f_n)` of every side-wall contact.
 //! Compressive stresses are positive in this file.
 
+use dem::math::Vector;
 use dem::snapshot::Snapshot;
 use dem::BodyKind;
 use homogenise::depth::{DepthAxis, DepthBins};
 use homogenise::mobilisation::{contact_mobilisations, ContactClass, COULOMB_LIMIT};
 use homogenise::walls::{plane_stress_profile, wall_stress_profile};
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
@@ -87,7 +87,7 @@ fn mean_grain_diameter(snap: &Snapshot) -> f64 {
 /// `bins` depth bins of equal thickness from a free surface at height `surface` down to the
 /// floor (y = 0).
 fn depth_bins(surface: f64, bins: usize) -> Result<DepthBins> {
-    let axis = DepthAxis::new(Vector2::new(0.0, -1.0), Vector2::new(0.0, surface))?;
+    let axis = DepthAxis::new(Vector::new(0.0, -1.0), Vector::new(0.0, surface))?;
     Ok(DepthBins::new(axis, surface / bins as f64, bins)?)
 }
 

@@ -21,11 +21,11 @@
 
 use datasets::config::JanssenConfig;
 use datasets::phases::{PhaseStats, RunUntilRest};
+use dem::math::Vector;
 use homogenise::state::solid_fraction;
 use homogenise::Region;
 use identify::janssen::JanssenSetup;
 use identify::CalibratedLaw;
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
@@ -218,7 +218,7 @@ impl PhasedRun for Column<'_> {
             // Release: the floor is lowered slowly so that the column slides along the walls
             // (Coulomb conditions at the wall contacts).
             RELEASE if self.release_steps() > 0 => {
-                world.bodies[st.bottom].velocity = Vector2::new(0.0, -c.release.speed);
+                world.bodies[st.bottom].velocity = Vector::new(0.0, -c.release.speed);
                 c.release.solver.apply(&mut world.params);
                 plan("release", Stop::Steps(self.release_steps()))
             }
@@ -432,8 +432,8 @@ fn homogenise(
     let top_skip = c.analysis.skip_top_diameters * d;
     let bottom_skip = c.analysis.skip_bottom_diameters * d;
     let phi_region = Region::Rectangle {
-        min: Vector2::new(0.0, bottom_skip),
-        max: Vector2::new(width, (profile.surface - top_skip).max(bottom_skip + d)),
+        min: Vector::new(0.0, bottom_skip),
+        max: Vector::new(width, (profile.surface - top_skip).max(bottom_skip + d)),
     };
     let phi = solid_fraction(snap, &phi_region)?;
     let rho_b = phi * c.grain.density;
