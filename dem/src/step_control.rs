@@ -295,7 +295,7 @@ pub fn step_subdivided_checked(
                 discarded += sweeps(&first_subs);
                 // The back-off of `auto` continues from the first solve, as if the step had
                 // been solved once at the run's tolerance (a tolerance change resets it).
-                world.work.backoff = first_world.work.backoff;
+                world.newton_backoff = first_world.newton_backoff;
             } else {
                 discarded += sweeps(&subs);
                 world.undo_to(&first_world);
@@ -326,7 +326,7 @@ pub fn step_subdivided_checked(
         break (subs, false, unconverged);
     };
     restore(world);
-    world.unconverged_problem = unconverged;
+    world.work.unconverged_problem = unconverged;
     let all_converged = subs.iter().all(|s| s.report.solver.converged);
     if !paused && configured > 0 {
         update_subdivision(state, start, level, all_converged);
