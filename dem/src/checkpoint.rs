@@ -40,9 +40,15 @@ fn err(path: &Path, reason: impl std::fmt::Display) -> DemError {
 
 /// Write `world` to `path` atomically (gzip JSON, temp file then rename).
 pub fn write_checkpoint(world: &World, path: &Path) -> Result<(), DemError> {
-    let file = File_ {
-        format: FORMAT.to_string(),
-        world: world.state(),
+    // The state by reference: the same keys as `File_`, without cloning the world.
+    #[derive(Serialize)]
+    struct FileRef<'a> {
+        format: &'a str,
+        world: &'a WorldState,
+    }
+    let file = FileRef {
+        format: FORMAT,
+        world,
     };
     crate::atomic::write_atomic(path, |w| {
         let mut gz = GzEncoder::new(w, Compression::fast());

@@ -1204,26 +1204,7 @@ impl World {
     /// The state after the last step as plain data (see [`crate::snapshot`]).
     pub fn snapshot(&self) -> Snapshot {
         let h = self.impulse_dt();
-        let bodies = self
-            .state
-            .bodies
-            .iter()
-            .map(|b| BodyState {
-                kind: b.kind,
-                name: b.name.clone(),
-                position: b.position,
-                angle: b.angle,
-                velocity: b.velocity,
-                omega: b.omega,
-                acceleration: b.acceleration,
-                angular_acceleration: b.angular_acceleration,
-                mass: b.mass,
-                inertia: b.inertia,
-                radius: b.radius,
-                density: b.density,
-                thickness: b.thickness,
-            })
-            .collect();
+        let bodies = self.state.bodies.iter().map(BodyState::from).collect();
         let contacts = self
             .state
             .contacts
