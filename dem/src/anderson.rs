@@ -211,6 +211,14 @@ impl Anderson {
         self.rhs = rhs;
         self.count = (self.count + 1).min(m);
         self.next = (self.next + 1) % m;
+        self.mix(g);
+    }
+
+    /// The second pass of [`Anderson::step`]: solves the normal equations on the stored
+    /// columns (regularised by `10⁻¹²` of their largest diagonal; a singular system resets the
+    /// memory) and replaces `g` by `g − ΔG γ`.
+    fn mix(&mut self, g: &mut [f64]) {
+        let m = self.m;
         let c = self.count;
         // Normal equations on the c stored columns (slots in insertion order).
         let mut maxd = 0.0f64;

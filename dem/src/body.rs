@@ -4,6 +4,7 @@ use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 pub use crate::snapshot::BodyKind;
+use crate::snapshot::BodyState;
 
 /// How one degree of freedom (x, y or rotation) of a body moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -141,5 +142,27 @@ impl Body {
             e += 0.5 * self.inertia * self.omega * self.omega;
         }
         e
+    }
+}
+
+impl From<&Body> for BodyState {
+    /// The body as a snapshot shows it: its state after a step, without its control (degrees
+    /// of freedom, applied loads, gravity switch).
+    fn from(b: &Body) -> Self {
+        BodyState {
+            kind: b.kind,
+            name: b.name.clone(),
+            position: b.position,
+            angle: b.angle,
+            velocity: b.velocity,
+            omega: b.omega,
+            acceleration: b.acceleration,
+            angular_acceleration: b.angular_acceleration,
+            mass: b.mass,
+            inertia: b.inertia,
+            radius: b.radius,
+            density: b.density,
+            thickness: b.thickness,
+        }
     }
 }

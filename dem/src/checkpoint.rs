@@ -16,48 +16,14 @@ use flate2::write::GzEncoder;
 use flate2::Compression;
 use serde::{Deserialize, Serialize};
 
-use crate::body::Body;
-use crate::collider::Collider;
-use crate::contact::ContactSet;
 use crate::error::DemError;
-use crate::material::ContactLaws;
-use crate::world::{StepReport, World, WorldParams};
+use crate::world::World;
 
 /// Format tag of checkpoint files.
 pub const FORMAT: &str = "grainlaw-checkpoint-v1";
 
-/// Everything needed to continue a run exactly.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct WorldState {
-    /// Time stepping parameters.
-    pub params: WorldParams,
-    /// Bodies.
-    pub bodies: Vec<Body>,
-    /// Colliders.
-    pub colliders: Vec<Collider>,
-    /// Contact laws.
-    pub laws: ContactLaws,
-    /// Time (s).
-    pub time: f64,
-    /// Steps done.
-    pub step_index: u64,
-    /// Contacts of the last step (their impulses warm-start the next one).
-    pub contacts: ContactSet,
-    /// Report of the last step.
-    pub last: StepReport,
-    /// Back-off of the `auto` solver's Newton stage.
-    #[serde(default)]
-    pub newton_backoff: crate::solver::NewtonBackoff,
-    /// The biperiodic deformable cell, if any ([`crate::cell`]).
-    #[serde(default)]
-    pub cell: Option<crate::cell::Cell>,
-    /// Its mixed stress/strain-rate control, if any.
-    #[serde(default)]
-    pub cell_control: Option<crate::cell::CellControl>,
-    /// The cell's mean stress after the last step (Pa).
-    #[serde(default)]
-    pub cell_stress: Option<crate::cell::Mat>,
-}
+/// Everything needed to continue a run exactly: the world's state, serialised.
+pub use crate::world::WorldState;
 
 #[derive(Serialize, Deserialize)]
 struct File_ {
@@ -74,9 +40,15 @@ fn err(path: &Path, reason: impl std::fmt::Display) -> DemError {
 
 /// Write `world` to `path` atomically (gzip JSON, temp file then rename).
 pub fn write_checkpoint(world: &World, path: &Path) -> Result<(), DemError> {
-    let file = File_ {
-        format: FORMAT.to_string(),
-        world: world.state(),
+    // The state by reference: the same keys as `File_`, without cloning the world.
+    #[derive(Serialize)]
+    struct FileRef<'a> {
+        format: &'a str,
+        world: &'a WorldState,
+    }
+    let file = FileRef {
+        format: FORMAT,
+        world,
     };
     crate::atomic::write_atomic(path, |w| {
         let mut gz = GzEncoder::new(w, Compression::fast());

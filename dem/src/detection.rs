@@ -1095,30 +1095,7 @@ impl Detector {
         self.walls.clear();
         let inv = cell.inverse();
         let l_norm = cell.l.norm();
-        let mut r_max = 0.0f64;
-        for col in colliders {
-            match col.shape {
-                Shape::Disk { radius, .. } => r_max = r_max.max(radius),
-                _ => {
-                    return Err(DemError::Parameter {
-                        name: "cell".into(),
-                        reason: format!(
-                            "a biperiodic cell holds disk grains only; body {} (`{}`) is a wall",
-                            col.body, bodies[col.body as usize].name
-                        ),
-                    })
-                }
-            }
-            if bodies[col.body as usize].kind != BodyKind::Grain {
-                return Err(DemError::Parameter {
-                    name: "cell".into(),
-                    reason: format!(
-                        "a biperiodic cell holds grains only; body {} (`{}`) is a wall",
-                        col.body, bodies[col.body as usize].name
-                    ),
-                });
-            }
-        }
+        let r_max = cell_disks_only(bodies, colliders)?;
         // An implicit cell changes L by δ within the step while the grains keep their
         // velocities: an image (shift h k, k ∈ {−1, 0, 1}²) then moves by |δ h k| dt ≤
         // dt Σ|δ_ij| (|a₁| + |a₂|) relative to them; `rate_bound` bounds Σ|δ_ij|. Only the
@@ -1194,28 +1171,7 @@ impl Detector {
             n[d] = k.min(cap.sqrt().max(3.0)) as usize;
         }
         let (n1, n2) = (n[0], n[1]);
-        let ncells = n1 * n2;
-        self.cell_of.clear();
-        self.cell_start.clear();
-        self.cell_start.resize(ncells + 1, 0);
-        for s in &self.reduced {
-            let i1 = ((s[0] * n1 as f64) as usize).min(n1 - 1);
-            let i2 = ((s[1] * n2 as f64) as usize).min(n2 - 1);
-            let id = (i2 * n1 + i1) as u32;
-            self.cell_of.push(id);
-            self.cell_start[id as usize + 1] += 1;
-        }
-        for i in 0..ncells {
-            self.cell_start[i + 1] += self.cell_start[i];
-        }
-        self.cell_items.clear();
-        self.cell_items.resize(nd, 0);
-        self.fill.clear();
-        self.fill.extend_from_slice(&self.cell_start[..ncells]);
-        for (d, &cid) in self.cell_of.iter().enumerate() {
-            self.cell_items[self.fill[cid as usize] as usize] = d as u32;
-            self.fill[cid as usize] += 1;
-        }
+        self.bin_cell_disks(n1, n2);
         for d in 0..nd {
             let ci = self.disk_collider[d];
             let cid = self.cell_of[d] as usize;
@@ -1245,6 +1201,34 @@ impl Detector {
             }
         }
         Ok(())
+    }
+
+    /// Bins the disks of [`Detector::detect_cell`] into its `n1 × n2` grid of the reduced
+    /// coordinates (`cell_of`, `cell_start`, `cell_items`).
+    fn bin_cell_disks(&mut self, n1: usize, n2: usize) {
+        let ncells = n1 * n2;
+        let nd = self.centre.len();
+        self.cell_of.clear();
+        self.cell_start.clear();
+        self.cell_start.resize(ncells + 1, 0);
+        for s in &self.reduced {
+            let i1 = ((s[0] * n1 as f64) as usize).min(n1 - 1);
+            let i2 = ((s[1] * n2 as f64) as usize).min(n2 - 1);
+            let id = (i2 * n1 + i1) as u32;
+            self.cell_of.push(id);
+            self.cell_start[id as usize + 1] += 1;
+        }
+        for i in 0..ncells {
+            self.cell_start[i + 1] += self.cell_start[i];
+        }
+        self.cell_items.clear();
+        self.cell_items.resize(nd, 0);
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.cell_start[..ncells]);
+        for (d, &cid) in self.cell_of.iter().enumerate() {
+            self.cell_items[self.fill[cid as usize] as usize] = d as u32;
+            self.fill[cid as usize] += 1;
+        }
     }
 
     /// The candidate partners of disk `d` (of `nd`) into `self.neighbours`, sorted and without
@@ -1351,6 +1335,36 @@ impl Detector {
             image,
         );
     }
+}
+
+/// The largest disk radius of a biperiodic cell's colliders (m), after checking that they are
+/// all disks of grains ([`Detector::detect_cell`]).
+fn cell_disks_only(bodies: &[Body], colliders: &[Collider]) -> Result<f64, DemError> {
+    let mut r_max = 0.0f64;
+    for col in colliders {
+        match col.shape {
+            Shape::Disk { radius, .. } => r_max = r_max.max(radius),
+            _ => {
+                return Err(DemError::Parameter {
+                    name: "cell".into(),
+                    reason: format!(
+                        "a biperiodic cell holds disk grains only; body {} (`{}`) is a wall",
+                        col.body, bodies[col.body as usize].name
+                    ),
+                })
+            }
+        }
+        if bodies[col.body as usize].kind != BodyKind::Grain {
+            return Err(DemError::Parameter {
+                name: "cell".into(),
+                reason: format!(
+                    "a biperiodic cell holds grains only; body {} (`{}`) is a wall",
+                    col.body, bodies[col.body as usize].name
+                ),
+            });
+        }
+    }
+    Ok(r_max)
 }
 
 #[cfg(test)]

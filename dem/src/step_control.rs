@@ -249,43 +249,14 @@ pub fn step_subdivided_checked(
             world.params.solver.max_iterations =
                 max_iterations.saturating_mul(world.params.solver.last_level_sweeps.max(1));
         }
-        let mut subs = Vec::with_capacity(n);
-        // The first unconverged sub-step's problem, when problems are recorded (for a dump).
-        let mut unconverged: Option<Unconverged> = None;
-        let mut failed = false;
-        for _ in 0..n {
-            let probe = EnergyProbe::before(world);
-            let report = match world.step() {
-                Ok(r) => r,
-                Err(_) if polishing => {
-                    failed = true;
-                    break;
-                }
-                Err(e) if !can_halve => {
+        let (mut subs, mut unconverged, failed) =
+            match attempt_substeps(world, n, can_halve, polishing) {
+                Ok(attempt) => attempt,
+                Err(e) => {
                     restore(world);
                     return Err(e);
                 }
-                // A non-finite state in an attempt that can still be halved: a smaller step
-                // is the usual cure, so it is undone like a failed solve.
-                Err(_) => {
-                    failed = true;
-                    break;
-                }
             };
-            let energy_residual = probe.residual(world);
-            let converged = report.solver.converged;
-            if !converged && unconverged.is_none() {
-                unconverged = world.last_problem().map(|p| (p.clone(), report));
-            }
-            subs.push(SubStep {
-                report,
-                energy_residual,
-            });
-            if !converged && (can_halve || polishing) {
-                failed = true;
-                break;
-            }
-        }
         let sweeps =
             |subs: &[SubStep]| -> usize { subs.iter().map(|s| s.report.solver.iterations).sum() };
         if let Some((first_world, first_subs, first_unconverged)) = first.take() {
@@ -295,7 +266,7 @@ pub fn step_subdivided_checked(
                 discarded += sweeps(&first_subs);
                 // The back-off of `auto` continues from the first solve, as if the step had
                 // been solved once at the run's tolerance (a tolerance change resets it).
-                world.work.backoff = first_world.work.backoff;
+                world.newton_backoff = first_world.newton_backoff;
             } else {
                 discarded += sweeps(&subs);
                 world.undo_to(&first_world);
@@ -326,7 +297,7 @@ pub fn step_subdivided_checked(
         break (subs, false, unconverged);
     };
     restore(world);
-    world.unconverged_problem = unconverged;
+    world.work.unconverged_problem = unconverged;
     let all_converged = subs.iter().all(|s| s.report.solver.converged);
     if !paused && configured > 0 {
         update_subdivision(state, start, level, all_converged);
@@ -342,6 +313,50 @@ pub fn step_subdivided_checked(
         paused,
         polished,
     })
+}
+
+/// The sub-steps of one attempt of [`step_subdivided_checked`], `n` steps of the world's
+/// current `dt`: their reports and energy residuals, the first unconverged one's problem (when
+/// problems are recorded, for a dump), and whether the attempt failed (a sub-step that did not
+/// converge while the step can still be halved or is a polish, or a non-finite state then: a
+/// smaller step is the usual cure, so it is undone like a failed solve).
+///
+/// # Errors
+/// The error of a sub-step when the step can neither be halved nor is a polish.
+fn attempt_substeps(
+    world: &mut World,
+    n: usize,
+    can_halve: bool,
+    polishing: bool,
+) -> Result<(Vec<SubStep>, Option<Unconverged>, bool), DemError> {
+    let mut subs = Vec::with_capacity(n);
+    let mut unconverged: Option<Unconverged> = None;
+    let mut failed = false;
+    for _ in 0..n {
+        let probe = EnergyProbe::before(world);
+        let report = match world.step() {
+            Ok(r) => r,
+            Err(e) if !polishing && !can_halve => return Err(e),
+            Err(_) => {
+                failed = true;
+                break;
+            }
+        };
+        let energy_residual = probe.residual(world);
+        let converged = report.solver.converged;
+        if !converged && unconverged.is_none() {
+            unconverged = world.last_problem().map(|p| (p.clone(), report));
+        }
+        subs.push(SubStep {
+            report,
+            energy_residual,
+        });
+        if !converged && (can_halve || polishing) {
+            failed = true;
+            break;
+        }
+    }
+    Ok((subs, unconverged, failed))
 }
 
 /// The level rule of [`step_subdivided`] after a step that started at `start` halvings and was
