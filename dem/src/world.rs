@@ -34,7 +34,7 @@ use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::blocked::BlockLayout;
-use crate::body::{Body, Dof};
+use crate::body::{external_loads, Body, Dof};
 use crate::cell::{Cell, CellControl, Mat, Vect};
 use crate::cell_coupling::CellCoupling;
 use crate::checkpoint::WorldState;
@@ -42,7 +42,6 @@ use crate::collider::{rotate, Collider, Shape};
 use crate::colouring::ContactColouring;
 use crate::contact::ContactSet;
 use crate::detection::{Detector, Periodic};
-use crate::energy::external_loads;
 use crate::error::DemError;
 use crate::fc::FcProblem;
 use crate::material::ContactLaws;
