@@ -41,7 +41,7 @@ pub fn run_scenario(
     interrupted: Arc<AtomicBool>,
 ) -> Result<RunOutcome> {
     let loaded = datasets::load(spec, sets)?;
-    crate::cli::check_out_dir(out, loaded.scenario.kind())?;
+    crate::output::dir::check_out_dir(out, loaded.scenario.kind())?;
     let mut ctx = RunContext {
         out: OutputDir::create(out)?,
         verbosity: if quiet {

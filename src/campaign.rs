@@ -38,6 +38,7 @@ use std::time::Instant;
 use toml::{Table, Value};
 
 use crate::error::{CliError, Result};
+use crate::fit_cmd::merged_table;
 use crate::output::dir::write_atomic;
 use crate::scenarios::rheology_fit::{FittedCurve, MeasuredPoint, RheologyFigure};
 
@@ -1038,151 +1039,11 @@ fn has_point_verdict(path: &Path) -> bool {
         .unwrap_or(false)
 }
 
-/// A `# key = value` metadata line (`key` an identifier, as `grainlaw fit` reads it), or None
-/// for a comment.
-fn metadata_line(line: &str) -> Option<(String, String)> {
-    let c = line.strip_prefix('#')?.trim();
-    let (k, v) = c.split_once('=')?;
-    let (k, v) = (k.trim(), v.trim());
-    let ident = !k.is_empty()
-        && k.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
-        && !k.starts_with(|ch: char| ch.is_ascii_digit());
-    (ident && !v.is_empty() && !v.contains(char::is_whitespace))
-        .then(|| (k.to_string(), v.to_string()))
-}
-
-/// Largest relative spread of a numeric metadata value over the merged runs: the runs of one
-/// campaign draw their grains from the same distribution, so their sample mean diameters differ
-/// by sampling noise (about 1 % for a few hundred grains); beyond this the runs are not one
-/// material and the merge is refused.
-pub const MERGE_METADATA_SPREAD: f64 = 0.05;
-
 /// Concatenates per-run CSV tables written by grainlaw (same header) and adds a `run` column
 /// ([`merged_table`]), into `merged`.
 fn merge_tables(files: &[(usize, PathBuf)], merged: &Path) -> Result<()> {
     let (text, _) = merged_table(files, &merged.display().to_string(), "grainlaw campaign")?;
     write_atomic(merged, text.as_bytes())
-}
-
-/// The text of per-run CSV tables written by grainlaw (same header) concatenated, with a `run`
-/// column (each file's index), and how many rows were left out: a table with a `point_verdict`
-/// column keeps only its rows whose verdict is 0. Their `# key = value` metadata must agree: a
-/// text value exactly, a number within [`MERGE_METADATA_SPREAD`] of the mean over the runs,
-/// which the merged table carries (a fit over grains of different sizes would mix scales).
-/// `name` names the merged table in messages, `by` the command merging (its first comment).
-/// The merge of `campaign --collect` and of `grainlaw fit LAW A.csv B.csv ...`.
-pub fn merged_table(files: &[(usize, PathBuf)], name: &str, by: &str) -> Result<(String, usize)> {
-    let mut metas: Vec<(PathBuf, Vec<(String, String)>)> = Vec::new();
-    let mut header: Option<String> = None;
-    let mut rows = Vec::new();
-    let mut dropped = 0usize;
-    for (index, path) in files {
-        let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
-        let mut meta = Vec::new();
-        let mut this_header = None;
-        let mut verdict_col = None;
-        for line in text.lines() {
-            let t = line.trim();
-            if t.is_empty() {
-                continue;
-            }
-            if t.starts_with('#') {
-                if let Some(kv) = metadata_line(t) {
-                    meta.push(kv);
-                }
-                continue;
-            }
-            if this_header.is_none() {
-                this_header = Some(t.to_string());
-                verdict_col = t.split(',').position(|h| h.trim() == "point_verdict");
-            } else {
-                let passed = verdict_col.is_none_or(|j| {
-                    t.split(',')
-                        .nth(j)
-                        .and_then(|v| v.trim().parse::<f64>().ok())
-                        == Some(0.0)
-                });
-                if passed {
-                    rows.push(format!("{t},{index}"));
-                } else {
-                    dropped += 1;
-                }
-            }
-        }
-        match &header {
-            None => header = this_header,
-            Some(h) if Some(h) != this_header.as_ref() => {
-                return Err(CliError::Input {
-                    path: path.display().to_string(),
-                    reason: "its columns differ from the first run's: the runs cannot be merged"
-                        .into(),
-                })
-            }
-            Some(_) => {}
-        }
-        metas.push((path.clone(), meta));
-    }
-    let first = &metas[0].1;
-    let mut merged_meta = Vec::new();
-    for (k, v0) in first {
-        let values: Vec<(&PathBuf, Option<&String>)> = metas
-            .iter()
-            .map(|(p, m)| (p, m.iter().find(|(k2, _)| k2 == k).map(|(_, v)| v)))
-            .collect();
-        if let Some((p, _)) = values.iter().find(|(_, v)| v.is_none()) {
-            return Err(CliError::Input {
-                path: p.display().to_string(),
-                reason: format!("metadata `{k}` is missing: the runs cannot be merged"),
-            });
-        }
-        let nums: Option<Vec<f64>> = values
-            .iter()
-            .map(|(_, v)| v.and_then(|v| v.parse::<f64>().ok()))
-            .collect();
-        match nums {
-            Some(xs) => {
-                let mean = xs.iter().sum::<f64>() / xs.len() as f64;
-                let spread = xs.iter().map(|x| (x - mean).abs()).fold(0.0, f64::max);
-                if spread > MERGE_METADATA_SPREAD * mean.abs() {
-                    return Err(CliError::Input {
-                        path: name.to_string(),
-                        reason: format!(
-                            "metadata `{k}` differs by {:.1} % between runs (more than {:.0} %): they are not one material and are not merged",
-                            100.0 * spread / mean.abs(),
-                            100.0 * MERGE_METADATA_SPREAD
-                        ),
-                    });
-                }
-                merged_meta.push(format!("# {k} = {mean:e}"));
-            }
-            None => {
-                if let Some((p, _)) = values.iter().find(|(_, v)| *v != Some(v0)) {
-                    return Err(CliError::Input {
-                        path: p.display().to_string(),
-                        reason: format!("metadata `{k}` differs from the first run's: the runs cannot be merged"),
-                    });
-                }
-                merged_meta.push(format!("# {k} = {v0}"));
-            }
-        }
-    }
-    let mut text = format!(
-        "# merged by {by}: the rows that passed their checks ({dropped} left out); column `run` is the run's index; numeric metadata are the means over the runs\n"
-    );
-    for m in merged_meta {
-        text.push_str(&m);
-        text.push('\n');
-    }
-    text.push_str(&header.unwrap_or_default());
-    text.push_str(",run\n");
-    for r in rows {
-        text.push_str(&r);
-        text.push('\n');
-    }
-    Ok((text, dropped))
 }
 
 #[cfg(test)]
@@ -1329,16 +1190,6 @@ mod tests {
         let e =
             plan("scenario = \"rolling\"\n[set]\nseed = 1\n[sweep]\nseed = [1, 2]\n").unwrap_err();
         assert!(e.one_line().contains("both"), "{}", e.one_line());
-    }
-
-    #[test]
-    fn metadata_lines_are_key_value_only() {
-        assert_eq!(
-            metadata_line("# grain_diameter_m = 2.9e-3"),
-            Some(("grain_diameter_m".into(), "2.9e-3".into()))
-        );
-        assert_eq!(metadata_line("# steady shear (I, mu = |sigma_xy|/P)"), None);
-        assert_eq!(metadata_line("# note: mu = tau / P"), None);
     }
 
     #[test]

@@ -22,7 +22,7 @@ use std::fs::File;
 use std::io::{self, BufReader, Write};
 use std::path::{Path, PathBuf};
 
-use datasets::phases::PhaseProgress;
+use datasets::phases::{PhaseProgress, RunUntilRest};
 use dem::checkpoint::WorldState;
 use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
@@ -32,7 +32,6 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CliError, Result};
-use crate::scenarios::common::Stop;
 
 /// Format tag of run checkpoints. v2: a biperiodic cell may be under the implicit control
 /// (`dem::cell::CellControl::implicit`), the default of `simple-shear` and `biaxial`, whose
@@ -164,6 +163,15 @@ impl ScenarioRecord {
         }
         s
     }
+}
+
+/// When a phase stops (part of its plan, [`PhasePlan`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Stop {
+    /// At rest (kinetic energy criterion) or at the time limit.
+    UntilRest(RunUntilRest),
+    /// After a number of steps.
+    Steps(u64),
 }
 
 /// One phase as planned when it started.

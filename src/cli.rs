@@ -617,30 +617,6 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
     }
 }
 
-/// Refuses an output directory that is a file, or that holds the outputs of a run of another
-/// scenario (its `scenario.toml` names it): the files of two scenarios would mix. A directory
-/// of an earlier run of the same scenario is reused (its stale `summary.json` is removed first).
-pub(crate) fn check_out_dir(dir: &Path, kind: &str) -> Result<()> {
-    if dir.exists() && !dir.is_dir() {
-        return Err(CliError::Usage(format!(
-            "--out {}: is a file, not a directory",
-            dir.display()
-        )));
-    }
-    let toml = dir.join("scenario.toml");
-    let there = std::fs::read_to_string(&toml)
-        .ok()
-        .and_then(|t| t.parse::<toml::Table>().ok())
-        .and_then(|t| t.get("scenario").and_then(|v| v.as_str()).map(String::from));
-    match there {
-        Some(other) if other != kind => Err(CliError::Usage(format!(
-            "--out {}: holds the outputs of a `{other}` run, not `{kind}`: choose another directory or remove it",
-            dir.display()
-        ))),
-        _ => Ok(()),
-    }
-}
-
 /// `grainlaw run`: a new run, or with `resume` the continuation of an interrupted one.
 pub fn run(args: RunArgs) -> Result<()> {
     if !(args.checkpoint_seconds >= 0.0 && args.checkpoint_seconds.is_finite()) {
@@ -667,7 +643,7 @@ pub fn run(args: RunArgs) -> Result<()> {
                 .out
                 .clone()
                 .unwrap_or_else(|| PathBuf::from("grainlaw-out").join(&loaded.name));
-            check_out_dir(&dir, loaded.scenario.kind())?;
+            crate::output::dir::check_out_dir(&dir, loaded.scenario.kind())?;
             (loaded, dir, args.set.clone())
         }
     };

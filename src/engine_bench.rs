@@ -25,7 +25,7 @@ pub fn sweep_rate(w: &World, sweeps: usize) -> f64 {
     let order: Vec<u32> = (0..rows.len() as u32).collect();
     let t0 = Instant::now();
     for _ in 0..sweeps {
-        dem::solver::sweep(&mut rows, &order, &mut vel, &inv, 1.0);
+        dem::sweep::sweep(&mut rows, &order, &mut vel, &inv, 1.0);
     }
     let secs = t0.elapsed().as_secs_f64();
     std::hint::black_box(&rows);

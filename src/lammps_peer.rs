@@ -206,9 +206,7 @@ impl PeerColumn {
                         return Err(bad("walls of different materials"));
                     }
                 }
-                (Shape::Disk { offset, .. }, BodyKind::Grain)
-                    if *offset == Vector::zeros() =>
-                {
+                (Shape::Disk { offset, .. }, BodyKind::Grain) if *offset == Vector::zeros() => {
                     if grain_mat
                         .replace(c.material)
                         .is_some_and(|m| m != c.material)

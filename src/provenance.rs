@@ -7,13 +7,12 @@
 //! the same time would have written. The date is the current UTC time, or the time given by the
 //! environment variable `SOURCE_DATE_EPOCH` (seconds since 1970-01-01T00:00:00Z, the
 //! reproducible-builds convention) when it is set, for outputs that must not depend on when they
-//! were made.
+//! were made. The provenance of a law is made from it by
+//! [`RunControl::law_provenance`](crate::scenarios::RunControl::law_provenance).
 
 use datasets::LoadedScenario;
-use identify::law::{epoch_seconds, sha256_hex, utc_date, InputFile, Provenance};
+use identify::law::{epoch_seconds, sha256_hex, utc_date, InputFile};
 use serde::{Deserialize, Serialize};
-
-use crate::scenarios::{RunContext, RunControl};
 
 /// What a run records about its start: the date and the input files with their SHA-256.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -45,15 +44,4 @@ impl RunOrigin {
             inputs,
         }
     }
-}
-
-/// The provenance of a law fitted by the run of `ctx` under `ctl`: scenario kind `scenario`,
-/// its seed, the `--set` overrides, the source (`builtin:NAME` or the TOML path), and the date
-/// and inputs of [`RunControl::origin`].
-pub fn of_run(ctx: &RunContext, ctl: &RunControl, scenario: &str, seed: u64) -> Provenance {
-    let mut p = Provenance::new(scenario, Some(seed)).with_overrides(ctl.sets.clone());
-    p.date = ctl.origin.date.clone();
-    p.inputs = ctl.origin.inputs.clone();
-    p.source = Some(ctx.loaded.source.clone());
-    p
 }

@@ -250,7 +250,7 @@ fn box_world(
             parallel: run.parallel,
             // The benchmark measures Gauss–Seidel at a fixed sweep cap (the published tables);
             // one Newton iteration on 10⁴ grains costs as much as hundreds of sweeps.
-            method: dem::solver::SolverMethod::Nlgs,
+            method: dem::fc::SolverMethod::Nlgs,
             max_halvings: run.max_halvings,
             check_every: run.check_every,
             last_level_sweeps: match run.max_halvings {

@@ -152,7 +152,7 @@ pub struct PhaseStats {
 
 /// Cost of one Newton iteration (a sparse LU of the step's problem) in sweeps, for
 /// [`PhaseStats::mean_solve_cost`]: about 20 on 700-contact columns
-/// ([`dem::solver::AUTO_HORIZON`]).
+/// ([`dem::fc::auto::AUTO_HORIZON`]).
 pub const NEWTON_ITERATION_SWEEPS: f64 = 20.0;
 
 /// Cost of one pivot of Lemke's method in sweeps, for [`PhaseStats::mean_solve_cost`]: the
@@ -573,7 +573,7 @@ mod tests {
         let mut w = stack(3, 1e-3, 0.0, 0.0, 1.0);
         w.params.dt = 1e-4;
         w.params.solver.max_iterations = 1;
-        w.params.solver.method = dem::solver::SolverMethod::Nlgs;
+        w.params.solver.method = dem::fc::SolverMethod::Nlgs;
         let run = RunUntilRest {
             min_time: 0.0,
             max_time: 0.1,

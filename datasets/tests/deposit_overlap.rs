@@ -28,7 +28,7 @@ fn fast_approaches(overlap_rate: f64, steps: usize) -> (usize, f64) {
     w.params.solver.max_iterations = 1000;
     // The criterion in isolation: Gauss–Seidel alone (Newton converges far below the tolerance
     // and hides it) and no position correction (which removes the overlaps it would leave).
-    w.params.solver.method = dem::solver::SolverMethod::Nlgs;
+    w.params.solver.method = dem::fc::SolverMethod::Nlgs;
     w.params.position_correction = false;
     w.params.overlap_rate = overlap_rate;
     let r_min = w

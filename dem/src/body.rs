@@ -166,3 +166,17 @@ impl From<&Body> for BodyState {
         }
     }
 }
+
+/// Gravity `g` (if it acts on the body) plus the applied force and torque, `(f_x, f_y, torque)`.
+pub fn external_loads(b: &Body, g: Vector2<f64>) -> [f64; 3] {
+    let grav = if b.gravity {
+        g * b.mass
+    } else {
+        Vector2::zeros()
+    };
+    [
+        grav.x + b.applied_force.x,
+        grav.y + b.applied_force.y,
+        b.applied_torque,
+    ]
+}

@@ -47,6 +47,9 @@ pub const DIM: usize = 2;
 pub type Vect = SVector<f64, DIM>;
 /// A matrix of the cell's space (cell matrix `h` in m, velocity gradient `L` in 1/s, stress in Pa).
 pub type Mat = SMatrix<f64, DIM, DIM>;
+
+/// The components `(i, j)` of `L` a cell control can impose a stress on: xx, yy, xy.
+pub const COMPONENTS: [(usize, usize); 3] = [(0, 0), (1, 1), (0, 1)];
 /// An integer lattice shift `k` (the image `x + h k`).
 pub type Shift = SVector<i64, DIM>;
 
@@ -378,7 +381,7 @@ impl CellControl {
         }
     }
 
-    /// What is imposed on xx, yy and xy, in that order ([`crate::cell_coupling::COMPONENTS`]).
+    /// What is imposed on xx, yy and xy, in that order ([`COMPONENTS`]).
     pub fn components(&self) -> [Imposed; 3] {
         [self.xx, self.yy, self.xy]
     }
@@ -396,12 +399,7 @@ impl CellControl {
     /// of the step (1/s).
     pub fn free_change(&self, l: &Mat, kinetic: &Mat) -> [f64; 3] {
         let mut d = [0.0; 3];
-        for (k, (c, ij)) in self
-            .components()
-            .into_iter()
-            .zip(crate::cell_coupling::COMPONENTS)
-            .enumerate()
-        {
+        for (k, (c, ij)) in self.components().into_iter().zip(COMPONENTS).enumerate() {
             if let Imposed::Stress(target) = c {
                 d[k] = l[ij].clamp(-self.max_rate, self.max_rate) - l[ij]
                     + self.gain * (target - kinetic[ij]);
@@ -416,11 +414,7 @@ impl CellControl {
     pub fn implicit_next(&self, l: &Mat) -> Mat {
         let mut out = *l;
         out[(1, 0)] = 0.0;
-        for (c, ij) in self
-            .components()
-            .into_iter()
-            .zip(crate::cell_coupling::COMPONENTS)
-        {
+        for (c, ij) in self.components().into_iter().zip(COMPONENTS) {
             if let Imposed::Rate(v) = c {
                 out[ij] = v;
             }

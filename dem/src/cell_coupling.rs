@@ -74,15 +74,12 @@
 //! grains). (Sweeping each class in fixed chunks with `δ` frozen and the chunks' increments
 //! added in chunk order is also deterministic, but is a Jacobi step on the cell's rank-3 term.)
 
-use crate::cell::{Cell, CellControl, Imposed, Mat};
+use crate::cell::{Cell, CellControl, Imposed, Mat, COMPONENTS};
 use crate::colouring::ContactColouring;
 use crate::contact::{ContactGeometry, ContactRow};
 use crate::local::Delassus2;
 use crate::parallel::coloured_sweep_where;
-use crate::solver::update;
-
-/// The components `(i, j)` of `L` a cell control can impose a stress on: xx, yy, xy.
-pub const COMPONENTS: [(usize, usize); 3] = [(0, 0), (1, 1), (0, 1)];
+use crate::sweep::update;
 
 /// No coupling slot.
 const NONE: u32 = u32::MAX;

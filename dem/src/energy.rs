@@ -9,25 +9,9 @@
 //! `δ = ΔK − W_ext − W_drive ≤ 0` (Moreau 1988; Acary & Brogliato 2008, §7.2): [`EnergyProbe`]
 //! measures it. The position correction ([`crate::stabilise`]) moves no velocity and is not in δ.
 
-use nalgebra::Vector2;
-
-use crate::body::{Body, BodyKind, Dof};
+use crate::body::{external_loads, Body, BodyKind, Dof};
 use crate::cell::Imposed;
 use crate::world::World;
-
-/// Gravity `g` (if it acts on the body) plus the applied force and torque, `(f_x, f_y, torque)`.
-pub fn external_loads(b: &Body, g: Vector2<f64>) -> [f64; 3] {
-    let grav = if b.gravity {
-        g * b.mass
-    } else {
-        Vector2::zeros()
-    };
-    [
-        grav.x + b.applied_force.x,
-        grav.y + b.applied_force.y,
-        b.applied_torque,
-    ]
-}
 
 /// [`external_loads`] on the free degrees of freedom of `b`, zero on imposed ones.
 pub fn free_loads(world: &World, b: &Body) -> [f64; 3] {
@@ -157,6 +141,7 @@ mod tests {
     use super::*;
     use crate::cell::{Cell, CellControl};
     use crate::{ContactLaws, WorldParams};
+    use nalgebra::Vector2;
 
     /// Without gravity, the scale of a cell under imposed σ_xx = σ_yy = −100 Pa (rate-controlled
     /// shear) is the work of both stresses over one mean diameter, 2 · 100 Pa · √V · d̄, exactly;

@@ -11,7 +11,9 @@
 //! - [`measure`]: the error measure (Siconos' fc2d error);
 //! - [`nsgs`]: nonlinear block Gauss–Seidel with the exact local solver of [`crate::local`];
 //! - [`newton`]: a proximal semismooth Newton method for dense, hyperstatic problems;
-//! - [`method`]: one entry point choosing between them (`nlgs`, `newton`, `auto`);
+//! - [`method`]: one entry point choosing between them (`nlgs`, `newton`, `lemke`, `auto`);
+//! - [`auto`]: the `auto` composite (Gauss–Seidel, Newton, the exact finish) and its stages,
+//!   shared with the engine's solver, which uses this layer (nothing here imports the engine);
 //! - [`crate::assemble`]: the problem of an engine step, for the Newton solver and for files;
 //! - [`ordering`]: contact orderings of the sweeps;
 //! - [`crate::anderson`]: Anderson acceleration of the sweeps (shared with the engine);
@@ -62,6 +64,7 @@
 //!   projecting the mixed iterate on the cones, restarting Anderson on a non-decreasing step.
 //! - Warm start ([`FcOptions::initial_guess`]) from a solution stops at once (0 sweeps).
 
+pub mod auto;
 pub mod block_csr;
 pub mod error;
 pub mod lemke;

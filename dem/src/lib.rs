@@ -58,6 +58,7 @@ pub mod snapshot;
 pub mod solver;
 pub mod stabilise;
 pub mod step_control;
+pub mod sweep;
 pub mod wavefront;
 pub mod world;
 

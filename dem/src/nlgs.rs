@@ -2,6 +2,17 @@
 //! ([`crate::solver`]) and the standalone one ([`crate::fc::nsgs`]): the iteration, its Anderson
 //! acceleration and the safeguard of that acceleration, written once.
 //!
+//! One driver, two problems. [`drive`] is the only NLGS iteration of the crate; what differs is
+//! the problem it sweeps ([`SweepProblem`]):
+//!
+//! | problem | where | its sweep | driven by |
+//! |---|---|---|---|
+//! | the engine's step (`solver::Step`) | [`crate::solver`] | O(1) per contact, body velocities kept current, `W` never assembled | `solver::nlgs_stage`, the Gauss–Seidel stage of [`crate::solver::solve`] |
+//! | a standalone problem (`fc::nsgs::FcSweeps`) | [`crate::fc::nsgs`] | the rows of an assembled `W` (block CSR, sweep order) | [`crate::fc::nsgs::solve`] |
+//!
+//! "NSGS" (Siconos' name, kept for the standalone module) and "NLGS" name the same iteration;
+//! [`crate::fc::SolverMethod::Nlgs`] selects it for either problem.
+//!
 //! A problem ([`SweepProblem`]) holds impulses `r ∈ ℝ^{2n}` (`(r_n, r_t)` per contact) and knows
 //! how to do one Gauss–Seidel sweep `r ← G(r)` (each contact's local problem solved exactly with
 //! the others fixed), how to evaluate the true error measure `e(r)` of

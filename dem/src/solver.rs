@@ -37,51 +37,21 @@ use crate::assemble::contact_problem_with;
 use crate::cell_coupling::CellCoupling;
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
-use crate::fc::method::{exact_finish, Finish};
+use crate::fc::auto::{run_auto, AutoStages, Backoff};
+use crate::fc::method::{exact_finish, Finish, SolverMethod};
 use crate::fc::newton::{self, NewtonParams, NewtonWork};
 use crate::fc::FcOptions;
-use crate::local::{natural_map_residual, select, ContactStatus};
+use crate::local::{natural_map_residual, select};
 use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
 use crate::parallel::{
-    coloured_sweep, local_update, max_over, reduce_chunks, runs_inline, scatter_velocities, CHUNK,
+    coloured_sweep, max_over, reduce_chunks, runs_inline, scatter_velocities, CHUNK,
     MIN_CHUNKS_PER_TASK,
 };
+use crate::sweep::{sweep, update};
 use crate::wavefront::Wavefront;
 
-/// Which algorithm solves the contact problem of a step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SolverMethod {
-    /// Nonlinear Gauss–Seidel only (this module): O(1) per contact update, fast on loose and
-    /// flowing packings, slow to carry a load change across a dense, hyperstatic one.
-    Nlgs,
-    /// The regularised semismooth Newton method of [`crate::fc::newton`] on the assembled
-    /// problem, from the warm start.
-    Newton,
-    /// Gauss–Seidel in chunks of [`SolverParams::auto_sweeps`] sweeps while it converges fast
-    /// enough, then, if it has not converged, Newton from its best iterate, then the exact
-    /// finish ([`crate::fc::method::exact_finish`]: the active-set solve, then Lemke's method),
-    /// then Gauss–Seidel for the sweeps left if all of these failed (the default).
-    #[default]
-    Auto,
-    /// Lemke's complementary pivoting method ([`crate::fc::lemke`]) on the assembled problem,
-    /// warm-started from the statuses of the stored impulses: an exact solution at the cost of
-    /// a few sparse pivots per contact, whatever the packing; Gauss–Seidel takes over if the
-    /// path fails.
-    Lemke,
-}
-
-impl SolverMethod {
-    /// The name used in TOML files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            SolverMethod::Nlgs => "nlgs",
-            SolverMethod::Newton => "newton",
-            SolverMethod::Auto => "auto",
-            SolverMethod::Lemke => "lemke",
-        }
-    }
-}
+/// The status of a contact, and of each contact, from its impulse (the step reads them here).
+pub use crate::sweep::{classify, status};
 
 /// The scale a solve's convergence is judged on ([`SolverParams::error_scale`]).
 ///
@@ -154,7 +124,7 @@ pub struct SolverParams {
     pub method: SolverMethod,
     /// Gauss–Seidel sweeps between two progress checks of `auto`: Newton takes over after a
     /// chunk whose rate would not reach the tolerance within the sweep cap
-    /// ([`gauss_seidel_will_finish`]).
+    /// ([`crate::fc::auto::gauss_seidel_will_finish`]).
     #[serde(default = "auto_sweeps")]
     pub auto_sweeps: usize,
     /// Parameters of the Newton solver (`newton` and `auto`).
@@ -222,31 +192,6 @@ fn auto_sweeps() -> usize {
 pub fn lemke_max_contacts() -> usize {
     0
 }
-
-/// The stall test of `auto`: Gauss–Seidel, whose error went from `before` to `after` over the
-/// last `chunk` sweeps, continues when at that linear rate it reaches `tolerance` within
-/// `left` sweeps and [`AUTO_HORIZON`] chunks, `chunk · ln(tol/after) / ln(after/before) ≤
-/// min(left, AUTO_HORIZON · chunk)`. One Newton iteration costs
-/// as much as 10–1000 sweeps on the reference problems, so a Gauss–Seidel that converges is
-/// left to finish; Newton takes over where the sweeps stall.
-pub fn gauss_seidel_will_finish(
-    before: f64,
-    after: f64,
-    chunk: usize,
-    tolerance: f64,
-    left: usize,
-) -> bool {
-    if left == 0 || after.is_nan() || after >= before || after <= 0.0 {
-        return false;
-    }
-    let needed = chunk as f64 * (tolerance / after).ln() / (after / before).ln();
-    needed <= (left as f64).min((AUTO_HORIZON * chunk) as f64)
-}
-
-/// `auto` hands over to Newton when Gauss–Seidel would need more than this many chunks to reach
-/// the tolerance at its current rate (on 700-contact columns a Newton iteration costs about 20
-/// sweeps, and the ones Gauss–Seidel cannot finish in 400 sweeps are those it stalls on).
-pub const AUTO_HORIZON: usize = 4;
 
 fn anderson_memory() -> usize {
     4
@@ -388,41 +333,6 @@ pub fn free_velocity_norms(rows: &[ContactRow], vel: &[[f64; 3]]) -> [f64; 2] {
     [s.sqrt(), w.sqrt()]
 }
 
-/// Update of one contact: exact local solve, optional relaxation projected back on the cone,
-/// velocities of its two bodies updated. O(1).
-/// Returns whether the impulse changed.
-#[inline(always)]
-pub(crate) fn update(
-    c: &mut ContactRow,
-    vel: &mut [[f64; 3]],
-    inv: &[[f64; 3]],
-    omega: f64,
-) -> bool {
-    let (a, b) = (c.a as usize, c.b as usize);
-    let (mut va, mut vb) = (vel[a], vel[b]);
-    let changed = local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega);
-    if changed {
-        vel[a] = va;
-        vel[b] = vb;
-    }
-    changed
-}
-
-/// One Gauss–Seidel sweep over `rows` in the order given by `order`, with relaxation `omega`.
-/// (Alternating forward and backward sweeps was tried and converged worse; see `fc`.)
-#[inline]
-pub fn sweep(
-    rows: &mut [ContactRow],
-    order: &[u32],
-    vel: &mut [[f64; 3]],
-    inv: &[[f64; 3]],
-    omega: f64,
-) {
-    for &i in order {
-        update(&mut rows[i as usize], vel, inv, omega);
-    }
-}
-
 /// [`sweep`] (the same impulses and velocities, bit for bit), handing `record(α, r_before,
 /// r_after)` each contact's impulses as it goes (the drive's copies before and after a sweep,
 /// without two more passes) and returning `(Σ_α ‖Δr_α‖², Σ_α ‖r_α‖²)` over the sweep (the
@@ -543,7 +453,7 @@ impl SweepOrder<'_> {
 ///
 /// `nlgs` sweeps up to `max_iterations` times ([`crate::nlgs::drive`]); `newton` assembles the
 /// step's problem ([`crate::assemble::contact_problem`]) and runs [`crate::fc::newton`] from the
-/// warm start, then sweeps for what is left; `auto` follows `run_auto` (sweeps while they
+/// warm start, then sweeps for what is left; `auto` follows [`crate::fc::auto::run_auto`] (sweeps while they
 /// converge fast enough, Newton, sweeps), with the back-off of [`NewtonBackoff`]. In every mode
 /// `max_iterations` bounds the sweeps in all, smoothing sweeps included.
 ///
@@ -624,7 +534,7 @@ fn solve_step(step: &mut Step, params: &SolverParams, work: &mut SolverWork) -> 
         ..
     } = work;
     if params.method == SolverMethod::Nlgs {
-        return nlgs(step, params, params.max_iterations, drive_work);
+        return nlgs_stage(step, params, params.max_iterations, drive_work);
     }
     if backoff.params != Some(*params) {
         // New solver settings (a new phase): Newton gets a fresh chance.
@@ -655,7 +565,7 @@ fn solve_step(step: &mut Step, params: &SolverParams, work: &mut SolverWork) -> 
             newton_iterations,
             ..
         } = stages.report;
-        let r = nlgs(
+        let r = nlgs_stage(
             stages.step,
             params,
             params.max_iterations,
@@ -678,89 +588,6 @@ fn solve_step(step: &mut Step, params: &SolverParams, work: &mut SolverWork) -> 
     stages.report
 }
 
-/// The two stages that `auto` alternates ([`run_auto`]), as the engine and standalone problems
-/// ([`crate::fc::solve_by`]) provide them. Each continues from the current iterate.
-pub(crate) trait AutoStages {
-    /// What a stage can fail with.
-    type Error;
-    /// At most `sweeps` Gauss–Seidel sweeps: `(sweeps done, error, converged)`.
-    fn sweeps(&mut self, sweeps: usize) -> Result<(usize, f64, bool), Self::Error>;
-    /// The Newton stage, with at most `sweeps` smoothing sweeps: `(smoothing sweeps, converged)`.
-    fn newton(&mut self, sweeps: usize) -> Result<(usize, bool), Self::Error>;
-    /// The exact finish ([`crate::fc::method::exact_finish`]: the active-set solve, then, if
-    /// `lemke`, Lemke's method) from the current iterate, kept when it lowers the error:
-    /// whether the solve has now converged, and whether Lemke's method ran.
-    fn finish(&mut self, lemke: bool) -> Result<(bool, bool), Self::Error>;
-}
-
-/// The `auto` schedule, for both the engine and `solve-fc`: Gauss–Seidel in chunks of `chunk`
-/// sweeps as long as [`gauss_seidel_will_finish`] (from the error `start_error` of the starting
-/// iterate); then, unless `backoff` says to skip it, Newton; then the exact finish (the
-/// active-set solve, then Lemke's method); then, if that failed, Gauss–Seidel for the sweeps
-/// left of `max_sweeps` and one more active-set solve from where they end. `chunk = 0` goes
-/// straight to Newton (the `newton` method). The back-off records the Newton stage's outcome.
-/// The stages keep their own report.
-pub(crate) fn run_auto<S: AutoStages>(
-    stages: &mut S,
-    start_error: f64,
-    chunk: usize,
-    tolerance: f64,
-    max_sweeps: usize,
-    backoff: Option<&mut NewtonBackoff>,
-) -> Result<(), S::Error> {
-    let (mut done, mut error, converged) = stages.sweeps(chunk.min(max_sweeps))?;
-    if converged {
-        return Ok(());
-    }
-    let mut reference = start_error;
-    while chunk > 0
-        && gauss_seidel_will_finish(reference, error, chunk, tolerance, max_sweeps - done)
-    {
-        reference = error;
-        let (n, e, c) = stages.sweeps(chunk.min(max_sweeps - done))?;
-        (done, error) = (done + n, e);
-        if c {
-            return Ok(());
-        }
-    }
-    let mut backoff = backoff;
-    match backoff.as_deref_mut() {
-        Some(b) if b.skip > 0 => {
-            // Newton failed on a recent step: Gauss–Seidel alone for the sweeps left.
-            b.skip -= 1;
-        }
-        b => {
-            let (used, converged) = stages.newton(max_sweeps - done)?;
-            if let Some(b) = b {
-                b.record(converged);
-            }
-            done += used;
-            if converged {
-                return Ok(());
-            }
-        }
-    }
-    let lemke = match backoff.as_deref_mut() {
-        Some(b) if b.lemke_skip > 0 => {
-            // Lemke's path failed on a recent step.
-            b.lemke_skip -= 1;
-            false
-        }
-        _ => true,
-    };
-    let (converged, lemke_ran) = stages.finish(lemke)?;
-    if let (Some(b), true) = (backoff, lemke_ran) {
-        b.record_lemke(converged);
-    }
-    if converged {
-        return Ok(());
-    }
-    if done < max_sweeps && !stages.sweeps(max_sweeps - done)?.2 {
-        stages.finish(false)?;
-    }
-    Ok(())
-}
-
 /// The engine's stages of [`run_auto`], accumulating one [`SolveReport`].
 struct EngineStages<'s, 'a> {
     step: &'s mut Step<'a>,
@@ -774,7 +601,7 @@ impl AutoStages for EngineStages<'_, '_> {
     type Error = std::convert::Infallible;
 
     fn sweeps(&mut self, sweeps: usize) -> Result<(usize, f64, bool), Self::Error> {
-        let r = nlgs(self.step, self.params, sweeps, self.drive_work);
+        let r = nlgs_stage(self.step, self.params, sweeps, self.drive_work);
         self.report = SolveReport {
             iterations: self.report.iterations + r.iterations,
             newton_iterations: self.report.newton_iterations,
@@ -887,7 +714,7 @@ struct Step<'a> {
     seed: u64,
     /// The cell's stress-controlled components as unknowns, if any ([`crate::cell_coupling`]).
     cell: Option<&'a mut CellCoupling>,
-    /// Whether the sweeps measure their change (set by [`nlgs`]: `check_every ≥ 1` and
+    /// Whether the sweeps measure their change (set by [`nlgs_stage`]: `check_every ≥ 1` and
     /// [`Step::can_measure`]); otherwise the contact loop does no more than [`sweep`]'s.
     measure: bool,
     /// The wavefront schedule of the natural order ([`crate::wavefront`]), used by its sweeps
@@ -952,7 +779,7 @@ impl SweepProblem for Step<'_> {
     }
 
     /// The relative change `‖Δr‖ / ‖r‖` of the sweep when [`Step::measure`] (measured as it
-    /// goes, for the check schedule of [`nlgs`]); `None` otherwise.
+    /// goes, for the check schedule of [`nlgs_stage`]); `None` otherwise.
     fn sweep(&mut self) -> Option<f64> {
         match (self.cell.as_deref_mut(), &mut self.order) {
             (Some(cell), SweepOrder::Natural(order)) => {
@@ -1163,7 +990,7 @@ fn global(
 /// clusters of sticking contacts (closed loops of grains). When the error has not halved over
 /// [`STALL_SWEEPS`] sweeps, the sweeps continue in a fresh pseudo-random order each time (seeded,
 /// so runs stay reproducible), which breaks the cycle.
-fn nlgs(
+fn nlgs_stage(
     step: &mut Step,
     params: &SolverParams,
     max_sweeps: usize,
@@ -1240,79 +1067,9 @@ impl SolverWork {
     }
 }
 
-/// Back-off of `auto`'s Newton stage: after a step where Newton did not converge, the next
-/// `skip` steps that stall use Gauss–Seidel alone; `skip` starts at 1 and doubles with every
-/// further failure (up to [`NewtonBackoff::MAX_SKIP`]); a converged Newton stage, or new solver
-/// settings, reset it.
-/// In a regime where Newton does not help (many contacts on the stick–slip boundary) this
-/// spares its cost on most steps while still trying it regularly. Part of the world's state
-/// (checkpointed), so a resumed run takes the same decisions.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct NewtonBackoff {
-    /// Stalled steps left before Newton is tried again.
-    pub skip: u32,
-    /// The `skip` that the next failure sets.
-    pub next: u32,
-    /// The solver settings this back-off was learnt with: other settings (a new phase, a
-    /// tighter tolerance) start afresh.
-    #[serde(default)]
-    pub params: Option<SolverParams>,
-    /// Stalled steps left before Lemke's method is tried again (the same doubling rule: a
-    /// path that ends on a ray, as in a jammed packing whose deformation is imposed, where the
-    /// contact problem has no solution, is not retried on every step).
-    #[serde(default)]
-    pub lemke_skip: u32,
-    /// The `lemke_skip` that the next failure of Lemke's method sets.
-    #[serde(default)]
-    pub lemke_next: u32,
-}
-
-impl NewtonBackoff {
-    /// Longest back-off (steps).
-    pub const MAX_SKIP: u32 = 8;
-
-    /// Records the outcome of a Newton stage.
-    pub fn record(&mut self, converged: bool) {
-        Self::update(&mut self.skip, &mut self.next, converged);
-    }
-
-    /// Records the outcome of Lemke's method (converged or not), as [`NewtonBackoff::record`].
-    pub fn record_lemke(&mut self, converged: bool) {
-        Self::update(&mut self.lemke_skip, &mut self.lemke_next, converged);
-    }
-
-    /// The doubling rule: reset on success, else skip `max(next, 1)` steps and double `next`
-    /// up to [`NewtonBackoff::MAX_SKIP`].
-    fn update(skip: &mut u32, next: &mut u32, converged: bool) {
-        if converged {
-            *skip = 0;
-            *next = 0;
-        } else {
-            *skip = (*next).max(1);
-            *next = (*skip * 2).min(Self::MAX_SKIP);
-        }
-    }
-}
-
-/// Status of each contact from its impulse ([`status`]).
-pub fn classify(rows: &[ContactRow], status: &mut [ContactStatus]) {
-    for (c, s) in rows.iter().zip(status.iter_mut()) {
-        *s = self::status(c);
-    }
-}
-
-/// Status of a contact from its impulse: open when `r_n ≤ 0`, sliding when on the cone's
-/// boundary (`|r_t| ≥ μ r_n (1 − 10⁻⁹)`), sticking otherwise.
-#[inline]
-pub fn status(c: &ContactRow) -> ContactStatus {
-    if c.r[0] <= 0.0 {
-        ContactStatus::Open
-    } else if c.r[1].abs() >= c.mu * c.r[0] * (1.0 - 1e-9) {
-        ContactStatus::Slide
-    } else {
-        ContactStatus::Stick
-    }
-}
+/// The back-off of the engine's `auto` ([`Backoff`]), learnt with a step's [`SolverParams`]:
+/// part of the world's state (checkpointed).
+pub type NewtonBackoff = Backoff<SolverParams>;
 
 #[cfg(test)]
 mod tests {

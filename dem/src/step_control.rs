@@ -44,7 +44,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::energy::EnergyProbe;
 use crate::error::DemError;
-use crate::solver::SolverMethod;
+use crate::fc::SolverMethod;
 use crate::stabilise::CorrectionReport;
 use crate::world::{StepReport, World};
 

@@ -77,7 +77,7 @@ impl Wavefront {
             self.depth[a] = d + 1;
             self.depth[b] = d + 1;
             depths = depths.max(d + 1);
-            let status = match crate::solver::status(c) {
+            let status = match crate::sweep::status(c) {
                 ContactStatus::Open => 0,
                 ContactStatus::Stick => 1,
                 ContactStatus::Slide => 2,
@@ -106,7 +106,7 @@ impl Wavefront {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::sweep;
+    use crate::sweep::sweep;
 
     /// A ring of disks `0–1–2–…–0` with contacts between neighbours, plus contacts of every
     /// fourth disk on a wall (body `n`).
@@ -270,9 +270,10 @@ mod tests {
     /// each and the best iterate returned (the drive's rule for a solve that does not converge).
     #[test]
     fn solve_in_natural_order_equals_sweeps_in_the_given_order() {
+        use crate::fc::SolverMethod;
         use crate::solver::{
-            apply_impulses, error_measure, free_velocity_norms, solve, SolverMethod, SolverParams,
-            SolverWork, SweepOrder,
+            apply_impulses, error_measure, free_velocity_norms, solve, SolverParams, SolverWork,
+            SweepOrder,
         };
         let n = 60;
         let mut rows0 = rows(n);

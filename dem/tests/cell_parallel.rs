@@ -6,7 +6,7 @@ mod common;
 use common::fingerprint;
 
 use dem::cell::{Cell, CellControl, Imposed, Mat, Vect};
-use dem::solver::SolverMethod;
+use dem::fc::SolverMethod;
 use dem::{ContactLaws, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};

@@ -114,7 +114,7 @@ fn predicted_error_checks_keep_every_step_converged() {
         w.params.dt = 2e-4;
         w.params.solver.tolerance = 1e-6;
         w.params.solver.max_iterations = 5_000;
-        w.params.solver.method = dem::solver::SolverMethod::Nlgs;
+        w.params.solver.method = dem::fc::SolverMethod::Nlgs;
         w.params.solver.check_every = check_every;
         let scale = energy_scale(&w);
         let (mut sweeps, mut worst, mut unconverged) = (0, f64::MIN, 0);

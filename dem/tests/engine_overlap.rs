@@ -274,7 +274,7 @@ fn a_sheared_dense_packing_keeps_its_overlaps_below_a_thousandth_of_the_radius()
     let solver = SolverParams {
         tolerance: 1e-5,
         max_iterations: 300,
-        method: dem::solver::SolverMethod::Nlgs,
+        method: dem::fc::SolverMethod::Nlgs,
         ..Default::default()
     };
     let mut w = sheared_strip(300, 30, solver, true);
@@ -317,7 +317,7 @@ fn compressed_crystal(nx: usize, ny: usize) -> World {
             tolerance: 1e-5,
             max_iterations: 100,
             parallel: true,
-            method: dem::solver::SolverMethod::Nlgs,
+            method: dem::fc::SolverMethod::Nlgs,
             ..Default::default()
         },
         ..Default::default()

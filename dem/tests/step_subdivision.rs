@@ -178,7 +178,7 @@ fn state_json(w: &World) -> String {
 #[test]
 fn energy_check_polishes_a_converged_step_at_a_tenth_of_the_tolerance() {
     let mut base = settled_box();
-    base.params.solver.method = dem::solver::SolverMethod::Nlgs;
+    base.params.solver.method = dem::fc::SolverMethod::Nlgs;
     base.params.solver.tolerance = 1e-6;
     base.params.solver.max_iterations = 20_000;
     base.params.solver.max_halvings = 2;
@@ -228,7 +228,7 @@ fn energy_check_polishes_a_converged_step_at_a_tenth_of_the_tolerance() {
     assert!(!d.polished);
     assert_eq!(d.substeps, e.substeps);
     assert_eq!((q.params.dt, q.params.solver.tolerance), (h, 1e-6));
-    assert_eq!(q.params.solver.method, dem::solver::SolverMethod::Nlgs);
+    assert_eq!(q.params.solver.method, dem::fc::SolverMethod::Nlgs);
     assert_eq!(state_json(&q), state_json(&plain));
     assert_eq!(
         d.discarded_sweeps, sweeps,
@@ -286,7 +286,7 @@ fn a_world_returned_to_its_undo_point_steps_as_a_clone() {
 #[test]
 fn the_largest_subdivision_may_sweep_a_multiple_of_the_cap() {
     let mut base = settled_box();
-    base.params.solver.method = dem::solver::SolverMethod::Nlgs;
+    base.params.solver.method = dem::fc::SolverMethod::Nlgs;
     base.params.solver.max_iterations = 3;
     base.params.solver.max_halvings = 1;
     let mut capped = base.clone();

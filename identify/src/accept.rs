@@ -34,8 +34,9 @@
 //! A refusal offers the simpler form the data support, when the law has one
 //! ([`IdentifyError::suggestion`]).
 
-use crate::error::{min_max, BoundSide, IdentifyError, Result, ScaleSide, Suggestion};
+use crate::error::{BoundSide, IdentifyError, Result, ScaleSide, Suggestion};
 use crate::report::{Estimate, FitReport};
+use crate::stats::min_max;
 
 /// Default threshold of [`check_r_squared`]: a law must explain at least half of the variance
 /// of its data, `R² ≥ 0.5`.

@@ -12,6 +12,7 @@
 //! the column. Computed numbers in messages are printed short ([`short`]).
 
 use crate::report::FitReport;
+use crate::stats::min_max;
 
 /// Which side of a box constraint a parameter ended on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -580,15 +581,6 @@ pub(crate) fn check_setup_positive(field: &str, value: f64) -> Result<()> {
         });
     }
     Ok(())
-}
-
-/// Smallest and largest value (`(+∞, −∞)` for an empty slice).
-pub(crate) fn min_max(values: &[f64]) -> (f64, f64) {
-    values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        })
 }
 
 #[cfg(test)]

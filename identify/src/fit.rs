@@ -330,7 +330,7 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
     for (g, name) in obs.group_names.iter().enumerate() {
         let values: Vec<f64> = group_values(obs, g);
         check_finite(name, &values)?;
-        let (lo, hi) = crate::error::min_max(&values);
+        let (lo, hi) = crate::stats::min_max(&values);
         if values.len() > 1 && hi - lo <= 1e-14 * lo.abs().max(hi.abs()) {
             return Err(IdentifyError::ZeroVariance {
                 column: name.clone(),

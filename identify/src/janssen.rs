@@ -28,13 +28,14 @@ use serde::{Deserialize, Serialize};
 use crate::accept::{r_squared_of, Acceptance, NestedForm, PhysicalRange};
 use crate::error::{
     check_finite, check_non_negative_pressure, check_same_len, check_setup_positive, check_spread,
-    min_max, BoundSide, IdentifyError, Result,
+    BoundSide, IdentifyError, Result,
 };
 use crate::fit::{
     fit_least_squares, log_grid, FitOptions, LeastSquaresModel, Observations, ParameterSpec,
 };
 use crate::laws::janssen::{janssen_shape, JanssenLaw, JanssenVerticalLaw, STANDARD_GRAVITY};
 use crate::report::{Estimate, FitReport, ValidityRange};
+use crate::stats::min_max;
 use nalgebra::DMatrix;
 
 /// What a refusal of the joint fit offers when `μ_w` reaches the wall friction.

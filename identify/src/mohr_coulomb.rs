@@ -52,7 +52,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::accept::{Acceptance, NestedForm, PhysicalRange};
 use crate::error::{
-    check_finite, check_non_negative_pressure, check_same_len, check_spread, min_max, BoundSide,
+    check_finite, check_non_negative_pressure, check_same_len, check_spread, BoundSide,
     IdentifyError, Result,
 };
 use crate::laws::mohr_coulomb::{p_q_from_tension_positive, MohrCoulombLaw};
@@ -60,6 +60,7 @@ use crate::report::{
     correlation_of, matrix_rows, Estimate, FitReport, GroupSummary, ValidityRange,
 };
 use crate::stats;
+use crate::stats::min_max;
 
 /// Stress states at yield (data). Compressive-positive magnitudes, Pa.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -217,7 +217,7 @@ pub fn fit_mu_i(series: &RheologySeries, options: &FitOptions) -> Result<MuIFit>
         Some(s) => e.suggesting(s),
         None => e,
     };
-    let (i_min, i_max) = crate::error::min_max(i);
+    let (i_min, i_max) = crate::stats::min_max(i);
     let grid = log_grid(1e-2 * i_min, 1e2 * i_max, 121);
     let (i0, c) = separable_start(&grid, mu, |i0| {
         DMatrix::from_fn(

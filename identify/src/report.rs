@@ -69,7 +69,7 @@ pub struct ValidityRange {
 impl ValidityRange {
     /// Range of `values` (min, max).
     pub fn of(variable: &str, unit: &str, values: &[f64]) -> Self {
-        let (min, max) = crate::error::min_max(values);
+        let (min, max) = crate::stats::min_max(values);
         ValidityRange {
             variable: variable.to_string(),
             unit: unit.to_string(),

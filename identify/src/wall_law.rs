@@ -28,8 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::accept::{check_scale, Acceptance, ScaleCheck};
 use crate::error::{
-    check_finite, check_same_len, check_setup_positive, check_spread, min_max, IdentifyError,
-    Result,
+    check_finite, check_same_len, check_setup_positive, check_spread, IdentifyError, Result,
 };
 use crate::fit::{
     fit_least_squares, log_grid, separable_start, FitOptions, LeastSquaresModel, Observations,
@@ -39,6 +38,7 @@ use crate::laws::boundary_layer::VelocityBoundaryLayer;
 use crate::laws::janssen::STANDARD_GRAVITY;
 use crate::laws::wall_friction::WallFrictionLaw;
 use crate::report::{Estimate, FitReport, ModelComparison, ValidityRange};
+use crate::stats::min_max;
 
 /// Wall friction against slip velocity (data).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -5,8 +5,9 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use dem::fc::SolverMethod;
 use dem::snapshot::BodyKind;
-use dem::solver::{ErrorScale, SolverMethod};
+use dem::solver::ErrorScale;
 use dem::{ContactLaws, SolverParams, WorldParams};
 
 use crate::arrays::{finite1, out1, out2, rows2};

@@ -271,7 +271,7 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
             )));
         }
     }
-    crate::cli::check_out_dir(&plan.out, "continuum-column-collapse")?;
+    crate::output::dir::check_out_dir(&plan.out, "continuum-column-collapse")?;
     let started = std::time::Instant::now();
     let mut out = OutputDir::create(&plan.out)?;
     let gerris_cmd = gerris::command(plan.gerris.as_deref());

@@ -262,7 +262,7 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
             )));
         }
     }
-    crate::cli::check_out_dir(&plan.out, "continuum-inclined-plane")?;
+    crate::output::dir::check_out_dir(&plan.out, "continuum-inclined-plane")?;
     let mut out = OutputDir::create(&plan.out)?;
     let case_dir = plan.out.join("gerris");
     let case = InclinedCase {

@@ -93,6 +93,30 @@ impl OutputDir {
     }
 }
 
+/// Refuses an output directory that is a file, or that holds the outputs of a run of another
+/// scenario (its `scenario.toml` names it): the files of two scenarios would mix. A directory
+/// of an earlier run of the same scenario is reused (its stale `summary.json` is removed first).
+pub(crate) fn check_out_dir(dir: &Path, kind: &str) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(CliError::Usage(format!(
+            "--out {}: is a file, not a directory",
+            dir.display()
+        )));
+    }
+    let toml = dir.join("scenario.toml");
+    let there = std::fs::read_to_string(&toml)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .and_then(|t| t.get("scenario").and_then(|v| v.as_str()).map(String::from));
+    match there {
+        Some(other) if other != kind => Err(CliError::Usage(format!(
+            "--out {}: holds the outputs of a `{other}` run, not `{kind}`: choose another directory or remove it",
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename;
 /// [`dem::atomic`]), creating the directory if needed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {

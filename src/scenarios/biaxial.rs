@@ -1680,7 +1680,7 @@ fn analyse(
     let d = mean_diameter(world);
     write_tables(c, pressures, &mut ctx.out, d, rows, dilatancy)?;
     let (s, headline) = pressure_summary(c, d, rows, ctx.out.path());
-    let provenance = crate::provenance::of_run(ctx, ctl, "biaxial", c.seed);
+    let provenance = ctl.law_provenance(ctx, "biaxial", c.seed);
     let mut rep = Report {
         out: &mut ctx.out,
         s,

@@ -3,26 +3,18 @@
 //! `summary.json`.
 
 use datasets::phases::{
-    continue_steps, continue_until_rest, PhaseProgress, PhaseStats, RunUntilRest,
-    ENERGY_GROWTH_TOLERANCE, PENETRATION_LIMIT,
+    continue_steps, continue_until_rest, PhaseProgress, PhaseStats, ENERGY_GROWTH_TOLERANCE,
+    PENETRATION_LIMIT,
 };
 use dem::{StepReport, World};
 use serde::{Deserialize, Serialize};
 
 use super::PhaseEnv;
+pub use crate::checkpoint::Stop;
 use crate::error::{CliError, Result};
 use crate::output::vtk::VtkSeries;
 use crate::output::{OutputDir, Summary};
 use crate::progress::{warn, Phase};
-
-/// When a phase stops.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Stop {
-    /// At rest (kinetic energy criterion) or at the time limit.
-    UntilRest(RunUntilRest),
-    /// After a number of steps.
-    Steps(u64),
-}
 
 /// Runs `world` through one phase with a progress bar, from `progress` (default for a new
 /// phase; kept up to date, so that a checkpoint can save it). `each` is called after every step

@@ -21,6 +21,7 @@ use std::time::Instant;
 
 use datasets::phases::{PhaseProgress, PhaseStats};
 use dem::{StepReport, World};
+use identify::law::Provenance;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
@@ -91,6 +92,17 @@ impl Default for RunControl {
 }
 
 impl RunControl {
+    /// The provenance of a law fitted by the run of `ctx` under this control: scenario kind
+    /// `scenario`, its seed, the `--set` overrides, the source (`builtin:NAME` or the TOML
+    /// path), and the date and inputs of [`RunControl::origin`].
+    pub fn law_provenance(&self, ctx: &RunContext, scenario: &str, seed: u64) -> Provenance {
+        let mut p = Provenance::new(scenario, Some(seed)).with_overrides(self.sets.clone());
+        p.date = self.origin.date.clone();
+        p.inputs = self.origin.inputs.clone();
+        p.source = Some(ctx.loaded.source.clone());
+        p
+    }
+
     /// A new run with these overrides and checkpoint policy.
     pub fn new(sets: Vec<String>, policy: CheckpointPolicy) -> Self {
         let now = Instant::now();

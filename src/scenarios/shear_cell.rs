@@ -996,7 +996,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
         mu_std_error: None,
         phi_std_error: None,
     };
-    let provenance = crate::provenance::of_run(ctx, ctl, "shear-cell", c.seed);
+    let provenance = ctl.law_provenance(ctx, "shear-cell", c.seed);
     let prov = || provenance.clone();
     let mut s = Summary::new();
     s.int("grains", c.grains as u64)

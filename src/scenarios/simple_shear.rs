@@ -682,7 +682,7 @@ pub fn run(
         mu_std_error: weights_if_usable(fit(|r| r.mu_se)),
         phi_std_error: weights_if_usable(fit(|r| r.phi_se)),
     };
-    let provenance = crate::provenance::of_run(ctx, ctl, "simple-shear", c.seed);
+    let provenance = ctl.law_provenance(ctx, "simple-shear", c.seed);
     let prov = || provenance.clone();
     let mut s = run_summary(c, d, &rows, &peaks);
     let mut headline = vec![format!("report: {}/", ctx.out.path().display())];

@@ -129,9 +129,9 @@ pub struct SolverSpec {
     #[serde(default)]
     pub parallel: bool,
     /// The algorithm: `"nlgs"`, `"newton"`, `"auto"` (default) or `"lemke"`
-    /// ([`dem::solver::SolverMethod`]).
+    /// ([`dem::fc::SolverMethod`]).
     #[serde(default)]
-    pub method: dem::solver::SolverMethod,
+    pub method: dem::fc::SolverMethod,
     /// Largest step (contacts) that `auto` ends with Lemke's method when the other stages did
     /// not converge ([`dem::SolverParams::lemke_max_contacts`], default 0: off).
     #[serde(default = "dem::solver::lemke_max_contacts")]

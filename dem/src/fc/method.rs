@@ -1,15 +1,50 @@
 //! One entry point for the solvers of a standalone problem, chosen by [`SolverMethod`] as in
 //! the engine (`nlgs`, `newton`, `auto`), with one report.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::auto::{run_auto, AutoStages, Backoff};
 use super::error::FcError;
 use super::lemke::{self, LemkeParams};
 use super::newton::{self, NewtonParams, NewtonStats};
 use super::nsgs::{self, FcOptions, FcSolution};
 use super::problem::FcProblem;
-pub use crate::solver::{gauss_seidel_will_finish, SolverMethod};
-use crate::solver::{run_auto, AutoStages};
+
+/// Which algorithm solves a contact problem: the engine's step ([`crate::SolverParams::method`])
+/// or a standalone problem ([`solve_by`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolverMethod {
+    /// Nonlinear Gauss–Seidel only: O(1) per contact update, fast on loose and
+    /// flowing packings, slow to carry a load change across a dense, hyperstatic one.
+    Nlgs,
+    /// The regularised semismooth Newton method of [`crate::fc::newton`] on the assembled
+    /// problem, from the warm start.
+    Newton,
+    /// Gauss–Seidel in chunks of [`crate::SolverParams::auto_sweeps`] sweeps while it converges fast
+    /// enough, then, if it has not converged, Newton from its best iterate, then the exact
+    /// finish ([`exact_finish`]: the active-set solve, then Lemke's method),
+    /// then Gauss–Seidel for the sweeps left if all of these failed (the default).
+    #[default]
+    Auto,
+    /// Lemke's complementary pivoting method ([`crate::fc::lemke`]) on the assembled problem,
+    /// warm-started from the statuses of the stored impulses: an exact solution at the cost of
+    /// a few sparse pivots per contact, whatever the packing; Gauss–Seidel takes over if the
+    /// path fails.
+    Lemke,
+}
+
+impl SolverMethod {
+    /// The name used in TOML files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverMethod::Nlgs => "nlgs",
+            SolverMethod::Newton => "newton",
+            SolverMethod::Auto => "auto",
+            SolverMethod::Lemke => "lemke",
+        }
+    }
+}
 
 /// Gauss–Seidel sweeps before `auto` hands over to Newton (as the engine's default
 /// [`crate::SolverParams::auto_sweeps`]).
@@ -118,9 +153,9 @@ pub fn exact_finish(
 /// Solves `problem` with `method`:
 /// - `nlgs`: [`nsgs::solve`] with `options`;
 /// - `newton`: [`newton::solve`] from `options.initial_guess`;
-/// - `auto`: the engine's schedule (`solver::run_auto`, without the back-off, which needs a
+/// - `auto`: the engine's schedule (`fc::auto::run_auto`, without the back-off, which needs a
 ///   sequence of steps): Gauss–Seidel in chunks of [`AUTO_SWEEPS`] sweeps while its rate would
-///   reach the tolerance in time ([`gauss_seidel_will_finish`]), then Newton from its best
+///   reach the tolerance in time ([`super::auto::gauss_seidel_will_finish`]), then Newton from its best
 ///   iterate, then Gauss–Seidel again for the sweeps left of `options.max_iterations` if Newton
 ///   did not reach the tolerance within `params.max_iterations`.
 ///
@@ -204,7 +239,7 @@ pub fn solve_by(
                 AUTO_SWEEPS,
                 options.tolerance,
                 options.max_iterations,
-                None,
+                None::<&mut Backoff<()>>,
             )?;
             let solution = stages.last.take().expect("the first stage always runs");
             Ok((

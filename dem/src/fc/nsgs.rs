@@ -114,8 +114,10 @@ pub struct FcSolution {
     pub converged: bool,
 }
 
-/// The problem copied into sweep order: structure of arrays, off-diagonal blocks only.
-struct Workspace {
+/// A standalone problem as the NLGS driver ([`crate::nlgs::drive`]) sweeps it, the
+/// counterpart of the engine's step (`crate::solver`): the problem copied into sweep order,
+/// structure of arrays, off-diagonal blocks only.
+struct FcSweeps {
     perm: Vec<u32>,
     row_ptr: Vec<u32>,
     col: Vec<u32>,
@@ -135,7 +137,7 @@ struct Workspace {
     lr_s: [f64; 3],
 }
 
-impl Workspace {
+impl FcSweeps {
     fn new(p: &FcProblem, ordering: ContactOrdering) -> Self {
         let n = p.contacts();
         let perm = contact_order(ordering, p.w(), p.q());
@@ -244,7 +246,7 @@ impl Workspace {
         let mut it = cols.chunks_exact(2).zip(vals.chunks_exact(2));
         for (c, w) in &mut it {
             // SAFETY: every column index is `inv[j] < n` (inverse of a permutation of 0..n, see
-            // `Workspace::new`), and `self.r.len() == n`.
+            // `FcSweeps::new`), and `self.r.len() == n`.
             let (rb, rc) = unsafe {
                 (
                     *self.r.get_unchecked(c[0] as usize),
@@ -348,7 +350,7 @@ impl Workspace {
 
 /// The problem in sweep order as [`drive`] sees it: the impulses are `r`; `u` is recomputed by
 /// each error evaluation.
-impl SweepProblem for Workspace {
+impl SweepProblem for FcSweeps {
     fn dim(&self) -> usize {
         2 * self.r.len()
     }
@@ -420,7 +422,7 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
     let n = problem.contacts();
     validate(n, options)?;
     let t0 = Instant::now();
-    let mut ws = Workspace::new(problem, options.ordering);
+    let mut ws = FcSweeps::new(problem, options.ordering);
     if let Some(g) = &options.initial_guess {
         for (new, &old) in ws.perm.iter().enumerate() {
             let old = old as usize;
@@ -468,7 +470,7 @@ pub fn solve(problem: &FcProblem, options: &FcOptions) -> Result<FcSolution, FcE
 /// Contact updates per second of `sweeps` plain Gauss–Seidel sweeps (no acceleration, no error
 /// evaluation) from `r = 0` on one core: the raw cost of one update, `nc · sweeps / seconds`.
 pub fn sweep_rate(problem: &FcProblem, sweeps: usize) -> f64 {
-    let mut ws = Workspace::new(problem, ContactOrdering::default());
+    let mut ws = FcSweeps::new(problem, ContactOrdering::default());
     let t = Instant::now();
     let mut d = 0.0;
     for _ in 0..sweeps {

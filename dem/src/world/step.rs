@@ -19,10 +19,10 @@
 
 use nalgebra::Vector2;
 
+use crate::body::external_loads;
 use crate::body::Dof;
 use crate::cell::{Mat, Vect};
 use crate::cell_coupling::CellCoupling;
-use crate::energy::external_loads;
 use crate::error::DemError;
 use crate::snapshot::BodyKind;
 use crate::solver::{self, SolveReport, SweepOrder};

@@ -567,10 +567,7 @@ fn report_fit(
                     "tau_w_negative_bins",
                     profile.negative_tau_w(window).len() as u64,
                 );
-            let law = CalibratedLaw::from_janssen(
-                f,
-                crate::provenance::of_run(ctx, ctl, "janssen", c.seed),
-            );
+            let law = CalibratedLaw::from_janssen(f, ctl.law_provenance(ctx, "janssen", c.seed));
             let exported = export_law(&mut ctx.out, verdict, "janssen", &law, checks.clone())?;
             headline.extend(exported.heading("janssen"));
             headline.push(format!(
