@@ -17,9 +17,9 @@
 //! seed 8 (689 contacts, a hyperstatic column sliding along its walls, 433 062 sweeps a step to
 //! reach the run's 10⁻⁶) stall at 4.6–14·10⁻⁸ after 2000 sweeps and the exact finish, at
 //! 4.5–7.5·10⁻⁸ after 5000 ([`SENSITIVITY_SWEEPS`]) and 4.5–7.1·10⁻⁸ after 20 000. A re-solve
-//! whose error is at most a tenth of the run's own error on the same problem
+//! whose error is at most a fifth of the run's own error on the same problem
 //! ([`RESOLVE_MARGIN`], `dem::fc::fc_error` of the run's impulses) is taken as the measure all
-//! the same: its residual is then a tenth of the run's. (A residual bounds the distance to a
+//! the same: its residual is then a fifth of the run's. (A residual bounds the distance to a
 //! solution only where the solution is unique: in a hyperstatic packing the impulses are not,
 //! and both solves pick one; the measure is of the stresses each gives.) Such re-solves are
 //! counted apart (`Sensitivity::near`, Janssen's own count): they measure the stress but do not
@@ -57,8 +57,15 @@ pub fn resolve_tolerance(run_error: f64) -> f64 {
 
 /// A re-solve that stops short of [`resolve_tolerance`] still measures the run when its
 /// error is at most the run's own error on the same problem over this factor (module
-/// documentation).
-pub const RESOLVE_MARGIN: f64 = 10.0;
+/// documentation): its change then differs from the change to an exact solution by about a
+/// fifth of it where the error bounds the distance linearly. Measured on the 2000-grain
+/// simple-shear cell at I = 0.01 (300 Gauss–Seidel sweeps a step, run errors 4–7·10⁻³, 18
+/// window steps re-solved from the run's impulses): 5000 sweeps reach 4.8–18× below the run
+/// (median 8.2), 10 000 sweeps 6.7–25× (median 14.7), and the two give per-sample changes of μ
+/// that differ by 1.8·10⁻³ (rms) against a scatter of 5.5·10⁻³ between samples and means of
+/// 5.4·10⁻⁴ and 4.8·10⁻⁴; at a tenth (the factor until 2026-12-06), 17 of 20 such re-solves
+/// were counted as failed.
+pub const RESOLVE_MARGIN: f64 = 5.0;
 
 /// Whether a re-solve that ended with `error` (`converged`: at [`SENSITIVITY_TOLERANCE`])
 /// measures a run whose impulses have `run_error` on the same problem and measure
@@ -70,10 +77,10 @@ pub fn measures_the_run(converged: bool, error: f64, run_error: f64) -> bool {
 /// The outcome of a re-solve of a sample's step.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Resolved<T> {
-    /// Solved to the tolerance, or to a tenth of the run's ([`measures_the_run`]): what the
+    /// Solved to the tolerance, or to a fifth of the run's ([`measures_the_run`]): what the
     /// measure gives on the re-solved state.
     Solved(T),
-    /// The re-solve reached neither the tolerance nor a tenth of the run's own error, or failed
+    /// The re-solve reached neither the tolerance nor a fifth of the run's own error, or failed
     /// (a singular factorisation, a non-finite state): counted as unresolved, left out of the
     /// measure.
     Failed,
@@ -158,21 +165,23 @@ pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<([f64; 2], 
 mod tests {
     use super::*;
 
-    /// Converged at 1e-8 always measures; short of it, a finite error at most a tenth of the
-    /// run's own (seed 8's Janssen re-solves: 4.6·10⁻⁸ against a run at 9.99·10⁻⁷, yes;
-    /// 1.4·10⁻⁷, no); a NaN never; against a run that had (almost) converged, only a
-    /// converged one.
+    /// Converged at 1e-8 always measures; short of it, a finite error at most a fifth of the
+    /// run's own (seed 8's Janssen re-solves: 4.6·10⁻⁸ and 1.4·10⁻⁷ against a run at
+    /// 9.99·10⁻⁷, yes; 2.1·10⁻⁷, no); a NaN never; against a run that had (almost) converged,
+    /// only a converged one.
     #[test]
-    fn a_re_solve_measures_the_run_within_a_tenth_of_its_error() {
+    fn a_re_solve_measures_the_run_within_a_fifth_of_its_error() {
         assert!(measures_the_run(true, 1e-9, 1e-6));
         assert!(measures_the_run(false, 4.6e-8, 9.99e-7));
-        assert!(measures_the_run(false, 1e-7, 1e-6));
-        assert!(!measures_the_run(false, 1.36e-7, 9.99e-7));
+        assert!(measures_the_run(false, 1.36e-7, 9.99e-7));
+        assert!(measures_the_run(false, 2e-7, 1e-6));
+        assert!(!measures_the_run(false, 2.1e-7, 9.99e-7));
         assert!(!measures_the_run(false, f64::NAN, 1e-6));
         assert!(!measures_the_run(false, 9e-8, 3e-7));
+        assert!(measures_the_run(false, 6e-8, 3e-7));
         assert!(!measures_the_run(false, 4.6e-8, 0.0));
-        assert!(measures_the_run(false, 9e-6, 1e-4));
-        assert_eq!(RESOLVE_MARGIN, 10.0);
+        assert!(measures_the_run(false, 1.9e-5, 1e-4));
+        assert_eq!(RESOLVE_MARGIN, 5.0);
     }
 
     /// The re-solve is made to a hundredth of the run's own error, never tighter than 10⁻⁸

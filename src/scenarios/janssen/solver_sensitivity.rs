@@ -24,7 +24,7 @@ pub struct JanssenSensitivity {
     pub failed: u64,
     /// Measured steps whose problem was not available (no re-solve tried).
     pub unavailable: u64,
-    /// Re-solved steps that stopped short of the tolerance, within a tenth of the run's own
+    /// Re-solved steps that stopped short of the tolerance, within a fifth of the run's own
     /// error (counted in `resolved`): they measure the fit, but do not stand in for the loaded
     /// contacts' proxy.
     pub near: u64,
