@@ -305,6 +305,10 @@ pub fn min_points(p: usize) -> usize {
 /// Fits `model` to `obs` from the start `theta0` and reports the estimate with its uncertainty
 /// (see the module documentation). `validity` is copied into the report.
 ///
+/// In stages: the observations are checked, the weighted minimisation runs (observation
+/// weights, then group weights), the report is built with the covariance, a parameter on its
+/// bound or a rank-deficient Jacobian is refused, and the bootstrap runs when asked for.
+///
 /// Errors: [`IdentifyError::TooFewPoints`] (`n < p + 2`), [`IdentifyError::NonFinite`],
 /// [`IdentifyError::ZeroVariance`] (a group with constant observations),
 /// [`IdentifyError::NoConvergence`], [`IdentifyError::ParameterAtBound`],
@@ -317,7 +321,50 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
     validity: Vec<ValidityRange>,
 ) -> Result<FitReport> {
     let specs = model.parameters();
-    let p = specs.len();
+    check_observations(model, obs, specs.len())?;
+    let theta0: Vec<f64> = theta0
+        .iter()
+        .zip(&specs)
+        .map(|(t, s)| t.clamp(s.lower, s.upper))
+        .collect();
+    let (outcome, weight) = minimise_weighted(model, obs, &theta0, &specs, options)?;
+    let theta = outcome.x.as_slice().to_vec();
+    let (mut report, rank_problem) = least_squares_report(
+        model,
+        obs,
+        &outcome,
+        &weight,
+        &specs,
+        options.confidence,
+        validity,
+    );
+
+    // A parameter on its bound is not an estimate.
+    if let Some((j, side, bound)) = parameter_on_bound(&specs, &theta0, &theta) {
+        return Err(IdentifyError::ParameterAtBound {
+            name: specs[j].name.clone(),
+            value: theta[j],
+            bound,
+            side,
+            report: Box::new(report),
+            suggestion: crate::error::Suggestion::none(),
+        });
+    }
+    if let Some(reason) = rank_problem {
+        return Err(IdentifyError::NotIdentifiable { reason });
+    }
+
+    if let Some(bs) = options.bootstrap {
+        report.bootstrap = Some(bootstrap(model, obs, &weight, &theta, &specs, options, bs));
+    }
+    Ok(report)
+}
+
+/// Stage 1, the observations: at least `p + 2` of them for `p` parameters, and in every group
+/// finite values that are not all the same (`max − min ≤ 10⁻¹⁴ max(|min|, |max|)` is constant).
+/// Errors: [`IdentifyError::TooFewPoints`], [`IdentifyError::NonFinite`],
+/// [`IdentifyError::ZeroVariance`].
+fn check_observations<M: LeastSquaresModel>(model: &M, obs: &Observations, p: usize) -> Result<()> {
     let n = obs.len();
     if n < min_points(p) {
         return Err(IdentifyError::TooFewPoints {
@@ -326,7 +373,6 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
             got: n,
         });
     }
-    let n_groups = obs.group_names.len();
     for (g, name) in obs.group_names.iter().enumerate() {
         let values: Vec<f64> = group_values(obs, g);
         check_finite(name, &values)?;
@@ -338,15 +384,22 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
             });
         }
     }
-    let theta0: Vec<f64> = theta0
-        .iter()
-        .zip(&specs)
-        .map(|(t, s)| t.clamp(s.lower, s.upper))
-        .collect();
-    let all: Vec<usize> = (0..n).collect();
+    Ok(())
+}
 
-    // Stage 1: the observations' own weights (1/σ_k, or 1); stage 2: one weight per group on
-    // top of them.
+/// Stage 2, the minimisation of `Σ_k w_k² (y_k − f_k(θ))²` from `theta0`: first with the
+/// observations' own weights (`1/σ_k`, or 1; [`observation_weights`]), then, with several
+/// groups and `options.reweight_groups`, again from that optimum with one weight per group on
+/// top of them ([`group_weights`]). Returns the last outcome and the weights it used.
+/// Errors: those of [`observation_weights`], [`IdentifyError::NoConvergence`].
+fn minimise_weighted<M: LeastSquaresModel>(
+    model: &M,
+    obs: &Observations,
+    theta0: &[f64],
+    specs: &[ParameterSpec],
+    options: &FitOptions,
+) -> Result<(lm::LmOutcome, Vec<f64>)> {
+    let all: Vec<usize> = (0..obs.len()).collect();
     let base = observation_weights(obs)?;
     let mut weight = base.clone();
     let mut outcome = run(
@@ -354,28 +407,14 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
         &obs.y,
         &weight,
         &all,
-        &theta0,
-        &specs,
+        theta0,
+        specs,
         options.max_iters,
     )?;
-    if n_groups > 1 && options.reweight_groups {
+    if obs.group_names.len() > 1 && options.reweight_groups {
         let f = model.predict(outcome.x.as_slice());
-        let s: Vec<f64> = (0..n_groups)
-            .map(|g| {
-                let (rss, ng) = (0..n)
-                    .filter(|&k| obs.group_of[k] == g)
-                    .fold((0.0, 0usize), |(a, c), k| {
-                        (a + (base[k] * (obs.y[k] - f[k])).powi(2), c + 1)
-                    });
-                (rss / ng.max(1) as f64).sqrt()
-            })
-            .collect();
-        let s_max = s.iter().cloned().fold(0.0, f64::max);
-        if s_max > 0.0 {
-            let floor = 1e-9 * s_max;
-            for k in 0..n {
-                weight[k] = base[k] * s_max / s[obs.group_of[k]].max(floor);
-            }
+        if let Some(grouped) = group_weights(obs, &base, &f) {
+            weight = grouped;
             let start = outcome.x.as_slice().to_vec();
             outcome = run(
                 model,
@@ -383,52 +422,88 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
                 &weight,
                 &all,
                 &start,
-                &specs,
+                specs,
                 options.max_iters,
             )?;
         }
     }
-    let theta = outcome.x.as_slice().to_vec();
-    let fitted = model.predict(&theta);
+    Ok((outcome, weight))
+}
+
+/// The weights of the second stage (two-stage feasible weighted least squares): each group's
+/// residual scale `s_g = √(Σ_{k∈g} (w_k (y_k − f_k))² / n_g)` from the first stage's
+/// predictions `f` and weights `w = base`, and `w'_k = w_k s_max / max(s_{g(k)}, 10⁻⁹ s_max)`.
+/// `None` when every residual is zero (`s_max = 0`).
+fn group_weights(obs: &Observations, base: &[f64], f: &[f64]) -> Option<Vec<f64>> {
+    let n = obs.len();
+    let s: Vec<f64> = (0..obs.group_names.len())
+        .map(|g| {
+            let (rss, ng) = (0..n)
+                .filter(|&k| obs.group_of[k] == g)
+                .fold((0.0, 0usize), |(a, c), k| {
+                    (a + (base[k] * (obs.y[k] - f[k])).powi(2), c + 1)
+                });
+            (rss / ng.max(1) as f64).sqrt()
+        })
+        .collect();
+    let s_max = s.iter().cloned().fold(0.0, f64::max);
+    if s_max > 0.0 {
+        let floor = 1e-9 * s_max;
+        Some(
+            (0..n)
+                .map(|k| base[k] * s_max / s[obs.group_of[k]].max(floor))
+                .collect(),
+        )
+    } else {
+        None
+    }
+}
+
+/// Stage 3, the report at the optimum `θ̂` of `outcome` with the final weights: residuals
+/// `r_k = y_k − f_k(θ̂)`, covariance `C = s² (J_wᵀ J_w)⁻¹` with `s² = Σ (w r)² / (n − p)`
+/// ([`covariance`]), standard errors `√C_jj` and intervals `θ̂_j ∓ t √C_jj` (Student's `t` at
+/// `n − p` degrees of freedom), the groups' summaries, `R² = 1 − Σ RSS_g / Σ TSS_g`, AIC and
+/// BIC, with the optimiser's iterations and `validity`. Returns the report and the reason the
+/// Jacobian is rank deficient, if it is.
+fn least_squares_report<M: LeastSquaresModel>(
+    model: &M,
+    obs: &Observations,
+    outcome: &lm::LmOutcome,
+    weight: &[f64],
+    specs: &[ParameterSpec],
+    confidence: f64,
+    validity: Vec<ValidityRange>,
+) -> (FitReport, Option<String>) {
+    let (n, p) = (obs.len(), specs.len());
+    let theta = outcome.x.as_slice();
+    let fitted = model.predict(theta);
     let residuals: Vec<f64> = obs.y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
 
     // Covariance from the weighted Jacobian, column-scaled for conditioning.
-    let jac = model.jacobian(&theta);
+    let jac = model.jacobian(theta);
     let jw = DMatrix::from_fn(n, p, |k, j| weight[k] * jac[(k, j)]);
     let wrss: f64 = residuals
         .iter()
-        .zip(&weight)
+        .zip(weight)
         .map(|(r, w)| (w * r).powi(2))
         .sum();
     let dof = n - p;
     let s2 = wrss / dof as f64;
-    let (cov, rank_problem) = covariance(&jw, s2, &specs);
-    let t = stats::t_critical(options.confidence, dof);
+    let (cov, rank_problem) = covariance(&jw, s2, specs);
+    let t = stats::t_critical(confidence, dof);
 
     let parameters: Vec<Estimate> = specs
         .iter()
         .enumerate()
         .map(|(j, s)| Estimate::new(&s.name, &s.unit, theta[j], cov[(j, j)].max(0.0).sqrt(), t))
         .collect();
-    let groups: Vec<GroupSummary> = (0..n_groups)
-        .map(|g| {
-            let idx: Vec<usize> = (0..n).filter(|&k| obs.group_of[k] == g).collect();
-            let mean = idx.iter().map(|&k| obs.y[k]).sum::<f64>() / idx.len().max(1) as f64;
-            GroupSummary {
-                name: obs.group_names[g].clone(),
-                n: idx.len(),
-                rss: idx.iter().map(|&k| residuals[k].powi(2)).sum(),
-                tss: idx.iter().map(|&k| (obs.y[k] - mean).powi(2)).sum(),
-                weight: idx.first().map_or(1.0, |&k| weight[k]),
-            }
-        })
-        .collect();
+    let groups = group_summaries(obs, &residuals, weight);
     let rss_total: f64 = groups.iter().map(|g| g.rss).sum();
     let tss_total: f64 = groups.iter().map(|g| g.tss).sum();
     let by_group: Vec<(usize, f64)> = groups.iter().map(|g| (g.n, g.rss)).collect();
-    let mut report = FitReport {
+    let report = FitReport {
         model: model.name(),
-        confidence: options.confidence,
+        confidence,
         t_critical: t,
         parameters,
         covariance: matrix_rows(&cov),
@@ -448,40 +523,47 @@ pub fn fit_least_squares<M: LeastSquaresModel>(
         validity,
         bootstrap: None,
     };
+    (report, rank_problem)
+}
 
-    // A parameter on its bound is not an estimate.
-    for (j, s) in specs.iter().enumerate() {
+/// Each group's summary: its size `n_g`, `RSS_g = Σ_{k∈g} r_k²` (unweighted), `TSS_g` about its
+/// mean, and the weight of its first observation.
+fn group_summaries(obs: &Observations, residuals: &[f64], weight: &[f64]) -> Vec<GroupSummary> {
+    let n = obs.len();
+    (0..obs.group_names.len())
+        .map(|g| {
+            let idx: Vec<usize> = (0..n).filter(|&k| obs.group_of[k] == g).collect();
+            let mean = idx.iter().map(|&k| obs.y[k]).sum::<f64>() / idx.len().max(1) as f64;
+            GroupSummary {
+                name: obs.group_names[g].clone(),
+                n: idx.len(),
+                rss: idx.iter().map(|&k| residuals[k].powi(2)).sum(),
+                tss: idx.iter().map(|&k| (obs.y[k] - mean).powi(2)).sum(),
+                weight: idx.first().map_or(1.0, |&k| weight[k]),
+            }
+        })
+        .collect()
+}
+
+/// Stage 4, the first parameter that ended on its bound: `(j, side, bound)` when
+/// `|θ_j − bound| ≤ 10⁻⁹ max(|θ0_j|, |θ_j|, |bound|)` for a finite bound (the lower one first).
+fn parameter_on_bound(
+    specs: &[ParameterSpec],
+    theta0: &[f64],
+    theta: &[f64],
+) -> Option<(usize, BoundSide, f64)> {
+    specs.iter().enumerate().find_map(|(j, s)| {
         let scale = theta0[j].abs().max(theta[j].abs()).max(1e-300);
-        let side = if s.lower.is_finite()
-            && (theta[j] - s.lower).abs() <= 1e-9 * scale.max(s.lower.abs())
-        {
-            Some((BoundSide::Lower, s.lower))
+        if s.lower.is_finite() && (theta[j] - s.lower).abs() <= 1e-9 * scale.max(s.lower.abs()) {
+            Some((j, BoundSide::Lower, s.lower))
         } else if s.upper.is_finite()
             && (theta[j] - s.upper).abs() <= 1e-9 * scale.max(s.upper.abs())
         {
-            Some((BoundSide::Upper, s.upper))
+            Some((j, BoundSide::Upper, s.upper))
         } else {
             None
-        };
-        if let Some((side, bound)) = side {
-            return Err(IdentifyError::ParameterAtBound {
-                name: s.name.clone(),
-                value: theta[j],
-                bound,
-                side,
-                report: Box::new(report),
-                suggestion: crate::error::Suggestion::none(),
-            });
         }
-    }
-    if let Some(reason) = rank_problem {
-        return Err(IdentifyError::NotIdentifiable { reason });
-    }
-
-    if let Some(bs) = options.bootstrap {
-        report.bootstrap = Some(bootstrap(model, obs, &weight, &theta, &specs, options, bs));
-    }
-    Ok(report)
+    })
 }
 
 /// `s² (J_wᵀJ_w)⁻¹` with column scaling; reports rank deficiency (condition number of the

@@ -323,7 +323,9 @@ pub fn fit_mohr_coulomb_supported(
     }
 }
 
-/// Fits the Mohr–Coulomb envelope (see the module documentation).
+/// Fits the Mohr–Coulomb envelope (see the module documentation), in stages: the data as the
+/// points of a line, the constrained line, its covariance and degrees of freedom, the map
+/// `(a, b) → (φ, c)`, the estimates and the report, and the checks.
 ///
 /// Errors: [`IdentifyError::TooFewPoints`] (< 4, < 3 with the cohesion fixed at zero),
 /// [`IdentifyError::NonFinite`],
@@ -335,7 +337,72 @@ pub fn fit_mohr_coulomb_with(
     data: &YieldData,
     options: &MohrCoulombOptions,
 ) -> Result<MohrCoulombFit> {
-    let confidence = options.confidence;
+    let line = yield_line(data, options.cohesion_fixed_zero)?;
+    let envelope = solve_envelope(&line, options.cohesion_fixed_zero)?;
+    let line_fit = line_covariance(&line, &envelope, options);
+    let t = stats::t_critical(options.confidence, line_fit.dof);
+    let (phi, c, cov) =
+        friction_and_cohesion(line_fit.a, line_fit.b, &line_fit.cov_ab, line.circles);
+    let (friction_angle, cohesion) =
+        envelope_estimates(phi, c, &cov, t, line_fit.b_upper, line.circles);
+    let report = envelope_report(
+        &line,
+        &line_fit,
+        envelope.cohesionless,
+        &cov,
+        t,
+        vec![friction_angle.clone(), cohesion.clone()],
+        options.confidence,
+    );
+    if let Some((bound, side)) = friction_angle_at_bound(line_fit.a, line.circles) {
+        return Err(IdentifyError::ParameterAtBound {
+            name: "friction_angle".into(),
+            value: phi,
+            bound,
+            side,
+            report: Box::new(report),
+            suggestion: crate::error::Suggestion::none(),
+        });
+    }
+    accept_envelope(&line, &envelope, &report, options)?;
+    let deg = 180.0 / std::f64::consts::PI;
+    let friction_angle_deg = Estimate {
+        name: "friction_angle_deg".into(),
+        unit: "deg".into(),
+        value: phi * deg,
+        std_error: friction_angle.std_error * deg,
+        ci_low: friction_angle.ci_low * deg,
+        ci_high: friction_angle.ci_high * deg,
+        at_bound: false,
+    };
+    Ok(MohrCoulombFit {
+        law: MohrCoulombLaw {
+            friction_angle_rad: phi,
+            cohesion_pa: c,
+        },
+        friction_angle,
+        friction_angle_deg,
+        cohesion,
+        report,
+    })
+}
+
+/// The stress states at yield as the points `(x_k, y_k)` of the line `y = a x + b` (module
+/// documentation): `(p, q)` for Mohr circles, `(σ_n, |τ|)` on a failure plane.
+struct YieldLine {
+    /// Abscissae `x_k` (`p` or `σ_n`, Pa).
+    x: Vec<f64>,
+    /// Ordinates `y_k` (`q` or `|τ|`, Pa).
+    y: Vec<f64>,
+    /// Mohr circles (`a = sin φ ≤ 1`) rather than a failure plane (`a = tan φ`).
+    circles: bool,
+}
+
+/// Stage 1, the data: the points of the line, checked finite, of equal lengths, at
+/// non-negative pressure `x ≥ 0` and radius `y ≥ 0`, at least 4 of them (3 with the cohesion
+/// fixed at zero), not all at the same pressure. Errors: those of [`fit_mohr_coulomb_with`] on
+/// the data.
+fn yield_line(data: &YieldData, fixed: bool) -> Result<YieldLine> {
     let (x, y, circles, xname, yname) = match data {
         YieldData::Circles { p_pa, q_pa } => (p_pa.clone(), q_pa.clone(), true, "p_Pa", "q_Pa"),
         YieldData::FailurePlane { sigma_n_pa, tau_pa } => (
@@ -359,7 +426,6 @@ pub fn fit_mohr_coulomb_with(
         });
     }
     let n = x.len();
-    let fixed = options.cohesion_fixed_zero;
     let needed = if fixed { 3 } else { 4 };
     if n < needed {
         return Err(IdentifyError::TooFewPoints {
@@ -373,44 +439,122 @@ pub fn fit_mohr_coulomb_with(
         });
     }
     check_spread(xname, &x)?;
-    let a_max = if circles { 1.0 } else { f64::INFINITY };
+    Ok(YieldLine { x, y, circles })
+}
+
+/// The constrained line and the cohesionless envelope nested in it.
+struct Envelope {
+    /// Slope `a` of the conic fit (0 with the cohesion fixed at zero).
+    a: f64,
+    /// Intercept `b ≥ 0` of the conic fit (0 with the cohesion fixed at zero).
+    b: f64,
+    /// The cohesion is fixed at zero, or the conic fit put it there (`b ≤ 10⁻⁸ max y`).
+    cohesionless: bool,
+    /// `S_xx = Σ x_k²`.
+    sxx: f64,
+    /// Slope of the line through the origin, `a₀ = Σ x_k y_k / S_xx` clamped to `[0, a_max]`.
+    a_origin: f64,
+    /// Its predictions `a₀ x_k` (the nested form of the acceptance checks).
+    origin_fit: Vec<f64>,
+}
+
+/// Stage 2, the envelope: `(a, b)` minimising `‖y − a x − b‖₂` subject to `a ≥ 0`, `b ≥ 0`
+/// and, for circles, `a ≤ 1` ([`solve_conic`]; not solved with the cohesion fixed at zero), and
+/// the least-squares line through the origin `a₀ = Σ x y / Σ x²`.
+/// Errors: [`IdentifyError::ConicSolver`].
+fn solve_envelope(line: &YieldLine, fixed: bool) -> Result<Envelope> {
+    let (x, y) = (&line.x, &line.y);
+    let a_max = if line.circles { 1.0 } else { f64::INFINITY };
     let (a, b) = if fixed {
         (0.0, 0.0)
     } else {
-        solve_conic(&x, &y, a_max)?
+        solve_conic(x, y, a_max)?
     };
-    let (_, y_max) = min_max(&y);
+    let (_, y_max) = min_max(y);
     let cohesionless = fixed || b <= 1e-8 * y_max;
     // The cohesionless envelope through the origin: the nested form.
     let sxx: f64 = x.iter().map(|v| v * v).sum();
-    let a_origin = (x.iter().zip(&y).map(|(u, v)| u * v).sum::<f64>() / sxx).clamp(0.0, a_max);
+    let a_origin = (x.iter().zip(y).map(|(u, v)| u * v).sum::<f64>() / sxx).clamp(0.0, a_max);
     let origin_fit: Vec<f64> = x.iter().map(|u| a_origin * u).collect();
+    Ok(Envelope {
+        a,
+        b,
+        cohesionless,
+        sxx,
+        a_origin,
+        origin_fit,
+    })
+}
 
-    // Covariance of (a, b) and the degrees of freedom.
-    let (a, b, cov_ab, dof, b_upper) = if cohesionless {
-        let a0 = a_origin;
-        let rss: f64 = x.iter().zip(&y).map(|(u, v)| (v - a0 * u).powi(2)).sum();
+/// The fitted line with its covariance.
+struct LineFit {
+    /// Slope `a` (the line through the origin's when cohesionless).
+    a: f64,
+    /// Intercept `b` (0 when cohesionless).
+    b: f64,
+    /// Covariance of `(a, b)`.
+    cov_ab: DMatrix<f64>,
+    /// Degrees of freedom, `n − 2` (`n − 1` when cohesionless).
+    dof: usize,
+    /// When cohesionless: the upper end of the intercept's one-sided interval and its standard
+    /// error, `(max(b_ols, 0) + t se(b_ols), se(b_ols))`, or `(0, 0)` for a cohesion the user
+    /// fixed.
+    b_upper: Option<(f64, f64)>,
+}
+
+/// Stage 3, covariance and degrees of freedom. With a free cohesion: the OLS covariance
+/// `s² (XᵀX)⁻¹`, `s² = RSS/(n − 2)`, `n − 2` degrees of freedom. Cohesionless: the line through
+/// the origin, `Var a₀ = RSS₀/(n − 1) / Σ x²`, `n − 1` degrees of freedom, and the one-sided
+/// interval of `b` from the unconstrained regression (module documentation), `[0, 0]` for a
+/// cohesion the user fixed.
+fn line_covariance(line: &YieldLine, envelope: &Envelope, options: &MohrCoulombOptions) -> LineFit {
+    let (x, y) = (&line.x, &line.y);
+    let n = x.len();
+    if envelope.cohesionless {
+        let a0 = envelope.a_origin;
+        let rss: f64 = x.iter().zip(y).map(|(u, v)| (v - a0 * u).powi(2)).sum();
         let dof = n - 1;
-        let var_a = rss / dof as f64 / sxx;
+        let var_a = rss / dof as f64 / envelope.sxx;
         // Fixed by the user: the interval of c is [0, 0]; held at 0 by the data: one-sided,
         // `[0, max(b_ols, 0) + t se(b_ols)]` with the standard error se(b_ols).
-        let bound = if fixed && !options.cohesion_held_by_data {
+        let bound = if options.cohesion_fixed_zero && !options.cohesion_held_by_data {
             (0.0, 0.0)
         } else {
-            let (_, b_ols, cov_ols, _) = ols(&x, &y);
-            let t2 = stats::t_critical(confidence, n - 2);
+            let (_, b_ols, cov_ols, _) = ols(x, y);
+            let t2 = stats::t_critical(options.confidence, n - 2);
             let se = cov_ols[(1, 1)].max(0.0).sqrt();
             (b_ols.max(0.0) + t2 * se, se)
         };
         let cov = DMatrix::from_row_slice(2, 2, &[var_a, 0.0, 0.0, 0.0]);
-        (a0, 0.0, cov, dof, Some(bound))
+        LineFit {
+            a: a0,
+            b: 0.0,
+            cov_ab: cov,
+            dof,
+            b_upper: Some(bound),
+        }
     } else {
-        let (_, _, cov, _) = ols(&x, &y);
-        (a, b, cov, n - 2, None)
-    };
-    let t = stats::t_critical(confidence, dof);
+        let (_, _, cov, _) = ols(x, y);
+        LineFit {
+            a: envelope.a,
+            b: envelope.b,
+            cov_ab: cov,
+            dof: n - 2,
+            b_upper: None,
+        }
+    }
+}
 
-    // (a, b) → (φ, c) and its Jacobian.
+/// Stage 4, `(a, b) → (φ, c)` and the covariance of `(φ, c)`, `J C_ab Jᵀ` with `J` the
+/// Jacobian `∂(φ, c)/∂(a, b)`. Circles: `φ = asin a`, `c = b / cos φ = b / √(1 − a²)`,
+/// `J = [[1/√(1 − a²), 0], [a b/(1 − a²)^{3/2}, 1/√(1 − a²)]]`. Failure plane: `φ = atan a`,
+/// `c = b`, `J = [[1/(1 + a²), 0], [0, 1]]`. Returns `(φ, c, C_φc)`.
+fn friction_and_cohesion(
+    a: f64,
+    b: f64,
+    cov_ab: &DMatrix<f64>,
+    circles: bool,
+) -> (f64, f64, DMatrix<f64>) {
     let (phi, c, jac) = if circles {
         let ca = (1.0 - a * a).max(0.0).sqrt();
         let phi = a.clamp(-1.0, 1.0).asin();
@@ -422,12 +566,21 @@ pub fn fit_mohr_coulomb_with(
         (a.atan(), b, jac)
     };
     let cov = &jac * cov_ab * jac.transpose();
-    let fitted: Vec<f64> = x.iter().map(|v| a * v + b).collect();
-    let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(o, f)| o - f).collect();
-    let rss: f64 = residuals.iter().map(|r| r * r).sum();
-    let ymean = y.iter().sum::<f64>() / n as f64;
-    let tss: f64 = y.iter().map(|v| (v - ymean).powi(2)).sum();
-    let n_params = if cohesionless { 1 } else { 2 };
+    (phi, c, cov)
+}
+
+/// Stage 5a, the estimates of `φ` (rad) and `c` (Pa): standard errors `√C_ii`, intervals
+/// `θ̂ ∓ t √C_ii`; a cohesion at zero (`b_upper`) is at its bound with the one-sided interval
+/// `[0, upper / cos φ]` and standard error `se / cos φ` for circles (`c = b / cos φ`), `[0, upper]`
+/// and `se` on a failure plane.
+fn envelope_estimates(
+    phi: f64,
+    c: f64,
+    cov: &DMatrix<f64>,
+    t: f64,
+    b_upper: Option<(f64, f64)>,
+    circles: bool,
+) -> (Estimate, Estimate) {
     let friction_angle = Estimate::new("friction_angle", "rad", phi, cov[(0, 0)].sqrt(), t);
     let mut cohesion = Estimate::new("cohesion", "Pa", c, cov[(1, 1)].max(0.0).sqrt(), t);
     if let Some((upper, se)) = b_upper {
@@ -438,13 +591,37 @@ pub fn fit_mohr_coulomb_with(
         cohesion.ci_low = 0.0;
         cohesion.ci_high = upper * to_c;
     }
-    let report = FitReport {
+    (friction_angle, cohesion)
+}
+
+/// Stage 5b, the report: predictions `a x_k + b`, residuals on `y`, `R² = 1 − RSS/TSS`, the
+/// residual variance `RSS/dof`, AIC and BIC with 1 parameter (cohesionless) or 2, and the
+/// ranges of `x` and `y` as the validity.
+fn envelope_report(
+    line: &YieldLine,
+    line_fit: &LineFit,
+    cohesionless: bool,
+    cov: &DMatrix<f64>,
+    t: f64,
+    parameters: Vec<Estimate>,
+    confidence: f64,
+) -> FitReport {
+    let (x, y, circles) = (&line.x, &line.y, line.circles);
+    let (a, b, dof) = (line_fit.a, line_fit.b, line_fit.dof);
+    let n = x.len();
+    let fitted: Vec<f64> = x.iter().map(|v| a * v + b).collect();
+    let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(o, f)| o - f).collect();
+    let rss: f64 = residuals.iter().map(|r| r * r).sum();
+    let ymean = y.iter().sum::<f64>() / n as f64;
+    let tss: f64 = y.iter().map(|v| (v - ymean).powi(2)).sum();
+    let n_params = if cohesionless { 1 } else { 2 };
+    FitReport {
         model: "mohr-coulomb".into(),
         confidence,
         t_critical: t,
-        parameters: vec![friction_angle.clone(), cohesion.clone()],
-        covariance: matrix_rows(&cov),
-        correlation: matrix_rows(&correlation_of(&cov)),
+        parameters,
+        covariance: matrix_rows(cov),
+        correlation: matrix_rows(&correlation_of(cov)),
         observed: y.clone(),
         fitted,
         residuals,
@@ -464,30 +641,40 @@ pub fn fit_mohr_coulomb_with(
         bic: stats::bic(&[(n, rss)], n_params),
         iterations: 0,
         validity: vec![
-            ValidityRange::of(if circles { "p" } else { "sigma_n" }, "Pa", &x),
-            ValidityRange::of(if circles { "q" } else { "tau" }, "Pa", &y),
+            ValidityRange::of(if circles { "p" } else { "sigma_n" }, "Pa", x),
+            ValidityRange::of(if circles { "q" } else { "tau" }, "Pa", y),
         ],
         bootstrap: None,
-    };
+    }
+}
+
+/// Stage 6a, the friction angle at a bound: `(bound, side)` when the slope ends at `a ≤ 10⁻⁹`
+/// (`φ = 0`) or, for circles, at `a ≥ 1 − 10⁻⁹` (`φ = π/2`); `None` inside.
+fn friction_angle_at_bound(a: f64, circles: bool) -> Option<(f64, BoundSide)> {
     let a_tol = 1e-9;
     if a <= a_tol || (circles && a >= 1.0 - a_tol) {
-        let (bound, side) = if a <= a_tol {
+        Some(if a <= a_tol {
             (0.0, BoundSide::Lower)
         } else {
             (std::f64::consts::FRAC_PI_2, BoundSide::Upper)
-        };
-        return Err(IdentifyError::ParameterAtBound {
-            name: "friction_angle".into(),
-            value: phi,
-            bound,
-            side,
-            report: Box::new(report),
-            suggestion: crate::error::Suggestion::none(),
-        });
+        })
+    } else {
+        None
     }
-    let nested = (!cohesionless).then(|| NestedForm {
+}
+
+/// Stage 6b, acceptance ([`crate::accept`]): `φ` inside `[0, π/2]`, `c ≥ 0` (offering
+/// [`COHESIONLESS`]), `R²` above `options.min_r_squared`, and, with a free cohesion, an adjusted
+/// `R²` not below the cohesionless envelope's. Errors: the refusals of [`Acceptance::check`].
+fn accept_envelope(
+    line: &YieldLine,
+    envelope: &Envelope,
+    report: &FitReport,
+    options: &MohrCoulombOptions,
+) -> Result<()> {
+    let nested = (!envelope.cohesionless).then(|| NestedForm {
         name: "the cohesionless envelope (# cohesion = 0)".into(),
-        r_squared: crate::accept::r_squared_of(&y, &origin_fit),
+        r_squared: crate::accept::r_squared_of(&line.y, &envelope.origin_fit),
         parameters: 1,
     });
     Acceptance::new("mohr-coulomb", options.min_r_squared)
@@ -498,25 +685,5 @@ pub fn fit_mohr_coulomb_with(
         ))
         .range(PhysicalRange::non_negative("cohesion").suggesting(COHESIONLESS))
         .nested(nested)
-        .check(&report)?;
-    let deg = 180.0 / std::f64::consts::PI;
-    let friction_angle_deg = Estimate {
-        name: "friction_angle_deg".into(),
-        unit: "deg".into(),
-        value: phi * deg,
-        std_error: friction_angle.std_error * deg,
-        ci_low: friction_angle.ci_low * deg,
-        ci_high: friction_angle.ci_high * deg,
-        at_bound: false,
-    };
-    Ok(MohrCoulombFit {
-        law: MohrCoulombLaw {
-            friction_angle_rad: phi,
-            cohesion_pa: c,
-        },
-        friction_angle,
-        friction_angle_deg,
-        cohesion,
-        report,
-    })
+        .check(report)
 }

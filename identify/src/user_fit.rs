@@ -312,12 +312,26 @@ pub fn fit_table(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Ca
         })
 }
 
-/// [`fit_table`] on rows that may all be fitted.
+/// [`fit_table`] on rows that may all be fitted: the overrides applied to the table's metadata,
+/// the provenance, and the law's own reading of columns and metadata and its fit.
 fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<CalibratedLaw> {
     let mut table = table.clone();
     for (k, v) in &options.metadata {
         table.metadata.insert(k.clone(), *v);
     }
+    let provenance = rows_provenance(&table, options);
+    match law {
+        "janssen" | "janssen-kmu" => fit_janssen_rows(law, &table, options, provenance),
+        "wall-law" => fit_wall_law_rows(&table, options, provenance),
+        "mu-i" | "mu-i-linear" | "phi-i" => fit_rheology_rows(law, &table, options, provenance),
+        // mohr-coulomb
+        _ => fit_mohr_coulomb_rows(&table, options, provenance),
+    }
+}
+
+/// The provenance of a fit from `table`: the scenario and seed of `options`, its metadata
+/// overrides (`key=value`), the date, and the table's source.
+fn rows_provenance(table: &Table, options: &CsvFitOptions) -> Provenance {
     let mut provenance = Provenance::new(&options.scenario, options.seed)
         .with_overrides(
             options
@@ -328,168 +342,195 @@ fn fit_rows(law: &str, table: &Table, options: &CsvFitOptions) -> Result<Calibra
         )
         .with_date_now();
     provenance.source = Some(table.source.clone());
-    match law {
-        "janssen" | "janssen-kmu" => {
-            let profile = JanssenProfile {
-                z_m: table.column("z_m")?,
-                sigma_v_pa: table.column("sigma_v_Pa")?,
-                sigma_h_pa: if law == "janssen" {
-                    Some(table.column("sigma_h_Pa")?)
-                } else {
-                    None
-                },
-                tau_w_pa: if law == "janssen" {
-                    table.optional_column("tau_w_Pa")?
-                } else {
-                    None
-                },
-            };
-            let setup = JanssenSetup {
-                width_m: table.metadata_value("width_m")?,
-                bulk_density_kg_m3: table.metadata_value("bulk_density_kg_m3")?,
-                gravity_m_s2: table.metadata_or("gravity_m_s2", STANDARD_GRAVITY),
-                wall_friction: if law == "janssen" {
-                    table.metadata_value("wall_friction")?
-                } else {
-                    table.metadata_or("wall_friction", f64::INFINITY)
-                },
-            };
-            let window = match (
-                table.metadata.get("depth_min_m"),
-                table.metadata.get("depth_max_m"),
-            ) {
-                (None, None) => None,
-                (lo, hi) => Some((
-                    lo.copied().unwrap_or(f64::NEG_INFINITY),
-                    hi.copied().unwrap_or(f64::INFINITY),
-                )),
-            };
-            let jopts = JanssenOptions {
-                depth_window: window,
-                use_tau_w: true,
-                fit: options.fit.clone(),
-            };
-            if law == "janssen" {
-                let fit = if table.metadata_or("full_mobilisation", 0.0) != 0.0 {
-                    fit_janssen_full_mobilisation(&profile, &setup, &jopts)?
-                } else {
-                    fit_janssen(&profile, &setup, &jopts)?
-                };
-                Ok(CalibratedLaw::from_janssen(&fit, provenance))
-            } else {
-                let fit = fit_janssen_k_mu(&profile, &setup, &jopts)?;
-                Ok(CalibratedLaw::from_janssen_k_mu(&fit, provenance))
-            }
+    provenance
+}
+
+/// `janssen` (`σ_v`, `σ_h` and the optional `τ_w`; `wall_friction` required, full mobilisation
+/// on `full_mobilisation ≠ 0`) or `janssen-kmu` (`σ_v` only) from the table.
+fn fit_janssen_rows(
+    law: &str,
+    table: &Table,
+    options: &CsvFitOptions,
+    provenance: Provenance,
+) -> Result<CalibratedLaw> {
+    let profile = JanssenProfile {
+        z_m: table.column("z_m")?,
+        sigma_v_pa: table.column("sigma_v_Pa")?,
+        sigma_h_pa: if law == "janssen" {
+            Some(table.column("sigma_h_Pa")?)
+        } else {
+            None
+        },
+        tau_w_pa: if law == "janssen" {
+            table.optional_column("tau_w_Pa")?
+        } else {
+            None
+        },
+    };
+    let setup = JanssenSetup {
+        width_m: table.metadata_value("width_m")?,
+        bulk_density_kg_m3: table.metadata_value("bulk_density_kg_m3")?,
+        gravity_m_s2: table.metadata_or("gravity_m_s2", STANDARD_GRAVITY),
+        wall_friction: if law == "janssen" {
+            table.metadata_value("wall_friction")?
+        } else {
+            table.metadata_or("wall_friction", f64::INFINITY)
+        },
+    };
+    let window = match (
+        table.metadata.get("depth_min_m"),
+        table.metadata.get("depth_max_m"),
+    ) {
+        (None, None) => None,
+        (lo, hi) => Some((
+            lo.copied().unwrap_or(f64::NEG_INFINITY),
+            hi.copied().unwrap_or(f64::INFINITY),
+        )),
+    };
+    let jopts = JanssenOptions {
+        depth_window: window,
+        use_tau_w: true,
+        fit: options.fit.clone(),
+    };
+    if law == "janssen" {
+        let fit = if table.metadata_or("full_mobilisation", 0.0) != 0.0 {
+            fit_janssen_full_mobilisation(&profile, &setup, &jopts)?
+        } else {
+            fit_janssen(&profile, &setup, &jopts)?
+        };
+        Ok(CalibratedLaw::from_janssen(&fit, provenance))
+    } else {
+        let fit = fit_janssen_k_mu(&profile, &setup, &jopts)?;
+        Ok(CalibratedLaw::from_janssen_k_mu(&fit, provenance))
+    }
+}
+
+/// `wall-law` from the table: the slip velocity and `μ_eff`, read or formed as `|τ_w| / σ_w`
+/// (`σ_w > 0`); the best of the candidate forms ([`select_wall_law`]) with its ranking.
+fn fit_wall_law_rows(
+    table: &Table,
+    options: &CsvFitOptions,
+    provenance: Provenance,
+) -> Result<CalibratedLaw> {
+    let vs = table.column("slip_velocity_m_s")?;
+    let mu = if table.has_column("mu_eff") {
+        table.column("mu_eff")?
+    } else if table.has_column("tau_w_Pa") || table.has_column("sigma_w_Pa") {
+        let tau = table.column("tau_w_Pa")?;
+        let sigma = table.column("sigma_w_Pa")?;
+        if let Some(k) = sigma.iter().position(|s| *s <= 0.0) {
+            return Err(IdentifyError::NegativePressure {
+                column: "sigma_w_Pa".into(),
+                index: k,
+                value: sigma[k],
+            });
         }
-        "wall-law" => {
-            let vs = table.column("slip_velocity_m_s")?;
-            let mu = if table.has_column("mu_eff") {
-                table.column("mu_eff")?
-            } else if table.has_column("tau_w_Pa") || table.has_column("sigma_w_Pa") {
-                let tau = table.column("tau_w_Pa")?;
-                let sigma = table.column("sigma_w_Pa")?;
-                if let Some(k) = sigma.iter().position(|s| *s <= 0.0) {
-                    return Err(IdentifyError::NegativePressure {
-                        column: "sigma_w_Pa".into(),
-                        index: k,
-                        value: sigma[k],
-                    });
-                }
-                tau.iter().zip(&sigma).map(|(t, s)| t.abs() / s).collect()
-            } else {
-                table.column("mu_eff")?
-            };
-            let d = table.metadata_value("grain_diameter_m")?;
-            let g = table.metadata_or("gravity_m_s2", STANDARD_GRAVITY);
-            let series = WallSlipSeries {
-                slip_velocity_m_s: vs,
-                mu_eff: mu,
-                grain_diameter_m: d,
-                gravity_m_s2: g,
-            };
-            let sel = select_wall_law(&series, &options.fit)?;
-            Ok(CalibratedLaw::from_wall_law(
-                sel.best(),
-                d,
-                g,
-                Some(sel.comparison.clone()),
-                provenance,
-            ))
+        tau.iter().zip(&sigma).map(|(t, s)| t.abs() / s).collect()
+    } else {
+        table.column("mu_eff")?
+    };
+    let d = table.metadata_value("grain_diameter_m")?;
+    let g = table.metadata_or("gravity_m_s2", STANDARD_GRAVITY);
+    let series = WallSlipSeries {
+        slip_velocity_m_s: vs,
+        mu_eff: mu,
+        grain_diameter_m: d,
+        gravity_m_s2: g,
+    };
+    let sel = select_wall_law(&series, &options.fit)?;
+    Ok(CalibratedLaw::from_wall_law(
+        sel.best(),
+        d,
+        g,
+        Some(sel.comparison.clone()),
+        provenance,
+    ))
+}
+
+/// `mu-i`, `mu-i-linear` or `phi-i` from the table (`I`, `mu` or `phi`, the optional `P` and
+/// standard errors); the grain scale is read after the fit.
+fn fit_rheology_rows(
+    law: &str,
+    table: &Table,
+    options: &CsvFitOptions,
+    provenance: Provenance,
+) -> Result<CalibratedLaw> {
+    let mut series = RheologySeries {
+        inertial_number: table.column("I")?,
+        pressure_pa: table.optional_column("P_Pa")?,
+        ..Default::default()
+    };
+    // The constants are asked for after the fit, so that an error in the data is
+    // reported first.
+    let o = &options.fit;
+    if law.starts_with("mu") {
+        series.mu = Some(table.column("mu")?);
+        series.mu_std_error = table.optional_column("mu_std_error")?;
+    } else {
+        series.phi = Some(table.column("phi")?);
+        series.phi_std_error = table.optional_column("phi_std_error")?;
+    }
+    Ok(match law {
+        "mu-i" => {
+            let fit = fit_mu_i(&series, o)?;
+            CalibratedLaw::from_mu_i(&fit, grain_scale(table)?, provenance)
         }
-        "mu-i" | "mu-i-linear" | "phi-i" => {
-            let mut series = RheologySeries {
-                inertial_number: table.column("I")?,
-                pressure_pa: table.optional_column("P_Pa")?,
-                ..Default::default()
-            };
-            // The constants are asked for after the fit, so that an error in the data is
-            // reported first.
-            let o = &options.fit;
-            if law.starts_with("mu") {
-                series.mu = Some(table.column("mu")?);
-                series.mu_std_error = table.optional_column("mu_std_error")?;
-            } else {
-                series.phi = Some(table.column("phi")?);
-                series.phi_std_error = table.optional_column("phi_std_error")?;
-            }
-            Ok(match law {
-                "mu-i" => {
-                    let fit = fit_mu_i(&series, o)?;
-                    CalibratedLaw::from_mu_i(&fit, grain_scale(&table)?, provenance)
-                }
-                "mu-i-linear" => {
-                    let fit = fit_mu_i_linear(&series, o)?;
-                    CalibratedLaw::from_mu_i_linear(&fit, grain_scale(&table)?, provenance)
-                }
-                _ => {
-                    let fit = fit_phi_i(&series, o)?;
-                    CalibratedLaw::from_phi_i(&fit, grain_scale(&table)?, provenance)
-                }
-            })
+        "mu-i-linear" => {
+            let fit = fit_mu_i_linear(&series, o)?;
+            CalibratedLaw::from_mu_i_linear(&fit, grain_scale(table)?, provenance)
         }
         _ => {
-            // mohr-coulomb
-            let data = if table.has_column("p_Pa") || table.has_column("q_Pa") {
-                YieldData::Circles {
-                    p_pa: table.column("p_Pa")?,
-                    q_pa: table.column("q_Pa")?,
-                }
-            } else if table.has_column("sigma_n_Pa") || table.has_column("tau_Pa") {
-                YieldData::FailurePlane {
-                    sigma_n_pa: table.column("sigma_n_Pa")?,
-                    tau_pa: table.column("tau_Pa")?,
-                }
-            } else {
-                let sxx = table.column("sigma_xx_Pa")?;
-                let syy = table.column("sigma_yy_Pa")?;
-                let sxy = table.column("sigma_xy_Pa")?;
-                let tensors: Vec<[f64; 3]> =
-                    (0..sxx.len()).map(|k| [sxx[k], syy[k], sxy[k]]).collect();
-                YieldData::from_tension_positive_tensors(&tensors)
-            };
-            let cohesion_fixed_zero = match table.metadata.get("cohesion") {
-                None => false,
-                Some(c) if *c == 0.0 => true,
-                Some(c) => {
-                    return Err(IdentifyError::Metadata {
-                        file: table.source.clone(),
-                        message: format!(
-                            "line {}: '# cohesion = {c}': only '# cohesion = 0' is read (it fixes c = 0); remove the line to fit c",
-                            table.metadata_lines.get("cohesion").copied().unwrap_or(0)
-                        ),
-                    })
-                }
-            };
-            let fit = fit_mohr_coulomb_with(
-                &data,
-                &MohrCoulombOptions {
-                    confidence: options.fit.confidence,
-                    cohesion_fixed_zero,
-                    min_r_squared: options.fit.min_r_squared,
-                    ..MohrCoulombOptions::default()
-                },
-            )?;
-            Ok(CalibratedLaw::from_mohr_coulomb(&fit, provenance))
+            let fit = fit_phi_i(&series, o)?;
+            CalibratedLaw::from_phi_i(&fit, grain_scale(table)?, provenance)
         }
-    }
+    })
+}
+
+/// `mohr-coulomb` from the table: Mohr circles (`p`, `q`), failure-plane tractions (`σ_n`, `τ`)
+/// or 2D tension-positive tensors, in that order of precedence, and `# cohesion = 0`.
+fn fit_mohr_coulomb_rows(
+    table: &Table,
+    options: &CsvFitOptions,
+    provenance: Provenance,
+) -> Result<CalibratedLaw> {
+    let data = if table.has_column("p_Pa") || table.has_column("q_Pa") {
+        YieldData::Circles {
+            p_pa: table.column("p_Pa")?,
+            q_pa: table.column("q_Pa")?,
+        }
+    } else if table.has_column("sigma_n_Pa") || table.has_column("tau_Pa") {
+        YieldData::FailurePlane {
+            sigma_n_pa: table.column("sigma_n_Pa")?,
+            tau_pa: table.column("tau_Pa")?,
+        }
+    } else {
+        let sxx = table.column("sigma_xx_Pa")?;
+        let syy = table.column("sigma_yy_Pa")?;
+        let sxy = table.column("sigma_xy_Pa")?;
+        let tensors: Vec<[f64; 3]> = (0..sxx.len()).map(|k| [sxx[k], syy[k], sxy[k]]).collect();
+        YieldData::from_tension_positive_tensors(&tensors)
+    };
+    let cohesion_fixed_zero = match table.metadata.get("cohesion") {
+        None => false,
+        Some(c) if *c == 0.0 => true,
+        Some(c) => {
+            return Err(IdentifyError::Metadata {
+                file: table.source.clone(),
+                message: format!(
+                    "line {}: '# cohesion = {c}': only '# cohesion = 0' is read (it fixes c = 0); remove the line to fit c",
+                    table.metadata_lines.get("cohesion").copied().unwrap_or(0)
+                ),
+            })
+        }
+    };
+    let fit = fit_mohr_coulomb_with(
+        &data,
+        &MohrCoulombOptions {
+            confidence: options.fit.confidence,
+            cohesion_fixed_zero,
+            min_r_squared: options.fit.min_r_squared,
+            ..MohrCoulombOptions::default()
+        },
+    )?;
+    Ok(CalibratedLaw::from_mohr_coulomb(&fit, provenance))
 }
