@@ -44,7 +44,9 @@
 //! within their suspect limits, the loaded-scale error and the worst error are judged only
 //! against their refusal limits and the fraction of steps above the tolerance is not judged:
 //! the residual was shown not to move the numbers, and the precision of the result is the
-//! criterion. A change is judged with the scatter of its samples (`√(Δ² + SE(Δ)²)`): it
+//! criterion (where some re-solves stopped short of 10⁻⁸, within a fifth of the run's own
+//! error on the problem's measure, the loaded-scale error keeps its suspect limit:
+//! [`Measured`]). A change is judged with the scatter of its samples (`√(Δ² + SE(Δ)²)`): it
 //! passes only if it is small and the samples are enough to tell. The re-solve measures the solver's
 //! effect on the forces of each sampled state, not on the trajectory that led there (positions
 //! move by `θ h Δv` only); the trajectory's drift is what the overlap and energy checks bound.
@@ -133,6 +135,23 @@ pub const SENSITIVITY_TOLERANCE: f64 = 1e-8;
 /// Fewest re-solved samples for a measured sensitivity to stand in for the loaded-scale error
 /// check.
 pub const SENSITIVITY_MIN_SAMPLES: u64 = 10;
+
+/// What a window's measured solver sensitivity ([`Checks::sensitivity`]) stands in for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Measured {
+    /// Not measured, too few samples, or a change beyond its limit: the solver's proxies
+    /// (steps above the tolerance, worst errors) are judged as without a measure.
+    No,
+    /// Measured and passed, with re-solves short of [`SENSITIVITY_TOLERANCE`] within a fifth of
+    /// the run's own error on the problem's error measure (`Sensitivity::near`): it stands in
+    /// for the proxies on that scale (the fraction of steps above the tolerance, the worst
+    /// error) but not for the loaded contacts' one, whose scale those re-solves were not
+    /// judged on.
+    ProblemScale,
+    /// Measured and passed with every re-solve at the tolerance: it stands in for the
+    /// loaded contacts' proxy too.
+    LoadedScale,
+}
 /// Largest fraction of samples whose re-solve may fail (left out of the measure) for the
 /// measure to stand; beyond it the check is suspect.
 pub const SENSITIVITY_UNRESOLVED_SUSPECT: f64 = 0.1;
@@ -330,13 +349,13 @@ impl Checks {
     /// effect must stay a small part of the result's error), a pressure change above
     /// [`pressure_limit`]; otherwise the absolute limits
     /// [`SENSITIVITY_MU_SUSPECT`], [`SENSITIVITY_PRESSURE_SUSPECT`]. The refusal limits are
-    /// absolute ([`SENSITIVITY_MU_REFUSED`], [`SENSITIVITY_PRESSURE_REFUSED`]). Returns whether
-    /// it was measured and passed (then it stands in for the suspect limits of the solver's
-    /// proxies, [`Checks::window_measured`]). Nothing is checked where nothing was re-solved.
-    pub fn sensitivity(&mut self, label: &str, s: &Sensitivity, statistical: [f64; 2]) -> bool {
+    /// absolute ([`SENSITIVITY_MU_REFUSED`], [`SENSITIVITY_PRESSURE_REFUSED`]). Returns what
+    /// the measure stands in for ([`Measured`]: the suspect limits of the solver's proxies,
+    /// [`Checks::window_measured`]). Nothing is checked where nothing was re-solved.
+    pub fn sensitivity(&mut self, label: &str, s: &Sensitivity, statistical: [f64; 2]) -> Measured {
         let tried = s.samples + s.unresolved;
         if tried == 0 {
-            return false;
+            return Measured::No;
         }
         let before = self.reasons.len();
         let failed = s.unresolved as f64 / tried as f64;
@@ -422,7 +441,12 @@ impl Checks {
                 },
             );
         }
-        self.reasons.len() == before && s.samples >= SENSITIVITY_MIN_SAMPLES && s.near == 0
+        let passed = self.reasons.len() == before && s.samples >= SENSITIVITY_MIN_SAMPLES;
+        match (passed, s.near == 0) {
+            (false, _) => Measured::No,
+            (true, false) => Measured::ProblemScale,
+            (true, true) => Measured::LoadedScale,
+        }
     }
 
     /// The numerics of the steps that feed a result: unconverged steps and worst error over the
@@ -446,8 +470,9 @@ impl Checks {
         // The solver's effect on the result measured and within its limits: the proxies
         // (steps above the tolerance, the worst error) are judged against their refusal limits
         // only; the precision of the result is the criterion, not a residual.
-        let measured =
-            self.sensitivity(label, &w.sensitivity, w.statistical_errors) || measured_passed;
+        let by_samples = self.sensitivity(label, &w.sensitivity, w.statistical_errors);
+        let measured = by_samples != Measured::No || measured_passed;
+        let measured_loaded = by_samples == Measured::LoadedScale || measured_passed;
         // Steps above the tolerance are a proxy of the solver's effect on the result: where
         // that effect was measured and passed, they are not judged (the solves may stop at a
         // sweep cap, the worst error's refusal limit still bounds them).
@@ -496,8 +521,10 @@ impl Checks {
             self.at_most(
                 "solver.loaded_error_over_tolerance",
                 e0,
-                // A measured sensitivity that passed stands in for the suspect limit.
-                if measured {
+                // A measured sensitivity that passed stands in for the suspect limit, where
+                // every re-solve reached the tolerance (one short of it was judged on the
+                // problem's scale only).
+                if measured_loaded {
                     SOLVER_ERROR_REFUSED
                 } else {
                     SOLVER_ERROR_SUSPECT
@@ -1445,6 +1472,17 @@ mod tests {
         assert!(names.contains(&"solver.sensitivity_mu"), "{names:?}");
         assert!(names.contains(&"solver.unconverged_fraction"), "{names:?}");
         assert_eq!(c.verdict(), Verdict::Refused);
+        // Every re-solve short of 1e-8, within a fifth of the run's error (the 2000-grain
+        // cell's): the measure stands in for the steps above the tolerance and the worst error,
+        // not for the loaded contacts' scale (20× the tolerance there: suspect).
+        let mut w = window(40, 7e-4);
+        w.sensitivity.near = 40;
+        w.worst_error = 1e-3;
+        w.worst_error_without_gap_shifts = 2e-3;
+        let c = judge(&w);
+        let names: Vec<_> = c.reasons.iter().map(|r| r.check.as_str()).collect();
+        assert_eq!(names, ["solver.loaded_error_over_tolerance"]);
+        assert_eq!(c.verdict(), Verdict::Suspect);
         // The pressure moving by 2 % (above 1.5 %): suspect by the measure.
         let c = judge(&window(40, 0.02));
         let names: Vec<_> = c.reasons.iter().map(|r| r.check.as_str()).collect();

@@ -159,10 +159,27 @@ pub struct SolverSpec {
     /// faster than `overlap_rate · R_min / h`), ≥ 0 (0: no such condition). Default 10⁻⁴.
     #[serde(default = "default_overlap_rate")]
     pub overlap_rate: f64,
+    /// Relaxation factor ω of the Gauss–Seidel update, `r ← proj_K(r + ω (r_local − r))`
+    /// ([`dem::SolverParams::relaxation`]), in (0, 2). Default 1 (plain Gauss–Seidel).
+    #[serde(default = "unit_relaxation")]
+    pub relaxation: f64,
+    /// Memory of the Anderson acceleration of the sweeps ([`dem::SolverParams::anderson_memory`];
+    /// Walker & Ni, SIAM J. Numer. Anal. 49 (2011) 1715–1735), in 0..=50 (0: plain sweeps).
+    /// Default: the engine's.
+    #[serde(default = "default_anderson_memory")]
+    pub anderson_memory: usize,
 }
 
 fn one() -> usize {
     1
+}
+
+fn unit_relaxation() -> f64 {
+    1.0
+}
+
+fn default_anderson_memory() -> usize {
+    dem::SolverParams::default().anderson_memory
 }
 
 /// Default of [`SolverSpec::overlap_rate`]: the engine's.
@@ -179,7 +196,8 @@ fn default_max_halvings() -> u32 {
 
 impl SolverSpec {
     /// Checks `0 < tolerance < 1`, `max_iterations ≥ 1`, `max_halvings ≤ 10`,
-    /// `check_every ≤ 1000` and `1 ≤ last_level_sweeps ≤ 1000`.
+    /// `check_every ≤ 1000`, `1 ≤ last_level_sweeps ≤ 1000`, `0 < relaxation < 2` and
+    /// `anderson_memory ≤ 50`.
     pub fn validate(&self, prefix: &str) -> Result<()> {
         in_range(
             &format!("{prefix}.tolerance"),
@@ -210,6 +228,17 @@ impl SolverSpec {
             0.0,
             1.0,
         )?;
+        if !(self.relaxation > 0.0 && self.relaxation < 2.0) {
+            return Err(crate::DatasetError::invalid(
+                &format!("{prefix}.relaxation"),
+                format!("{} is outside (0, 2)", self.relaxation),
+            ));
+        }
+        limits::at_most(
+            &format!("{prefix}.anderson_memory"),
+            self.anderson_memory,
+            50,
+        )?;
         Ok(())
     }
 
@@ -231,6 +260,8 @@ impl SolverSpec {
             check_every: self.check_every,
             last_level_sweeps: self.last_level_sweeps,
             error_scale: self.error_scale,
+            relaxation: self.relaxation,
+            anderson_memory: self.anderson_memory,
             ..Default::default()
         }
     }
