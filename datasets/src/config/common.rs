@@ -230,7 +230,7 @@ impl SolverSpec {
         )?;
         if !(self.relaxation > 0.0 && self.relaxation < 2.0) {
             return Err(crate::DatasetError::invalid(
-                &format!("{prefix}.relaxation"),
+                format!("{prefix}.relaxation"),
                 format!("{} is outside (0, 2)", self.relaxation),
             ));
         }
