@@ -78,6 +78,7 @@ use crate::cell::{Cell, CellControl, Imposed, Mat, COMPONENTS};
 use crate::colouring::ContactColouring;
 use crate::contact::{ContactGeometry, ContactRow};
 use crate::local::Delassus2;
+use crate::math::Spatial;
 use crate::parallel::coloured_sweep_where;
 use crate::sweep::update;
 
@@ -308,8 +309,8 @@ impl CellCoupling {
         &mut self,
         rows: &mut [ContactRow],
         order: &[u32],
-        vel: &mut [[f64; 3]],
-        inv: &[[f64; 3]],
+        vel: &mut [Spatial],
+        inv: &[Spatial],
         omega: f64,
     ) {
         for &i in order {
@@ -331,8 +332,8 @@ impl CellCoupling {
         &mut self,
         c: &mut ContactRow,
         s: usize,
-        vel: &mut [[f64; 3]],
-        inv: &[[f64; 3]],
+        vel: &mut [Spatial],
+        inv: &[Spatial],
         omega: f64,
     ) {
         c.affine = self.affine_of(s, &self.delta);
@@ -359,8 +360,8 @@ impl CellCoupling {
         &mut self,
         rows: &mut [ContactRow],
         colouring: &ContactColouring,
-        vel: &mut [[f64; 3]],
-        inv: &[[f64; 3]],
+        vel: &mut [Spatial],
+        inv: &[Spatial],
         mobile: &[bool],
         omega: f64,
     ) {

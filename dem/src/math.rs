@@ -52,6 +52,13 @@ pub const ANG_DIM: usize = 1;
 /// inverse-mass triple: 3 in 2D, 6 in 3D).
 pub const SPATIAL_DIM: usize = DIM + ANG_DIM;
 
+/// A rigid body's packed triple of generalised components, `[Real; SPATIAL_DIM]`: `(v_x, v_y, ω)`
+/// of a velocity, `(1/m, 1/m, 1/I)` of an inverse mass, `(F_x, F_y, torque)·h` of an impulse, a
+/// displacement `(Δx, Δy, Δθ)`. The layout of the solver's hot loops, which keep one per body
+/// in flat arrays ([`Twist`] is the named form; [`Twist::from_array`], [`Twist::to_array`]).
+/// In 3D the same name is six numbers (`SPATIAL_DIM` = 6).
+pub type Spatial = [Real; SPATIAL_DIM];
+
 /// A vector of the space (a position, a velocity, a force, a lever arm, a normal…), in SI
 /// units of what it holds. `SVector<Real, DIM>`, the same type as `nalgebra::Vector2<f64>`.
 pub type Vector = SVector<Real, DIM>;

@@ -2,7 +2,13 @@
 
 use super::block_csr::BlockCsr2;
 use super::error::FcError;
-use crate::local::Delassus2;
+use crate::local::{Coulomb2, Delassus2};
+
+/// The friction cone of an fc-problem-v1 contact ([`FcProblem::cone`]): the plane Coulomb cone
+/// (the format is 2D). The Gauss–Seidel sweep (`super::nsgs`) and the error measure
+/// (`super::measure`) reach the law through [`crate::cone::FrictionCone`] on it; Lemke's and
+/// Newton's methods are 2D by algorithm and read `μ` directly.
+pub type ProblemCone = Coulomb2;
 
 /// One 2D frictional-contact problem (fc-problem-v1), contact-local frames, normal first:
 ///
@@ -277,7 +283,13 @@ impl FcProblem {
         &self.w
     }
 
-    /// Symmetric part of the diagonal block of contact `α`, as used by the local solver.
+    /// The friction cone of contact `α`, `|r_t| ≤ μ_α r_n`.
+    pub fn cone(&self, alpha: usize) -> ProblemCone {
+        Coulomb2 { mu: self.mu[alpha] }
+    }
+
+    /// Symmetric part of the diagonal block of contact `α`, as used by the local solver (the
+    /// block of its [`ProblemCone`]).
     pub fn delassus(&self, alpha: usize) -> Delassus2 {
         self.diag[alpha]
     }
