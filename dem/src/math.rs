@@ -31,9 +31,9 @@
 //! The choice of a feature over generics on a dimension type is argued in
 //! `docs/architecture.md` §"Dimension layer".
 //!
-//! Not yet converted: the engine's own files (`cell.rs` keeps its local `DIM`, `Vect`, `Mat`,
-//! which are the same types as [`DIM`], [`Vector`], [`Tensor`]; the solver's per-body arrays
-//! `[f64; 3]` of velocities, inverse masses and impulses).
+//! The engine (`dem/src`) is written against these names too: its vectors are [`Vector`]s, the
+//! cell's matrices [`Tensor`]s, and the per-body triples of the solver's hot loops (velocities,
+//! inverse masses, impulses, displacements) [`Spatial`] arrays.
 
 use nalgebra::{Matrix2, Point2, SVector, UnitComplex};
 use serde::{Deserialize, Serialize};
@@ -103,9 +103,9 @@ pub fn ang_cross(w: AngVector, r: &Vector) -> Vector {
 /// The velocity of a rigid body, a twist `(v, ω)`: the velocity `v` of its centre of mass (m/s)
 /// and its angular velocity `ω` (rad/s, counter-clockwise about e_z in the plane).
 ///
-/// It replaces the bare triple `[f64; 3] = (v_x, v_y, ω)` outside the engine's hot loops, where
-/// the solver keeps the triples packed for speed ([`Twist::from_array`] and
-/// [`Twist::to_array`] convert exactly). The velocity field of the body is
+/// It is the named form of a [`Spatial`] velocity `(v_x, v_y, ω)`, which the engine's hot loops
+/// keep packed, one per body, for speed ([`Twist::from_array`] and [`Twist::to_array`] convert
+/// exactly). The velocity field of the body is
 /// `u(x) = v + ω × (x − c)` ([`Twist::velocity_at`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Twist {
@@ -155,12 +155,10 @@ mod tests {
 
     #[test]
     fn aliases_are_the_plane_types() {
-        // The dimension layer is the same nalgebra types the engine's cell writes out.
+        // The dimension layer is the plane nalgebra types.
         let v: nalgebra::Vector2<f64> = Vector::new(1.0, 2.0);
-        let c: crate::cell::Vect = v;
-        let t: crate::cell::Mat = Tensor::identity();
-        assert_eq!(DIM, crate::cell::DIM);
-        assert_eq!(c.len(), DIM);
+        let t: nalgebra::Matrix2<f64> = Tensor::identity();
+        assert_eq!(v.len(), DIM);
         assert_eq!(t.nrows(), DIM);
         assert_eq!(SPATIAL_DIM, 3);
     }

@@ -40,7 +40,7 @@ use std::time::Instant;
 
 use super::error::FcError;
 use super::ordering::{contact_order, ContactOrdering};
-use super::problem::{FcProblem, ProblemCone};
+use super::problem::{FcProblem, ProblemCone, LOW_RANK};
 use crate::cone::FrictionCone;
 use crate::local::Delassus2;
 use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
@@ -137,9 +137,9 @@ struct FcSweeps {
     omega: f64,
     /// The problem's low-rank term in sweep order (empty without one): `B_cκ` per contact,
     /// `m_κ`, and the current sums `s_κ = Σ_c B_cκ · r_c`, kept current by the sweep.
-    lr_coef: Vec<[[f64; 2]; 3]>,
-    lr_m: [f64; 3],
-    lr_s: [f64; 3],
+    lr_coef: Vec<[[f64; 2]; LOW_RANK]>,
+    lr_m: [f64; LOW_RANK],
+    lr_s: [f64; LOW_RANK],
 }
 
 impl FcSweeps {
