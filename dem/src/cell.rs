@@ -47,9 +47,8 @@ use crate::math::{Real, Tensor, Vector, DIM};
 pub const COMPONENTS: [(usize, usize); 3] = [(0, 0), (1, 1), (0, 1)];
 /// One value per component of [`COMPONENTS`] (xx, yy, xy): a compliance, a free change `δ⁰`
 /// or a change `δ` of `L` ([`CellControl::free_change`], [`crate::cell_coupling`]). Its length
-/// is the number of components of `L` a stress may be imposed on, not the rigid-body
-/// [`crate::math::SPATIAL_DIM`] that it equals in the plane (a 3D cell would have six, and the
-/// 3D `SPATIAL_DIM` is six too, by coincidence).
+/// is the number of components of `L` a stress may be imposed on (three in the plane), not the
+/// rigid-body [`crate::math::SPATIAL_DIM`] that it happens to equal.
 pub type ComponentValues = [Real; COMPONENTS.len()];
 /// An integer lattice shift `k` (the image `x + h k`).
 pub type Shift = SVector<i64, DIM>;

@@ -16,7 +16,10 @@
 //! `docs/formats.md` §1.2), and the exact solution of one contact's problem given its Delassus
 //! block ([`FrictionCone::Block`]) and the others' contribution `q` (the Gauss–Seidel update).
 //! The generic predictor–corrector ([`predictor_corrector`], [`solve_local_iterated`]) is
-//! written once against the interface.
+//! written once against the interface, and so is the relaxed local update of every
+//! Gauss–Seidel sweep of the crate ([`relaxed_local_solve`], called through
+//! `crate::sweep::solve_row` on any row implementing `crate::sweep::SweepRow`: the engine's
+//! rows, the standalone problem's, a 3D row).
 //!
 //! Implementations: `crate::local::Coulomb2`, the plane cone, whose local solve is the closed
 //! form over its three outcomes (`crate::local::solve_local`); the 3D circular cone of the compile-only

@@ -14,9 +14,9 @@
 //! contact exactly. With over-relaxation `ω ≠ 1`, `r_α ← proj_K((1 − ω) r_α^old + ω r_α^local)`,
 //! which keeps `r_α` in the Coulomb cone. The update is the sweep's one,
 //! [`crate::sweep::solve_row`] ([`crate::cone::relaxed_local_solve`] written against
-//! [`crate::cone::FrictionCone`]), on the row's view of the problem (`ProblemRow`). The row of W is recomputed at each update (block CSR in
-//! sweep order, diagonal blocks apart): cost proportional to the row's block count, no
-//! allocation in the loop.
+//! [`crate::cone::FrictionCone`]), on the row's view of the problem (`ProblemRow`). The row of
+//! W is recomputed at each update (block CSR in sweep order, diagonal blocks apart): cost
+//! proportional to the row's block count, no allocation in the loop.
 //!
 //! **Acceleration.** Once the contact statuses stop changing, one sweep is an affine map and
 //! Gauss–Seidel converges linearly and slowly (the weight of a pile has to diffuse through the
