@@ -75,7 +75,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use datasets::config::SimpleShearConfig;
-use dem::cell::{Cell, Vect};
+use dem::cell::Cell;
+use dem::math::Vector as Vect;
 use dem::BodyKind;
 
 use crate::error::{CliError, Result};
@@ -910,7 +911,7 @@ mod tests {
     /// edges, overlap by 0.5 mm at their minimum image; far grains do not overlap.
     #[test]
     fn overlaps_are_found_across_the_periodic_edges() {
-        use dem::cell::Mat;
+        use dem::math::Tensor as Mat;
         // a₁ = (0.1, 0), a₂ = (0.03, 0.08)
         let cell = Cell::new(Mat::new(0.1, 0.03, 0.0, 0.08), Mat::zeros()).unwrap();
         // b − a₂ is 1.5 mm below a: the pair meets across the tilted top and bottom edges

@@ -415,7 +415,7 @@ fn every_kind_of_lammps_box_gives_the_minimum_image() {
     let (a, b) = ([0.001, 0.0005], [0.001 + 0.004, 0.0005 + 0.01 - 0.002]);
     let e = read(two_disks(dir.path(), 2, bounds, a, b, r, [0.0, 1.0]));
     let cell = e.snapshot.cell.expect("biperiodic");
-    assert_eq!(cell.h, dem::cell::Mat::new(0.01, 0.004, 0.0, 0.01));
+    assert_eq!(cell.h, dem::math::Tensor::new(0.01, 0.004, 0.0, 0.01));
     // one snapshot of two disks: neither an interval nor enough grains for a velocity fit
     assert_eq!(e.velocity_gradient, Some(GradientSource::Zero));
     let d = branch(&e.snapshot);

@@ -19,11 +19,12 @@ use crate::cell_coupling::CellCoupling;
 use crate::contact::ContactRow;
 use crate::fc::block_csr::BlockCsr2;
 use crate::fc::problem::{FcProblem, LowRank};
+use crate::math::Spatial;
 
 /// Row of contact `c` on the body of `side` (0: `a`, 1: `b`): `[n-row, t-row]`, each
 /// `(x, y, θ)`.
 #[inline]
-fn body_rows(c: &ContactRow, side: usize) -> [[f64; 3]; 2] {
+fn body_rows(c: &ContactRow, side: usize) -> [Spatial; 2] {
     let [nx, ny] = c.n;
     if side == 1 {
         [[nx, ny, c.k[2]], [-ny, nx, c.k[3]]]
@@ -34,13 +35,13 @@ fn body_rows(c: &ContactRow, side: usize) -> [[f64; 3]; 2] {
 
 /// `W = H M⁻¹ Hᵀ` of the contacts `rows` with inverse masses `inv` (per body `[1/m, 1/m, 1/I]`,
 /// zero for imposed degrees of freedom).
-pub fn delassus_matrix(rows: &[ContactRow], inv: &[[f64; 3]]) -> BlockCsr2 {
+pub fn delassus_matrix(rows: &[ContactRow], inv: &[Spatial]) -> BlockCsr2 {
     delassus_with(rows, inv, None)
 }
 
 /// [`delassus_matrix`] plus the term `m Σ_κ B_κ B_κᵀ` of a cell whose stress-controlled
 /// components are unknowns of the step ([`crate::cell_coupling`], [`CellCoupling::low_rank`]).
-pub fn delassus_with(rows: &[ContactRow], inv: &[[f64; 3]], cell: Option<&LowRank>) -> BlockCsr2 {
+pub fn delassus_with(rows: &[ContactRow], inv: &[Spatial], cell: Option<&LowRank>) -> BlockCsr2 {
     // Body → (contact, side) adjacency in compressed form.
     let nb = inv.len();
     let mut count = vec![0usize; nb + 1];
@@ -93,7 +94,7 @@ pub fn delassus_with(rows: &[ContactRow], inv: &[[f64; 3]], cell: Option<&LowRan
 
 /// The step's problem: `W` from [`delassus_matrix`], `q_α = H_α v_free + shift_α` from the free
 /// velocities, μ from the rows.
-pub fn contact_problem(rows: &[ContactRow], v_free: &[[f64; 3]], inv: &[[f64; 3]]) -> FcProblem {
+pub fn contact_problem(rows: &[ContactRow], v_free: &[Spatial], inv: &[Spatial]) -> FcProblem {
     contact_problem_with(rows, v_free, inv, None)
 }
 
@@ -102,8 +103,8 @@ pub fn contact_problem(rows: &[ContactRow], v_free: &[[f64; 3]], inv: &[[f64; 3]
 /// `Σ_κ B_κ δ⁰_κ` of the cell's change on the coupled contacts.
 pub fn contact_problem_with(
     rows: &[ContactRow],
-    v_free: &[[f64; 3]],
-    inv: &[[f64; 3]],
+    v_free: &[Spatial],
+    inv: &[Spatial],
     cell: Option<&CellCoupling>,
 ) -> FcProblem {
     // A term among the contacts across the boundary is folded into W as it is assembled (the

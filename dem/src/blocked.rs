@@ -12,6 +12,7 @@
 
 use crate::colouring::slab_order;
 use crate::contact::ContactRow;
+use crate::math::Spatial;
 
 /// A block-contiguous copy of a contact problem (see the module documentation).
 #[derive(Debug, Clone, Default)]
@@ -26,11 +27,11 @@ pub struct BlockLayout {
     /// Contact rows, renumbered.
     pub rows: Vec<ContactRow>,
     /// Velocities, renumbered.
-    pub vel: Vec<[f64; 3]>,
+    pub vel: Vec<Spatial>,
     /// Free velocities, renumbered.
-    pub v_free: Vec<[f64; 3]>,
+    pub v_free: Vec<Spatial>,
     /// Inverse masses, renumbered.
-    pub inv: Vec<[f64; 3]>,
+    pub inv: Vec<Spatial>,
     /// Mobility flags, renumbered.
     pub mobile: Vec<bool>,
     /// Body centres (m), renumbered.
@@ -43,9 +44,9 @@ impl BlockLayout {
     pub fn gather(
         &mut self,
         rows: &[ContactRow],
-        vel: &[[f64; 3]],
-        v_free: &[[f64; 3]],
-        inv: &[[f64; 3]],
+        vel: &[Spatial],
+        v_free: &[Spatial],
+        inv: &[Spatial],
         mobile: &[bool],
         pos: &[[f64; 2]],
         blocks: usize,
@@ -85,7 +86,7 @@ impl BlockLayout {
             c.b = self.body_new[c.b as usize];
             c
         }));
-        let perm = |src: &[[f64; 3]], dst: &mut Vec<[f64; 3]>| {
+        let perm = |src: &[Spatial], dst: &mut Vec<Spatial>| {
             dst.clear();
             dst.extend(self.body_old.iter().map(|&i| src[i as usize]));
         };
@@ -107,7 +108,7 @@ impl BlockLayout {
 
     /// Copies the impulses (with the Lemke basis bits that go with them) and velocities back
     /// to the world's numbering.
-    pub fn scatter(&self, rows: &mut [ContactRow], vel: &mut [[f64; 3]]) {
+    pub fn scatter(&self, rows: &mut [ContactRow], vel: &mut [Spatial]) {
         for (c, &k) in self.rows.iter().zip(&self.row_old) {
             rows[k as usize].r = c.r;
             rows[k as usize].basis = c.basis;

@@ -1,6 +1,6 @@
 //! Rigid bodies: grains (disks) and walls, with per-degree-of-freedom control.
 
-use nalgebra::Vector2;
+use crate::math::{Spatial, Vector};
 use serde::{Deserialize, Serialize};
 
 pub use crate::snapshot::BodyKind;
@@ -24,11 +24,11 @@ pub struct Body {
     /// Name (walls); empty for grains.
     pub name: String,
     /// Centre of mass (m).
-    pub position: Vector2<f64>,
+    pub position: Vector,
     /// Rotation angle (rad, counter-clockwise).
     pub angle: f64,
     /// Velocity (m/s).
-    pub velocity: Vector2<f64>,
+    pub velocity: Vector,
     /// Angular velocity (rad/s).
     pub omega: f64,
     /// Mass (kg); `m = ρ π R² · thickness` for a disk; infinite for a fixed wall.
@@ -47,27 +47,27 @@ pub struct Body {
     pub dofs: [Dof; 3],
     /// Constant applied force (N) on free degrees of freedom, besides gravity (e.g. a
     /// pressure-controlled platen).
-    pub applied_force: Vector2<f64>,
+    pub applied_force: Vector,
     /// Constant applied torque (N·m).
     pub applied_torque: f64,
     /// Whether gravity acts on the free degrees of freedom of this body.
     pub gravity: bool,
     /// Mean acceleration over the last step (m/s²), `(v⁺ − v⁻)/h`.
-    pub acceleration: Vector2<f64>,
+    pub acceleration: Vector,
     /// Mean angular acceleration over the last step (rad/s²).
     pub angular_acceleration: f64,
 }
 
 impl Body {
     /// A free disk grain at rest: `m = ρ π R² t`, `I = m R² / 2`.
-    pub fn disk(position: Vector2<f64>, radius: f64, density: f64, thickness: f64) -> Self {
+    pub fn disk(position: Vector, radius: f64, density: f64, thickness: f64) -> Self {
         let mass = density * std::f64::consts::PI * radius * radius * thickness;
         Body {
             kind: BodyKind::Grain,
             name: String::new(),
             position,
             angle: 0.0,
-            velocity: Vector2::zeros(),
+            velocity: Vector::zeros(),
             omega: 0.0,
             mass,
             inertia: 0.5 * mass * radius * radius,
@@ -75,16 +75,16 @@ impl Body {
             density,
             thickness,
             dofs: [Dof::Free; 3],
-            applied_force: Vector2::zeros(),
+            applied_force: Vector::zeros(),
             applied_torque: 0.0,
             gravity: true,
-            acceleration: Vector2::zeros(),
+            acceleration: Vector::zeros(),
             angular_acceleration: 0.0,
         }
     }
 
     /// A wall body whose motion is fully imposed (velocity `velocity`, no rotation).
-    pub fn wall(name: &str, position: Vector2<f64>, velocity: Vector2<f64>) -> Self {
+    pub fn wall(name: &str, position: Vector, velocity: Vector) -> Self {
         Body {
             kind: BodyKind::Wall,
             name: name.to_string(),
@@ -98,17 +98,17 @@ impl Body {
             density: 0.0,
             thickness: 1.0,
             dofs: [Dof::Imposed; 3],
-            applied_force: Vector2::zeros(),
+            applied_force: Vector::zeros(),
             applied_torque: 0.0,
             gravity: false,
-            acceleration: Vector2::zeros(),
+            acceleration: Vector::zeros(),
             angular_acceleration: 0.0,
         }
     }
 
     /// Inverse mass per degree of freedom `(1/m, 1/m, 1/I)`, zero where the motion is imposed.
     #[inline]
-    pub fn inverse_mass(&self) -> [f64; 3] {
+    pub fn inverse_mass(&self) -> Spatial {
         let inv = |d: Dof, m: f64| {
             if d == Dof::Free && m > 0.0 {
                 1.0 / m
@@ -168,11 +168,11 @@ impl From<&Body> for BodyState {
 }
 
 /// Gravity `g` (if it acts on the body) plus the applied force and torque, `(f_x, f_y, torque)`.
-pub fn external_loads(b: &Body, g: Vector2<f64>) -> [f64; 3] {
+pub fn external_loads(b: &Body, g: Vector) -> Spatial {
     let grav = if b.gravity {
         g * b.mass
     } else {
-        Vector2::zeros()
+        Vector::zeros()
     };
     [
         grav.x + b.applied_force.x,

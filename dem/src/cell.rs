@@ -34,22 +34,22 @@
 //! contact dynamics: Radjai & Dubois (2011), "Discrete-element modeling of granular
 //! materials", Wiley–ISTE, ch. on boundary conditions.
 //!
-//! Types are written with the dimension [`DIM`] so that a 3D cell has the same shape.
+//! Types are written with the names of the dimension layer (`crate::math`: [`DIM`],
+//! [`Vector`], [`Tensor`]) so that a 3D cell has the same shape.
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
 use crate::error::DemError;
-
-/// Space dimension of the cell.
-pub const DIM: usize = 2;
-/// A vector of the cell's space (m, m/s, ...).
-pub type Vect = SVector<f64, DIM>;
-/// A matrix of the cell's space (cell matrix `h` in m, velocity gradient `L` in 1/s, stress in Pa).
-pub type Mat = SMatrix<f64, DIM, DIM>;
+use crate::math::{Real, Tensor, Vector, DIM};
 
 /// The components `(i, j)` of `L` a cell control can impose a stress on: xx, yy, xy.
 pub const COMPONENTS: [(usize, usize); 3] = [(0, 0), (1, 1), (0, 1)];
+/// One value per component of [`COMPONENTS`] (xx, yy, xy): a compliance, a free change `δ⁰`
+/// or a change `δ` of `L` ([`CellControl::free_change`], [`crate::cell_coupling`]). Its length
+/// is the number of components of `L` a stress may be imposed on (three in the plane), not the
+/// rigid-body [`crate::math::SPATIAL_DIM`] that it happens to equal.
+pub type ComponentValues = [Real; COMPONENTS.len()];
 /// An integer lattice shift `k` (the image `x + h k`).
 pub type Shift = SVector<i64, DIM>;
 
@@ -60,15 +60,15 @@ pub const MAX_TILT: f64 = 0.5;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Cell {
     /// Cell matrix, columns = cell vectors `a₁, a₂` (m); `det h > 0`.
-    pub h: Mat,
+    pub h: Tensor,
     /// Homogeneous velocity gradient `L = ∂v/∂x` (1/s), `L_ij = ∂v_i/∂x_j`.
-    pub l: Mat,
+    pub l: Tensor,
 }
 
 impl Cell {
     /// A cell with matrix `h` (columns the cell vectors, m) and velocity gradient `l` (1/s);
     /// refuses a non-finite or degenerate (`det h ≤ 0`) matrix or a non-finite gradient.
-    pub fn new(h: Mat, l: Mat) -> Result<Self, DemError> {
+    pub fn new(h: Tensor, l: Tensor) -> Result<Self, DemError> {
         let c = Cell { h, l };
         c.check()?;
         Ok(c)
@@ -76,7 +76,7 @@ impl Cell {
 
     /// The rectangle `[0, lx) × [0, ly)` (m) at rest.
     pub fn rectangle(lx: f64, ly: f64) -> Result<Self, DemError> {
-        Cell::new(Mat::new(lx, 0.0, 0.0, ly), Mat::zeros())
+        Cell::new(Tensor::new(lx, 0.0, 0.0, ly), Tensor::zeros())
     }
 
     /// Checks the cell: finite, `det h > 0`, finite `L`.
@@ -105,18 +105,18 @@ impl Cell {
     }
 
     /// `h⁻¹` (1/m).
-    pub fn inverse(&self) -> Mat {
+    pub fn inverse(&self) -> Tensor {
         // det h > 0 is an invariant of the type (checked at construction, kept by `advance`).
-        self.h.try_inverse().unwrap_or_else(Mat::zeros)
+        self.h.try_inverse().unwrap_or_else(Tensor::zeros)
     }
 
     /// Reduced coordinates `s = h⁻¹ x`.
-    pub fn reduced(&self, x: &Vect) -> Vect {
+    pub fn reduced(&self, x: &Vector) -> Vector {
         self.inverse() * x
     }
 
     /// The point of the cell equivalent to `x`: `(x + h k, k)` with `h⁻¹(x + h k) ∈ [0, 1)²`.
-    pub fn wrap(&self, x: &Vect) -> (Vect, Shift) {
+    pub fn wrap(&self, x: &Vector) -> (Vector, Shift) {
         let s = self.reduced(x);
         let mut k = Shift::zeros();
         let mut sw = s;
@@ -139,13 +139,13 @@ impl Cell {
     }
 
     /// Shift vector `h k` (m) of the lattice shift `k`.
-    pub fn shift_vector(&self, k: &Shift) -> Vect {
+    pub fn shift_vector(&self, k: &Shift) -> Vector {
         self.h * k.map(|v| v as f64)
     }
 
     /// The shortest image of the separation `dx` (m): `(dx + h k, k)` minimising `|dx + h k|`
     /// (module documentation; exact for a reduced cell).
-    pub fn min_image(&self, dx: &Vect) -> (Vect, Shift) {
+    pub fn min_image(&self, dx: &Vector) -> (Vector, Shift) {
         let s = self.reduced(dx);
         let k0: Shift = s.map(|v| -(v.round() as i64));
         let mut best = (self.shift_vector(&k0) + dx, k0);
@@ -168,7 +168,7 @@ impl Cell {
     }
 
     /// Velocity of the image shift `k` relative to the original: `L h k` (m/s).
-    pub fn image_velocity(&self, k: &Shift) -> Vect {
+    pub fn image_velocity(&self, k: &Shift) -> Vector {
         self.l * self.shift_vector(k)
     }
 
@@ -176,13 +176,13 @@ impl Cell {
     /// cell (the affine field is defined up to a uniform velocity; the centre keeps a
     /// homogeneous kick [`crate::World::set_velocity_gradient`] free of net momentum for a
     /// uniform packing).
-    pub fn affine_velocity(&self, x: &Vect) -> Vect {
+    pub fn affine_velocity(&self, x: &Vector) -> Vector {
         self.l * (x - self.centre())
     }
 
     /// Centre of the cell `h (½, ½)` (m).
-    pub fn centre(&self) -> Vect {
-        self.h * Vect::repeat(0.5)
+    pub fn centre(&self) -> Vector {
+        self.h * Vector::repeat(0.5)
     }
 
     /// Advances the cell by `dt` (s) at constant `L`: `h ← exp(L dt) h`.
@@ -193,7 +193,7 @@ impl Cell {
     /// Advances the cell by `dt` (s) at the constant gradient `l` (1/s), `h ← exp(l dt) h`,
     /// leaving its own `L` unchanged (an implicit control's step deforms the cell with the
     /// `L⁺` its solve found before the grains take it, [`crate::cell_coupling`]).
-    pub fn advance_with(&mut self, l: &Mat, dt: f64) {
+    pub fn advance_with(&mut self, l: &Tensor, dt: f64) {
         let f = (l * dt).exp();
         self.h = f * self.h;
     }
@@ -223,13 +223,13 @@ impl Cell {
 
     /// Widths of the cell across each pair of opposite faces (m): `det h / |a₂|` across the
     /// faces parallel to `a₂`, `det h / |a₁|` across those parallel to `a₁` (`1/|row_d(h⁻¹)|`).
-    pub fn widths(&self) -> Vect {
+    pub fn widths(&self) -> Vector {
         let inv = self.inverse();
-        Vect::from_fn(|d, _| 1.0 / inv.row(d).norm())
+        Vector::from_fn(|d, _| 1.0 / inv.row(d).norm())
     }
 
     /// Strain rate `D = (L + Lᵀ)/2` (1/s).
-    pub fn strain_rate(&self) -> Mat {
+    pub fn strain_rate(&self) -> Tensor {
         (self.l + self.l.transpose()) * 0.5
     }
 }
@@ -397,7 +397,7 @@ impl CellControl {
     /// the implicit law ([`CellControl::implicit`], [`crate::cell_coupling`]) that carries no
     /// contact impulse, from the gradient `l` and the kinetic stress `kinetic` (Pa) at the start
     /// of the step (1/s).
-    pub fn free_change(&self, l: &Mat, kinetic: &Mat) -> [f64; 3] {
+    pub fn free_change(&self, l: &Tensor, kinetic: &Tensor) -> ComponentValues {
         let mut d = [0.0; 3];
         for (k, (c, ij)) in self.components().into_iter().zip(COMPONENTS).enumerate() {
             if let Imposed::Stress(target) = c {
@@ -411,7 +411,7 @@ impl CellControl {
     /// The velocity gradient for the next step of the implicit law ([`CellControl::implicit`]):
     /// `l` with the imposed rates set and `L_yx = 0`; the stress-controlled components are
     /// those the step's solve found.
-    pub fn implicit_next(&self, l: &Mat) -> Mat {
+    pub fn implicit_next(&self, l: &Tensor) -> Tensor {
         let mut out = *l;
         out[(1, 0)] = 0.0;
         for (c, ij) in self.components().into_iter().zip(COMPONENTS) {
@@ -424,7 +424,7 @@ impl CellControl {
 
     /// The velocity gradient after a step of `dt` (s) that ended with the mean stress `sigma`
     /// (Pa, symmetric), from the current `l` (law in the type's documentation).
-    pub fn update(&self, l: &Mat, sigma: &Mat, dt: f64) -> Mat {
+    pub fn update(&self, l: &Tensor, sigma: &Tensor, dt: f64) -> Tensor {
         let alpha = if self.relaxation > dt {
             dt / self.relaxation
         } else {
@@ -448,7 +448,7 @@ impl CellControl {
     /// Mean signed stress error `(1/n) Σ (σ_ij − σ*_ij)` over the `n` stress-controlled
     /// components (Pa): negative when the stress is more compressive than the targets; 0 when
     /// none is controlled. It grows with the rates of those components.
-    pub fn signed_error(&self, sigma: &Mat) -> f64 {
+    pub fn signed_error(&self, sigma: &Tensor) -> f64 {
         let mut s = 0.0;
         let mut n = 0;
         for (c, ij) in [(self.xx, (0, 0)), (self.yy, (1, 1)), (self.xy, (0, 1))] {
@@ -466,8 +466,8 @@ impl CellControl {
 
     /// The unit change of `L` of the implicit correction: 1 on every stress-controlled
     /// component, 0 elsewhere.
-    pub fn direction(&self) -> Mat {
-        let mut m = Mat::zeros();
+    pub fn direction(&self) -> Tensor {
+        let mut m = Tensor::zeros();
         for (c, ij) in [(self.xx, (0, 0)), (self.yy, (1, 1)), (self.xy, (0, 1))] {
             if let Imposed::Stress(_) = c {
                 m[ij] = 1.0;
@@ -478,7 +478,7 @@ impl CellControl {
 
     /// Largest stress error `|σ*_ij − σ_ij|` over the stress-controlled components (Pa); 0 when
     /// none is.
-    pub fn stress_error(&self, sigma: &Mat) -> f64 {
+    pub fn stress_error(&self, sigma: &Tensor) -> f64 {
         [(self.xx, (0, 0)), (self.yy, (1, 1)), (self.xy, (0, 1))]
             .iter()
             .filter_map(|&(c, ij)| match c {

@@ -74,10 +74,12 @@
 //! grains). (Sweeping each class in fixed chunks with `δ` frozen and the chunks' increments
 //! added in chunk order is also deterministic, but is a Jacobi step on the cell's rank-3 term.)
 
-use crate::cell::{Cell, CellControl, Imposed, Mat, COMPONENTS};
+use crate::cell::{Cell, CellControl, ComponentValues, Imposed, COMPONENTS};
 use crate::colouring::ContactColouring;
 use crate::contact::{ContactGeometry, ContactRow};
 use crate::local::Delassus2;
+use crate::math::Spatial;
+use crate::math::Tensor;
 use crate::parallel::coloured_sweep_where;
 use crate::sweep::update;
 
@@ -90,11 +92,11 @@ const NONE: u32 = u32::MAX;
 #[derive(Debug, Clone, Default)]
 pub struct CellCoupling {
     /// `m_κ = g/(h V)` per component, 0 where the rate is imposed (1/(kg·m²)).
-    compliance: [f64; 3],
+    compliance: ComponentValues,
     /// `δ⁰_κ` (1/s).
-    delta0: [f64; 3],
+    delta0: ComponentValues,
     /// Current `δ_κ` (1/s); every coupled row's `affine` is `base + Σ_κ B_κ δ_κ` outside a sweep.
-    delta: [f64; 3],
+    delta: ComponentValues,
     /// Coupled rows (indices into the step's rows).
     rows: Vec<u32>,
     /// Each coupled row's affine velocity with `L⁻` (m/s, contact frame).
@@ -128,7 +130,7 @@ impl CellCoupling {
         follows: &[bool],
         dt: f64,
         thickness: f64,
-        delta0: [f64; 3],
+        delta0: ComponentValues,
     ) -> Option<Self> {
         if !ctl.implicit {
             return None;
@@ -209,8 +211,8 @@ impl CellCoupling {
 
     /// The current change `δ = L⁺ − L⁻` of the velocity gradient (1/s): zero on the components
     /// whose rate is imposed.
-    pub fn delta(&self) -> Mat {
-        let mut d = Mat::zeros();
+    pub fn delta(&self) -> Tensor {
+        let mut d = Tensor::zeros();
         for (k, &ij) in COMPONENTS.iter().enumerate() {
             d[ij] = self.delta[k];
         }
@@ -220,7 +222,7 @@ impl CellCoupling {
     /// The change of `δ` (1/s, as a matrix: zero on the components whose rate is imposed) that
     /// impulses `r` (N·s, interleaved `(r_n, r_t)` per row of `rows`) give instead of the rows'
     /// own: `Δδ_κ = m_κ Σ_c B_cκ · (r_c − r_c^rows)` over the coupled rows.
-    pub fn delta_change(&self, rows: &[ContactRow], r: &[f64]) -> Mat {
+    pub fn delta_change(&self, rows: &[ContactRow], r: &[f64]) -> Tensor {
         let mut dd = [0.0; 3];
         for (s, &i) in self.rows.iter().enumerate() {
             let i = i as usize;
@@ -231,7 +233,7 @@ impl CellCoupling {
                 *x += self.compliance[k] * (b[0] * d[0] + b[1] * d[1]);
             }
         }
-        let mut m = Mat::zeros();
+        let mut m = Tensor::zeros();
         for (k, &ij) in COMPONENTS.iter().enumerate() {
             m[ij] = dd[k];
         }
@@ -240,7 +242,7 @@ impl CellCoupling {
 
     /// `Σ_κ B_cκ δ_κ` of slot `s` for the change `delta`.
     #[inline]
-    fn affine_of(&self, s: usize, delta: &[f64; 3]) -> [f64; 2] {
+    fn affine_of(&self, s: usize, delta: &ComponentValues) -> [f64; 2] {
         let (b, c) = (&self.base[s], &self.coef[s]);
         let mut a = *b;
         for k in 0..3 {
@@ -308,8 +310,8 @@ impl CellCoupling {
         &mut self,
         rows: &mut [ContactRow],
         order: &[u32],
-        vel: &mut [[f64; 3]],
-        inv: &[[f64; 3]],
+        vel: &mut [Spatial],
+        inv: &[Spatial],
         omega: f64,
     ) {
         for &i in order {
@@ -331,8 +333,8 @@ impl CellCoupling {
         &mut self,
         c: &mut ContactRow,
         s: usize,
-        vel: &mut [[f64; 3]],
-        inv: &[[f64; 3]],
+        vel: &mut [Spatial],
+        inv: &[Spatial],
         omega: f64,
     ) {
         c.affine = self.affine_of(s, &self.delta);
@@ -359,8 +361,8 @@ impl CellCoupling {
         &mut self,
         rows: &mut [ContactRow],
         colouring: &ContactColouring,
-        vel: &mut [[f64; 3]],
-        inv: &[[f64; 3]],
+        vel: &mut [Spatial],
+        inv: &[Spatial],
         mobile: &[bool],
         omega: f64,
     ) {

@@ -1,6 +1,6 @@
 //! Shapes attached to bodies: disks (grains, glued disks of rough walls), lines and segments.
 
-use nalgebra::Vector2;
+use crate::math::Vector;
 use serde::{Deserialize, Serialize};
 
 /// A shape in its body's frame (rotated by the body's angle, translated by its position).
@@ -11,22 +11,22 @@ pub enum Shape {
         /// Radius (m).
         radius: f64,
         /// Centre relative to the body's centre, body frame (m).
-        offset: Vector2<f64>,
+        offset: Vector,
     },
     /// An infinite line through `point` with unit `normal` pointing to the grains' side: a
     /// one-sided wall, gap `g = (c − p)·n − R` for a disk of centre c.
     Line {
         /// A point of the line, body frame (m).
-        point: Vector2<f64>,
+        point: Vector,
         /// Unit normal towards the grains, body frame.
-        normal: Vector2<f64>,
+        normal: Vector,
     },
     /// A segment from `a` to `b` (two-sided, rounded ends of radius 0), body frame (m).
     Segment {
         /// First end (m).
-        a: Vector2<f64>,
+        a: Vector,
         /// Second end (m).
-        b: Vector2<f64>,
+        b: Vector,
     },
 }
 
@@ -43,11 +43,11 @@ pub struct Collider {
 
 /// Rotation of `v` by `angle` (rad).
 #[inline]
-pub fn rotate(v: Vector2<f64>, angle: f64) -> Vector2<f64> {
+pub fn rotate(v: Vector, angle: f64) -> Vector {
     // A disk centred on its body (the common case) has a zero offset: no sin/cos per pair.
     if angle == 0.0 || (v.x == 0.0 && v.y == 0.0) {
         return v;
     }
     let (s, c) = angle.sin_cos();
-    Vector2::new(c * v.x - s * v.y, s * v.x + c * v.y)
+    Vector::new(c * v.x - s * v.y, s * v.x + c * v.y)
 }

@@ -16,7 +16,10 @@
 //! `docs/formats.md` §1.2), and the exact solution of one contact's problem given its Delassus
 //! block ([`FrictionCone::Block`]) and the others' contribution `q` (the Gauss–Seidel update).
 //! The generic predictor–corrector ([`predictor_corrector`], [`solve_local_iterated`]) is
-//! written once against the interface.
+//! written once against the interface, and so is the relaxed local update of every
+//! Gauss–Seidel sweep of the crate ([`relaxed_local_solve`], called through
+//! `crate::sweep::solve_row` on any row implementing `crate::sweep::SweepRow`: the engine's
+//! rows, the standalone problem's, a 3D row).
 //!
 //! Implementations: `crate::local::Coulomb2`, the plane cone, whose local solve is the closed
 //! form over its three outcomes (`crate::local::solve_local`); the 3D circular cone of the compile-only
@@ -199,4 +202,35 @@ pub fn solve_local_iterated<C: FrictionCone>(
         }
     }
     (r, status)
+}
+
+/// The relaxed local update of nonlinear Gauss–Seidel, written once for every cone: the exact
+/// solution `r* = solve_local(W, q)` of the contact's problem ([`FrictionCone::solve_local`]),
+/// and with a relaxation factor `ω ≠ 1` the relaxed impulse projected back on the cone,
+///
+/// ```text
+/// r ← r*                                    (ω = 1)
+/// r ← proj_K(r_old + ω (r* − r_old))         (ω ≠ 1)
+/// ```
+///
+/// so that `r` stays in `K_μ` (the over-relaxed NLGS of M. Jean, *The non-smooth contact
+/// dynamics method*, CMAME 177 (1999) 235–257). Every sweep of the crate calls it, through
+/// [`crate::sweep::solve_row`].
+#[inline(always)]
+pub fn relaxed_local_solve<C: FrictionCone>(
+    cone: &C,
+    w: &C::Block,
+    q: C::Local,
+    old: C::Local,
+    omega: Real,
+) -> C::Local {
+    let (mut r, _) = cone.solve_local(w, q);
+    if omega != 1.0 {
+        let mut t = old;
+        for ((t, o), x) in t.as_mut().iter_mut().zip(old.as_ref()).zip(r.as_ref()) {
+            *t = o + omega * (x - o);
+        }
+        r = cone.project(t).0;
+    }
+    r
 }

@@ -4,7 +4,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::local::{ContactStatus, Delassus2};
+use crate::local::{ContactStatus, Coulomb2, Delassus2};
+use crate::math::Spatial;
+
+/// The friction cone of the engine's contact rows ([`ContactRow::cone`]): the plane Coulomb
+/// cone. The one name a 3D engine changes (to `crate::dim3::Coulomb3`, with the rows' frame,
+/// Delassus block and impulse in three components); the sweeps are written against
+/// [`crate::cone::FrictionCone`] through [`crate::sweep::SweepRow`].
+pub type RowCone = Coulomb2;
 
 /// What the solver reads and writes for one contact (hot data, 17 words).
 ///
@@ -48,10 +55,16 @@ pub struct ContactRow {
 }
 
 impl ContactRow {
+    /// The contact's friction cone, `|r_t| ≤ μ r_n` with its coefficient [`ContactRow::mu`].
+    #[inline(always)]
+    pub fn cone(&self) -> RowCone {
+        Coulomb2 { mu: self.mu }
+    }
+
     /// Local relative velocity `u = H v + (shift, 0) + affine` from body velocities
     /// `[v_x, v_y, ω]`.
     #[inline(always)]
-    pub fn velocity(&self, va: &[f64; 3], vb: &[f64; 3]) -> [f64; 2] {
+    pub fn velocity(&self, va: &Spatial, vb: &Spatial) -> [f64; 2] {
         let [nx, ny] = self.n;
         let dx = vb[0] - va[0];
         let dy = vb[1] - va[1];
@@ -67,10 +80,10 @@ impl ContactRow {
     pub fn apply(
         &self,
         d: [f64; 2],
-        va: &mut [f64; 3],
-        ia: &[f64; 3],
-        vb: &mut [f64; 3],
-        ib: &[f64; 3],
+        va: &mut Spatial,
+        ia: &Spatial,
+        vb: &mut Spatial,
+        ib: &Spatial,
     ) {
         let [nx, ny] = self.n;
         let fx = d[0] * nx - d[1] * ny;
@@ -86,7 +99,7 @@ impl ContactRow {
     /// The generalised impulse `H_bᵀ r` (side 1) or `−H_aᵀ r` (side 0) on one body of the
     /// contact, before the inverse mass: `(F_x, F_y, torque)`·h.
     #[inline(always)]
-    pub fn impulse_on(&self, side: u32, r: [f64; 2]) -> [f64; 3] {
+    pub fn impulse_on(&self, side: u32, r: [f64; 2]) -> Spatial {
         let [nx, ny] = self.n;
         let fx = r[0] * nx - r[1] * ny;
         let fy = r[0] * ny + r[1] * nx;
@@ -99,10 +112,10 @@ impl ContactRow {
 
     /// The local Delassus block from the inverse masses of both bodies.
     #[inline]
-    pub fn delassus(n: [f64; 2], k: [f64; 4], ia: &[f64; 3], ib: &[f64; 3]) -> Delassus2 {
+    pub fn delassus(n: [f64; 2], k: [f64; 4], ia: &Spatial, ib: &Spatial) -> Delassus2 {
         let [nx, ny] = n;
         let (tx, ty) = (-ny, nx);
-        let lin = |i: &[f64; 3]| {
+        let lin = |i: &Spatial| {
             (
                 i[0] * nx * nx + i[1] * ny * ny,
                 i[0] * nx * tx + i[1] * ny * ty,

@@ -17,10 +17,10 @@
 //! detection after a step whose disks outran their margins reuse it too. Every pair it gives is
 //! tested exactly as the grid's, in the same order, so the contacts are the same bit for bit.
 
-use nalgebra::Vector2;
+use crate::math::{Spatial, Vector};
 
 use crate::body::{Body, BodyKind};
-use crate::cell::{Cell, Vect};
+use crate::cell::Cell;
 use crate::collider::{rotate, Collider, Shape};
 use crate::contact::{ContactGeometry, ContactRow, ContactSet, CLOSED_GAP};
 use crate::error::DemError;
@@ -65,7 +65,7 @@ pub struct Detector {
     /// tests read dense arrays rather than the bodies.
     disk_body: Vec<u32>,
     disk_kinematic: Vec<bool>,
-    disk_offset: Vec<Vector2<f64>>,
+    disk_offset: Vec<Vector>,
     centre: Vec<[f64; 2]>,
     radius: Vec<f64>,
     margin: Vec<f64>,
@@ -173,8 +173,8 @@ impl Grid {
 
 /// A line or segment in world coordinates.
 enum WallShape {
-    Line { p: Vector2<f64>, n: Vector2<f64> },
-    Segment { a: Vector2<f64>, b: Vector2<f64> },
+    Line { p: Vector, n: Vector },
+    Segment { a: Vector, b: Vector },
 }
 
 impl Detector {
@@ -194,7 +194,7 @@ impl Detector {
     pub fn detect(
         &mut self,
         bodies: &[Body],
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         colliders: &[Collider],
         laws: &ContactLaws,
         periodic: Option<Periodic>,
@@ -227,7 +227,7 @@ impl Detector {
     pub fn finds_deep_overlap(
         &mut self,
         bodies: &[Body],
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         colliders: &[Collider],
         laws: &ContactLaws,
         periodic: Option<Periodic>,
@@ -255,7 +255,7 @@ impl Detector {
     fn detect_to<S: ContactSink>(
         &mut self,
         bodies: &[Body],
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         colliders: &[Collider],
         laws: &ContactLaws,
         periodic: Option<Periodic>,
@@ -669,8 +669,8 @@ impl Detector {
     pub fn outran(
         &self,
         colliders: &[Collider],
-        displacement: &[[f64; 3]],
-        correction: &[[f64; 3]],
+        displacement: &[Spatial],
+        correction: &[Spatial],
     ) -> bool {
         let slack = 0.5 * self.swept_gap;
         let travel = |body: usize, arm: f64| {
@@ -702,7 +702,7 @@ impl Detector {
     #[inline]
     fn disk_disk<S: ContactSink>(
         &self,
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         colliders: &[Collider],
         laws: &ContactLaws,
         periodic: Option<Periodic>,
@@ -733,15 +733,15 @@ impl Detector {
         // Coincident centres: a full overlap with an arbitrary normal, so that validation
         // reports it and the solver keeps them from approaching further.
         let n = if dist > 0.0 {
-            Vector2::new(dx / dist, dy / dist)
+            Vector::new(dx / dist, dy / dist)
         } else {
-            Vector2::new(0.0, 1.0)
+            Vector::new(0.0, 1.0)
         };
         let gap = dist - ra - rb;
         // Contact point on the surface of b; levers from the bodies' centres of mass.
         let lever_b = -n * rb + self.disk_offset[dj];
-        let lever_a = Vector2::new(dx, dy) - n * rb + self.disk_offset[di];
-        let point = Vector2::new(pb[0], pb[1]) - n * rb;
+        let lever_a = Vector::new(dx, dy) - n * rb + self.disk_offset[di];
+        let point = Vector::new(pb[0], pb[1]) - n * rb;
         let (ca, cb) = (&colliders[ci as usize], &colliders[cj as usize]);
         out.contact(
             inv_mass,
@@ -767,7 +767,7 @@ impl Detector {
     fn wall_disk<S: ContactSink>(
         &self,
         bodies: &[Body],
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         colliders: &[Collider],
         laws: &ContactLaws,
         periodic: Option<Periodic>,
@@ -783,7 +783,7 @@ impl Detector {
         if ba == bb || (bodies[ba].is_kinematic() && bodies[bb].is_kinematic()) {
             return;
         }
-        let c = Vector2::new(self.centre[e][0], self.centre[e][1]);
+        let c = Vector::new(self.centre[e][0], self.centre[e][1]);
         let r = self.radius[e];
         let (n, gap) = match *shape {
             WallShape::Line { p, n } => {
@@ -802,9 +802,9 @@ impl Detector {
                     Some(per) => &[0.0, per.length, -per.length],
                     None => &[0.0],
                 };
-                let mut d = Vector2::new(f64::INFINITY, 0.0);
+                let mut d = Vector::new(f64::INFINITY, 0.0);
                 for &sx in shifts {
-                    let ac = c + Vector2::new(sx, 0.0) - a;
+                    let ac = c + Vector::new(sx, 0.0) - a;
                     let s = if l2 > 0.0 {
                         (ac.dot(&ab) / l2).clamp(0.0, 1.0)
                     } else {
@@ -822,7 +822,7 @@ impl Detector {
                 let n = if dist > 0.0 {
                     d / dist
                 } else {
-                    Vector2::new(-ab.y, ab.x).normalize()
+                    Vector::new(-ab.y, ab.x).normalize()
                 };
                 (n, dist - r)
             }
@@ -858,10 +858,10 @@ impl Detector {
 }
 
 #[inline]
-fn disk_offset(b: &Body, c: &Collider) -> Vector2<f64> {
+fn disk_offset(b: &Body, c: &Collider) -> Vector {
     match c.shape {
         Shape::Disk { offset, .. } => rotate(offset, b.angle),
-        _ => Vector2::zeros(),
+        _ => Vector::zeros(),
     }
 }
 
@@ -869,14 +869,14 @@ fn disk_offset(b: &Body, c: &Collider) -> Vector2<f64> {
 /// velocity `L h k` (m/s) it moves with relative to `b` ([`crate::cell`]).
 #[derive(Debug, Clone, Copy)]
 struct Image {
-    shift: Vector2<f64>,
-    velocity: Vector2<f64>,
+    shift: Vector,
+    velocity: Vector,
 }
 
 impl Image {
     const NONE: Image = Image {
-        shift: Vector2::new(0.0, 0.0),
-        velocity: Vector2::new(0.0, 0.0),
+        shift: Vector::new(0.0, 0.0),
+        velocity: Vector::new(0.0, 0.0),
     };
 }
 
@@ -887,7 +887,7 @@ trait ContactSink {
     #[allow(clippy::too_many_arguments)]
     fn contact(
         &mut self,
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         laws: &ContactLaws,
         ca: &Collider,
         cb: &Collider,
@@ -895,10 +895,10 @@ trait ContactSink {
         cj: u32,
         ba: usize,
         bb: usize,
-        n: Vector2<f64>,
-        point: Vector2<f64>,
-        lever_a: Vector2<f64>,
-        lever_b: Vector2<f64>,
+        n: Vector,
+        point: Vector,
+        lever_a: Vector,
+        lever_b: Vector,
         gap: f64,
         closed_gap: f64,
         image: Image,
@@ -909,7 +909,7 @@ impl ContactSink for ContactSet {
     #[inline]
     fn contact(
         &mut self,
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         laws: &ContactLaws,
         ca: &Collider,
         cb: &Collider,
@@ -917,10 +917,10 @@ impl ContactSink for ContactSet {
         cj: u32,
         ba: usize,
         bb: usize,
-        n: Vector2<f64>,
-        point: Vector2<f64>,
-        lever_a: Vector2<f64>,
-        lever_b: Vector2<f64>,
+        n: Vector,
+        point: Vector,
+        lever_a: Vector,
+        lever_b: Vector,
         gap: f64,
         closed_gap: f64,
         image: Image,
@@ -944,7 +944,7 @@ impl ContactSink for DeepOverlapProbe {
     #[inline]
     fn contact(
         &mut self,
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         _laws: &ContactLaws,
         _ca: &Collider,
         _cb: &Collider,
@@ -952,10 +952,10 @@ impl ContactSink for DeepOverlapProbe {
         _cj: u32,
         ba: usize,
         bb: usize,
-        n: Vector2<f64>,
-        _point: Vector2<f64>,
-        lever_a: Vector2<f64>,
-        lever_b: Vector2<f64>,
+        n: Vector,
+        _point: Vector,
+        lever_a: Vector,
+        lever_b: Vector,
         gap: f64,
         closed_gap: f64,
         _image: Image,
@@ -973,15 +973,15 @@ impl ContactSink for DeepOverlapProbe {
 /// contact of normal `n` between bodies `ba` and `bb`.
 #[inline(always)]
 fn contact_block(
-    inv_mass: &[[f64; 3]],
+    inv_mass: &[Spatial],
     ba: usize,
     bb: usize,
-    n: Vector2<f64>,
-    lever_a: Vector2<f64>,
-    lever_b: Vector2<f64>,
+    n: Vector,
+    lever_a: Vector,
+    lever_b: Vector,
 ) -> ([f64; 4], crate::local::Delassus2) {
-    let t = Vector2::new(-n.y, n.x);
-    let cross = |r: Vector2<f64>, v: Vector2<f64>| r.x * v.y - r.y * v.x;
+    let t = Vector::new(-n.y, n.x);
+    let cross = |r: Vector, v: Vector| r.x * v.y - r.y * v.x;
     let k = [
         cross(lever_a, n),
         cross(lever_a, t),
@@ -996,7 +996,7 @@ fn contact_block(
 #[inline]
 fn push_contact(
     out: &mut ContactSet,
-    inv_mass: &[[f64; 3]],
+    inv_mass: &[Spatial],
     laws: &ContactLaws,
     ca: &Collider,
     cb: &Collider,
@@ -1004,15 +1004,15 @@ fn push_contact(
     cj: u32,
     ba: usize,
     bb: usize,
-    n: Vector2<f64>,
-    point: Vector2<f64>,
-    lever_a: Vector2<f64>,
-    lever_b: Vector2<f64>,
+    n: Vector,
+    point: Vector,
+    lever_a: Vector,
+    lever_b: Vector,
     gap: f64,
     closed_gap: f64,
     image: Image,
 ) {
-    let t = Vector2::new(-n.y, n.x);
+    let t = Vector::new(-n.y, n.x);
     let (k, w) = contact_block(inv_mass, ba, bb, n, lever_a, lever_b);
     let nn = [n.x, n.y];
     out.rows.push(ContactRow {
@@ -1024,7 +1024,7 @@ fn push_contact(
         shift: 0.0,
         // −0.0 without an image: `x + (−0.0)` is `x` bit for bit (also for x = −0.0), so the
         // relative velocities of walls and the x-periodic cell are unchanged by the term.
-        affine: if image.shift == Vector2::zeros() {
+        affine: if image.shift == Vector::zeros() {
             [-0.0, -0.0]
         } else {
             [n.dot(&image.velocity), t.dot(&image.velocity)]
@@ -1069,7 +1069,7 @@ impl Detector {
     pub fn detect_cell(
         &mut self,
         bodies: &[Body],
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         colliders: &[Collider],
         laws: &ContactLaws,
         cell: &Cell,
@@ -1265,7 +1265,7 @@ impl Detector {
     fn disk_disk_cell(
         &self,
         bodies: &[Body],
-        inv_mass: &[[f64; 3]],
+        inv_mass: &[Spatial],
         colliders: &[Collider],
         laws: &ContactLaws,
         cell: &Cell,
@@ -1282,7 +1282,7 @@ impl Detector {
         }
         let (ba, bb) = (ca.body as usize, cb.body as usize);
         let (pa, pb) = (self.centre[di], self.centre[dj]);
-        let raw = Vect::new(pb[0] - pa[0], pb[1] - pa[1]);
+        let raw = Vector::new(pb[0] - pa[0], pb[1] - pa[1]);
         let (branch, k) = cell.min_image(&raw);
         let (ra, rb) = (self.radius[di], self.radius[dj]);
         let drift = if k == crate::cell::Shift::zeros() {
@@ -1299,7 +1299,7 @@ impl Detector {
         let n = if dist > 0.0 {
             branch / dist
         } else {
-            Vector2::new(0.0, 1.0)
+            Vector::new(0.0, 1.0)
         };
         let gap = dist - ra - rb;
         let off_a = disk_offset(&bodies[ba], ca);
@@ -1307,7 +1307,7 @@ impl Detector {
         let lever_b = -n * rb + off_b;
         let lever_a = branch - n * rb + off_a;
         // The point is given near b (inside the cell); the image is that of b seen from a.
-        let point = Vector2::new(pb[0], pb[1]) - n * rb;
+        let point = Vector::new(pb[0], pb[1]) - n * rb;
         let image = if k == crate::cell::Shift::zeros() {
             Image::NONE
         } else {
@@ -1414,18 +1414,18 @@ mod tests {
             }),
         ] {
             let mut rng = ChaCha8Rng::seed_from_u64(3);
-            let mut bodies = vec![Body::wall("floor", Vector2::zeros(), Vector2::zeros())];
+            let mut bodies = vec![Body::wall("floor", Vector::zeros(), Vector::zeros())];
             let mut colliders = vec![Collider {
                 body: 0,
                 shape: Shape::Line {
-                    point: Vector2::zeros(),
-                    normal: Vector2::new(0.0, 1.0),
+                    point: Vector::zeros(),
+                    normal: Vector::new(0.0, 1.0),
                 },
                 material: 0,
             }];
             while bodies.len() < 151 {
                 let r = rng.random_range(1e-3..2e-3);
-                let c = Vector2::new(rng.random_range(0.0..0.05), rng.random_range(r..0.03));
+                let c = Vector::new(rng.random_range(0.0..0.05), rng.random_range(r..0.03));
                 let free = bodies.iter().skip(1).all(|b| {
                     let mut dx = b.position.x - c.x;
                     if let Some(p) = periodic {
@@ -1438,14 +1438,14 @@ mod tests {
                         body: bodies.len() as u32,
                         shape: Shape::Disk {
                             radius: r,
-                            offset: Vector2::zeros(),
+                            offset: Vector::zeros(),
                         },
                         material: 0,
                     });
                     bodies.push(Body::disk(c, r, 2500.0, 1.0));
                 }
             }
-            let inv: Vec<[f64; 3]> = bodies.iter().map(Body::inverse_mass).collect();
+            let inv: Vec<Spatial> = bodies.iter().map(Body::inverse_mass).collect();
             let laws = ContactLaws::new(&["m"], 0.5);
             let (gap, dt) = (1e-4, 5e-4);
             let mut full = Detector::default();
@@ -1456,7 +1456,7 @@ mod tests {
             for call in 0..600 {
                 for body in bodies.iter_mut().skip(1) {
                     let kick =
-                        Vector2::new(rng.random_range(-0.02..0.02), rng.random_range(-0.02..0.02));
+                        Vector::new(rng.random_range(-0.02..0.02), rng.random_range(-0.02..0.02));
                     body.velocity = body.velocity * 0.9 + kick;
                     body.position += body.velocity * dt;
                     if let Some(p) = periodic {
@@ -1497,12 +1497,12 @@ mod tests {
     #[test]
     fn reused_candidates_find_pairs_approaching_head_on() {
         let (r, v, dt, gap) = (1.5e-3, 0.01, 5e-4, 1e-4);
-        let mut bodies = vec![Body::wall("floor", Vector2::zeros(), Vector2::zeros())];
+        let mut bodies = vec![Body::wall("floor", Vector::zeros(), Vector::zeros())];
         let mut colliders = vec![Collider {
             body: 0,
             shape: Shape::Line {
-                point: Vector2::zeros(),
-                normal: Vector2::new(0.0, 1.0),
+                point: Vector::zeros(),
+                normal: Vector::new(0.0, 1.0),
             },
             material: 0,
         }];
@@ -1517,16 +1517,16 @@ mod tests {
                     body: bodies.len() as u32,
                     shape: Shape::Disk {
                         radius: r,
-                        offset: Vector2::zeros(),
+                        offset: Vector::zeros(),
                     },
                     material: 0,
                 });
-                let mut b = Body::disk(Vector2::new(x, y), r, 2500.0, 1.0);
-                b.velocity = Vector2::new(vx, 0.0);
+                let mut b = Body::disk(Vector::new(x, y), r, 2500.0, 1.0);
+                b.velocity = Vector::new(vx, 0.0);
                 bodies.push(b);
             }
         }
-        let inv: Vec<[f64; 3]> = bodies.iter().map(Body::inverse_mass).collect();
+        let inv: Vec<Spatial> = bodies.iter().map(Body::inverse_mass).collect();
         let laws = ContactLaws::new(&["m"], 0.5);
         let mut det = Detector::default();
         let mut out = ContactSet::default();
@@ -1562,12 +1562,12 @@ mod tests {
         let (mut deep, mut shallow) = (0, 0);
         let mut det = Detector::default();
         for draw in 0..400 {
-            let mut bodies = vec![Body::wall("floor", Vector2::zeros(), Vector2::zeros())];
+            let mut bodies = vec![Body::wall("floor", Vector::zeros(), Vector::zeros())];
             let mut colliders = vec![Collider {
                 body: 0,
                 shape: Shape::Line {
-                    point: Vector2::zeros(),
-                    normal: Vector2::new(0.0, 1.0),
+                    point: Vector::zeros(),
+                    normal: Vector::new(0.0, 1.0),
                 },
                 material: 0,
             }];
@@ -1578,12 +1578,12 @@ mod tests {
                 let depth = rng.random_range(0.3..1.1) * threshold * ra.min(rb);
                 let (x, y) = (0.01 * k as f64, 0.005);
                 let angle: f64 = rng.random_range(0.0..std::f64::consts::TAU);
-                let dir = Vector2::new(angle.cos(), angle.sin());
-                let a = Vector2::new(x, if rng.random_bool(0.2) { ra } else { y });
+                let dir = Vector::new(angle.cos(), angle.sin());
+                let a = Vector::new(x, if rng.random_bool(0.2) { ra } else { y });
                 let b = a + dir * (ra + rb - depth);
                 if k == 0 {
                     // A clump of the two disks, fixed: no contact between them.
-                    bodies.push(Body::wall("clump", (a + b) * 0.5, Vector2::zeros()));
+                    bodies.push(Body::wall("clump", (a + b) * 0.5, Vector::zeros()));
                     for (c, r) in [(a, ra), (b, rb)] {
                         colliders.push(Collider {
                             body: 1,
@@ -1601,14 +1601,14 @@ mod tests {
                         body: bodies.len() as u32,
                         shape: Shape::Disk {
                             radius: r,
-                            offset: Vector2::zeros(),
+                            offset: Vector::zeros(),
                         },
                         material: 0,
                     });
                     bodies.push(Body::disk(c, r, 2500.0, 1.0));
                 }
             }
-            let inv: Vec<[f64; 3]> = bodies.iter().map(Body::inverse_mass).collect();
+            let inv: Vec<Spatial> = bodies.iter().map(Body::inverse_mass).collect();
             let reach = 2.5e-4;
             let probe = det
                 .finds_deep_overlap(&bodies, &inv, &colliders, &laws, None, reach, 0.0, 0.0)

@@ -11,10 +11,11 @@
 
 use crate::body::{external_loads, Body, BodyKind, Dof};
 use crate::cell::Imposed;
+use crate::math::Spatial;
 use crate::world::World;
 
 /// [`external_loads`] on the free degrees of freedom of `b`, zero on imposed ones.
-pub fn free_loads(world: &World, b: &Body) -> [f64; 3] {
+pub fn free_loads(world: &World, b: &Body) -> Spatial {
     let f = external_loads(b, world.params.gravity);
     let mut out = [0.0; 3];
     for d in 0..3 {
@@ -140,8 +141,8 @@ pub fn load_energy_scale(world: &World) -> f64 {
 mod tests {
     use super::*;
     use crate::cell::{Cell, CellControl};
+    use crate::math::Vector;
     use crate::{ContactLaws, WorldParams};
-    use nalgebra::Vector2;
 
     /// Without gravity, the scale of a cell under imposed σ_xx = σ_yy = −100 Pa (rate-controlled
     /// shear) is the work of both stresses over one mean diameter, 2 · 100 Pa · √V · d̄, exactly;
@@ -149,13 +150,13 @@ mod tests {
     #[test]
     fn scale_of_a_stress_controlled_cell_is_the_work_of_its_stresses() {
         let params = WorldParams {
-            gravity: Vector2::zeros(),
+            gravity: Vector::zeros(),
             ..Default::default()
         };
         let mut w = World::new(params, ContactLaws::new(&["g"], 0.3));
         for k in 0..4 {
             w.add_grain(
-                Vector2::new(2.5e-3 * (k as f64 + 0.5), 5e-3),
+                Vector::new(2.5e-3 * (k as f64 + 0.5), 5e-3),
                 1e-3,
                 2500.0,
                 0,

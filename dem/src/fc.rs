@@ -85,5 +85,5 @@ pub use newton::{NewtonParams, NewtonStats};
 pub use nsgs::{solve, Acceleration, FcOptions, FcSolution};
 pub use ordering::ContactOrdering;
 pub use output::{write_problem, write_solution};
-pub use problem::{FcProblem, LowRank, LOW_RANK_EXPAND_MAX_CONTACTS};
+pub use problem::{FcProblem, LowRank, ProblemCone, LOW_RANK_EXPAND_MAX_CONTACTS};
 pub use reader::read_problem;

@@ -28,7 +28,7 @@
 //! first step. On the benchmark columns ([`C_MIN`], [`P_MAX`] chosen by trying 0.2–0.85 and
 //! 1–2) the primed start halves to quarters the error and approach speed of the first steps.
 
-use nalgebra::Vector2;
+use crate::math::{Spatial, Vector};
 
 use crate::body::Body;
 use crate::contact::ContactRow;
@@ -50,8 +50,8 @@ pub const P_MAX: f64 = 2.0;
 pub fn weight_impulses(
     rows: &mut [ContactRow],
     bodies: &[Body],
-    inv: &[[f64; 3]],
-    gravity: Vector2<f64>,
+    inv: &[Spatial],
+    gravity: Vector,
     h: f64,
 ) {
     for c in rows.iter_mut() {
@@ -103,7 +103,7 @@ pub fn weight_impulses(
         let contacts = &adj[offsets[i] as usize..offsets[i + 1] as usize];
         // Rise of each contact's normal as seen from grain i.
         let rise = |c: &ContactRow| {
-            let d = Vector2::new(c.n[0], c.n[1]) * if c.b as usize == i { 1.0 } else { -1.0 };
+            let d = Vector::new(c.n[0], c.n[1]) * if c.b as usize == i { 1.0 } else { -1.0 };
             -d.dot(&down)
         };
         let sum: f64 = contacts
@@ -138,7 +138,7 @@ mod tests {
     use crate::contact::ContactRow;
 
     fn grain(x: f64, y: f64, m: f64) -> Body {
-        let mut b = Body::disk(Vector2::new(x, y), 1.0, 1.0, 1.0);
+        let mut b = Body::disk(Vector::new(x, y), 1.0, 1.0, 1.0);
         b.mass = m;
         b
     }
@@ -148,7 +148,7 @@ mod tests {
     /// `P / (2 cos 30°)` each, which balances the grain exactly (statics of a symmetric wedge).
     #[test]
     fn a_grain_on_two_slanted_supports_is_balanced() {
-        let wall = Body::wall("side", Vector2::zeros(), Vector2::zeros());
+        let wall = Body::wall("side", Vector::zeros(), Vector::zeros());
         let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
         let mut bodies = vec![
             wall,
@@ -160,7 +160,7 @@ mod tests {
         for b in &mut bodies[1..3] {
             b.dofs = [crate::Dof::Imposed; 3];
         }
-        let inv: Vec<[f64; 3]> = bodies.iter().map(Body::inverse_mass).collect();
+        let inv: Vec<Spatial> = bodies.iter().map(Body::inverse_mass).collect();
         let mk = |a: u32, b: u32, n: [f64; 2]| ContactRow {
             a,
             b,
@@ -171,7 +171,7 @@ mod tests {
         // normals from a (support) to b (the top grain)
         let mut rows = vec![mk(1, 3, [s, c]), mk(2, 3, [-s, c]), mk(0, 3, [1.0, 0.0])];
         let (g, h) = (9.81, 1e-3);
-        weight_impulses(&mut rows, &bodies, &inv, Vector2::new(0.0, -g), h);
+        weight_impulses(&mut rows, &bodies, &inv, Vector::new(0.0, -g), h);
         let p = 2.0 * g * h;
         for row in &rows[..2] {
             assert!((row.r[0] - p / (2.0 * c)).abs() <= 1e-12 * p, "{:?}", row.r);
@@ -186,14 +186,14 @@ mod tests {
     /// of all three, the middle one two, the top one one (exact for a column of single grains).
     #[test]
     fn a_stack_passes_its_whole_weight_to_the_floor() {
-        let floor = Body::wall("floor", Vector2::zeros(), Vector2::zeros());
+        let floor = Body::wall("floor", Vector::zeros(), Vector::zeros());
         let bodies = vec![
             floor,
             grain(0.0, 1.0, 1.0),
             grain(0.0, 3.0, 2.0),
             grain(0.0, 5.0, 3.0),
         ];
-        let inv: Vec<[f64; 3]> = bodies.iter().map(Body::inverse_mass).collect();
+        let inv: Vec<Spatial> = bodies.iter().map(Body::inverse_mass).collect();
         let row = |a: u32, b: u32| ContactRow {
             a,
             b,
@@ -203,7 +203,7 @@ mod tests {
         };
         let mut rows = vec![row(0, 1), row(1, 2), row(2, 3)];
         let (g, h) = (9.81, 1e-3);
-        weight_impulses(&mut rows, &bodies, &inv, Vector2::new(0.0, -g), h);
+        weight_impulses(&mut rows, &bodies, &inv, Vector::new(0.0, -g), h);
         let expect = [6.0 * g * h, 5.0 * g * h, 3.0 * g * h];
         for (c, e) in rows.iter().zip(expect) {
             assert!((c.r[0] - e).abs() <= 1e-12 * e, "{} vs {e}", c.r[0]);

@@ -31,9 +31,9 @@
 //! The choice of a feature over generics on a dimension type is argued in
 //! `docs/architecture.md` §"Dimension layer".
 //!
-//! Not yet converted: the engine's own files (`cell.rs` keeps its local `DIM`, `Vect`, `Mat`,
-//! which are the same types as [`DIM`], [`Vector`], [`Tensor`]; the solver's per-body arrays
-//! `[f64; 3]` of velocities, inverse masses and impulses).
+//! The engine (`dem/src`) is written against these names too: its vectors are [`Vector`]s, the
+//! cell's matrices [`Tensor`]s, and the per-body triples of the solver's hot loops (velocities,
+//! inverse masses, impulses, displacements) [`Spatial`] arrays.
 
 use nalgebra::{Matrix2, Point2, SVector, UnitComplex};
 use serde::{Deserialize, Serialize};
@@ -51,6 +51,13 @@ pub const ANG_DIM: usize = 1;
 /// Degrees of freedom of a rigid body, `DIM + ANG_DIM` (the length of a twist, a wrench or an
 /// inverse-mass triple: 3 in 2D, 6 in 3D).
 pub const SPATIAL_DIM: usize = DIM + ANG_DIM;
+
+/// A rigid body's packed triple of generalised components, `[Real; SPATIAL_DIM]`: `(v_x, v_y, ω)`
+/// of a velocity, `(1/m, 1/m, 1/I)` of an inverse mass, `(F_x, F_y, torque)·h` of an impulse, a
+/// displacement `(Δx, Δy, Δθ)`. The layout of the solver's hot loops, which keep one per body
+/// in flat arrays ([`Twist`] is the named form; [`Twist::from_array`], [`Twist::to_array`]).
+/// In 3D the same name is six numbers (`SPATIAL_DIM` = 6).
+pub type Spatial = [Real; SPATIAL_DIM];
 
 /// A vector of the space (a position, a velocity, a force, a lever arm, a normal…), in SI
 /// units of what it holds. `SVector<Real, DIM>`, the same type as `nalgebra::Vector2<f64>`.
@@ -96,9 +103,9 @@ pub fn ang_cross(w: AngVector, r: &Vector) -> Vector {
 /// The velocity of a rigid body, a twist `(v, ω)`: the velocity `v` of its centre of mass (m/s)
 /// and its angular velocity `ω` (rad/s, counter-clockwise about e_z in the plane).
 ///
-/// It replaces the bare triple `[f64; 3] = (v_x, v_y, ω)` outside the engine's hot loops, where
-/// the solver keeps the triples packed for speed ([`Twist::from_array`] and
-/// [`Twist::to_array`] convert exactly). The velocity field of the body is
+/// It is the named form of a [`Spatial`] velocity `(v_x, v_y, ω)`, which the engine's hot loops
+/// keep packed, one per body, for speed ([`Twist::from_array`] and [`Twist::to_array`] convert
+/// exactly). The velocity field of the body is
 /// `u(x) = v + ω × (x − c)` ([`Twist::velocity_at`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Twist {
@@ -148,12 +155,10 @@ mod tests {
 
     #[test]
     fn aliases_are_the_plane_types() {
-        // The dimension layer is the same nalgebra types the engine's cell writes out.
+        // The dimension layer is the plane nalgebra types.
         let v: nalgebra::Vector2<f64> = Vector::new(1.0, 2.0);
-        let c: crate::cell::Vect = v;
-        let t: crate::cell::Mat = Tensor::identity();
-        assert_eq!(DIM, crate::cell::DIM);
-        assert_eq!(c.len(), DIM);
+        let t: nalgebra::Matrix2<f64> = Tensor::identity();
+        assert_eq!(v.len(), DIM);
         assert_eq!(t.nrows(), DIM);
         assert_eq!(SPATIAL_DIM, 3);
     }

@@ -16,7 +16,8 @@ use rayon::prelude::*;
 
 use crate::colouring::ContactColouring;
 use crate::contact::ContactRow;
-use crate::local::{project_on_cone, solve_local};
+use crate::math::Spatial;
+use crate::sweep::local_update;
 
 /// Contacts per chunk of the fixed-partition reductions.
 pub const CHUNK: usize = 1024;
@@ -59,39 +60,6 @@ impl<T> Shared<T> {
     }
 }
 
-/// The exact local update of one contact on given body velocities: `r ← solve_local(W, u − W r)`,
-/// optionally relaxed and projected back on the cone; returns whether the impulse changed
-/// (then `va`, `vb` hold the updated velocities).
-#[inline(always)]
-pub(crate) fn local_update(
-    c: &mut ContactRow,
-    va: &mut [f64; 3],
-    ia: &[f64; 3],
-    vb: &mut [f64; 3],
-    ib: &[f64; 3],
-    omega: f64,
-) -> bool {
-    let u = c.velocity(va, vb);
-    let wr = c.w.mul(c.r);
-    let q = [u[0] - wr[0], u[1] - wr[1]];
-    let (mut r, _) = solve_local(&c.w, q, c.mu);
-    if omega != 1.0 {
-        let t = [
-            c.r[0] + omega * (r[0] - c.r[0]),
-            c.r[1] + omega * (r[1] - c.r[1]),
-        ];
-        r = project_on_cone(t, c.mu).0;
-    }
-    let d = [r[0] - c.r[0], r[1] - c.r[1]];
-    if d != [0.0, 0.0] {
-        c.apply(d, va, ia, vb, ib);
-        c.r = r;
-        true
-    } else {
-        false
-    }
-}
-
 /// Updates contact `i` through shared pointers, writing back only the velocities of mobile
 /// bodies.
 ///
@@ -102,8 +70,8 @@ pub(crate) fn local_update(
 unsafe fn update_shared(
     rows: Shared<ContactRow>,
     i: usize,
-    vel: Shared<[f64; 3]>,
-    inv: &[[f64; 3]],
+    vel: Shared<Spatial>,
+    inv: &[Spatial],
     mobile: &[bool],
     omega: f64,
 ) {
@@ -158,8 +126,8 @@ fn for_each_coloured(colouring: &ContactColouring, f: impl Fn(usize) + Sync) {
 pub fn coloured_sweep(
     rows: &mut [ContactRow],
     colouring: &ContactColouring,
-    vel: &mut [[f64; 3]],
-    inv: &[[f64; 3]],
+    vel: &mut [Spatial],
+    inv: &[Spatial],
     mobile: &[bool],
     omega: f64,
 ) {
@@ -172,8 +140,8 @@ pub fn coloured_sweep(
 pub(crate) fn coloured_sweep_where(
     rows: &mut [ContactRow],
     colouring: &ContactColouring,
-    vel: &mut [[f64; 3]],
-    inv: &[[f64; 3]],
+    vel: &mut [Spatial],
+    inv: &[Spatial],
     mobile: &[bool],
     omega: f64,
     keep: impl Fn(usize) -> bool + Sync,
@@ -207,9 +175,9 @@ pub(crate) fn coloured_sweep_where(
 pub fn scatter_velocities(
     rows: &[ContactRow],
     colouring: &ContactColouring,
-    vel: &mut [[f64; 3]],
-    v_free: &[[f64; 3]],
-    inv: &[[f64; 3]],
+    vel: &mut [Spatial],
+    v_free: &[Spatial],
+    inv: &[Spatial],
     mobile: &[bool],
 ) {
     assert!(vel.len() == v_free.len() && vel.len() == inv.len() && vel.len() == mobile.len());

@@ -5,7 +5,7 @@
 //! thickness along z), masses in kg, areas in m², volumes in m³.
 //! A contact force is the step's impulse divided by the time step, `f = R / h`.
 
-use nalgebra::Vector2;
+use crate::math::Vector;
 use serde::{Deserialize, Serialize};
 
 use crate::local::ContactStatus;
@@ -28,15 +28,15 @@ pub struct BodyState {
     /// Name given in the scenario (walls: `left`, `right`, `bottom`, ...); empty for grains.
     pub name: String,
     /// Centre of mass (m). Inside the periodic cell when the x direction is periodic.
-    pub position: Vector2<f64>,
+    pub position: Vector,
     /// Rotation angle (rad, counter-clockwise).
     pub angle: f64,
     /// Velocity of the centre after the step, `v⁺` (m/s).
-    pub velocity: Vector2<f64>,
+    pub velocity: Vector,
     /// Angular velocity after the step, `ω⁺` (rad/s).
     pub omega: f64,
     /// Mean acceleration over the step, `(v⁺ − v⁻)/h` (m/s²), consistent with the impulses.
-    pub acceleration: Vector2<f64>,
+    pub acceleration: Vector,
     /// Mean angular acceleration over the step, `(ω⁺ − ω⁻)/h` (rad/s²).
     pub angular_acceleration: f64,
     /// Mass (kg); `f64::INFINITY` for a wall whose motion is imposed.
@@ -70,9 +70,9 @@ pub struct ContactState {
     pub body_b: u32,
     /// Contact point (m): on the surface of `b`, `x = c_b − R_b n` for a disk `b`.
     /// With a periodic x direction, the point is given near body `b`.
-    pub point: Vector2<f64>,
+    pub point: Vector,
     /// Unit normal from `a` to `b`.
-    pub normal: Vector2<f64>,
+    pub normal: Vector,
     /// Normal force (N), `r_n / h ≥ 0`.
     pub force_n: f64,
     /// Tangential force (N), `r_t / h`, `|f_t| ≤ μ f_n`.
@@ -85,19 +85,19 @@ pub struct ContactState {
     pub status: ContactStatus,
     /// Lever arm of the contact point from the centre of `a`, `x − c_a` (m). Walls that are
     /// lines have their reference point as centre.
-    pub lever_a: Vector2<f64>,
+    pub lever_a: Vector,
     /// Lever arm of the contact point from the centre of `b`, `x − c_b` (m).
-    pub lever_b: Vector2<f64>,
+    pub lever_b: Vector,
 }
 
 impl ContactState {
     /// Unit tangent `t = (−n_y, n_x)`.
-    pub fn tangent(&self) -> Vector2<f64> {
-        Vector2::new(-self.normal.y, self.normal.x)
+    pub fn tangent(&self) -> Vector {
+        Vector::new(-self.normal.y, self.normal.x)
     }
 
     /// Force vector on body `b` (N): `f_n n + f_t t`.
-    pub fn force_on_b(&self) -> Vector2<f64> {
+    pub fn force_on_b(&self) -> Vector {
         self.normal * self.force_n + self.tangent() * self.force_t
     }
 
@@ -118,21 +118,21 @@ pub enum WallGeometry {
     /// Infinite line through `point` with unit `normal` pointing into the sample.
     Line {
         /// A point of the line (m).
-        point: Vector2<f64>,
+        point: Vector,
         /// Unit normal pointing to the side where grains are.
-        normal: Vector2<f64>,
+        normal: Vector,
     },
     /// Segment from `a` to `b`; grains may touch either side or the ends.
     Segment {
         /// First end (m).
-        a: Vector2<f64>,
+        a: Vector,
         /// Second end (m).
-        b: Vector2<f64>,
+        b: Vector,
     },
     /// A rigid clump of glued disks (rough wall): centres (m) and radii (m).
     Clump {
         /// Disk centres in world coordinates (m).
-        centres: Vec<Vector2<f64>>,
+        centres: Vec<Vector>,
         /// Disk radii (m).
         radii: Vec<f64>,
     },
@@ -148,7 +148,7 @@ pub struct WallState {
     /// Geometry in world coordinates.
     pub geometry: WallGeometry,
     /// Total contact force received during the step (N), sum of `R/h` over its contacts.
-    pub force: Vector2<f64>,
+    pub force: Vector,
     /// Total contact torque about the body's centre (N·m).
     pub torque: f64,
 }
@@ -163,7 +163,7 @@ pub struct Snapshot {
     /// Time step h (s).
     pub dt: f64,
     /// Gravity vector (m/s²).
-    pub gravity: Vector2<f64>,
+    pub gravity: Vector,
     /// Periodic cell along x, `[x_min, x_max)` (m), if any.
     pub periodic_x: Option<[f64; 2]>,
     /// Biperiodic deformable cell (matrix `h`, velocity gradient `L`), if any

@@ -36,12 +36,14 @@ use serde::{Deserialize, Serialize};
 use crate::assemble::contact_problem_with;
 use crate::cell_coupling::CellCoupling;
 use crate::colouring::ContactColouring;
+use crate::cone::FrictionCone;
 use crate::contact::ContactRow;
 use crate::fc::auto::{run_auto, AutoStages, Backoff};
 use crate::fc::method::{exact_finish, Finish, SolverMethod};
 use crate::fc::newton::{self, NewtonParams, NewtonWork};
 use crate::fc::FcOptions;
-use crate::local::{natural_map_residual, select};
+use crate::local::select;
+use crate::math::Spatial;
 use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
 use crate::parallel::{
     coloured_sweep, max_over, reduce_chunks, runs_inline, scatter_velocities, CHUNK,
@@ -257,7 +259,7 @@ pub use crate::nlgs::{STAGNATION_WINDOW, STALL_SWEEPS};
 
 /// Apply the impulses currently stored in `rows` to the velocities (warm start):
 /// `v ← v + M⁻¹ Hᵀ R`.
-pub fn apply_impulses(rows: &[ContactRow], vel: &mut [[f64; 3]], inv: &[[f64; 3]]) {
+pub fn apply_impulses(rows: &[ContactRow], vel: &mut [Spatial], inv: &[Spatial]) {
     for c in rows {
         if c.r != [0.0, 0.0] {
             let (a, b) = (c.a as usize, c.b as usize);
@@ -271,7 +273,7 @@ pub fn apply_impulses(rows: &[ContactRow], vel: &mut [[f64; 3]], inv: &[[f64; 3]
 
 /// Error measure of the current state: `‖r − proj_K(r − ū)‖ / max(q_norm, ‖r‖, ‖u‖)`.
 /// Summed over fixed chunks ([`reduce_chunks`]): the same bits on any number of threads.
-pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 {
+pub fn error_measure(rows: &[ContactRow], vel: &[Spatial], q_norm: f64) -> f64 {
     error_measures(rows, vel, [q_norm, q_norm])[0]
 }
 
@@ -289,10 +291,10 @@ pub fn error_measure(rows: &[ContactRow], vel: &[[f64; 3]], q_norm: f64) -> f64 
 /// by up to hundreds of times at small steps (physics.md §1.6), not the second. (A pair that
 /// closes within the step, or approaches fast, can make the second scale the larger.) One
 /// pass; the first value's sums are those of the measure alone, bit for bit.
-pub fn error_measures(rows: &[ContactRow], vel: &[[f64; 3]], q_norms: [f64; 2]) -> [f64; 2] {
+pub fn error_measures(rows: &[ContactRow], vel: &[Spatial], q_norms: [f64; 2]) -> [f64; 2] {
     let [e2, r2, u2, w2] = reduce_chunks(rows, |c| {
         let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
-        let e = natural_map_residual(c.r, u, c.mu);
+        let e = c.cone().natural_map_residual(c.r, u);
         let w = u[0] - c.shift.max(0.0);
         [
             e[0] * e[0] + e[1] * e[1],
@@ -312,7 +314,7 @@ pub fn error_measures(rows: &[ContactRow], vel: &[[f64; 3]], q_norms: [f64; 2]) 
 /// gap-closing shift) or loaded (`r_n > 0`): the rate at which the current iterate would make
 /// them overlap. Open contacts closing within the step are not counted (their `u_n` includes the
 /// gap shift, so `u_n ≥ 0` already means "stops at contact").
-pub fn approach_speed(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
+pub fn approach_speed(rows: &[ContactRow], vel: &[Spatial]) -> f64 {
     max_over(rows, |c| {
         let un = c.velocity(&vel[c.a as usize], &vel[c.b as usize])[0];
         select(c.shift <= 0.0 || c.r[0] > 0.0, -un, 0.0)
@@ -324,7 +326,7 @@ pub fn approach_speed(rows: &[ContactRow], vel: &[[f64; 3]]) -> f64 {
 /// computed from the velocities *before* the warm-start impulses are applied, and the same
 /// norm without the positive gap-closing shifts: the two scales of [`error_measures`]. One
 /// pass.
-pub fn free_velocity_norms(rows: &[ContactRow], vel: &[[f64; 3]]) -> [f64; 2] {
+pub fn free_velocity_norms(rows: &[ContactRow], vel: &[Spatial]) -> [f64; 2] {
     let [s, w] = reduce_chunks(rows, |c| {
         let u = c.velocity(&vel[c.a as usize], &vel[c.b as usize]);
         let wn = u[0] - c.shift.max(0.0);
@@ -341,8 +343,8 @@ pub fn free_velocity_norms(rows: &[ContactRow], vel: &[[f64; 3]]) -> [f64; 2] {
 fn sweep_recorded(
     rows: &mut [ContactRow],
     order: &[u32],
-    vel: &mut [[f64; 3]],
-    inv: &[[f64; 3]],
+    vel: &mut [Spatial],
+    inv: &[Spatial],
     omega: f64,
     mut record: impl FnMut(usize, [f64; 2], [f64; 2]),
 ) -> (f64, f64) {
@@ -371,9 +373,9 @@ pub const PLAIN_SWEEPS: usize = 6;
 /// `v = v_free + M⁻¹ Hᵀ R`.
 pub fn rebuild_velocities(
     rows: &[ContactRow],
-    vel: &mut [[f64; 3]],
-    v_free: &[[f64; 3]],
-    inv: &[[f64; 3]],
+    vel: &mut [Spatial],
+    v_free: &[Spatial],
+    inv: &[Spatial],
     order: &SweepOrder,
 ) {
     match order {
@@ -402,13 +404,7 @@ pub enum SweepOrder<'a> {
 }
 
 impl SweepOrder<'_> {
-    fn sweep(
-        &mut self,
-        rows: &mut [ContactRow],
-        vel: &mut [[f64; 3]],
-        inv: &[[f64; 3]],
-        omega: f64,
-    ) {
+    fn sweep(&mut self, rows: &mut [ContactRow], vel: &mut [Spatial], inv: &[Spatial], omega: f64) {
         match self {
             SweepOrder::Natural(order) => sweep(rows, order, vel, inv, omega),
             SweepOrder::Coloured { colouring, mobile } => {
@@ -472,9 +468,9 @@ impl SweepOrder<'_> {
 pub fn solve(
     rows: &mut [ContactRow],
     order: SweepOrder,
-    vel: &mut [[f64; 3]],
-    v_free: &[[f64; 3]],
-    inv: &[[f64; 3]],
+    vel: &mut [Spatial],
+    v_free: &[Spatial],
+    inv: &[Spatial],
     q_norms: [f64; 2],
     approach_limit: f64,
     params: &SolverParams,
@@ -698,9 +694,9 @@ const SHUFFLE_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
 struct Step<'a> {
     rows: &'a mut [ContactRow],
     order: SweepOrder<'a>,
-    vel: &'a mut [[f64; 3]],
-    v_free: &'a [[f64; 3]],
-    inv: &'a [[f64; 3]],
+    vel: &'a mut [Spatial],
+    v_free: &'a [Spatial],
+    inv: &'a [Spatial],
     /// `[‖q‖, ‖q − s⁺‖]`, the scales of [`error_measures`].
     q_norms: [f64; 2],
     /// Both measures of [`error_measures`] at the last evaluation (NaN before any).

@@ -53,6 +53,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contact::{ContactGeometry, ContactRow};
+use crate::math::Spatial;
 
 /// Slop of the projection, as a fraction of the smaller radius of the pair (1): overlaps up to
 /// `SLOP · min(R_a, R_b)` are left alone. Equal to [`crate::contact::CLOSED_GAP`] (the contact's
@@ -97,12 +98,12 @@ pub struct CorrectionReport {
 pub struct Projection {
     gap: Vec<f64>,
     p: Vec<f64>,
-    dq: Vec<[f64; 3]>,
+    dq: Vec<Spatial>,
 }
 
 /// Normal part of `H Δq` for one contact: `n·(Δx_b − Δx_a) + (ρ_b×n) Δθ_b − (ρ_a×n) Δθ_a`.
 #[inline(always)]
-fn normal_motion(row: &ContactRow, da: &[f64; 3], db: &[f64; 3]) -> f64 {
+fn normal_motion(row: &ContactRow, da: &Spatial, db: &Spatial) -> f64 {
     let [nx, ny] = row.n;
     nx * (db[0] - da[0]) + ny * (db[1] - da[1]) + row.k[2] * db[2] - row.k[0] * da[2]
 }
@@ -110,7 +111,7 @@ fn normal_motion(row: &ContactRow, da: &[f64; 3], db: &[f64; 3]) -> f64 {
 impl Projection {
     /// The position correction `Δq_corr = M⁻¹ H_nᵀ P` of each body (`[Δx, Δy, Δθ]`) found by the
     /// last [`Projection::project`].
-    pub fn correction(&self) -> &[[f64; 3]] {
+    pub fn correction(&self) -> &[Spatial] {
         &self.dq
     }
 
@@ -122,8 +123,8 @@ impl Projection {
         &mut self,
         rows: &[ContactRow],
         geometry: &[ContactGeometry],
-        displacement: &[[f64; 3]],
-        inv: &[[f64; 3]],
+        displacement: &[Spatial],
+        inv: &[Spatial],
     ) -> CorrectionReport {
         let mut report = CorrectionReport::default();
         self.dq.clear();

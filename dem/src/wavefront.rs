@@ -43,6 +43,8 @@
 
 use crate::contact::ContactRow;
 use crate::local::ContactStatus;
+#[cfg(test)]
+use crate::math::Spatial;
 
 /// Buffers of [`Wavefront::build`], kept between solves.
 #[derive(Debug, Clone, Default)]
@@ -147,14 +149,14 @@ mod tests {
         rows
     }
 
-    fn inverse(n: usize) -> Vec<[f64; 3]> {
+    fn inverse(n: usize) -> Vec<Spatial> {
         let mut inv = vec![[1.0, 1.0, 3.0]; n];
         inv.push([0.0; 3]);
         inv
     }
 
     /// Velocities of the `n` disks (the wall, body `n`, at rest).
-    fn velocities(n: usize) -> Vec<[f64; 3]> {
+    fn velocities(n: usize) -> Vec<Spatial> {
         (0..=n)
             .map(|i| {
                 let x = i as f64;
@@ -179,7 +181,7 @@ mod tests {
     }
 
     /// The bits of the impulses and velocities.
-    fn bits(rows: &[ContactRow], v: &[[f64; 3]]) -> Vec<u64> {
+    fn bits(rows: &[ContactRow], v: &[Spatial]) -> Vec<u64> {
         rows.iter()
             .flat_map(|c| c.r)
             .chain(v.iter().flatten().copied())

@@ -30,11 +30,10 @@
 //! gravity and the applied loads over the correction, the opposite of the potential energy it
 //! adds, is reported in [`StepReport::position_correction`] (`load_work`).
 
-use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
 use crate::body::{Body, Dof};
-use crate::cell::{Cell, Mat, Vect};
+use crate::cell::{Cell, ComponentValues};
 use crate::cell_coupling::CellCoupling;
 use crate::collider::{rotate, Collider, Shape};
 use crate::contact::ContactSet;
@@ -42,6 +41,7 @@ use crate::detection::Periodic;
 use crate::error::DemError;
 use crate::fc::FcProblem;
 use crate::material::ContactLaws;
+use crate::math::{Spatial, Tensor, Vector};
 use crate::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
 use crate::solver::{self, SolveReport, SolverParams};
 use crate::stabilise::CorrectionReport;
@@ -56,7 +56,7 @@ pub struct WorldParams {
     /// several contacts can gain a little energy.
     pub theta: f64,
     /// Gravity (m/s²).
-    pub gravity: Vector2<f64>,
+    pub gravity: Vector,
     /// Periodic cell along x, `[x_min, x_max)` (m).
     pub periodic_x: Option<[f64; 2]>,
     /// Detection gap (m): pairs closer than this become contacts.
@@ -84,7 +84,7 @@ impl Default for WorldParams {
         WorldParams {
             dt: 1e-3,
             theta: 1.0,
-            gravity: Vector2::new(0.0, -9.81),
+            gravity: Vector::new(0.0, -9.81),
             periodic_x: None,
             detection_gap: 1e-4,
             overlap_rate: default_overlap_rate(),
@@ -94,8 +94,9 @@ impl Default for WorldParams {
     }
 }
 
-/// Spatial blocks of the parallel sweep ([`ContactColouring::build_blocked`]); fixed, so the
-/// numbers do not depend on the thread count.
+/// Spatial blocks of the parallel sweep
+/// ([`crate::colouring::ContactColouring::build_blocked`]); fixed, so the numbers do not depend
+/// on the thread count.
 pub const SWEEP_BLOCKS: usize = 16;
 /// Below this many contacts the parallel mode sweeps one block (sequentially, same order on any
 /// thread count).
@@ -222,7 +223,7 @@ impl World {
     /// every grain, `v ← v + (l − L)(x − c)` (a homogeneous deformation rate: YADE's
     /// `homoDeform`), so that the grains follow the cell at once instead of by waves from its
     /// boundaries. Returns the kinetic energy this added (J). No-op without a cell.
-    pub fn set_velocity_gradient(&mut self, l: Mat) -> f64 {
+    pub fn set_velocity_gradient(&mut self, l: Tensor) -> f64 {
         let Some(cell) = self.state.cell.as_mut() else {
             return 0.0;
         };
@@ -256,13 +257,13 @@ impl World {
     /// inertia (`homogenise::stress`, `docs/physics.md` §2.1), computed here because the
     /// engine's cell control needs it every step; the last is the kinetic (Reynolds) stress of
     /// the velocity fluctuations. `None` without a cell or before the first step.
-    pub fn cell_stress(&self) -> Option<Mat> {
+    pub fn cell_stress(&self) -> Option<Tensor> {
         self.state.cell_stress
     }
 
-    fn measure_cell_stress(&self, cell: &Cell) -> Mat {
+    fn measure_cell_stress(&self, cell: &Cell) -> Tensor {
         let h = self.impulse_dt();
-        let mut m = Mat::zeros();
+        let mut m = Tensor::zeros();
         for (row, geo) in self
             .state
             .contacts
@@ -274,22 +275,22 @@ impl World {
                 continue;
             }
             let [nx, ny] = row.n;
-            let f = Vect::new(row.r[0] * nx - row.r[1] * ny, row.r[0] * ny + row.r[1] * nx) / h;
-            let l = Vect::new(
+            let f = Vector::new(row.r[0] * nx - row.r[1] * ny, row.r[0] * ny + row.r[1] * nx) / h;
+            let l = Vector::new(
                 geo.lever_b[0] - geo.lever_a[0],
                 geo.lever_b[1] - geo.lever_a[1],
             );
             m += f * l.transpose();
         }
         let thickness = self.grain_thickness();
-        let j = Mat::new(0.0, -1.0, 1.0, 0.0);
+        let j = Tensor::new(0.0, -1.0, 1.0, 0.0);
         for b in self
             .state
             .bodies
             .iter()
             .filter(|b| b.kind == BodyKind::Grain)
         {
-            m += (j * (-b.angular_acceleration) + Mat::identity() * (b.omega * b.omega))
+            m += (j * (-b.angular_acceleration) + Tensor::identity() * (b.omega * b.omega))
                 * (0.5 * b.inertia);
         }
         let s = m / (cell.volume() * thickness);
@@ -307,9 +308,9 @@ impl World {
 
     /// Kinetic (Reynolds) stress of the grains' velocity fluctuations in `cell` (Pa, tension
     /// positive): `−(1/V) Σ_p m_p ṽ_p ⊗ ṽ_p`, `ṽ_p = v_p − L (x_p − c)` minus its mass mean.
-    fn kinetic_stress(&self, cell: &Cell) -> Mat {
+    fn kinetic_stress(&self, cell: &Cell) -> Tensor {
         let c = cell.centre();
-        let (mut mass, mut mom) = (0.0, Vect::zeros());
+        let (mut mass, mut mom) = (0.0, Vector::zeros());
         for b in self
             .state
             .bodies
@@ -322,9 +323,9 @@ impl World {
         let mean = if mass > 0.0 {
             mom / mass
         } else {
-            Vect::zeros()
+            Vector::zeros()
         };
-        let mut m = Mat::zeros();
+        let mut m = Tensor::zeros();
         for b in self
             .state
             .bodies
@@ -387,7 +388,7 @@ impl World {
     }
 
     /// The frictional-contact problem of the last step (`u = W r + q` in the contacts' order,
-    /// impulses in N·s), when [`World::record_problems`] was set for it.
+    /// impulses in N·s), when [`WorldState::record_problems`] was set for it.
     pub fn last_problem(&self) -> Option<&FcProblem> {
         self.state.last_step.problem.as_ref()
     }
@@ -396,7 +397,7 @@ impl World {
     /// step of [`crate::step_control::step_subdivided`] some kept sub-step of which did not
     /// converge, the first such sub-step's (the step's failure, where the last sub-step may
     /// have converged); otherwise the last (sub-)step's ([`World::last_problem`],
-    /// [`World::last_report`]). `None` unless [`World::record_problems`] was set.
+    /// [`World::last_report`]). `None` unless [`WorldState::record_problems`] was set.
     pub fn problem_of_last_step(&self) -> Option<(&FcProblem, StepReport)> {
         match &self.work.unconverged_problem {
             Some((p, r)) => Some((p, *r)),
@@ -413,7 +414,7 @@ impl World {
     /// and free velocities (`u = W r + q`, [`crate::assemble::contact_problem`]; the contacts in
     /// the order of [`World::snapshot`]), with the impulses its solve returned (N·s, interleaved
     /// `(r_n, r_t)`): what [`World::snapshot_with_last_impulses`] takes other impulses for.
-    /// Needs no [`World::record_problems`]; after [`World::undo_to`], the problem of the step
+    /// Needs no [`WorldState::record_problems`]; after [`World::undo_to`], the problem of the step
     /// that led to the point returned to. With a deformable cell under an implicit control, the
     /// problem with the cell's stress-controlled components eliminated
     /// ([`crate::assemble::contact_problem_with`], [`crate::cell_coupling`]), as the step solved
@@ -524,7 +525,7 @@ impl World {
                 }
             }
         }
-        let dv: Vec<[f64; 3]> = dj
+        let dv: Vec<Spatial> = dj
             .iter()
             .zip(&self.state.last_step.inv)
             .map(|(j, i)| [i[0] * j[0], i[1] * j[1], i[2] * j[2]])
@@ -535,7 +536,7 @@ impl World {
         // The cell's change with the impulses, and the grains following it.
         if let (Some(coupling), Some(cell)) = (self.last_coupling(), snap.cell.as_mut()) {
             let dl = coupling.delta_change(rows, r);
-            if dl != Mat::zeros() {
+            if dl != Tensor::zeros() {
                 cell.l += dl;
                 let c = cell.centre();
                 for (b, body) in snap.bodies.iter_mut().zip(&self.state.bodies) {
@@ -555,11 +556,11 @@ impl World {
             if *d == [0.0, 0.0, 0.0] {
                 continue;
             }
-            b.velocity += Vector2::new(d[0], d[1]);
+            b.velocity += Vector::new(d[0], d[1]);
             b.omega += d[2];
-            b.acceleration += Vector2::new(d[0], d[1]) / h;
+            b.acceleration += Vector::new(d[0], d[1]) / h;
             b.angular_acceleration += d[2] / h;
-            b.position += Vector2::new(d[0], d[1]) * (theta * h);
+            b.position += Vector::new(d[0], d[1]) * (theta * h);
             b.angle += theta * h * d[2];
             if let (Some(p), BodyKind::Grain) = (periodic, b.kind) {
                 b.position.x = p.wrap(b.position.x);
@@ -568,7 +569,7 @@ impl World {
         for wall in &mut snap.walls {
             let j = dj[wall.body as usize];
             if j != [0.0, 0.0, 0.0] {
-                wall.force += Vector2::new(j[0], j[1]) / h;
+                wall.force += Vector::new(j[0], j[1]) / h;
                 wall.torque += j[2] / h;
             }
         }
@@ -584,20 +585,14 @@ impl World {
     }
 
     /// Add a free disk grain (thickness 1 m); returns its body index.
-    pub fn add_grain(
-        &mut self,
-        position: Vector2<f64>,
-        radius: f64,
-        density: f64,
-        material: u16,
-    ) -> u32 {
+    pub fn add_grain(&mut self, position: Vector, radius: f64, density: f64, material: u16) -> u32 {
         self.add_grain_with_thickness(position, radius, density, 1.0, material)
     }
 
     /// Add a free disk grain of given thickness (m); returns its body index.
     pub fn add_grain_with_thickness(
         &mut self,
-        position: Vector2<f64>,
+        position: Vector,
         radius: f64,
         density: f64,
         thickness: f64,
@@ -611,7 +606,7 @@ impl World {
             body: b,
             shape: Shape::Disk {
                 radius,
-                offset: Vector2::zeros(),
+                offset: Vector::zeros(),
             },
             material,
         });
@@ -623,18 +618,18 @@ impl World {
     pub fn add_line_wall(
         &mut self,
         name: &str,
-        point: Vector2<f64>,
-        normal: Vector2<f64>,
+        point: Vector,
+        normal: Vector,
         material: u16,
     ) -> u32 {
         let b = self.state.bodies.len() as u32;
         self.state
             .bodies
-            .push(Body::wall(name, point, Vector2::zeros()));
+            .push(Body::wall(name, point, Vector::zeros()));
         self.state.colliders.push(Collider {
             body: b,
             shape: Shape::Line {
-                point: Vector2::zeros(),
+                point: Vector::zeros(),
                 normal: normal.normalize(),
             },
             material,
@@ -643,18 +638,10 @@ impl World {
     }
 
     /// Add a fixed segment wall from `a` to `b`; returns its body index (centre at the middle).
-    pub fn add_segment_wall(
-        &mut self,
-        name: &str,
-        a: Vector2<f64>,
-        b: Vector2<f64>,
-        material: u16,
-    ) -> u32 {
+    pub fn add_segment_wall(&mut self, name: &str, a: Vector, b: Vector, material: u16) -> u32 {
         let id = self.state.bodies.len() as u32;
         let c = (a + b) * 0.5;
-        self.state
-            .bodies
-            .push(Body::wall(name, c, Vector2::zeros()));
+        self.state.bodies.push(Body::wall(name, c, Vector::zeros()));
         self.state.colliders.push(Collider {
             body: id,
             shape: Shape::Segment { a: a - c, b: b - c },
@@ -669,16 +656,14 @@ impl World {
     pub fn add_clump(
         &mut self,
         name: &str,
-        centres: &[Vector2<f64>],
+        centres: &[Vector],
         radii: &[f64],
         material: u16,
     ) -> u32 {
         let id = self.state.bodies.len() as u32;
         let n = centres.len().max(1) as f64;
-        let c = centres.iter().fold(Vector2::zeros(), |s, x| s + x) / n;
-        self.state
-            .bodies
-            .push(Body::wall(name, c, Vector2::zeros()));
+        let c = centres.iter().fold(Vector::zeros(), |s, x| s + x) / n;
+        self.state.bodies.push(Body::wall(name, c, Vector::zeros()));
         for (x, &r) in centres.iter().zip(radii) {
             self.state.colliders.push(Collider {
                 body: id,
@@ -756,7 +741,7 @@ impl World {
     }
 
     /// Total contact force (N) and torque (N·m) received by body `b` during the last step.
-    pub fn contact_force(&self, b: usize) -> (Vector2<f64>, f64) {
+    pub fn contact_force(&self, b: usize) -> (Vector, f64) {
         let f = self
             .state
             .last_step
@@ -764,7 +749,7 @@ impl World {
             .get(b)
             .copied()
             .unwrap_or([0.0; 3]);
-        (Vector2::new(f[0], f[1]), f[2])
+        (Vector::new(f[0], f[1]), f[2])
     }
 
     /// Kinetic energy of all free degrees of freedom (J).
@@ -1055,7 +1040,10 @@ impl World {
     /// inside the cell do not drift with the cell). Normal impulses across the boundary mostly
     /// open the cell further, but frictional or shear ones can close it more: a change beyond
     /// the margins detects again after the step (`image_outran`).
-    fn detect_step_contacts(&mut self, free_change: Option<[f64; 3]>) -> Result<(), DemError> {
+    fn detect_step_contacts(
+        &mut self,
+        free_change: Option<ComponentValues>,
+    ) -> Result<(), DemError> {
         let mut set = std::mem::take(&mut self.state.contacts);
         let (gap, h, g) = (
             self.state.params.detection_gap,
@@ -1071,7 +1059,7 @@ impl World {
     /// The impulse-free change `δ⁰` of the stress-controlled components of an implicit cell
     /// control over the next step ([`CellControl::free_change`](crate::cell::CellControl::free_change), with the kinetic stress now);
     /// `None` without one.
-    fn implicit_free_change(&self) -> Option<[f64; 3]> {
+    fn implicit_free_change(&self) -> Option<ComponentValues> {
         match (self.state.cell_control, self.state.cell) {
             (Some(ctl), Some(cell)) if ctl.implicit => {
                 Some(ctl.free_change(&cell.l, &self.kinetic_stress(&cell)))
@@ -1215,15 +1203,15 @@ impl World {
             .map(|((row, geo), st)| ContactState {
                 body_a: row.a,
                 body_b: row.b,
-                point: Vector2::new(geo.point[0], geo.point[1]),
-                normal: Vector2::new(row.n[0], row.n[1]),
+                point: Vector::new(geo.point[0], geo.point[1]),
+                normal: Vector::new(row.n[0], row.n[1]),
                 force_n: row.r[0] / h,
                 force_t: row.r[1] / h,
                 gap: geo.gap,
                 mu: row.mu,
                 status: *st,
-                lever_a: Vector2::new(geo.lever_a[0], geo.lever_a[1]),
-                lever_b: Vector2::new(geo.lever_b[0], geo.lever_b[1]),
+                lever_a: Vector::new(geo.lever_a[0], geo.lever_a[1]),
+                lever_b: Vector::new(geo.lever_b[0], geo.lever_b[1]),
             })
             .collect();
         let mut walls = Vec::new();
@@ -1286,6 +1274,6 @@ impl World {
 }
 
 /// `h⁻¹` of a cell matrix (`det h > 0` for a cell).
-fn cell_inverse(h: &Mat) -> Mat {
-    h.try_inverse().unwrap_or_else(Mat::zeros)
+fn cell_inverse(h: &Tensor) -> Tensor {
+    h.try_inverse().unwrap_or_else(Tensor::zeros)
 }

@@ -4,7 +4,8 @@
 
 mod common;
 
-use dem::cell::{Cell, CellControl, Imposed, Mat, Shift, Vect};
+use dem::cell::{Cell, CellControl, Imposed, Shift};
+use dem::math::{Tensor, Vector};
 use dem::{ContactLaws, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
@@ -30,14 +31,14 @@ fn params(dt: f64) -> WorldParams {
 #[test]
 fn empty_cell_deforms_as_l_says() {
     let (a, g, b) = (0.3, 1.7, -0.2);
-    let h0 = Mat::new(0.02, 0.005, 0.0, 0.03);
-    let mut cell = Cell::new(h0, Mat::new(a, g, 0.0, b)).unwrap();
+    let h0 = Tensor::new(0.02, 0.005, 0.0, 0.03);
+    let mut cell = Cell::new(h0, Tensor::new(a, g, 0.0, b)).unwrap();
     let (dt, n) = (1e-3, 1000);
     for _ in 0..n {
         cell.advance(dt);
     }
     let t = dt * n as f64;
-    let e = Mat::new(
+    let e = Tensor::new(
         (a * t).exp(),
         g * ((a * t).exp() - (b * t).exp()) / (a - b),
         0.0,
@@ -47,7 +48,11 @@ fn empty_cell_deforms_as_l_says() {
     let err = (cell.h - exact).abs().max() / h0.abs().max();
     assert!(err < 1e-12, "relative error {err:e}");
     // Simple shear: L nilpotent, the tilt grows by exactly γ̇ t (Lees–Edwards offset).
-    let mut le = Cell::new(Mat::new(0.02, 0.0, 0.0, 0.03), Mat::new(0.0, 2.0, 0.0, 0.0)).unwrap();
+    let mut le = Cell::new(
+        Tensor::new(0.02, 0.0, 0.0, 0.03),
+        Tensor::new(0.0, 2.0, 0.0, 0.0),
+    )
+    .unwrap();
     for _ in 0..100 {
         le.advance(1e-3);
     }
@@ -59,8 +64,8 @@ fn empty_cell_deforms_as_l_says() {
 fn random_cell(rng: &mut ChaCha8Rng) -> Cell {
     let (lx, ly) = (rng.random_range(0.5..2.0), rng.random_range(0.5..2.0));
     let tilt = rng.random_range(-0.5..0.5);
-    let h = Mat::new(lx, tilt * lx, 0.0, ly);
-    Cell::new(h, Mat::zeros()).unwrap()
+    let h = Tensor::new(lx, tilt * lx, 0.0, ly);
+    Cell::new(h, Tensor::zeros()).unwrap()
 }
 
 /// The minimum image across both boundaries of a sheared cell is the shortest of the 9 images
@@ -72,7 +77,7 @@ fn minimum_image_matches_brute_force() {
     for _ in 0..1000 {
         let cell = random_cell(&mut rng);
         let p = |rng: &mut ChaCha8Rng| {
-            let x = cell.h * Vect::new(rng.random_range(-1.5..2.5), rng.random_range(-1.5..2.5));
+            let x = cell.h * Vector::new(rng.random_range(-1.5..2.5), rng.random_range(-1.5..2.5));
             cell.wrap(&x).0
         };
         let (xi, xj) = (p(&mut rng), p(&mut rng));
@@ -100,7 +105,7 @@ fn minimum_image_matches_brute_force() {
 }
 
 /// Two equal disks of a cell `cell`, `a` at `xa`, `b` at `xb`, with velocities `va`, `vb`.
-fn pair(cell: Cell, xa: Vect, xb: Vect, va: Vect, vb: Vect) -> World {
+fn pair(cell: Cell, xa: Vector, xb: Vector, va: Vector, vb: Vector) -> World {
     let mut w = World::new(params(1e-4), ContactLaws::new(&["g"], 0.4));
     let a = w.add_grain(xa, 1e-3, 2500.0, 0) as usize;
     let b = w.add_grain(xb, 1e-3, 2500.0, 0) as usize;
@@ -117,15 +122,15 @@ fn pair(cell: Cell, xa: Vect, xb: Vect, va: Vect, vb: Vect) -> World {
 fn contact_across_the_corner_equals_inside() {
     let gd = 5.0;
     let cell = Cell::new(
-        Mat::new(0.02, 0.004, 0.0, 0.02),
-        Mat::new(0.0, gd, 0.0, 0.0),
+        Tensor::new(0.02, 0.004, 0.0, 0.02),
+        Tensor::new(0.0, gd, 0.0, 0.0),
     )
     .unwrap();
     // Branch from a to b: (1.4, 1.3) mm, overlapping gap −0.0... closed within the step.
-    let branch = Vect::new(1.45e-3, 1.35e-3);
-    let fluct_a = Vect::new(0.02, 0.01);
-    let fluct_b = Vect::new(-0.03, -0.02);
-    let run = |xa: Vect| {
+    let branch = Vector::new(1.45e-3, 1.35e-3);
+    let fluct_a = Vector::new(0.02, 0.01);
+    let fluct_b = Vector::new(-0.03, -0.02);
+    let run = |xa: Vector| {
         let xb = xa + branch;
         let va = fluct_a + cell.affine_velocity(&xa);
         // The image of b at xb moves with the affine velocity at xb.
@@ -140,10 +145,10 @@ fn contact_across_the_corner_equals_inside() {
         (r, k, dv, c.geometry[0].gap)
     };
     // Near the upper-right corner of the tilted cell: b's centre lies beyond both faces.
-    let corner = cell.h * Vect::new(0.98, 0.97);
+    let corner = cell.h * Vector::new(0.98, 0.97);
     let (r_corner, k, dv_c, gap_c) = run(corner);
     assert_eq!(k, Shift::new(-1, -1), "the pair must cross both boundaries");
-    let middle = cell.h * Vect::new(0.4, 0.4);
+    let middle = cell.h * Vector::new(0.4, 0.4);
     let (r_mid, k0, dv_m, gap_m) = run(middle);
     assert_eq!(k0, Shift::zeros());
     assert!(r_mid[0] > 0.0, "the pair must collide: {r_mid:?}");
@@ -171,16 +176,20 @@ fn contact_across_the_corner_equals_inside() {
 #[test]
 fn remap_preserves_pair_distances() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
-    let mut cell = Cell::new(Mat::new(1.0, 0.0, 0.0, 1.2), Mat::new(0.0, 1.0, 0.0, 0.0)).unwrap();
-    let pts: Vec<Vect> = (0..60)
-        .map(|_| cell.h * Vect::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)))
+    let mut cell = Cell::new(
+        Tensor::new(1.0, 0.0, 0.0, 1.2),
+        Tensor::new(0.0, 1.0, 0.0, 0.0),
+    )
+    .unwrap();
+    let pts: Vec<Vector> = (0..60)
+        .map(|_| cell.h * Vector::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)))
         .collect();
     // Shear to a tilt of 0.84 (beyond ½), moving the points affinely.
     let h0 = cell.h;
     cell.advance(0.7);
     let f = cell.h * h0.try_inverse().unwrap();
-    let pts: Vec<Vect> = pts.iter().map(|x| f * x).collect();
-    let brute = |c: &Cell, a: &Vect, b: &Vect| {
+    let pts: Vec<Vector> = pts.iter().map(|x| f * x).collect();
+    let brute = |c: &Cell, a: &Vector, b: &Vector| {
         let mut best = f64::INFINITY;
         for i in -3..=3 {
             for j in -3..=3 {
@@ -198,7 +207,7 @@ fn remap_preserves_pair_distances() {
     assert!((cell.tilt() - 0.84).abs() < 1e-12);
     assert_eq!(cell.remap(), 1);
     assert!(cell.tilt().abs() <= 0.5);
-    let wrapped: Vec<Vect> = pts.iter().map(|x| cell.wrap(x).0).collect();
+    let wrapped: Vec<Vector> = pts.iter().map(|x| cell.wrap(x).0).collect();
     let after: Vec<f64> = wrapped
         .iter()
         .enumerate()
@@ -224,8 +233,8 @@ fn packing(n_side: usize, seed: u64, mu: f64) -> World {
     for i in 0..n_side {
         for j in 0..n_side {
             let r = 1e-3 * rng.random_range(0.8..1.2);
-            let jit = Vect::new(rng.random_range(-0.1..0.1), rng.random_range(-0.1..0.1)) * 1e-3;
-            let x = Vect::new(i as f64 + 0.5, j as f64 + 0.5) * spacing + jit;
+            let jit = Vector::new(rng.random_range(-0.1..0.1), rng.random_range(-0.1..0.1)) * 1e-3;
+            let x = Vector::new(i as f64 + 0.5, j as f64 + 0.5) * spacing + jit;
             w.add_grain(x, r, 2500.0, 0);
         }
     }
@@ -259,11 +268,11 @@ fn stress_control_reaches_its_target() {
         worst = worst.max(probe.residual(w) / e);
     };
     // Compression at an imposed rate, stopped at φ = 0.74.
-    w.set_velocity_gradient(Mat::new(-gd, 0.0, 0.0, -gd));
+    w.set_velocity_gradient(Tensor::new(-gd, 0.0, 0.0, -gd));
     while area / w.cell().unwrap().volume() < 0.74 {
         step(&mut w);
     }
-    w.set_velocity_gradient(Mat::new(0.0, gd, 0.0, 0.0));
+    w.set_velocity_gradient(Tensor::new(0.0, gd, 0.0, 0.0));
     w.cell_control = Some(CellControl {
         xx: Imposed::Rate(0.0),
         yy: Imposed::Stress(-p),
@@ -314,7 +323,7 @@ fn implicit_control_holds_a_rigid_lattice_at_its_stress() {
     for i in 0..nx {
         for j in 0..ny {
             w.add_grain(
-                Vect::new((2 * i + 1) as f64 * r, (2 * j + 1) as f64 * r),
+                Vector::new((2 * i + 1) as f64 * r, (2 * j + 1) as f64 * r),
                 r,
                 2500.0,
                 0,
@@ -407,7 +416,7 @@ fn kinetic_xx(w: &World) -> f64 {
     let grains: Vec<_> = w.bodies.iter().filter(|b| b.mass > 0.0).collect();
     let c0 = cell.centre();
     let mass: f64 = grains.iter().map(|b| b.mass).sum();
-    let mom = grains.iter().fold(Vect::zeros(), |m, b| {
+    let mom = grains.iter().fold(Vector::zeros(), |m, b| {
         m + (b.velocity - cell.l * (b.position - c0)) * b.mass
     });
     let mean_v = mom / mass;
@@ -512,7 +521,7 @@ fn implicit_cell_steps_are_not_subdivided() {
     w.params.solver.tolerance = 1e-300;
     w.params.solver.max_halvings = 3;
     // Compress the lattice into contact first (imposed gradient, no control).
-    w.set_velocity_gradient(Mat::new(-20.0, 0.0, 0.0, -20.0));
+    w.set_velocity_gradient(Tensor::new(-20.0, 0.0, 0.0, -20.0));
     for _ in 0..40 {
         w.step().unwrap();
     }
@@ -681,16 +690,16 @@ fn cell_detection_finds_every_pair_an_image_drift_closes() {
     let mut w = World::new(params(1e-3), ContactLaws::new(&["g"], 0.3));
     for i in 0..n {
         for j in 0..n {
-            let x = Vect::new(i as f64 + 0.5, j as f64 + 0.5) * pitch;
+            let x = Vector::new(i as f64 + 0.5, j as f64 + 0.5) * pitch;
             let b = w.add_grain(x, 1e-3 * rng.random_range(0.9..1.1), 2500.0, 0);
             w.bodies[b as usize].velocity =
-                Vect::new(rng.random_range(-0.01..0.01), rng.random_range(-0.01..0.01));
+                Vector::new(rng.random_range(-0.01..0.01), rng.random_range(-0.01..0.01));
         }
     }
     let side = pitch * n as f64;
     w.set_cell(Some(Cell::rectangle(side, side).unwrap()))
         .unwrap();
-    w.set_velocity_gradient(Mat::new(0.0, 1.0, 0.0, 0.0));
+    w.set_velocity_gradient(Tensor::new(0.0, 1.0, 0.0, 0.0));
     let cell = *w.cell().unwrap();
     let dt = 1e-3;
     let lattice = 0.5 * dt * (cell.h.column(0).norm() + cell.h.column(1).norm());
@@ -725,9 +734,9 @@ fn cell_detection_finds_every_pair_an_image_drift_closes() {
             let s: f64 = x.iter().map(|v| v.abs()).sum();
             delta = x.map(|v| v * rate_bound / s);
         }
-        let l = cell.l + Mat::new(delta[0], delta[2], 0.0, delta[1]);
+        let l = cell.l + Tensor::new(delta[0], delta[2], 0.0, delta[1]);
         let h = cell.h + dt * l * cell.h;
-        let x: Vec<Vect> = w
+        let x: Vec<Vector> = w
             .bodies
             .iter()
             .map(|b| b.position + dt * b.velocity)
@@ -736,7 +745,7 @@ fn cell_detection_finds_every_pair_an_image_drift_closes() {
             for b in a + 1..x.len() {
                 let touch = (-1..=1).any(|i| {
                     (-1..=1).any(|j| {
-                        let k = Vect::new(i as f64, j as f64);
+                        let k = Vector::new(i as f64, j as f64);
                         let gap =
                             (x[b] + h * k - x[a]).norm() - w.bodies[a].radius - w.bodies[b].radius;
                         gap <= 0.0

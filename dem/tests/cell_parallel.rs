@@ -5,8 +5,9 @@
 mod common;
 use common::fingerprint;
 
-use dem::cell::{Cell, CellControl, Imposed, Mat, Vect};
+use dem::cell::{Cell, CellControl, Imposed};
 use dem::fc::SolverMethod;
+use dem::math::{Tensor, Vector};
 use dem::{ContactLaws, SolverParams, World, WorldParams};
 use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
@@ -43,7 +44,7 @@ fn sheared_crystal(n: usize, parallel: bool, tolerance: f64, max_iterations: usi
     for j in 0..n {
         for i in 0..n {
             let shift = if j % 2 == 1 { R } else { 0.0 };
-            let x = Vect::new(R + 2.0 * R * i as f64 + shift, 0.5 * dy + dy * j as f64);
+            let x = Vector::new(R + 2.0 * R * i as f64 + shift, 0.5 * dy + dy * j as f64);
             w.add_grain(x, R * rng.random_range(0.98..1.0), RHO, 0);
         }
     }
@@ -51,7 +52,7 @@ fn sheared_crystal(n: usize, parallel: bool, tolerance: f64, max_iterations: usi
         Cell::rectangle(2.0 * R * n as f64, dy * n as f64).unwrap(),
     ))
     .unwrap();
-    w.set_velocity_gradient(Mat::new(0.0, gd, 0.0, 0.0));
+    w.set_velocity_gradient(Tensor::new(0.0, gd, 0.0, 0.0));
     w.cell_control = Some(CellControl::implicit_law(
         Imposed::Rate(0.0),
         Imposed::Stress(-P),

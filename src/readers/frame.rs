@@ -28,9 +28,9 @@
 
 use std::collections::HashMap;
 
-use dem::cell::{Cell, Mat};
+use dem::cell::Cell;
 use dem::local::ContactStatus;
-use dem::math::Vector;
+use dem::math::{Tensor as Mat, Vector};
 use dem::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
 use homogenise::kinematics::{velocity_gradient, VelocityWeight};
 use homogenise::Region;

@@ -25,7 +25,8 @@
 
 use datasets::config::{BiaxialConfig, Preparation};
 use datasets::phases::PhaseStats;
-use dem::cell::{CellControl, Imposed, Mat};
+use dem::cell::{CellControl, Imposed};
+use dem::math::Tensor as Mat;
 use homogenise::averaging::block_average;
 use homogenise::cell::cell_state;
 use identify::critical_state::{

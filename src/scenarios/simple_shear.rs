@@ -13,7 +13,8 @@
 
 use datasets::config::SimpleShearConfig;
 use datasets::phases::PhaseStats;
-use dem::cell::{CellControl, Imposed, Mat};
+use dem::cell::{CellControl, Imposed};
+use dem::math::Tensor as Mat;
 use homogenise::averaging::block_average;
 use homogenise::cell::cell_state;
 use identify::law::GrainScale;

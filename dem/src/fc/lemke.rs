@@ -370,6 +370,94 @@ enum Cover {
     Infeasible,
 }
 
+/// The covering vector `d = B v` of a path (added into `d`, which holds zeros) and `v`:
+/// `v = e` for [`Cover::Unit`] (`B = I`), `v_i = δ − x*_i` on the basics infeasible at `x*`
+/// (and 0 elsewhere) for [`Cover::Infeasible`], `δ = 10⁻⁶ ‖q̄‖∞`.
+fn covering(
+    lcp: &Lcp,
+    vars: &[usize],
+    cover: Cover,
+    x: &[f64],
+    qn: f64,
+    d: &mut [f64],
+) -> Vec<f64> {
+    // v = B⁻¹ d.
+    let v: Vec<f64> = match cover {
+        Cover::Unit => vec![1.0; lcp.m],
+        Cover::Infeasible => x
+            .iter()
+            .map(|&xi| if xi < 0.0 { 1e-6 * qn - xi } else { 0.0 })
+            .collect(),
+    };
+    let mut col = Vec::new();
+    for (&var, &vi) in vars.iter().zip(&v) {
+        if vi != 0.0 {
+            col.clear();
+            lcp.column(var, &[], &mut col);
+            for &(i, c) in &col {
+                d[i] += vi * c;
+            }
+        }
+    }
+    v
+}
+
+/// Harris' two-pass ratio test of a pivot with basic values `x` and entering column
+/// `y = B⁻¹ a`: the largest step that no basic variable overshoots by more than
+/// `δ = HARRIS_DELTA ‖q̄‖∞` (`qn = ‖q̄‖∞`), then, among the rows blocking within it, the row of
+/// `z₀` (variable code `z0`) or else the largest pivot. `None` when no row blocks (a ray).
+fn ratio_test(x: &[f64], y: &[f64], vars: &[usize], z0: usize, qn: f64) -> Option<usize> {
+    let m = x.len();
+    let ymax = y.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    let tol = 1e-11 * ymax;
+    let delta = HARRIS_DELTA * qn;
+    let mut bound = f64::INFINITY;
+    for i in 0..m {
+        if y[i] > tol {
+            bound = bound.min((x[i].max(0.0) + delta) / y[i]);
+        }
+    }
+    if !bound.is_finite() {
+        return None;
+    }
+    let mut row = usize::MAX;
+    let mut row_y = 0.0;
+    for i in 0..m {
+        if y[i] > tol && x[i].max(0.0) / y[i] <= bound {
+            if vars[i] == z0 {
+                row = i;
+                break;
+            }
+            if y[i] > row_y {
+                row = i;
+                row_y = y[i];
+            }
+        }
+    }
+    Some(row)
+}
+
+/// The values of the complementary basis `vars` at the end of a path, from a fresh
+/// factorisation (`x_B = B⁻¹ q̄`); the path's own values `x` when that factorisation fails or
+/// gives a value that is not finite.
+fn complementary_values(
+    lcp: &Lcp,
+    vars: &[usize],
+    d: &[f64],
+    basis: &mut Basis,
+    x: Vec<f64>,
+) -> Vec<f64> {
+    if !basis.factorise(lcp, vars, d) {
+        return x;
+    }
+    let mut fresh = lcp.q.clone();
+    basis.solve(&mut fresh);
+    if !fresh.iter().all(|v| v.is_finite()) {
+        return x;
+    }
+    fresh
+}
+
 /// One Lemke path from the complementary basis `vars` with the covering vector of `cover`;
 /// `d` receives that vector. Returns the outcome and the final basis values.
 fn path(
@@ -407,24 +495,8 @@ fn path(
         basis.solve(&mut x);
         return (LemkeOutcome::Solved, x);
     }
-    // v = B⁻¹ d.
-    let v: Vec<f64> = match cover {
-        Cover::Unit => vec![1.0; m],
-        Cover::Infeasible => x
-            .iter()
-            .map(|&xi| if xi < 0.0 { 1e-6 * qn - xi } else { 0.0 })
-            .collect(),
-    };
+    let v = covering(lcp, vars, cover, &x, qn, d);
     let mut col = Vec::new();
-    for (&var, &vi) in vars.iter().zip(&v) {
-        if vi != 0.0 {
-            col.clear();
-            lcp.column(var, &[], &mut col);
-            for &(i, c) in &col {
-                d[i] += vi * c;
-            }
-        }
-    }
     // z₀ enters at the row that needs the largest t for x + t v ≥ 0, t = max(−x_i / v_i).
     // Some x_i < 0 (else returned above), and v_i > 0 there: t > 0.
     let Some((imin, t)) = x
@@ -475,34 +547,9 @@ fn path(
         if !y.iter().all(|v| v.is_finite()) {
             return (LemkeOutcome::Singular, x);
         }
-        let ymax = y.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        let tol = 1e-11 * ymax;
-        // Harris' two-pass ratio test: the largest step that no basic variable overshoots by
-        // more than δ, then, among the rows blocking within it, z₀ or the largest pivot.
-        let delta = HARRIS_DELTA * qn;
-        let mut bound = f64::INFINITY;
-        for i in 0..m {
-            if y[i] > tol {
-                bound = bound.min((x[i].max(0.0) + delta) / y[i]);
-            }
-        }
-        if !bound.is_finite() {
+        let Some(row) = ratio_test(&x, &y, vars, z0, qn) else {
             return (LemkeOutcome::Ray, x);
-        }
-        let mut row = usize::MAX;
-        let mut row_y = 0.0;
-        for i in 0..m {
-            if y[i] > tol && x[i].max(0.0) / y[i] <= bound {
-                if vars[i] == z0 {
-                    row = i;
-                    break;
-                }
-                if y[i] > row_y {
-                    row = i;
-                    row_y = y[i];
-                }
-            }
-        }
+        };
         let theta = x[row].max(0.0) / y[row];
         for i in 0..m {
             x[i] -= theta * y[i];
@@ -531,17 +578,10 @@ fn path(
             x[z0_row] = 0.0;
         }
         if leaving == z0 || z0_vanished {
-            // A complementary basis: its exact values, from a fresh factorisation.
-            let kept = x.clone();
-            if !basis.factorise(lcp, vars, d) {
-                return (LemkeOutcome::Solved, kept);
-            }
-            x.clone_from(&lcp.q);
-            basis.solve(&mut x);
-            if !x.iter().all(|v| v.is_finite()) {
-                return (LemkeOutcome::Solved, kept);
-            }
-            return (LemkeOutcome::Solved, x);
+            return (
+                LemkeOutcome::Solved,
+                complementary_values(lcp, vars, d, basis, x),
+            );
         }
         if since >= params.refactor_every {
             since = 0;

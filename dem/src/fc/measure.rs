@@ -8,9 +8,8 @@
 //! with ρ = 1 in the projection and all contacts stacked in one vector; when the scale
 //! `max(‖q‖, ‖r‖, ‖u‖)` is not above machine epsilon the absolute residual is returned.
 
-use super::problem::FcProblem;
+use super::problem::{FcProblem, ProblemCone};
 use crate::cone::natural_map_error;
-use crate::local::Coulomb2;
 
 /// The error measure `e` and the velocity `u = W r + q` at impulses `r` (length 2 nc).
 ///
@@ -29,5 +28,5 @@ pub fn fc_error(problem: &FcProblem, r: &[f64]) -> f64 {
 /// The error measure from `μ`, `q`, `r` and an already computed `u = W r + q` (all interleaved
 /// `(n, t)` per contact): [`natural_map_error`] on the plane cones.
 pub fn error_given_velocity(mu: &[f64], q: &[f64], r: &[f64], u: &[f64]) -> f64 {
-    natural_map_error(mu.len(), |a| Coulomb2 { mu: mu[a] }, q, r, u)
+    natural_map_error(mu.len(), |a| ProblemCone { mu: mu[a] }, q, r, u)
 }

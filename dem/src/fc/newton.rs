@@ -2,6 +2,14 @@
 //! that it stays well posed when `W` is singular (hyperstatic packings), an Armijo line search,
 //! and Gauss–Seidel sweeps when the line search fails.
 //!
+//! **2D only, by algorithm.** The linearisation below is written for the plane cone: per
+//! contact a 2×2 generalised Jacobian of `Φ` over the interval `[−μ z_n⁺, μ z_n⁺]` (the plane
+//! cone's tangential projection). A 3D contact's circular cone has a 3×3 Jacobian of the
+//! second-order cone projection (Acary, Brémond & Huber 2018, §3.2), another module; this one
+//! takes the plane cone's data (`μ`, the 2×2 blocks) directly, not through
+//! [`crate::cone::FrictionCone`]. Its smoothing sweeps are the shared ones
+//! ([`crate::fc::nsgs`], [`crate::sweep::solve_row`]).
+//!
 //! **Formulation** (Alart & Curnier 1991; the 2D form of Acary, Brémond & Huber 2018, §3.2).
 //! With `u = W r + q` and per-contact weights `ρ_n = 1/W_nn`, `ρ_t = 1/W_tt`,
 //!

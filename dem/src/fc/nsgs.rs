@@ -4,16 +4,19 @@
 //! **Sweep.** For contact α, with all other impulses fixed,
 //!
 //! ```text
-//! q̃_α = q_α + Σ_{β≠α} W_αβ r_β + K_α r_α,      r_α ← local::solve_local(S_α, q̃_α, μ_α)
+//! q̃_α = q_α + Σ_{β≠α} W_αβ r_β + K_α r_α,      r_α ← cone_α.solve_local(S_α, q̃_α)
 //! ```
 //!
 //! where `W_αα = S_α + K_α` (symmetric part `S_α`, a [`Delassus2`], and skew part `K_α`, zero
-//! for a symmetric W and lagged by one sweep otherwise). `solve_local` returns the fixed point of
-//! the bipotential predictor–corrector for the 2×2 block, so each update solves its contact
-//! exactly. With over-relaxation `ω ≠ 1`, `r_α ← proj_K((1 − ω) r_α^old + ω r_α^local)`, which
-//! keeps `r_α` in the Coulomb cone. The row of W is recomputed at each update (block CSR in
-//! sweep order, diagonal blocks apart): cost proportional to the row's block count, no
-//! allocation in the loop.
+//! for a symmetric W and lagged by one sweep otherwise) and `cone_α` the contact's friction cone
+//! ([`FcProblem::cone`], a [`ProblemCone`]). The plane cone's `solve_local` returns the fixed
+//! point of the bipotential predictor–corrector for the 2×2 block, so each update solves its
+//! contact exactly. With over-relaxation `ω ≠ 1`, `r_α ← proj_K((1 − ω) r_α^old + ω r_α^local)`,
+//! which keeps `r_α` in the Coulomb cone. The update is the sweep's one,
+//! [`crate::sweep::solve_row`] ([`crate::cone::relaxed_local_solve`] written against
+//! [`crate::cone::FrictionCone`]), on the row's view of the problem (`ProblemRow`). The row of
+//! W is recomputed at each update (block CSR in sweep order, diagonal blocks apart): cost
+//! proportional to the row's block count, no allocation in the loop.
 //!
 //! **Acceleration.** Once the contact statuses stop changing, one sweep is an affine map and
 //! Gauss–Seidel converges linearly and slowly (the weight of a pile has to diffuse through the
@@ -37,9 +40,11 @@ use std::time::Instant;
 
 use super::error::FcError;
 use super::ordering::{contact_order, ContactOrdering};
-use super::problem::FcProblem;
-use crate::local::{natural_map_residual, project_on_cone, solve_local, Delassus2};
+use super::problem::{FcProblem, ProblemCone, LOW_RANK};
+use crate::cone::FrictionCone;
+use crate::local::Delassus2;
 use crate::nlgs::{drive, CheckSchedule, DriveParams, DriveWork, SweepProblem};
+use crate::sweep::{solve_row, SweepRow};
 
 /// Acceleration of the Gauss–Seidel sweeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -124,7 +129,7 @@ struct FcSweeps {
     val: Vec<[f64; 4]>,
     diag: Vec<Delassus2>,
     skew: Vec<f64>,
-    mu: Vec<f64>,
+    cone: Vec<ProblemCone>,
     q: Vec<[f64; 2]>,
     r: Vec<[f64; 2]>,
     u: Vec<[f64; 2]>,
@@ -132,9 +137,9 @@ struct FcSweeps {
     omega: f64,
     /// The problem's low-rank term in sweep order (empty without one): `B_cκ` per contact,
     /// `m_κ`, and the current sums `s_κ = Σ_c B_cκ · r_c`, kept current by the sweep.
-    lr_coef: Vec<[[f64; 2]; 3]>,
-    lr_m: [f64; 3],
-    lr_s: [f64; 3],
+    lr_coef: Vec<[[f64; 2]; LOW_RANK]>,
+    lr_m: [f64; LOW_RANK],
+    lr_s: [f64; LOW_RANK],
 }
 
 impl FcSweeps {
@@ -158,7 +163,7 @@ impl FcSweeps {
         let mut val = Vec::with_capacity(w.nnz_blocks());
         let mut diag = Vec::with_capacity(n);
         let mut skew = Vec::with_capacity(n);
-        let mut mu = Vec::with_capacity(n);
+        let mut cone = Vec::with_capacity(n);
         let mut q = Vec::with_capacity(n);
         let mut row: Vec<(u32, [f64; 4])> = Vec::new();
         row_ptr.push(0u32);
@@ -178,7 +183,7 @@ impl FcSweeps {
             row_ptr.push(col.len() as u32);
             diag.push(p.delassus(old));
             skew.push(p.diagonal_skew(old));
-            mu.push(p.mu()[old]);
+            cone.push(p.cone(old));
             q.push([p.q()[2 * old], p.q()[2 * old + 1]]);
         }
         let (lr_coef, lr_m) = match p.low_rank() {
@@ -195,7 +200,7 @@ impl FcSweeps {
             val,
             diag,
             skew,
-            mu,
+            cone,
             q,
             r: vec![[0.0; 2]; n],
             u: vec![[0.0; 2]; n],
@@ -273,22 +278,8 @@ impl FcSweeps {
         let mut d = 0.0;
         let low_rank = !self.lr_coef.is_empty();
         for a in 0..self.r.len() {
-            let mut qa = self.local_q(a);
-            if low_rank {
-                let x = self.low_rank_q(a);
-                qa[0] += x[0];
-                qa[1] += x[1];
-            }
-            let mu = self.mu[a];
-            let (mut rn, _) = solve_local(&self.diag[a], qa, mu);
+            let rn = solve_row(&ProblemRow { sweeps: self, a }, (), omega);
             let old = self.r[a];
-            if omega != 1.0 {
-                let t = [
-                    old[0] + omega * (rn[0] - old[0]),
-                    old[1] + omega * (rn[1] - old[1]),
-                ];
-                rn = project_on_cone(t, mu).0;
-            }
             self.r[a] = rn;
             let d0 = rn[0] - old[0];
             let d1 = rn[1] - old[1];
@@ -323,7 +314,7 @@ impl FcSweeps {
             u[0] += s[0];
             u[1] += s[1];
             self.u[a] = u;
-            let e = natural_map_residual(ra, u, self.mu[a]);
+            let e = self.cone[a].natural_map_residual(ra, u);
             res2 += e[0] * e[0] + e[1] * e[1];
             let q = self.q[a];
             q2 += q[0] * q[0] + q[1] * q[1];
@@ -345,6 +336,46 @@ impl FcSweeps {
             .map(|r| r[0] * r[0] + r[1] * r[1])
             .sum::<f64>()
             .sqrt()
+    }
+}
+
+/// Row `a` of a problem in sweep order as a Gauss–Seidel sweep sees it ([`SweepRow`]): its
+/// cone and the symmetric part `S_α` of its diagonal block; its free velocity is
+/// `q̃_α = q_α + Σ_{β≠α} W_αβ r_β + K_α r_α` (with the low-rank term's part from the other
+/// contacts), read from the problem's current impulses.
+struct ProblemRow<'a> {
+    sweeps: &'a FcSweeps,
+    a: usize,
+}
+
+impl SweepRow for ProblemRow<'_> {
+    type Cone = ProblemCone;
+    type Context = ();
+
+    #[inline(always)]
+    fn cone(&self) -> ProblemCone {
+        self.sweeps.cone[self.a]
+    }
+
+    #[inline(always)]
+    fn block(&self) -> &Delassus2 {
+        &self.sweeps.diag[self.a]
+    }
+
+    #[inline(always)]
+    fn impulse(&self) -> [f64; 2] {
+        self.sweeps.r[self.a]
+    }
+
+    #[inline(always)]
+    fn free_velocity(&self, (): ()) -> [f64; 2] {
+        let mut q = self.sweeps.local_q(self.a);
+        if !self.sweeps.lr_coef.is_empty() {
+            let x = self.sweeps.low_rank_q(self.a);
+            q[0] += x[0];
+            q[1] += x[1];
+        }
+        q
     }
 }
 

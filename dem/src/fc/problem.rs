@@ -2,7 +2,13 @@
 
 use super::block_csr::BlockCsr2;
 use super::error::FcError;
-use crate::local::Delassus2;
+use crate::local::{Coulomb2, Delassus2};
+
+/// The friction cone of an fc-problem-v1 contact ([`FcProblem::cone`]): the plane Coulomb cone
+/// (the format is 2D). The Gauss–Seidel sweep (`super::nsgs`) and the error measure
+/// (`super::measure`) reach the law through [`crate::cone::FrictionCone`] on it; Lemke's and
+/// Newton's methods are 2D by algorithm and read `μ` directly.
+pub type ProblemCone = Coulomb2;
 
 /// One 2D frictional-contact problem (fc-problem-v1), contact-local frames, normal first:
 ///
@@ -33,6 +39,12 @@ pub struct FcProblem {
 /// three sums current, [`super::nsgs`]).
 pub const LOW_RANK_EXPAND_MAX_CONTACTS: usize = 1800;
 
+/// The rank of a [`LowRank`] term: the three components of a biperiodic cell's velocity
+/// gradient (xx, yy, xy) that a stress may control, eliminated from a step's problem
+/// (`crate::cell_coupling`). Not the rigid-body `crate::math::SPATIAL_DIM`, which is also 3 in
+/// the plane.
+pub const LOW_RANK: usize = 3;
+
 /// A rank-three term `Σ_κ m_κ b_κ b_κᵀ` of the Delassus operator: a biperiodic cell's
 /// stress-controlled components eliminated from the step's problem (`crate::cell_coupling`:
 /// `m_κ = g/(h V)`, `b_κ` stacked from each contact's `B_cκ`). Every contact the cell's change
@@ -40,10 +52,10 @@ pub const LOW_RANK_EXPAND_MAX_CONTACTS: usize = 1800;
 #[derive(Debug, Clone, PartialEq)]
 pub struct LowRank {
     /// `m_κ` of xx, yy, xy (1/(kg·m²)); 0 for a component whose rate is imposed.
-    pub compliance: [f64; 3],
+    pub compliance: [f64; LOW_RANK],
     /// `B_cκ = (b_κ,2c, b_κ,2c+1)` per contact and component (m); zero for a contact the cell's
     /// change does not reach.
-    pub coef: Vec<[[f64; 2]; 3]>,
+    pub coef: Vec<[[f64; 2]; LOW_RANK]>,
 }
 
 impl LowRank {
@@ -82,7 +94,7 @@ impl LowRank {
     }
 
     /// `s_κ = b_κᵀ r` for impulses `r` (interleaved, length 2 nc).
-    pub fn sums(&self, r: &[f64]) -> [f64; 3] {
+    pub fn sums(&self, r: &[f64]) -> [f64; LOW_RANK] {
         let mut s = [0.0; 3];
         for (c, x) in self.coef.iter().zip(r.chunks_exact(2)) {
             for k in 0..3 {
@@ -277,7 +289,13 @@ impl FcProblem {
         &self.w
     }
 
-    /// Symmetric part of the diagonal block of contact `α`, as used by the local solver.
+    /// The friction cone of contact `α`, `|r_t| ≤ μ_α r_n`.
+    pub fn cone(&self, alpha: usize) -> ProblemCone {
+        Coulomb2 { mu: self.mu[alpha] }
+    }
+
+    /// Symmetric part of the diagonal block of contact `α`, as used by the local solver (the
+    /// block of its [`ProblemCone`]).
     pub fn delassus(&self, alpha: usize) -> Delassus2 {
         self.diag[alpha]
     }

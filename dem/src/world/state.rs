@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::blocked::BlockLayout;
 use crate::body::Body;
-use crate::cell::{Cell, CellControl, Mat};
+use crate::cell::{Cell, CellControl};
 use crate::cell_coupling::CellCoupling;
 use crate::collider::Collider;
 use crate::colouring::ContactColouring;
@@ -16,6 +16,7 @@ use crate::contact::ContactSet;
 use crate::detection::Detector;
 use crate::fc::FcProblem;
 use crate::material::ContactLaws;
+use crate::math::{Spatial, Tensor};
 use crate::solver::{NewtonBackoff, SolverWork};
 use crate::stabilise::Projection;
 
@@ -62,7 +63,7 @@ pub struct WorldState {
     /// Mean stress of the cell after the last step (Pa),
     /// [`World::cell_stress`](super::World::cell_stress).
     #[serde(default)]
-    pub(crate) cell_stress: Option<Mat>,
+    pub(crate) cell_stress: Option<Tensor>,
     /// Keep the frictional-contact problem of each step
     /// ([`World::last_problem`](super::World::last_problem)), to write it to a file
     /// (`grainlaw run --dump-problems`). Costs one assembly of `W` per step. Not checkpointed.
@@ -102,11 +103,11 @@ impl WorldState {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct LastStep {
     /// Inverse mass per degree of freedom of every body, `(1/m, 1/m, 1/I)`, zero where imposed.
-    pub(crate) inv: Vec<[f64; 3]>,
+    pub(crate) inv: Vec<Spatial>,
     /// Contact force and torque received by each body (N, N·m).
-    pub(crate) body_force: Vec<[f64; 3]>,
+    pub(crate) body_force: Vec<Spatial>,
     /// The free velocities of the step (empty when its problem is not available).
-    pub(crate) v_free: Vec<[f64; 3]>,
+    pub(crate) v_free: Vec<Spatial>,
     /// The step's problem, when [`WorldState::record_problems`] is set.
     pub(crate) problem: Option<FcProblem>,
     /// What a deformable cell's step adds to its contact problem.
@@ -137,7 +138,7 @@ pub(crate) struct WorkSpace {
     /// same with or without it).
     pub(crate) detector: Detector,
     /// Velocities during the solve, `(v_x, v_y, ω)` per body.
-    pub(crate) vel: Vec<[f64; 3]>,
+    pub(crate) vel: Vec<Spatial>,
     /// Sweep order in natural mode.
     pub(crate) order: Vec<u32>,
     /// Whether each body has a free degree of freedom (parallel sweep).
@@ -152,9 +153,9 @@ pub(crate) struct WorkSpace {
     /// [`WorldState::newton_backoff`] around each solve).
     pub(crate) solver: SolverWork,
     /// Displacement of each body over the step.
-    pub(crate) displacement: Vec<[f64; 3]>,
+    pub(crate) displacement: Vec<Spatial>,
     /// Fluctuating displacements of the step (cell only), for the outran check.
-    pub(crate) fluct_displacement: Vec<[f64; 3]>,
+    pub(crate) fluct_displacement: Vec<Spatial>,
     /// The position correction's projection.
     pub(crate) projection: Projection,
     /// Contacts detected again after a step whose disks outran their swept margins.

@@ -17,13 +17,12 @@
 //!
 //! [`WorldState`]: super::WorldState
 
-use nalgebra::Vector2;
-
 use crate::body::external_loads;
 use crate::body::Dof;
-use crate::cell::{Mat, Vect};
+use crate::cell::ComponentValues;
 use crate::cell_coupling::CellCoupling;
 use crate::error::DemError;
+use crate::math::{Tensor, Vector};
 use crate::snapshot::BodyKind;
 use crate::solver::{self, SolveReport, SweepOrder};
 use crate::stabilise::CorrectionReport;
@@ -36,7 +35,7 @@ struct Solved {
     report: SolveReport,
     /// The change `δ` of the cell's velocity gradient found with the impulses (zero without an
     /// implicit cell control).
-    delta: Mat,
+    delta: Tensor,
     /// Whether each body follows the cell's change within the step ([`World::follows_cell`];
     /// empty when none does).
     follows: Vec<bool>,
@@ -86,11 +85,11 @@ impl World {
         // State only: every re-solve starts from it ([`World::undo_point`]).
         let backup = self.undo_point();
         let first = self.step_plain()?;
-        let f0 = ctl.signed_error(&self.state.cell_stress.unwrap_or_else(Mat::zeros));
+        let f0 = ctl.signed_error(&self.state.cell_stress.unwrap_or_else(Tensor::zeros));
         if f0.abs() <= ctl.tolerance {
             return Ok(first);
         }
-        let l0 = backup.cell.map_or_else(Mat::zeros, |c| c.l);
+        let l0 = backup.cell.map_or_else(Tensor::zeros, |c| c.l);
         let mut tries = 0u32;
         let attempt = |w: &mut World, delta: f64, tries: &mut u32| -> Result<f64, DemError> {
             w.undo_to(&backup);
@@ -100,7 +99,7 @@ impl World {
             *tries += 1;
             r.cell_corrections = *tries;
             w.last = r;
-            Ok(ctl.signed_error(&w.state.cell_stress.unwrap_or_else(Mat::zeros)))
+            Ok(ctl.signed_error(&w.state.cell_stress.unwrap_or_else(Tensor::zeros)))
         };
         // Bracket the root of f(δ) (f grows with δ): [lo, hi] with f(lo) < 0 < f(hi).
         let (mut lo, mut hi);
@@ -181,7 +180,7 @@ impl World {
     /// the time step changed, `R = h r`). Returns the impulse-free change of an implicit cell
     /// over the step ([`World::implicit_free_change`]): its images' drift widens the swept
     /// margins, and the contact problem starts from it.
-    fn detect(&mut self) -> Result<Option<[f64; 3]>, DemError> {
+    fn detect(&mut self) -> Result<Option<ComponentValues>, DemError> {
         let h = self.state.params.dt;
         std::mem::swap(&mut self.state.contacts, &mut self.work.previous);
         let free_change = self.implicit_free_change();
@@ -257,7 +256,7 @@ impl World {
     /// bipotential (with the cell's stress-controlled components as unknowns under an implicit
     /// control, [`crate::cell_coupling`]). Keeps the free velocities (and the problem, when
     /// problems are recorded) for after the step, and the contacts' statuses.
-    fn solve_contacts(&mut self, free_change: Option<[f64; 3]>) -> Solved {
+    fn solve_contacts(&mut self, free_change: Option<ComponentValues>) -> Solved {
         let h = self.state.params.dt;
         let q_norms = solver::free_velocity_norms(&self.state.contacts.rows, &self.work.vel);
         let thickness = self.grain_thickness();
@@ -304,7 +303,7 @@ impl World {
         solver::classify(&self.state.contacts.rows, &mut self.state.contacts.status);
         // The images moved with L⁺ h k = (L⁻ + δ) h k during the solve: the cell deforms with
         // L⁺ (`deform_cell`), the grains follow δ at the end of the step (`control_cell`).
-        let delta = coupling.as_ref().map_or_else(Mat::zeros, |c| c.delta());
+        let delta = coupling.as_ref().map_or_else(Tensor::zeros, |c| c.delta());
         self.work.image_outran = delta.abs().sum() > self.work.detector.image_rate();
         self.state.last_step.cell_step = match (self.state.cell, self.state.cell_control) {
             (Some(_), Some(ctl)) if !ctl.implicit => None,
@@ -442,7 +441,7 @@ impl World {
                 }
             }
             let vm = [b.velocity.x, b.velocity.y, b.omega];
-            b.acceleration = Vector2::new((v[0] - vm[0]) / h, (v[1] - vm[1]) / h);
+            b.acceleration = Vector::new((v[0] - vm[0]) / h, (v[1] - vm[1]) / h);
             b.angular_acceleration = (v[2] - vm[2]) / h;
             let mut d = [
                 h * ((1.0 - theta) * vm[0] + theta * v[0]),
@@ -458,7 +457,7 @@ impl World {
             b.position.x += d[0];
             b.position.y += d[1];
             b.angle += d[2];
-            b.velocity = Vector2::new(v[0], v[1]);
+            b.velocity = Vector::new(v[0], v[1]);
             b.omega = v[2];
             if let Some(p) = periodic {
                 if b.kind == BodyKind::Grain {
@@ -486,7 +485,7 @@ impl World {
             let c = cell.centre();
             self.work.fluct_displacement.clear();
             for (b, d) in self.state.bodies.iter().zip(&self.work.displacement) {
-                let x_old = b.position - Vect::new(d[0], d[1]);
+                let x_old = b.position - Vector::new(d[0], d[1]);
                 let a = if affine {
                     (l + delta) * (x_old - c) * h
                 } else {
@@ -507,7 +506,7 @@ impl World {
                 .zip(&self.state.contacts.geometry)
             {
                 if geo.image != [0.0, 0.0] {
-                    let u = dh * Vect::new(geo.image[0], geo.image[1]);
+                    let u = dh * Vector::new(geo.image[0], geo.image[1]);
                     cell_gap_shift.push(row.n[0] * u.x + row.n[1] * u.y);
                 } else {
                     cell_gap_shift.push(0.0);
@@ -553,7 +552,7 @@ impl World {
     /// the new velocity gradient with the homogeneous change of the grains' velocities (under
     /// an implicit control they take the step's change `delta` too, from `L⁻` to the next `L`),
     /// whose kinetic energy is added to `cell_work` (J). Nothing without a cell.
-    fn control_cell(&mut self, delta: Mat, cell_work: &mut f64) {
+    fn control_cell(&mut self, delta: Tensor, cell_work: &mut f64) {
         let h = self.state.params.dt;
         if let Some(cell) = self.state.cell {
             let sigma = self.measure_cell_stress(&cell);
