@@ -734,10 +734,8 @@ mod tests {
             format!("average_strain={a}"),
             r#"leave_out=["mu-i","mu-i-linear","phi-i"]"#.to_string(),
         ];
-        match datasets::load("simple-shear", &sets).unwrap().scenario {
-            datasets::Scenario::SimpleShear(c) => c,
-            _ => unreachable!(),
-        }
+        let loaded = crate::scenarios::registry::load("simple-shear", &sets).unwrap();
+        crate::scenarios::registry::config_of(&loaded).unwrap()
     }
 
     /// Numbers of the data lines after `Atoms # sphere`.

@@ -299,8 +299,8 @@ pub fn run<'py>(
 #[pyfunction]
 pub fn scenarios(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    for b in datasets::BUILTINS.iter() {
-        d.set_item(b.name, b.description)?;
+    for s in grainlaw::scenarios::registry::SCENARIOS.iter() {
+        d.set_item(s.name(), s.description())?;
     }
     Ok(d)
 }
