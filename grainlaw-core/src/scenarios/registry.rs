@@ -1,7 +1,7 @@
 //! The one list of scenarios. Each entry is a [`Scenario`]: its name and one-line description,
 //! its built-in TOML (`datasets/scenarios/NAME.toml`, embedded), its typed configuration
 //! (`datasets::config`, loaded with `--set` overrides through [`load`]) and its runner
-//! (`src/scenarios/NAME.rs`). The command line (`run`, `scenarios`, `campaign`, `bench`), the
+//! (`grainlaw-core/src/scenarios/NAME.rs`). The command line (`run`, `scenarios`, `campaign`, `bench`), the
 //! library API ([`crate::api`]), the Python bindings and the tests find scenarios here and
 //! nowhere else; [`run_controlled`] runs a loaded one through its entry.
 //!
@@ -59,7 +59,7 @@ pub struct Runner<C> {
     pub description: &'static str,
     /// [`Scenario::builtin_toml`].
     pub toml: &'static str,
-    /// The runner (`src/scenarios/NAME.rs`'s `run`).
+    /// The runner (`grainlaw-core/src/scenarios/NAME.rs`'s `run`).
     pub run: fn(&C, &mut RunContext, &mut RunControl) -> Result<RunOutcome>,
 }
 
@@ -102,55 +102,55 @@ pub static SCENARIOS: [&dyn Scenario; 9] = [
     &Runner::<JanssenConfig> {
         name: "janssen",
         description: "350 grains deposited in a column, relaxed, released: wall stress vs depth, Janssen fit (Fig. 7)",
-        toml: include_str!("../../datasets/scenarios/janssen.toml"),
+        toml: include_str!("../../../datasets/scenarios/janssen.toml"),
         run: janssen::run,
     },
     &Runner::<RollingConfig> {
         name: "rolling",
         description: "one disk rolling down a slope: exact mean stress with inertia (eq. 13-14)",
-        toml: include_str!("../../datasets/scenarios/rolling.toml"),
+        toml: include_str!("../../../datasets/scenarios/rolling.toml"),
         run: rolling::run,
     },
     &Runner::<ArrangementsConfig> {
         name: "arrangements",
         description: "rectangular, triangular, cannonball stacks in a box: load on the walls (Fig. 5)",
-        toml: include_str!("../../datasets/scenarios/arrangements.toml"),
+        toml: include_str!("../../../datasets/scenarios/arrangements.toml"),
         run: arrangements::run,
     },
     &Runner::<StickSlipConfig> {
         name: "stick-slip",
         description: "bottom wall pushed up under a deposit, three friction cases (Fig. 6)",
-        toml: include_str!("../../datasets/scenarios/stick-slip.toml"),
+        toml: include_str!("../../../datasets/scenarios/stick-slip.toml"),
         run: stick_slip::run,
     },
     &Runner::<InclinedFlowConfig> {
         name: "inclined-flow",
         description: "480 grains flowing down a rough 26° slope: inertia-ratio map (Fig. 4), velocity profile",
-        toml: include_str!("../../datasets/scenarios/inclined-flow.toml"),
+        toml: include_str!("../../../datasets/scenarios/inclined-flow.toml"),
         run: inclined_flow::run,
     },
     &Runner::<ShearCellConfig> {
         name: "shear-cell",
         description: "plane shear at imposed pressure over several inertial numbers: mu(I), phi(I), wall law",
-        toml: include_str!("../../datasets/scenarios/shear-cell.toml"),
+        toml: include_str!("../../../datasets/scenarios/shear-cell.toml"),
         run: shear_cell::run,
     },
     &Runner::<SimpleShearConfig> {
         name: "simple-shear",
         description: "Lees-Edwards shear of a biperiodic cell at imposed normal stress over several inertial numbers: mu(I), phi(I)",
-        toml: include_str!("../../datasets/scenarios/simple-shear.toml"),
+        toml: include_str!("../../../datasets/scenarios/simple-shear.toml"),
         run: simple_shear::run,
     },
     &Runner::<BiaxialConfig> {
         name: "biaxial",
         description: "biaxial compression of a biperiodic cell at constant lateral stress over several confining pressures: peak and critical friction, dilatancy, Mohr-Coulomb",
-        toml: include_str!("../../datasets/scenarios/biaxial.toml"),
+        toml: include_str!("../../../datasets/scenarios/biaxial.toml"),
         run: biaxial::run,
     },
     &Runner::<ColumnCollapseConfig> {
         name: "column-collapse",
         description: "a 2D column of about 2500 grains (a = 6.26) collapsing onto a rough floor: front x_f(t), profiles, runout, against contact dynamics",
-        toml: include_str!("../../datasets/scenarios/column-collapse.toml"),
+        toml: include_str!("../../../datasets/scenarios/column-collapse.toml"),
         run: column_collapse::run,
     },
 ];
