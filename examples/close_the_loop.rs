@@ -63,7 +63,7 @@ fn run_scenario(name: &str, set: &[&str], dir: &Path) -> Result<(), Box<dyn std:
     let mut ctx = RunContext {
         out: OutputDir::create(dir)?,
         verbosity: Verbosity::Normal,
-        loaded: datasets::load(name, &set)?,
+        loaded: grainlaw::scenarios::registry::load(name, &set)?,
         interrupted: Arc::new(AtomicBool::new(false)),
         dump: None,
     };

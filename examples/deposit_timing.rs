@@ -11,10 +11,10 @@ fn main() {
     } else {
         vec![1, 2, 4, 8]
     };
-    let loaded = datasets::load("janssen", &[format!("grains={grains}")]).unwrap();
-    let datasets::Scenario::Janssen(c) = loaded.scenario else {
-        unreachable!()
-    };
+    let loaded =
+        grainlaw::scenarios::registry::load("janssen", &[format!("grains={grains}")]).unwrap();
+    let c: datasets::config::JanssenConfig =
+        grainlaw::scenarios::registry::config_of(&loaded).unwrap();
     for s in subs {
         let width = datasets::build::column_width(&c.grain, c.grains, c.column_aspect);
         let mut col = datasets::build::column(

@@ -15,7 +15,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .unwrap_or_else(|| "grainlaw-out/janssen-example".into());
     // A stiffer wall friction than the paper's, with the same seed.
-    let loaded = datasets::load("janssen", &["friction.grain_wall=0.4".into()])?;
+    let loaded =
+        grainlaw::scenarios::registry::load("janssen", &["friction.grain_wall=0.4".into()])?;
     let mut ctx = RunContext {
         out: OutputDir::create(std::path::Path::new(&dir))?,
         verbosity: Verbosity::Normal,

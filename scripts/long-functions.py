@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """List the functions longer than a limit outside tests (issue 37: none over 150 lines).
 
-    scripts/long-functions.py [LIMIT] [DIR ...]      (defaults: 150, src/scenarios datasets/src)
+    scripts/long-functions.py [LIMIT] [DIR ...]      (defaults: 150, grainlaw-core/src/scenarios datasets/src)
 
 Prints `LINES FILE:LINE NAME` per function, longest first; exits 1 when one is listed. A
 function is counted from its `fn` line to its closing brace (braces in strings, character
@@ -53,7 +53,7 @@ def long_functions(path, limit):
 def main():
     args = sys.argv[1:]
     limit = int(args.pop(0)) if args and args[0].isdigit() else 150
-    dirs = args or ["src/scenarios", "datasets/src"]
+    dirs = args or ["grainlaw-core/src/scenarios", "datasets/src"]
     found = []
     for d in dirs:
         for root, _, files in os.walk(d):

@@ -3,7 +3,7 @@
 
     find r, u :  u = W r + q,   K_mu* ∋ u + mu|u_t| n  ⟂  r ∈ K_mu   (per contact)
 
-This is the peer run of `grainlaw bench` (src/siconos_peer.rs, which embeds this file and feeds
+This is the peer run of `grainlaw bench` (grainlaw-core/src/siconos_peer.rs, which embeds this file and feeds
 it to the interpreter on stdin): Siconos numerics' `fc2d_driver` (NSGS with sparse block
 storage, or Lemke's method, `fc2d_lexicolemke`) from r = 0. It is a reduced copy of the
 project's earlier stand-alone Siconos driver (same reading, same problem construction, same

@@ -28,6 +28,7 @@ use datasets::benchmarks::{
 };
 
 use crate::error::{CliError, Result};
+use crate::scenarios::{biaxial, registry};
 
 /// What to run.
 #[derive(Debug, Clone)]
@@ -607,11 +608,9 @@ fn biaxial_rows(plan: &BenchPlan) -> Result<()> {
         "s/percent"
     );
     for &n in &plan.biaxial_grains {
-        let r = crate::scenarios::biaxial::bench_rve(
-            n,
-            plan.biaxial_compress_steps,
-            plan.biaxial_steps,
-        )?;
+        let loaded = registry::load("biaxial", &biaxial::bench_sets(n))?;
+        let c: datasets::config::BiaxialConfig = registry::config_of(&loaded)?;
+        let r = biaxial::bench_rve(&c, plan.biaxial_compress_steps, plan.biaxial_steps)?;
         println!(
             "{:>7} {:>10.1} {:>9.0} {:>8.1} {:>8.2} {:>8} {:>8.3} {:>11.2e} {:>10.0}",
             r.grains,
@@ -806,7 +805,7 @@ fn grainlaw_rve(n: usize, plan: &RvePlan) -> Result<OurRve> {
         RVE_LEAVE_OUT.to_string(),
     ];
     let sets: Vec<String> = sets.into_iter().chain(plan.sets.iter().cloned()).collect();
-    let loaded = datasets::load("simple-shear", &sets)?;
+    let loaded = crate::scenarios::registry::load("simple-shear", &sets)?;
     let dir = std::env::temp_dir().join(format!("grainlaw-bench-rve-{}-{n}", std::process::id()));
     let mut ctx = crate::scenarios::RunContext {
         out: crate::output::OutputDir::create(&dir)?,
@@ -914,12 +913,9 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
     );
     for &n in &plan.grains {
         let ours = grainlaw_rve(n, plan)?;
-        let datasets::Scenario::SimpleShear(c) = &ours.loaded.scenario else {
-            return Err(CliError::Usage(
-                "bench --rve: not a simple-shear scenario".into(),
-            ));
-        };
-        let peer = PeerRve::from_config(c, plan.inertial, wall_limit)?;
+        let c: datasets::config::SimpleShearConfig =
+            crate::scenarios::registry::config_of(&ours.loaded)?;
+        let peer = PeerRve::from_config(&c, plan.inertial, wall_limit)?;
         let outcome = match &lammps {
             Some(lmp) => {
                 let dir = std::env::temp_dir()

@@ -35,7 +35,7 @@ use crate::error::{CliError, Result};
 use crate::output::OutputDir;
 use crate::progress::Verbosity;
 use crate::scenarios::phased::DEFAULT_CHECKPOINT_SECONDS;
-use crate::scenarios::{self, CheckpointPolicy, RunContext, RunControl};
+use crate::scenarios::{self, registry, CheckpointPolicy, RunContext, RunControl};
 
 /// grainlaw: discrete-element simulations of granular media turned into calibrated continuum laws.
 #[derive(Debug, Parser)]
@@ -637,13 +637,13 @@ pub fn run(args: RunArgs) -> Result<()> {
             (loaded.0, dir.clone(), loaded.1)
         }
         None => {
-            let spec = args.scenario.as_deref().unwrap_or("janssen");
-            let loaded = datasets::load(spec, &args.set)?;
+            let spec = args.scenario.as_deref().unwrap_or(registry::DEFAULT);
+            let loaded = registry::load(spec, &args.set)?;
             let dir = args
                 .out
                 .clone()
                 .unwrap_or_else(|| PathBuf::from("grainlaw-out").join(&loaded.name));
-            crate::output::dir::check_out_dir(&dir, loaded.scenario.kind())?;
+            crate::output::dir::check_out_dir(&dir, loaded.config.kind())?;
             (loaded, dir, args.set.clone())
         }
     };
@@ -729,7 +729,7 @@ fn resumed_scenario(
     };
     match scenario {
         Some(spec) => {
-            let given = datasets::load(spec, set)?;
+            let given = registry::load(spec, set)?;
             if given.effective_toml != rec.effective_toml {
                 let mut g = given.source.clone();
                 for o in set {
@@ -749,10 +749,12 @@ fn resumed_scenario(
         }
         None => {}
     }
-    let loaded = datasets::scenario::from_text(&rec.name, &rec.source, &rec.effective_toml, &[])
-        .map_err(|e| CliError::Checkpoint {
-            path: checkpoint::file_of(dir).display().to_string(),
-            reason: format!("its scenario does not load any more ({e})"),
+    let loaded =
+        registry::from_text(&rec.name, &rec.source, &rec.effective_toml, &[]).map_err(|e| {
+            CliError::Checkpoint {
+                path: checkpoint::file_of(dir).display().to_string(),
+                reason: format!("its scenario does not load any more ({e})"),
+            }
         })?;
     Ok((loaded, rec.sets, rec.allow_suspect))
 }
@@ -760,23 +762,18 @@ fn resumed_scenario(
 fn scenarios_cmd(show: Option<&str>) -> Result<()> {
     match show {
         Some(name) => {
-            let b = datasets::builtin(name).ok_or_else(|| {
-                CliError::Dataset(datasets::DatasetError::UnknownScenario {
-                    name: name.to_string(),
-                    known: datasets::builtin::builtin_names(),
-                })
-            })?;
-            print!("{}", b.toml);
+            let s = registry::get(name)?;
+            print!("{}", s.builtin_toml());
             // the laws it fits and the data each needs, from the same table the load checks
-            let loaded = datasets::load(name, &[])?;
-            let needs = datasets::config::laws::describe(&loaded.scenario.law_needs());
+            let loaded = registry::load(name, &[])?;
+            let needs = datasets::config::laws::describe(&loaded.config.law_needs());
             if !needs.is_empty() {
                 println!("\n{}", needs.join("\n"));
             }
         }
         None => {
-            for b in datasets::BUILTINS.iter() {
-                println!("{:<15} {}", b.name, b.description);
+            for s in registry::SCENARIOS.iter() {
+                println!("{:<15} {}", s.name(), s.description());
             }
             println!("\nRun one with `grainlaw run NAME`, print its keys with `grainlaw scenarios --show NAME`.");
         }

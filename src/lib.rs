@@ -1,33 +1,13 @@
-//! # grainlaw — the command line and its pieces
+//! # grainlaw — the command line
 //!
-//! `grainlaw run [SCENARIO]` runs one of the paper's experiments end to end: simulation
-//! ([`dem`]), homogenisation ([`homogenise`]), identification ([`identify`]), figures
-//! ([`plot`]), CSV, VTK and `summary.json` ([`output`]). The scenarios and generators are in
-//! [`datasets`]; the runners in [`scenarios`]; the command line in [`cli`].
+//! `grainlaw run [SCENARIO]` runs one of the paper's experiments end to end. This package is
+//! the command line only: argument parsing and the commands' printing ([`cli`], the tables of
+//! [`bench_cmd`] and [`fc_cmd`]). Everything it runs is in the library crate
+//! [`grainlaw_core`] (scenarios, readers, verdicts, campaigns, plots), re-exported here so that
+//! `grainlaw::scenarios`, `grainlaw::api`, … name the same items.
 
-pub mod api;
+pub use grainlaw_core::*;
+
 pub mod bench_cmd;
-pub mod campaign;
-pub mod checkpoint;
 pub mod cli;
-pub mod continuum;
-pub mod engine_bench;
-pub mod error;
-pub mod fc_bench;
 pub mod fc_cmd;
-pub mod fit_cmd;
-pub mod floats;
-pub mod homogenise_cmd;
-pub mod lammps_peer;
-pub mod lammps_rve_peer;
-pub mod output;
-pub mod plot;
-pub mod progress;
-pub mod provenance;
-pub mod readers;
-pub mod rve;
-pub mod scenarios;
-pub mod siconos_peer;
-pub mod verdict;
-
-pub use error::{CliError, Result};

@@ -133,7 +133,9 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
 }
 
 fn builtin(name: &str) -> &'static str {
-    datasets::builtin(name).unwrap().toml
+    grainlaw::scenarios::registry::get(name)
+        .unwrap()
+        .builtin_toml()
 }
 
 /// Writes `text` to `dir/name`.
@@ -662,11 +664,11 @@ fn non_finite_values_in_every_float_key() {
     let d = dir.path();
     let mut rows = Vec::new();
     let mut count = 0;
-    for b in datasets::BUILTINS.iter() {
-        let table: Table = b.toml.parse().unwrap();
+    for b in grainlaw::scenarios::registry::SCENARIOS.iter() {
+        let table: Table = b.builtin_toml().parse().unwrap();
         let mut keys = Vec::new();
         float_keys(&table, "", &mut keys);
-        assert!(keys.len() >= 5, "{}: {keys:?}", b.name);
+        assert!(keys.len() >= 5, "{}: {keys:?}", b.name());
         for key in &keys {
             for (word, v) in [
                 ("nan", f64::NAN),
@@ -688,8 +690,8 @@ fn non_finite_values_in_every_float_key() {
                 };
                 rows.push(Row {
                     label: "non-finite --set",
-                    args: vec!["run".into(), b.name.into(), "--set".into(), set_arg],
-                    needles: vec![format!("builtin:{}", b.name), format!("key `{key}`")],
+                    args: vec!["run".into(), b.name().into(), "--set".into(), set_arg],
+                    needles: vec![format!("builtin:{}", b.name()), format!("key `{key}`")],
                     absent: Vec::new(),
                 });
                 let mut t = table.clone();

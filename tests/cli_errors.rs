@@ -76,7 +76,11 @@ fn bad_scenario_input_is_one_line_exit_2() {
     .unwrap();
     std::fs::write(
         d.join("extra.toml"),
-        datasets::builtin("rolling").unwrap().toml.to_string() + "\nwobble = 3\n",
+        grainlaw::scenarios::registry::get("rolling")
+            .unwrap()
+            .builtin_toml()
+            .to_string()
+            + "\nwobble = 3\n",
     )
     .unwrap();
     let cases: &[(&[&str], &[&str])] = &[

@@ -16,33 +16,38 @@ fn scenarios_lists_and_shows_every_builtin() {
     let o = grainlaw(&["scenarios"]);
     assert!(o.status.success());
     let text = String::from_utf8(o.stdout).unwrap();
-    for b in datasets::BUILTINS.iter() {
-        assert!(text.contains(b.name), "{} not listed", b.name);
-        let o = grainlaw(&["scenarios", "--show", b.name]);
+    for b in grainlaw::scenarios::registry::SCENARIOS.iter() {
+        assert!(text.contains(b.name()), "{} not listed", b.name());
+        let o = grainlaw(&["scenarios", "--show", b.name()]);
         assert!(o.status.success());
         let shown = String::from_utf8(o.stdout).unwrap();
         // the built-in TOML, then (for a scenario that fits laws) the data each law needs, as
         // comments
-        let rest = shown.strip_prefix(b.toml).expect("the built-in TOML first");
+        let rest = shown
+            .strip_prefix(b.builtin_toml())
+            .expect("the built-in TOML first");
         assert!(
             rest.lines().all(|l| l.is_empty() || l.starts_with('#')),
             "{rest}"
         );
-        let fits = datasets::load(b.name, &[]).unwrap().scenario.law_needs();
+        let fits = grainlaw::scenarios::registry::load(b.name(), &[])
+            .unwrap()
+            .config
+            .law_needs();
         for need in &fits {
             assert!(
                 rest.contains(&format!("#   {} (", need.law)),
                 "{}: {rest}",
-                b.name
+                b.name()
             );
         }
-        assert_eq!(rest.is_empty(), fits.is_empty(), "{}: {rest}", b.name);
+        assert_eq!(rest.is_empty(), fits.is_empty(), "{}: {rest}", b.name());
         // The TOML shown is a complete scenario: it loads as a file.
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("s.toml");
         std::fs::write(&p, &shown).unwrap();
-        datasets::load(p.to_str().unwrap(), &[]).unwrap();
-        assert!(shown.contains("seed"), "{} has no seed", b.name);
+        grainlaw::scenarios::registry::load(p.to_str().unwrap(), &[]).unwrap();
+        assert!(shown.contains("seed"), "{} has no seed", b.name());
     }
 }
 

@@ -48,10 +48,8 @@ fn output_dir_writes_atomically_and_removes_a_stale_summary() {
 /// A settled rolling disk: one grain vertex, one contact line, one wall line.
 #[test]
 fn vtk_polydata_counts() {
-    let l = datasets::load("rolling", &[]).unwrap();
-    let datasets::Scenario::Rolling(c) = l.scenario else {
-        panic!()
-    };
+    let l = grainlaw::scenarios::registry::load("rolling", &[]).unwrap();
+    let c: datasets::config::RollingConfig = grainlaw::scenarios::registry::config_of(&l).unwrap();
     let (mut w, _, _) = datasets::build::rolling(&c).unwrap();
     for _ in 0..5 {
         w.step().unwrap();

@@ -2,7 +2,7 @@
 //! machine has Siconos (`/usr/bin/python3 -c 'import siconos.numerics'`, or the interpreter of
 //! `GRAINLAW_SICONOS_PYTHON`); each test prints why it is skipped otherwise (CI machines may
 //! not have Siconos). The parsing and labelling tests that need no Siconos are unit tests of
-//! `src/siconos_peer.rs`.
+//! `grainlaw-core/src/siconos_peer.rs`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -1,106 +1,97 @@
 //! Loading a scenario: a built-in name or a TOML path, `--set` overrides applied on the TOML
 //! table, then typed deserialisation (`deny_unknown_fields`) and validation.
 
+use std::any::Any;
 use std::path::Path;
+use std::sync::Arc;
 
 use serde::de::DeserializeOwned;
 use toml::{Table, Value};
 
-use crate::builtin::{builtin, builtin_names};
-use crate::config::{
-    ArrangementsConfig, BiaxialConfig, ColumnCollapseConfig, InclinedFlowConfig, JanssenConfig,
-    RollingConfig, ShearCellConfig, SimpleShearConfig, StickSlipConfig,
-};
 use crate::error::{DatasetError, Result};
 use crate::overrides::{apply_override, parse_override};
 
-/// A typed, validated scenario.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Scenario {
-    /// Janssen column.
-    Janssen(JanssenConfig),
-    /// One disk rolling on a slope.
-    Rolling(RollingConfig),
-    /// Stacks in a box.
-    Arrangements(ArrangementsConfig),
-    /// Bottom wall pushed up under a deposit.
-    StickSlip(StickSlipConfig),
-    /// Flow down a rough slope.
-    InclinedFlow(InclinedFlowConfig),
-    /// Plane shear at imposed pressure.
-    ShearCell(ShearCellConfig),
-    /// Lees–Edwards shear of a biperiodic cell at imposed normal stress.
-    SimpleShear(SimpleShearConfig),
-    /// Biaxial compression of a biperiodic cell at constant lateral stress.
-    Biaxial(BiaxialConfig),
-    /// Collapse of a granular column onto a rough floor.
-    ColumnCollapse(ColumnCollapseConfig),
-}
+/// A typed, validated scenario configuration: what every scenario kind's config struct
+/// (`config::JanssenConfig`, …) tells the loader and the runners, whatever its keys. The
+/// implementations are in [`crate::kinds`]; the list of kinds, with their built-in TOML and
+/// their runners, is the root package's registry (`grainlaw::scenarios::registry`), which the
+/// loader reads through [`Catalogue`].
+pub trait ScenarioConfig: std::fmt::Debug + Send + Sync + Any {
+    /// The scenario kind (`janssen`, `rolling`, ...), the value of its `scenario` key.
+    fn kind(&self) -> &'static str;
 
-impl Scenario {
-    /// The scenario kind (`janssen`, `rolling`, ...).
-    pub fn kind(&self) -> &'static str {
-        match self {
-            Scenario::Janssen(_) => "janssen",
-            Scenario::Rolling(_) => "rolling",
-            Scenario::Arrangements(_) => "arrangements",
-            Scenario::StickSlip(_) => "stick-slip",
-            Scenario::InclinedFlow(_) => "inclined-flow",
-            Scenario::ShearCell(_) => "shear-cell",
-            Scenario::SimpleShear(_) => "simple-shear",
-            Scenario::Biaxial(_) => "biaxial",
-            Scenario::ColumnCollapse(_) => "column-collapse",
-        }
-    }
+    /// The seed.
+    fn seed(&self) -> u64;
 
-    /// The laws it fits and the data each needs (`config::laws`).
-    pub fn law_needs(&self) -> Vec<crate::config::laws::LawNeed> {
-        match self {
-            Scenario::Janssen(_) => vec![crate::config::laws::LawNeed {
-                law: "janssen",
-                formula: "σ_v(z) of Janssen 1895, K and μ_w jointly",
-                key: "",
-                needs: 4,
-                have: None,
-                why: "depth bins of the wall profile in the fit window",
-                instead_of: None,
-            }],
-            Scenario::ShearCell(c) => c.law_needs(),
-            Scenario::SimpleShear(c) => c.law_needs(),
-            Scenario::Biaxial(c) => c.law_needs(),
-            _ => Vec::new(),
-        }
+    /// Checks every value, naming the key at fault (the struct's `validate`).
+    fn check(&self) -> Result<()>;
+
+    /// The laws it fits and the data each needs (`config::laws`); none by default.
+    fn law_needs(&self) -> Vec<crate::config::laws::LawNeed> {
+        Vec::new()
     }
 
     /// The laws the plan leaves out (`leave_out`; empty for a scenario without the key).
-    pub fn leave_out(&self) -> &[String] {
-        match self {
-            Scenario::ShearCell(c) => &c.leave_out,
-            Scenario::SimpleShear(c) => &c.leave_out,
-            Scenario::Biaxial(c) => &c.leave_out,
-            _ => &[],
-        }
+    fn leave_out(&self) -> &[String] {
+        &[]
     }
 
+    /// A line said at the start of a run about the plan's length, if the kind has one.
+    fn plan_note(&self) -> Option<String> {
+        None
+    }
+
+    /// How many grains its largest world holds (before it is built).
+    fn grains(&self) -> usize;
+
+    /// Builds every world its runner builds first (the *build* stage, without running it):
+    /// everything the generators and the engine would refuse is refused here.
+    fn build_first(&self) -> Result<()>;
+
+    /// The config as `Any`, for the runner of its kind to take its own type back.
+    fn as_any(&self) -> &dyn Any;
+}
+
+impl dyn ScenarioConfig {
     /// Whether the plan leaves the law `law` out.
     pub fn leaves_out(&self, law: &str) -> bool {
         self.leave_out().iter().any(|l| l == law)
     }
 
-    /// The seed.
-    pub fn seed(&self) -> u64 {
-        match self {
-            Scenario::Janssen(c) => c.seed,
-            Scenario::Rolling(c) => c.seed,
-            Scenario::Arrangements(c) => c.seed,
-            Scenario::StickSlip(c) => c.seed,
-            Scenario::InclinedFlow(c) => c.seed,
-            Scenario::ShearCell(c) => c.seed,
-            Scenario::SimpleShear(c) => c.seed,
-            Scenario::Biaxial(c) => c.seed,
-            Scenario::ColumnCollapse(c) => c.seed,
-        }
+    /// The config as its own type, if it is of that type.
+    pub fn downcast_ref<C: ScenarioConfig>(&self) -> Option<&C> {
+        self.as_any().downcast_ref::<C>()
     }
+}
+
+/// The scenario kinds the loader knows: their built-in TOML texts and their typed
+/// configurations. Implemented by the root package's registry, the one list of scenarios.
+pub trait Catalogue {
+    /// The full TOML text of the built-in scenario `name`, if there is one.
+    fn builtin_toml(&self, name: &str) -> Option<&'static str>;
+
+    /// The built-in names, comma separated (for messages).
+    fn names(&self) -> String;
+
+    /// The typed, validated configuration of kind `kind` from its TOML table (`None` for a kind
+    /// it does not know). [`typed_config`] is the usual implementation for one kind.
+    fn config(
+        &self,
+        kind: &str,
+        table: Table,
+        source: &str,
+    ) -> Option<Result<Arc<dyn ScenarioConfig>>>;
+}
+
+/// The typed configuration `C` of `table` (unknown keys refused, [`typed`]), validated
+/// ([`ScenarioConfig::check`]), errors naming `source`.
+pub fn typed_config<C: ScenarioConfig + DeserializeOwned>(
+    table: Table,
+    source: &str,
+) -> Result<Arc<dyn ScenarioConfig>> {
+    let c: C = typed(table, source)?;
+    c.check().map_err(|e| e.in_source(source))?;
+    Ok(Arc::new(c))
 }
 
 /// A loaded scenario with where it came from and its effective TOML (overrides applied).
@@ -112,8 +103,8 @@ pub struct LoadedScenario {
     pub source: String,
     /// The TOML actually run, overrides included (written next to the results).
     pub effective_toml: String,
-    /// The typed scenario.
-    pub scenario: Scenario,
+    /// The typed scenario configuration.
+    pub config: Arc<dyn ScenarioConfig>,
 }
 
 /// Position (1-based line, column) of byte `offset` in `text`.
@@ -193,14 +184,14 @@ pub fn typed<T: DeserializeOwned>(table: Table, source: &str) -> Result<T> {
     })
 }
 
-/// Loads `spec` (a built-in name or a TOML file path), applies `sets` (`KEY=VALUE`), then
-/// deserialises and validates it.
-pub fn load(spec: &str, sets: &[String]) -> Result<LoadedScenario> {
-    let (name, source, text) = if let Some(b) = builtin(spec) {
+/// Loads `spec` (a built-in name of `catalogue` or a TOML file path), applies `sets`
+/// (`KEY=VALUE`), then deserialises and validates it as its kind in `catalogue`.
+pub fn load(catalogue: &dyn Catalogue, spec: &str, sets: &[String]) -> Result<LoadedScenario> {
+    let (name, source, text) = if let Some(toml) = catalogue.builtin_toml(spec) {
         (
-            b.name.to_string(),
-            format!("builtin:{}", b.name),
-            b.toml.to_string(),
+            spec.to_string(),
+            format!("builtin:{spec}"),
+            toml.to_string(),
         )
     } else {
         let path = Path::new(spec);
@@ -208,7 +199,7 @@ pub fn load(spec: &str, sets: &[String]) -> Result<LoadedScenario> {
         if !looks_like_file {
             return Err(DatasetError::UnknownScenario {
                 name: spec.to_string(),
-                known: builtin_names(),
+                known: catalogue.names(),
             });
         }
         let text = std::fs::read_to_string(path).map_err(|e| DatasetError::Io {
@@ -222,11 +213,17 @@ pub fn load(spec: &str, sets: &[String]) -> Result<LoadedScenario> {
             .to_string();
         (stem, spec.to_string(), text)
     };
-    from_text(&name, &source, &text, sets)
+    from_text(catalogue, &name, &source, &text, sets)
 }
 
 /// Like [`load`] from TOML text already read; `source` names it in messages.
-pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Result<LoadedScenario> {
+pub fn from_text(
+    catalogue: &dyn Catalogue,
+    name: &str,
+    source: &str,
+    text: &str,
+    sets: &[String],
+) -> Result<LoadedScenario> {
     let mut table = parse_table(text, source)?;
     let kind_before = table.get("scenario").cloned();
     for s in sets {
@@ -265,74 +262,27 @@ pub fn from_text(name: &str, source: &str, text: &str, sets: &[String]) -> Resul
             return Err(DatasetError::Type {
                 source_name: source.to_string(),
                 key: "scenario".into(),
-                reason: format!("missing: name the scenario kind ({})", builtin_names()),
+                reason: format!("missing: name the scenario kind ({})", catalogue.names()),
             })
         }
     };
-    let scenario = match kind.as_str() {
-        "janssen" => {
-            let c: JanssenConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::Janssen(c)
-        }
-        "rolling" => {
-            let c: RollingConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::Rolling(c)
-        }
-        "arrangements" => {
-            let c: ArrangementsConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::Arrangements(c)
-        }
-        "stick-slip" => {
-            let c: StickSlipConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::StickSlip(c)
-        }
-        "inclined-flow" => {
-            let c: InclinedFlowConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::InclinedFlow(c)
-        }
-        "shear-cell" => {
-            let c: ShearCellConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::ShearCell(c)
-        }
-        "simple-shear" => {
-            let c: SimpleShearConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::SimpleShear(c)
-        }
-        "biaxial" => {
-            let c: BiaxialConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::Biaxial(c)
-        }
-        "column-collapse" => {
-            let c: ColumnCollapseConfig = typed(table, source)?;
-            c.validate().map_err(|e| e.in_source(source))?;
-            Scenario::ColumnCollapse(c)
-        }
-        other => {
-            return Err(DatasetError::invalid(
-                "scenario",
-                format!(
-                    "unknown scenario kind `{other}` (known: {})",
-                    builtin_names()
-                ),
-            )
-            .in_source(source))
-        }
-    };
+    let config = catalogue.config(&kind, table, source).unwrap_or_else(|| {
+        Err(DatasetError::invalid(
+            "scenario",
+            format!(
+                "unknown scenario kind `{kind}` (known: {})",
+                catalogue.names()
+            ),
+        )
+        .in_source(source))
+    })?;
     // before the run, not after: a plan that cannot identify a law it fits is refused here
-    crate::config::laws::check(&scenario.law_needs(), scenario.leave_out())
+    crate::config::laws::check(&config.law_needs(), config.leave_out())
         .map_err(|e| e.in_source(source))?;
     Ok(LoadedScenario {
         name: name.to_string(),
         source: source.to_string(),
         effective_toml,
-        scenario,
+        config,
     })
 }

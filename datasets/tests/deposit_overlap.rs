@@ -80,9 +80,13 @@ fn converged_steps_respect_the_approach_speed_limit() {
 /// fell through it (two grains at the same centre, "overlap by 5.000e-3 m").
 #[test]
 fn equal_disks_in_an_exact_width_column_do_not_overlap() {
-    let l = datasets::load("column-collapse", &["grain.radius_spread=0".into()]).unwrap();
-    let datasets::Scenario::ColumnCollapse(c) = l.scenario else {
-        unreachable!()
-    };
+    let source = "builtin:column-collapse";
+    let mut table =
+        datasets::scenario::parse_table(include_str!("../scenarios/column-collapse.toml"), source)
+            .unwrap();
+    let spread = datasets::overrides::parse_override("grain.radius_spread=0").unwrap();
+    datasets::overrides::apply_override(&mut table, &spread, source).unwrap();
+    let c: datasets::config::ColumnCollapseConfig =
+        datasets::scenario::typed(table, source).unwrap();
     datasets::build::column_collapse_deposit(&c).unwrap();
 }

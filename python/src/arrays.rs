@@ -93,10 +93,7 @@ pub fn out2<'py, const K: usize>(py: Python<'py>, rows: &[[f64; K]]) -> Bound<'p
 }
 
 /// 2×2 tensors as an `(n, 2, 2)` float64 array, `a[k, i, j] = T_k[i, j]`.
-pub fn out_tensors<'py>(
-    py: Python<'py>,
-    ts: &[Tensor],
-) -> PyResult<Bound<'py, PyAny>> {
+pub fn out_tensors<'py>(py: Python<'py>, ts: &[Tensor]) -> PyResult<Bound<'py, PyAny>> {
     let flat: Vec<f64> = ts
         .iter()
         .flat_map(|t| [t[(0, 0)], t[(0, 1)], t[(1, 0)], t[(1, 1)]])

@@ -1,14 +1,14 @@
 //! `grainlaw.continuum`: a calibrated μ(I) law run in Gerris, as `grainlaw continuum` does it
-//! (root crate, `grainlaw::continuum`).
+//! (the library crate, `grainlaw_core::continuum`).
 
 use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use grainlaw::continuum::dem_column::{group_profiles, read_rows, FrontRow, ProfileRow};
-use grainlaw::continuum::{column_collapse, inclined_plane, ColumnPlan, InclinedPlan};
-use grainlaw::verdict::{RunVerdict, Verdict};
+use grainlaw_core::continuum::dem_column::{group_profiles, read_rows, FrontRow, ProfileRow};
+use grainlaw_core::continuum::{column_collapse, inclined_plane, ColumnPlan, InclinedPlan};
+use grainlaw_core::verdict::{RunVerdict, Verdict};
 
 use crate::arrays::out1;
 use crate::errors::{cli_err, input, panic_err, verdict_err, OutputError};
@@ -23,7 +23,7 @@ fn table<'py>(py: Python<'py>, path: &Path) -> PyResult<Option<Bound<'py, PyDict
     if !path.is_file() {
         return Ok(None);
     }
-    let t = grainlaw::api::read_csv_table(path).map_err(|e| cli_err(py, e))?;
+    let t = grainlaw_core::api::read_csv_table(path).map_err(|e| cli_err(py, e))?;
     let cols = PyDict::new(py);
     for (h, c) in t.headers.into_iter().zip(t.columns) {
         cols.set_item(h, out1(py, c))?;

@@ -24,7 +24,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
 
-use grainlaw::CliError;
+use grainlaw_core::CliError;
 
 create_exception!(
     grainlaw,

@@ -405,7 +405,7 @@ impl Law {
             .to_json_string()
             .map_err(|e| identify_err(py, e))?
             + "\n";
-        grainlaw::output::dir::write_atomic(&path, text.as_bytes())
+        grainlaw_core::output::dir::write_atomic(&path, text.as_bytes())
             .map_err(|e| crate::errors::cli_err(py, e))
     }
 

@@ -4,7 +4,7 @@
 //! per-law fit functions. The pieces:
 //!
 //! - [`run`]: `run(scenario, overrides, out, progress, allow_suspect)`: a scenario end to end,
-//!   as `grainlaw run` (root crate, `grainlaw::api::run_scenario`), the GIL released; a run
+//!   as `grainlaw run` (`grainlaw_core::api::run_scenario`), the GIL released; a run
 //!   whose verdict the command line would exit 3 for raises `ResultRefused` / `ResultSuspect`;
 //! - [`world`]: `World` and `Snapshot` over `dem::World` and `dem::Snapshot`;
 //! - [`homog`]: per-grain and region mean stress (contact + inertia parts), solid fraction,
@@ -14,7 +14,7 @@
 //! - [`fit`]: the fits of `identify` from numpy columns and `Law`, the calibrated-law JSON
 //!   (schemas 1 and 2) with vectorised evaluation;
 //! - [`continuum`]: `continuum(case, law, ...)`: a μ(I) law run in Gerris (`grainlaw continuum`,
-//!   root crate `grainlaw::continuum`), the GIL released;
+//!   library crate `grainlaw_core::continuum`), the GIL released;
 //! - [`errors`]: the exception hierarchy (`GrainlawError` and its subclasses).
 //!
 //! Units SI, 2D quantities per metre of thickness, stresses tension positive (the fits take

@@ -1,9 +1,9 @@
 //! Snapshots of other DEM codes (LAMMPS/LIGGGHTS dumps, LMGC90 2D files, plain
 //! grainlaw-snapshot-v1 JSON) read into [`Snapshot`]s, the input of the homogenisation
-//! functions: the readers of `grainlaw homogenise --from` (`grainlaw::readers`,
+//! functions: the readers of `grainlaw homogenise --from` (`grainlaw_core::readers`,
 //! docs/formats.md §7), and `homogenise`: the whole `grainlaw homogenise --from` (CSV tables,
 //! figures, VTK, summary.json) from Python, the same Rust function
-//! (`grainlaw::homogenise_cmd::homogenise`).
+//! (`grainlaw_core::homogenise_cmd::homogenise`).
 
 use std::path::PathBuf;
 
@@ -25,8 +25,8 @@ fn read_options(
     inertia_factor: f64,
     density: Option<f64>,
     columns: Option<std::collections::BTreeMap<String, String>>,
-) -> grainlaw::readers::ReadOptions {
-    grainlaw::readers::ReadOptions {
+) -> grainlaw_core::readers::ReadOptions {
+    grainlaw_core::readers::ReadOptions {
         gravity: [gravity.0, gravity.1],
         mu,
         wall_mu,
@@ -76,10 +76,10 @@ pub fn read_snapshots<'py>(
     columns: Option<std::collections::BTreeMap<String, String>>,
     wall_mu: Option<f64>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let format: grainlaw::readers::Format = format.parse().map_err(input)?;
+    let format: grainlaw_core::readers::Format = format.parse().map_err(input)?;
     let opts = read_options(mu, wall_mu, dt, gravity, inertia_factor, density, columns);
     let snaps = py
-        .detach(|| grainlaw::readers::read(format, &files, &opts))
+        .detach(|| grainlaw_core::readers::read(format, &files, &opts))
         .map_err(|e| input(e.to_string()))?;
     let list = PyList::empty(py);
     for s in snaps {
@@ -139,8 +139,8 @@ pub fn homogenise<'py>(
     columns: Option<std::collections::BTreeMap<String, String>>,
     wall_mu: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let format: grainlaw::readers::Format = format.parse().map_err(input)?;
-    let plan = grainlaw::homogenise_cmd::HomogenisePlan {
+    let format: grainlaw_core::readers::Format = format.parse().map_err(input)?;
+    let plan = grainlaw_core::homogenise_cmd::HomogenisePlan {
         format,
         files,
         out: out.clone(),
@@ -150,7 +150,7 @@ pub fn homogenise<'py>(
     let outcome = py
         .detach(|| {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                grainlaw::homogenise_cmd::homogenise(&plan)
+                grainlaw_core::homogenise_cmd::homogenise(&plan)
             }))
         })
         .map_err(panic_err)?
@@ -177,12 +177,12 @@ pub fn homogenise<'py>(
 /// --
 ///
 /// The synthetic LAMMPS dump of `grainlaw bench --homogenise-grains N`
-/// (`grainlaw::homogenise_cmd::synthetic_lammps_dump`): ``(atoms, pairs)``, the texts of the
+/// (`grainlaw_core::homogenise_cmd::synthetic_lammps_dump`): ``(atoms, pairs)``, the texts of the
 /// per-atom and local dumps of ``n`` disks of radius 0.5 mm on a square lattice of spacing
 /// 0.999 mm, each touching its right and upper neighbours (about ``2 n`` contacts). For the
 /// benchmarks (python/bench/overhead.py), not part of the public API.
 #[pyfunction]
 #[pyo3(name = "_synthetic_lammps_dump")]
 pub fn synthetic_lammps_dump(n: usize) -> (String, String) {
-    grainlaw::homogenise_cmd::synthetic_lammps_dump(n)
+    grainlaw_core::homogenise_cmd::synthetic_lammps_dump(n)
 }

@@ -81,14 +81,14 @@ fn run_released(
     dir: &Path,
     quiet: bool,
     allow_suspect: bool,
-) -> PyResult<grainlaw::scenarios::RunOutcome> {
+) -> PyResult<grainlaw_core::scenarios::RunOutcome> {
     let flag = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel();
     let (result, interrupt) = std::thread::scope(|s| {
         let worker_flag = flag.clone();
         s.spawn(move || {
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                grainlaw::api::run_scenario(spec, sets, dir, quiet, allow_suspect, worker_flag)
+                grainlaw_core::api::run_scenario(spec, sets, dir, quiet, allow_suspect, worker_flag)
             }));
             let _ = tx.send(r);
         });
@@ -140,7 +140,7 @@ fn read_text(path: &Path) -> PyResult<String> {
 fn collect<'py>(
     py: Python<'py>,
     dir: &Path,
-    outcome: &grainlaw::scenarios::RunOutcome,
+    outcome: &grainlaw_core::scenarios::RunOutcome,
 ) -> PyResult<Bound<'py, PyDict>> {
     let result = PyDict::new(py);
     let json = py.import("json")?;
@@ -166,7 +166,7 @@ fn collect<'py>(
             .and_then(|s| s.to_str())
             .unwrap_or_default();
         if name.ends_with(".csv") {
-            let t = grainlaw::api::read_csv_table(&path).map_err(|e| cli_err(py, e))?;
+            let t = grainlaw_core::api::read_csv_table(&path).map_err(|e| cli_err(py, e))?;
             let cols = PyDict::new(py);
             for (h, c) in t.headers.into_iter().zip(t.columns) {
                 cols.set_item(h, out1(py, c))?;
@@ -299,8 +299,8 @@ pub fn run<'py>(
 #[pyfunction]
 pub fn scenarios(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    for b in datasets::BUILTINS.iter() {
-        d.set_item(b.name, b.description)?;
+    for s in grainlaw_core::scenarios::registry::SCENARIOS.iter() {
+        d.set_item(s.name(), s.description())?;
     }
     Ok(d)
 }

@@ -265,14 +265,26 @@ impl SimpleShearConfig {
 
 #[cfg(test)]
 mod tests {
-    use crate::scenario::{load, Scenario};
+    use super::SimpleShearConfig;
+    use crate::overrides::{apply_override, parse_override};
+    use crate::scenario::{parse_table, typed, ScenarioConfig};
+    use crate::Result;
 
-    fn config(sets: &[&str]) -> super::SimpleShearConfig {
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        match load("simple-shear", &sets).expect("loads").scenario {
-            Scenario::SimpleShear(c) => c,
-            _ => unreachable!(),
+    /// The built-in TOML with `sets` applied, typed and validated (what the loader does).
+    fn load(sets: &[String]) -> Result<SimpleShearConfig> {
+        let source = "builtin:simple-shear";
+        let mut table = parse_table(include_str!("../../scenarios/simple-shear.toml"), source)?;
+        for s in sets {
+            apply_override(&mut table, &parse_override(s)?, source)?;
         }
+        let c: SimpleShearConfig = typed(table, source)?;
+        c.check()?;
+        Ok(c)
+    }
+
+    fn config(sets: &[&str]) -> SimpleShearConfig {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        load(&sets).expect("loads")
     }
 
     /// Grains given in metres where millimetres were meant (radius 1.5 m): the grains' time
@@ -302,10 +314,10 @@ mod tests {
             .iter()
             .map(|s| s.to_string())
             .collect();
-        let e = load("simple-shear", &sets).unwrap_err().to_string();
+        let e = load(&sets).unwrap_err().to_string();
         assert!(e.contains("max_steps") && e.contains("time steps"), "{e}");
         let mut more = sets.clone();
         more.push("max_steps=1e8".into());
-        assert!(load("simple-shear", &more).is_ok());
+        assert!(load(&more).is_ok());
     }
 }

@@ -1,4 +1,4 @@
-//! Measurements of the engine behind `grainlaw bench` ([`crate::bench_cmd`]; the benchmark
+//! Measurements of the engine behind `grainlaw bench` (`grainlaw::bench_cmd`; the benchmark
 //! worlds are built in `datasets::benchmarks`, settled by `dem::settle`): the bare sweep rate
 //! of a world's contacts ([`sweep_rate`]) and the memory footprint of the engine's data layout
 //! ([`MemoryFootprint`]).

@@ -1738,31 +1738,33 @@ pub struct BiaxialBench {
     pub unconverged: usize,
 }
 
-/// The biaxial benchmark row: the built-in `biaxial` scenario with `grains` grains at
-/// p₀ = 1 kPa, `compress_steps` steps of isotropic compression (not timed per step), then
-/// `axial_steps` timed steps of the axial compression (the scenario's own control and solver
-/// settings; rayon's global pool).
-pub fn bench_rve(grains: usize, compress_steps: usize, axial_steps: usize) -> Result<BiaxialBench> {
-    let loaded = datasets::scenario::load(
-        "biaxial",
-        &[
-            format!("grains={grains}"),
-            "confining_pressures=[1000.0]".to_string(),
-            // a benchmark of the engine: nothing is fitted
-            r#"leave_out=["mohr-coulomb", "critical-state", "stress-dilatancy"]"#.to_string(),
-        ],
-    )?;
-    let datasets::Scenario::Biaxial(c) = loaded.scenario else {
-        return Err(crate::error::CliError::Usage(
-            "the built-in biaxial scenario is not a biaxial scenario".into(),
-        ));
-    };
+/// The overrides of the built-in `biaxial` scenario for a benchmark row of `grains` grains
+/// ([`bench_rve`]): p₀ = 1 kPa, nothing fitted.
+pub fn bench_sets(grains: usize) -> Vec<String> {
+    vec![
+        format!("grains={grains}"),
+        "confining_pressures=[1000.0]".to_string(),
+        // a benchmark of the engine: nothing is fitted
+        r#"leave_out=["mohr-coulomb", "critical-state", "stress-dilatancy"]"#.to_string(),
+    ]
+}
+
+/// The biaxial benchmark row: the built-in `biaxial` scenario loaded with [`bench_sets`],
+/// `compress_steps` steps of isotropic compression (not timed per step), then `axial_steps`
+/// timed steps of the axial compression (the scenario's own control and solver settings;
+/// rayon's global pool).
+pub fn bench_rve(
+    c: &BiaxialConfig,
+    compress_steps: usize,
+    axial_steps: usize,
+) -> Result<BiaxialBench> {
+    let grains = c.grains;
     let bx = Biaxial {
-        c: &c,
+        c,
         pressures: vec![1000.0],
     };
     let p0 = 1000.0;
-    let mut w = datasets::build_cell::biaxial(&c)?;
+    let mut w = datasets::build_cell::biaxial(c)?;
     if c.preparation == Preparation::Dense {
         w.laws.set_friction(0, 0, 0.0);
     }

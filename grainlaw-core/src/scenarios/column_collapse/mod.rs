@@ -38,7 +38,7 @@ pub use profile::{scaling, HeightProfile};
 /// The published contact-dynamics front of the case a = 6.26 (Staron & Hinch 2005, as shipped
 /// with the Gerris example `column` of Lagrée, Staron & Popinet 2011): the CSV with its source.
 pub const REFERENCE_CSV: &str =
-    include_str!("../../../datasets/reference/column-collapse-contact-dynamics-a6.26.csv");
+    include_str!("../../../../datasets/reference/column-collapse-contact-dynamics-a6.26.csv");
 
 /// Aspect ratio of the reference run.
 pub const REFERENCE_ASPECT_RATIO: f64 = 6.26;

@@ -330,7 +330,7 @@ impl PeerColumn {
         };
         let limit = self.wall_limit.max(1.0).ceil() as u64;
         format!(
-            "# grainlaw bench: LAMMPS peer of a Janssen column (see src/lammps_peer.rs)
+            "# grainlaw bench: LAMMPS peer of a Janssen column (see grainlaw-core/src/lammps_peer.rs)
 units si
 dimension 2
 atom_style sphere

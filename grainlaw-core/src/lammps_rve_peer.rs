@@ -282,7 +282,7 @@ impl PeerRve {
         let servo_dt = SERVO_EVERY as f64 * m.dt;
         let limit = self.wall_limit.max(1.0).ceil() as u64;
         format!(
-            "# grainlaw bench --rve: LAMMPS peer of the simple-shear RVE (see src/lammps_rve_peer.rs)
+            "# grainlaw bench --rve: LAMMPS peer of the simple-shear RVE (see grainlaw-core/src/lammps_rve_peer.rs)
 units si
 dimension 2
 atom_style sphere
@@ -735,10 +735,8 @@ mod tests {
             format!("average_strain={a}"),
             r#"leave_out=["mu-i","mu-i-linear","phi-i"]"#.to_string(),
         ];
-        match datasets::load("simple-shear", &sets).unwrap().scenario {
-            datasets::Scenario::SimpleShear(c) => c,
-            _ => unreachable!(),
-        }
+        let loaded = crate::scenarios::registry::load("simple-shear", &sets).unwrap();
+        crate::scenarios::registry::config_of(&loaded).unwrap()
     }
 
     /// Numbers of the data lines after `Atoms # sphere`.
@@ -842,7 +840,8 @@ mod tests {
     /// the scenario's current defaults.
     #[test]
     fn the_log_of_a_real_run_is_read() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/external/lammps-rve-peer");
+        let dir =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../datasets/external/lammps-rve-peer");
         let text = crate::readers::read_text(&dir.join("log.lammps.gz")).unwrap();
         let script = std::fs::read_to_string(dir.join("in.rve")).unwrap();
         let data = std::fs::read_to_string(dir.join("rve.data")).unwrap();

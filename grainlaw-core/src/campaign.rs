@@ -300,7 +300,7 @@ pub fn campaign(args: CampaignArgs) -> Result<()> {
     // Every run's overrides are checked here (the scenario is loaded, not run): a bad key or
     // value in the plan is one line, before any run starts.
     for r in &runs {
-        datasets::load(&plan.scenario, &r.sets).map_err(|e| {
+        crate::scenarios::registry::load(&plan.scenario, &r.sets).map_err(|e| {
             plan_error(
                 &args.plan,
                 format!("run {:04} ({}): {e}", r.index, describe(r)),

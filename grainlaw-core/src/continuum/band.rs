@@ -161,7 +161,7 @@ mod tests {
     fn axis_runs_give_the_delta_method_for_a_linear_output() {
         let text = std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/tests/fixtures/continuum/lagree2011_mu_i_law.json"
+            "/../tests/fixtures/continuum/lagree2011_mu_i_law.json"
         ))
         .unwrap();
         let law = CalibratedLaw::from_json_str(&text).unwrap();

@@ -2,20 +2,25 @@
 //! arbitrary input (property tests), reproducible generation.
 
 use datasets::build::{column, column_width};
-use datasets::scenario::from_text;
-use datasets::{load, DatasetError, Scenario, BUILTINS};
+use datasets::config::{JanssenConfig, StickSlipConfig};
+use datasets::DatasetError;
+use grainlaw::scenarios::registry::{config_of, from_text, load, SCENARIOS};
 use proptest::prelude::*;
 
 #[test]
 fn every_builtin_loads_and_has_a_seed() {
-    for b in BUILTINS.iter() {
-        let l = load(b.name, &[]).unwrap_or_else(|e| panic!("{}: {e}", b.name));
-        assert_eq!(l.scenario.kind(), b.name);
-        assert_eq!(l.source, format!("builtin:{}", b.name));
-        assert!(b.toml.contains("seed ="), "{} has no seed key", b.name);
+    for b in SCENARIOS.iter() {
+        let l = load(b.name(), &[]).unwrap_or_else(|e| panic!("{}: {e}", b.name()));
+        assert_eq!(l.config.kind(), b.name());
+        assert_eq!(l.source, format!("builtin:{}", b.name()));
+        assert!(
+            b.builtin_toml().contains("seed ="),
+            "{} has no seed key",
+            b.name()
+        );
         // The seed can be changed like any key.
-        let l = load(b.name, &["seed=42".into()]).unwrap();
-        assert_eq!(l.scenario.seed(), 42);
+        let l = load(b.name(), &["seed=42".into()]).unwrap();
+        assert_eq!(l.config.seed(), 42);
     }
 }
 
@@ -30,16 +35,14 @@ fn overrides_reach_the_typed_config() {
         ],
     )
     .unwrap();
-    let Scenario::Janssen(c) = l.scenario else {
-        panic!()
-    };
+    let c: JanssenConfig = config_of(&l).unwrap();
     assert_eq!(c.grains, 2000);
     assert_eq!(c.grain.radius_mean, 2e-3);
     assert_eq!(c.friction.grain_wall, 0.4);
     assert!(l.effective_toml.contains("grains = 2000"));
     // The effective TOML loads back to the same configuration.
     let again = from_text("j", "effective", &l.effective_toml, &[]).unwrap();
-    assert_eq!(again.scenario, Scenario::Janssen(c));
+    assert_eq!(config_of::<JanssenConfig>(&again).unwrap(), c);
 }
 
 /// The built-in Janssen column averages its measurement over 4 steps; a scenario file written
@@ -48,9 +51,7 @@ fn overrides_reach_the_typed_config() {
 #[test]
 fn janssen_measurement_window_of_builtin_and_of_older_files() {
     let builtin = load("janssen", &[]).unwrap();
-    let Scenario::Janssen(c) = &builtin.scenario else {
-        panic!()
-    };
+    let c: JanssenConfig = config_of(&builtin).unwrap();
     assert_eq!(c.analysis.measure_steps, 4);
     let older: String = builtin
         .effective_toml
@@ -59,23 +60,23 @@ fn janssen_measurement_window_of_builtin_and_of_older_files() {
         .map(|l| format!("{l}\n"))
         .collect();
     assert!(!older.contains("measure_steps"));
-    let Scenario::Janssen(c) = from_text("older", "older", &older, &[]).unwrap().scenario else {
-        panic!()
-    };
+    let c: JanssenConfig = config_of(&from_text("older", "older", &older, &[]).unwrap()).unwrap();
     assert_eq!(c.analysis.measure_steps, 1);
 }
 
 #[test]
 fn errors_name_the_key_or_line() {
-    let t = datasets::builtin("rolling").unwrap().toml;
+    let t = grainlaw::scenarios::registry::get("rolling")
+        .unwrap()
+        .builtin_toml();
     let e = from_text("r", "f.toml", &format!("{t}\nextra = 1\n"), &[]).unwrap_err();
     assert!(
         matches!(&e, DatasetError::UnknownKey { key, .. } if key == "extra"),
         "{e}"
     );
-    let jt = datasets::builtin("janssen")
+    let jt = grainlaw::scenarios::registry::get("janssen")
         .unwrap()
-        .toml
+        .builtin_toml()
         .replace("radius_spread", "radius_sprad");
     let e = from_text("j", "f.toml", &jt, &[]).unwrap_err();
     assert!(e.to_string().contains("grain.radius_sprad"), "{e}");
@@ -124,9 +125,7 @@ fn errors_name_the_key_or_line() {
 /// seed is generated identically (a different seed differs).
 #[test]
 fn janssen_geometry_and_reproducible_generation() {
-    let Scenario::Janssen(c) = load("janssen", &[]).unwrap().scenario else {
-        panic!()
-    };
+    let c: JanssenConfig = config_of(&load("janssen", &[]).unwrap()).unwrap();
     let w = column_width(&c.grain, c.grains, c.column_aspect);
     let diameters = w / (2.0 * c.grain.radius_mean);
     assert!((9.0..11.0).contains(&diameters), "{diameters}");
@@ -163,9 +162,7 @@ fn janssen_geometry_and_reproducible_generation() {
 /// A grain dropped on the floor comes to rest; the phase counts its steps.
 #[test]
 fn run_until_rest_stops_at_rest() {
-    let Scenario::StickSlip(c) = load("stick-slip", &["grains=3".into()]).unwrap().scenario else {
-        panic!()
-    };
+    let c: StickSlipConfig = config_of(&load("stick-slip", &["grains=3".into()]).unwrap()).unwrap();
     let mut col = column(&c.grain, 3, 0.02, &c.cases.walls_and_grains, 1, 1e-3).unwrap();
     let stats = datasets::phases::run_until_rest(
         &mut col.world,
@@ -198,7 +195,7 @@ proptest! {
     /// or fail with an error, never a panic.
     #[test]
     fn loader_never_panics_on_mutated_builtins(which in 0usize..6, line in 0usize..60, token in "[-a-z0-9.\\[\\]\"=]{0,12}") {
-        let t = BUILTINS[which].toml;
+        let t = SCENARIOS[which].builtin_toml();
         let mut lines: Vec<String> = t.lines().map(String::from).collect();
         let k = line % lines.len();
         if let Some((key, _)) = lines[k].split_once('=') {

@@ -24,7 +24,7 @@ use crate::output::OutputDir;
 
 /// The font file shipped with the repository (DejaVu Sans, Bitstream Vera licence, see
 /// `assets/fonts/DejaVuSans-LICENSE.txt`).
-static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 
 /// Font family name used by every figure.
 pub const FONT_FAMILY: &str = "sans-serif";

@@ -40,8 +40,8 @@ pub fn run_scenario(
     allow_suspect: bool,
     interrupted: Arc<AtomicBool>,
 ) -> Result<RunOutcome> {
-    let loaded = datasets::load(spec, sets)?;
-    crate::output::dir::check_out_dir(out, loaded.scenario.kind())?;
+    let loaded = scenarios::registry::load(spec, sets)?;
+    crate::output::dir::check_out_dir(out, loaded.config.kind())?;
     let mut ctx = RunContext {
         out: OutputDir::create(out)?,
         verbosity: if quiet {

@@ -12,10 +12,7 @@
 
 use std::path::Path;
 
-use datasets::build::{arrangement, column, column_width, inclined_flow, rolling, shear_cell};
-use datasets::generators::Arrangement;
-use datasets::scenario::from_text;
-use datasets::{DatasetError, Scenario, BUILTINS};
+use grainlaw::scenarios::registry::{from_text, SCENARIOS};
 use proptest::prelude::*;
 use toml::{Table, Value};
 
@@ -122,7 +119,7 @@ fn leaf_keys(t: &Table, prefix: &str, out: &mut Vec<String>) {
 }
 
 fn builtin_leaf_keys(which: usize) -> Vec<String> {
-    let t: Table = BUILTINS[which].toml.parse().unwrap();
+    let t: Table = SCENARIOS[which].builtin_toml().parse().unwrap();
     let mut keys = Vec::new();
     leaf_keys(&t, "", &mut keys);
     keys
@@ -199,51 +196,6 @@ fn apply(text: &str, edits: &[Edit], keys: &[String]) -> String {
     lines.join("\n")
 }
 
-/// Builds every world the scenario's runner would build first.
-fn build(s: &Scenario) -> Result<(), DatasetError> {
-    match s {
-        Scenario::Janssen(c) => {
-            let w = column_width(&c.grain, c.grains, c.column_aspect);
-            let dt = c.dt / c.deposit.substeps as f64;
-            column(&c.grain, c.grains, w, &c.friction, c.seed, dt).map(drop)
-        }
-        Scenario::Rolling(c) => rolling(c).map(drop),
-        Scenario::Arrangements(c) => {
-            for kind in Arrangement::ALL {
-                arrangement(c, kind)?;
-            }
-            Ok(())
-        }
-        Scenario::StickSlip(c) => {
-            let w = c.width_diameters * 2.0 * c.grain.radius_mean;
-            let dt = c.dt / c.deposit.substeps as f64;
-            for (_, f) in c.cases.list() {
-                column(&c.grain, c.grains, w, &f, c.seed, dt)?;
-            }
-            Ok(())
-        }
-        Scenario::InclinedFlow(c) => inclined_flow(c).map(drop),
-        Scenario::ShearCell(c) => shear_cell(c).map(drop),
-        Scenario::SimpleShear(c) => datasets::build_cell::simple_shear(c).map(drop),
-        Scenario::Biaxial(c) => datasets::build_cell::biaxial(c).map(drop),
-        Scenario::ColumnCollapse(c) => datasets::build::column_collapse_deposit(c).map(drop),
-    }
-}
-
-fn grains(s: &Scenario) -> usize {
-    match s {
-        Scenario::Janssen(c) => c.grains,
-        Scenario::Rolling(_) => 1,
-        Scenario::Arrangements(c) => c.columns * c.rows.max(c.columns),
-        Scenario::StickSlip(c) => c.grains,
-        Scenario::InclinedFlow(c) => c.grains,
-        Scenario::ShearCell(c) => c.grains,
-        Scenario::SimpleShear(c) => c.grains,
-        Scenario::Biaxial(c) => c.grains,
-        Scenario::ColumnCollapse(c) => c.poured_grains(),
-    }
-}
-
 /// The rules every input must follow (module documentation).
 fn check(text: &str, sets: &[String]) -> Result<(), TestCaseError> {
     match from_text("fuzz", "fuzz.toml", text, sets) {
@@ -254,8 +206,8 @@ fn check(text: &str, sets: &[String]) -> Result<(), TestCaseError> {
             prop_assert!(m.chars().count() <= MAX_MESSAGE, "message too long: {m}");
         }
         Ok(l) => {
-            if grains(&l.scenario) <= BUILD_GRAINS {
-                if let Err(e) = build(&l.scenario) {
+            if l.config.grains() <= BUILD_GRAINS {
+                if let Err(e) = l.config.build_first() {
                     prop_assert!(
                         false,
                         "loaded but does not build: {e}\n--set {sets:?}\n{text}"
@@ -273,11 +225,11 @@ proptest! {
     /// Built-in scenarios with 1–4 random line edits.
     #[test]
     fn mutated_builtins_load_or_fail_in_one_line(
-        which in 0usize..BUILTINS.len(),
+        which in 0usize..SCENARIOS.len(),
         edits in prop::collection::vec(edit(), 1..5),
     ) {
         let keys = builtin_leaf_keys(which);
-        let text = apply(BUILTINS[which].toml, &edits, &keys);
+        let text = apply(SCENARIOS[which].builtin_toml(), &edits, &keys);
         check(&text, &[])?;
     }
 
@@ -285,7 +237,7 @@ proptest! {
     /// time) or a random word, the value a random token.
     #[test]
     fn random_overrides_load_or_fail_in_one_line(
-        which in 0usize..BUILTINS.len(),
+        which in 0usize..SCENARIOS.len(),
         sets in prop::collection::vec(
             (any::<usize>(), any::<usize>(), prop::bool::weighted(0.9), "[a-z_.]{0,12}"), 1..4),
     ) {
@@ -297,14 +249,14 @@ proptest! {
                 format!("{key}={}", TOKENS[t % TOKENS.len()])
             })
             .collect();
-        check(BUILTINS[which].toml, &sets)?;
+        check(SCENARIOS[which].builtin_toml(), &sets)?;
     }
 
     /// One leaf key of a built-in set to a random finite float over 600 orders of magnitude
     /// (either sign): loads and builds, or fails in one line.
     #[test]
     fn random_magnitudes_load_or_fail_in_one_line(
-        which in 0usize..BUILTINS.len(),
+        which in 0usize..SCENARIOS.len(),
         k in any::<usize>(),
         mantissa in -10.0f64..10.0,
         exponent in -300i32..300,
@@ -312,7 +264,7 @@ proptest! {
         let keys = builtin_leaf_keys(which);
         let v = mantissa * 10f64.powi(exponent);
         let set = format!("{}={v:e}", keys[k % keys.len()]);
-        check(BUILTINS[which].toml, &[set])?;
+        check(SCENARIOS[which].builtin_toml(), &[set])?;
     }
 }
 
@@ -352,7 +304,7 @@ fn corpus_inputs_are_refused_with_their_message() {
         let e = match from_text("corpus", &name, &text, &sets) {
             Ok(l) => panic!(
                 "{name}: loaded ({}), expected an error containing `{expect}`",
-                l.scenario.kind()
+                l.config.kind()
             ),
             Err(e) => e.to_string(),
         };

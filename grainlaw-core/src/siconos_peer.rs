@@ -26,7 +26,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// The solver script, embedded (`scripts/siconos_solve_fc.py`).
-pub const SCRIPT: &str = include_str!("../scripts/siconos_solve_fc.py");
+pub const SCRIPT: &str = include_str!("../../scripts/siconos_solve_fc.py");
 
 /// The first word of the script's result line.
 pub const LINE_TAG: &str = "siconos-fc-v1";

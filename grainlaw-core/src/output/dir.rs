@@ -96,7 +96,7 @@ impl OutputDir {
 /// Refuses an output directory that is a file, or that holds the outputs of a run of another
 /// scenario (its `scenario.toml` names it): the files of two scenarios would mix. A directory
 /// of an earlier run of the same scenario is reused (its stale `summary.json` is removed first).
-pub(crate) fn check_out_dir(dir: &Path, kind: &str) -> Result<()> {
+pub fn check_out_dir(dir: &Path, kind: &str) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         return Err(CliError::Usage(format!(
             "--out {}: is a file, not a directory",
