@@ -18,7 +18,7 @@
 //! | worst solver error in the window / tolerance ([`SOLVER_ERROR_SUSPECT`], [`SOLVER_ERROR_REFUSED`]) | 10 | 1000 |
 //! | the same over the loaded contacts' scale (`dem::SolveReport::error_without_gap_shifts`) / tolerance | 10 (unless the sensitivity below was measured and passed) | 1000 |
 //! | change of the window's μ when its samples' steps are solved to 10⁻⁸ ([`Sensitivity`]), with the samples' scatter, `√(Δμ² + SE(Δμ)²)` ([`Sensitivity::measured_changes`]) | a quarter of μ's standard error where the scenario gives it ([`SENSITIVITY_SE_FRACTION`]: simple-shear), else 0.005 | 0.02 |
-//! | relative change of its pressure under the same re-solve, idem | a quarter of the larger of its relative standard error and `2 SE(μ) / 0.2` where given ([`pressure_limit`]), else 2.5 % | 10 % |
+//! | relative change of its pressure under the same re-solve, idem | a quarter of the larger of its relative standard error and `SE(μ) / 0.2` where given ([`pressure_limit`]), else 2.5 % | 10 % |
 //! | samples whose re-solve did not reach 10⁻⁸ | 10 % | — |
 //! | steps of the window whose energy grew beyond `ENERGY_GROWTH_TOLERANCE` | 1 % | 25 % (≥ 20 steps) |
 //! | energy gained by any one step of the window / E_load ([`ENERGY_STEP_SUSPECT`], [`ENERGY_STEP_REFUSED`]) | 1 % | 100 % |
@@ -100,9 +100,10 @@ pub const SENSITIVITY_MU_REFUSED: f64 = 0.02;
 /// Relative change of a window's pressure `−σ_yy` under the same re-solve above which the
 /// result is suspect (1). The pressure enters the results through μ (checked on its own) and
 /// `I = γ̇ d / √(P/ρ)`: `ΔI/I = ΔP/2P`, 1.25 % here, which moves μ by 0.0025 (half its limit)
-/// where μ(I) is steepest in the default cell (`dμ/d ln I ≈ 0.2` at I ≈ 0.2). The slow shear
+/// where μ(I) is steepest in the default cell ([`SENSITIVITY_MU_SLOPE`]): the one rule of
+/// [`pressure_limit`], `SENSITIVITY_MU_SUSPECT / SENSITIVITY_MU_SLOPE`. The slow shear
 /// (I = 0.005) measures 0.3–1.3 % at the default tolerance, from one lead stage to the next.
-pub const SENSITIVITY_PRESSURE_SUSPECT: f64 = 0.025;
+pub const SENSITIVITY_PRESSURE_SUSPECT: f64 = SENSITIVITY_MU_SUSPECT / SENSITIVITY_MU_SLOPE;
 /// The same, above which the result is refused (1): I off by 5 %.
 pub const SENSITIVITY_PRESSURE_REFUSED: f64 = 0.10;
 /// Largest solver effect on a reported mean, as a fraction of its statistical error, before
@@ -118,15 +119,15 @@ pub const SENSITIVITY_MU_SLOPE: f64 = 0.2;
 
 /// The suspect limit of a window's relative pressure change under the re-solve, from its
 /// statistical errors `[SE(μ), SE(P)/P]`: [`SENSITIVITY_SE_FRACTION`] of the larger of the
-/// pressure's own relative standard error and of `2 SE(μ) / SENSITIVITY_MU_SLOPE`, the pressure
-/// change that moves μ through `I = γ̇ d / √(P/ρ)` by its standard error
-/// ([`SENSITIVITY_MU_SLOPE`]). Under a stress control the pressure is held and its own standard
+/// pressure's own relative standard error and of `SE(μ) / SENSITIVITY_MU_SLOPE`, the pressure
+/// change that moves μ through `I = γ̇ d / √(P/ρ)` by half of μ's own limit
+/// ([`SENSITIVITY_MU_SLOPE`]; the rule of [`SENSITIVITY_PRESSURE_SUSPECT`]). Under a stress control the pressure is held and its own standard
 /// error is tiny (10⁻⁴ of P in the 2000-grain cell at I = 0.01); what its change does to the
 /// reported point is through `I` and μ, whose precision is μ's. NaN or 0 when neither is known.
 pub fn pressure_limit(statistical: [f64; 2]) -> f64 {
     let known = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
     SENSITIVITY_SE_FRACTION
-        * known(statistical[1]).max(2.0 * known(statistical[0]) / SENSITIVITY_MU_SLOPE)
+        * known(statistical[1]).max(known(statistical[0]) / SENSITIVITY_MU_SLOPE)
 }
 /// Tolerance of the re-solve of a sample's step (the error measure of the step's problem,
 /// `dem::fc::fc_error`): 10⁻⁸, tens of thousands of times below the runs' 10⁻⁴ and, with the
@@ -430,9 +431,9 @@ impl Checks {
                         100.0 * t,
                         if of_se {
                             format!(
-                                ", from the statistical errors: {SENSITIVITY_SE_FRACTION} of max(SE(P)/P = {:.2e}, 2 SE(μ) / {SENSITIVITY_MU_SLOPE} = {:.2e})",
+                                ", from the statistical errors: {SENSITIVITY_SE_FRACTION} of max(SE(P)/P = {:.2e}, SE(μ) / {SENSITIVITY_MU_SLOPE} = {:.2e})",
                                 statistical[1],
-                                2.0 * statistical[0] / SENSITIVITY_MU_SLOPE
+                                statistical[0] / SENSITIVITY_MU_SLOPE
                             )
                         } else {
                             String::new()
@@ -1421,8 +1422,8 @@ mod tests {
     /// 40 samples (SE(Δμ) 8.7·10⁻⁴) and is suspect on 10 (1.7·10⁻³): the same small mean, not
     /// resolved by ten samples. Where it passes, the fraction of steps above the tolerance
     /// (every step at the sweep cap) is not judged; the pressure, held by the control (its own
-    /// SE 10⁻⁴ of P), is judged against the change that moves μ through I by a quarter of
-    /// SE(μ), `0.25 · 2 · 6·10⁻³ / 0.2 = 1.5 %`.
+    /// SE 10⁻⁴ of P), is judged against the change that moves μ through I by half of μ's
+    /// limit, `0.25 · 6·10⁻³ / 0.2 = 0.75 %`.
     #[test]
     fn the_solver_effect_is_judged_with_its_samples_scatter() {
         let window = |n: usize, dp: f64| {
@@ -1460,7 +1461,7 @@ mod tests {
         let [dmu, dp] = w.sensitivity.measured_changes();
         assert!((dmu - (5e-4f64).hypot(se_mu)).abs() < 2e-5, "{dmu}");
         assert!((dp - 7e-4).abs() < 1e-9, "{dp}");
-        assert!((pressure_limit(w.statistical_errors) - 0.015).abs() < 1e-12);
+        assert!((pressure_limit(w.statistical_errors) - 0.0075).abs() < 1e-12);
         // Ok: the measure passed, so the worst error (50× the tolerance) is judged against the
         // refusal limit only (1000×) and the steps above the tolerance not at all.
         let c = judge(&w);
@@ -1483,7 +1484,7 @@ mod tests {
         let names: Vec<_> = c.reasons.iter().map(|r| r.check.as_str()).collect();
         assert_eq!(names, ["solver.loaded_error_over_tolerance"]);
         assert_eq!(c.verdict(), Verdict::Suspect);
-        // The pressure moving by 2 % (above 1.5 %): suspect by the measure.
+        // The pressure moving by 2 % (above 0.75 %): suspect by the measure.
         let c = judge(&window(40, 0.02));
         let names: Vec<_> = c.reasons.iter().map(|r| r.check.as_str()).collect();
         assert!(names.contains(&"solver.sensitivity_pressure"), "{names:?}");
