@@ -53,12 +53,13 @@ pub struct SimpleShearConfig {
     pub cell_control: CellControlMode,
     /// Under the implicit control, the grains follow the cell's change within each step
     /// (`dem::CellControl::affine`: every contact sees the uniform deformation, no boundary wave
-    /// for Gauss–Seidel to carry in) instead of at its end. Default `false` (the runs recorded so
-    /// far); `true` is for large cells solved by `nlgs`: at 2000 grains it stops the cell's
-    /// ringing (σ_yy from ±66 % to ±0.1 % of its target from step to step) and cuts the
-    /// overlaps 18-fold; above 1800 contacts the global methods do not run on its dense cell
-    /// term.
-    #[serde(default)]
+    /// for Gauss–Seidel to carry in) instead of at its end. Default `true` (since 2026-12-06;
+    /// `false` before): at 2000 grains it stops the cell's ringing (σ_yy from ±66 % to ±0.1 % of
+    /// its target from step to step) and cuts the overlaps 18-fold; at the end of the step, the
+    /// default 200-grain cell ran away at I = 0.25 with a travel of 0.01 a step (one seed of
+    /// three, another suspect for a step's energy growth; `docs/solver.md`). Above 1800
+    /// contacts the global methods do not run on its dense cell term.
+    #[serde(default = "default_cell_affine")]
     pub cell_affine: bool,
     /// Duration of the isotropic compression in units of the grains' time `t_g = d √(ρ/P)`
     /// (1; 32 t_g is 0.15 s for the default 3 mm grains at 1 kPa): the cell's strain-rate cap
@@ -94,6 +95,10 @@ pub fn whole_steps(ratio: f64) -> u64 {
 /// Default of [`SimpleShearConfig::max_steps`]: 10⁶ steps (about an hour at a few ms a step).
 pub const DEFAULT_MAX_PLAN_STEPS: f64 = 1e6;
 
+fn default_cell_affine() -> bool {
+    true
+}
+
 fn default_max_plan_steps() -> f64 {
     DEFAULT_MAX_PLAN_STEPS
 }
@@ -114,7 +119,7 @@ impl SimpleShearConfig {
     /// Time step of the shear run at shear rate `gamma_dot` (1/s) with mean diameter `d` (m):
     /// neighbours a diameter apart travel `travel_per_step · R̄` relative to each other per
     /// step, `Δt = travel_per_step · R̄ / (γ̇ d)`, capped by `dt_max` if given. A strain of
-    /// `travel_per_step R̄ / d` per step: 0.01 at the default 0.02.
+    /// `travel_per_step R̄ / d` per step: 0.005 at the default 0.01.
     pub fn shear_dt(&self, gamma_dot: f64, d: f64) -> f64 {
         let dt = self.travel_per_step * self.grain.radius_mean / (gamma_dot * d);
         self.dt_max.map_or(dt, |m| dt.min(m))
@@ -299,11 +304,11 @@ mod tests {
         assert!((mm.grain_time() - tg).abs() < 1e-12 * tg);
         assert!((m.grain_time() / mm.grain_time() - 1000.0).abs() < 1e-9);
         assert_eq!(mm.planned_steps(), m.planned_steps());
-        // travel rule: a strain of travel_per_step · R̄ / d = 0.01 per step, 300 steps for 3
+        // travel rule: a strain of travel_per_step · R̄ / d = 0.005 per step, 600 steps for 3
         let (compression, runs) = mm.planned_steps();
-        assert!(runs.iter().all(|&n| n == 300), "{runs:?}");
-        // compression: 32 t_g at Δt = travel · R̄ / (I_c √(P/ρ)) = t_g / 2
-        assert_eq!(compression, 64);
+        assert!(runs.iter().all(|&n| n == 600), "{runs:?}");
+        // compression: 32 t_g at Δt = travel · R̄ / (I_c √(P/ρ)) = t_g / 4
+        assert_eq!(compression, 128);
     }
 
     /// A plan beyond `max_steps` (10⁶ by default) is refused at load, naming the key and the
