@@ -80,7 +80,7 @@ use crate::contact::{ContactGeometry, ContactRow};
 use crate::local::Delassus2;
 use crate::math::Spatial;
 use crate::math::Tensor;
-use crate::parallel::coloured_sweep_where;
+use crate::parallel::{coloured_sweep_where, coloured_units, update_shared, Shared};
 use crate::sweep::update;
 
 /// No coupling slot.
@@ -367,6 +367,10 @@ impl CellCoupling {
         omega: f64,
     ) {
         assert_eq!(self.slot.len(), rows.len(), "coupling of other rows");
+        if self.within_step {
+            self.sweep_units(rows, colouring, vel, inv, mobile, omega);
+            return;
+        }
         let slot = &self.slot;
         coloured_sweep_where(rows, colouring, vel, inv, mobile, omega, |i| {
             slot[i] == NONE
@@ -375,6 +379,86 @@ impl CellCoupling {
             let i = self.rows[s] as usize;
             self.update_coupled(&mut rows[i], s, vel, inv, omega);
         }
+        self.sync(rows);
+    }
+
+    /// [`CellCoupling::sweep_coupled`] when the grains follow the cell within the step, so that
+    /// every contact between two grains is coupled and the one-thread pass over the coupled
+    /// contacts would be the whole sweep: the colour-ordered sweep in fixed units
+    /// ([`crate::parallel::coloured_units`]: each block's interior, then each class in chunks),
+    /// each unit a Gauss–Seidel pass with its own copy of `δ` kept current by its own updates,
+    /// the units' changes of `δ` added in unit order after each phase:
+    ///
+    /// ```text
+    /// for phase in (blocks, class 1, class 2, …):
+    ///     for unit in phase (concurrently):   δ_u ← δ;  for c in unit: update c with δ_u;  δ_u += m B_c · Δr_c
+    ///     δ ← δ + Σ_u (δ_u − δ)               (unit order)
+    /// ```
+    ///
+    /// Within a unit it is the exact Gauss–Seidel step of the eliminated problem; between the
+    /// units of a phase it is a Jacobi step on the cell's rank-three term (Renouf, Dubois &
+    /// Alart 2004 for the colour-ordered sweep). The units are fixed by the colouring, so the
+    /// bits are the same on any number of threads.
+    fn sweep_units(
+        &mut self,
+        rows: &mut [ContactRow],
+        colouring: &ContactColouring,
+        vel: &mut [Spatial],
+        inv: &[Spatial],
+        mobile: &[bool],
+        omega: f64,
+    ) {
+        assert_eq!(
+            colouring.order.len() + colouring.block_order.len(),
+            rows.len(),
+            "colouring of other rows"
+        );
+        assert!(vel.len() == inv.len() && vel.len() == mobile.len());
+        let n_rows = rows.len();
+        let (pr, pv) = (Shared(rows.as_mut_ptr()), Shared(vel.as_mut_ptr()));
+        let this = &*self;
+        let mut delta = self.delta;
+        coloured_units(
+            colouring,
+            &mut delta,
+            |start: &ComponentValues, ids: &[u32]| {
+                let mut local = *start;
+                for &i in ids {
+                    let i = i as usize;
+                    assert!(i < n_rows);
+                    let s = this.slot[i];
+                    // SAFETY: within a phase no two units share a row or a mobile body
+                    // (`ContactColouring::build_blocked`: blocks' interiors are disjoint, a
+                    // class's contacts share no mobile body); `i` checked, body indices checked
+                    // in `update_shared`.
+                    if s == NONE {
+                        unsafe { update_shared(pr, i, pv, inv, mobile, omega) };
+                        continue;
+                    }
+                    let s = s as usize;
+                    let row = unsafe { pr.ptr().add(i) };
+                    let before = unsafe {
+                        (*row).affine = this.affine_of(s, &local);
+                        (*row).r
+                    };
+                    if unsafe { update_shared(pr, i, pv, inv, mobile, omega) } {
+                        let after = unsafe { (*row).r };
+                        let d = [after[0] - before[0], after[1] - before[1]];
+                        for ((x, b), m) in local.iter_mut().zip(&this.coef[s]).zip(&this.compliance)
+                        {
+                            *x += m * (b[0] * d[0] + b[1] * d[1]);
+                        }
+                    }
+                }
+                std::array::from_fn(|k| local[k] - start[k])
+            },
+            |delta: &mut ComponentValues, change: ComponentValues| {
+                for (x, c) in delta.iter_mut().zip(change) {
+                    *x += c;
+                }
+            },
+        );
+        self.delta = delta;
         self.sync(rows);
     }
 

@@ -46,7 +46,7 @@ pub const PARALLEL_MIN: usize = 4 * TASK;
 
 /// A raw pointer shared between the tasks of one colour class.
 #[derive(Clone, Copy)]
-struct Shared<T>(*mut T);
+pub(crate) struct Shared<T>(pub(crate) *mut T);
 // SAFETY: a `Shared` is only dereferenced at indices that no other task of the same class
 // touches (see `update_shared`); the pointee outlives the parallel section.
 unsafe impl<T> Send for Shared<T> {}
@@ -55,7 +55,7 @@ unsafe impl<T> Sync for Shared<T> {}
 impl<T> Shared<T> {
     /// The pointer (a method, so that closures capture the whole `Shared`, not its field).
     #[inline(always)]
-    fn ptr(self) -> *mut T {
+    pub(crate) fn ptr(self) -> *mut T {
         self.0
     }
 }
@@ -67,21 +67,22 @@ impl<T> Shared<T> {
 /// No other thread may access row `i` or the velocity of a mobile body of row `i` at the same
 /// time; immobile bodies are only read (their velocity is never written by the solver).
 #[inline(always)]
-unsafe fn update_shared(
+pub(crate) unsafe fn update_shared(
     rows: Shared<ContactRow>,
     i: usize,
     vel: Shared<Spatial>,
     inv: &[Spatial],
     mobile: &[bool],
     omega: f64,
-) {
+) -> bool {
     // SAFETY: guaranteed by the caller (colour classes, `i` in bounds).
     let c = unsafe { &mut *rows.ptr().add(i) };
     let (a, b) = (c.a as usize, c.b as usize);
     assert!(a < inv.len() && b < inv.len(), "contact body out of range");
     let (pa, pb) = unsafe { (vel.ptr().add(a), vel.ptr().add(b)) };
     let (mut va, mut vb) = unsafe { (*pa, *pb) };
-    if local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega) {
+    let changed = local_update(c, &mut va, &inv[a], &mut vb, &inv[b], omega);
+    if changed {
         if mobile[a] {
             unsafe { *pa = va };
         }
@@ -89,6 +90,7 @@ unsafe fn update_shared(
             unsafe { *pb = vb };
         }
     }
+    changed
 }
 
 /// Runs `f(i)` for every contact `i`: first the blocks' interiors (blocks concurrently, each in
@@ -116,6 +118,53 @@ fn for_each_coloured(colouring: &ContactColouring, f: impl Fn(usize) + Sync) {
                 .par_iter()
                 .with_min_len(TASK)
                 .for_each(|&i| f(i as usize));
+        }
+    }
+}
+
+/// The colour-ordered traversal of [`for_each_coloured`] in fixed *units* with a state `S`
+/// between them: the blocks' interiors (one unit per block, concurrently), then each colour
+/// class in turn (one unit if it is sequential or smaller than [`PARALLEL_MIN`], else chunks
+/// of [`TASK`] contacts, concurrently). Every unit of a phase reads the state as it was at the
+/// phase's start and returns its change `A`; the changes are merged into the state in unit
+/// order after the phase (`merge`). The units and the merge order are fixed by the colouring,
+/// not by the thread count, so the results have the same bits on any number of threads. The
+/// cell-coupled sweep of the grains following the cell within the step uses it
+/// ([`crate::cell_coupling::CellCoupling::sweep_coupled`]: `S` the cell's change `δ`).
+pub(crate) fn coloured_units<S: Sync, A: Send>(
+    colouring: &ContactColouring,
+    state: &mut S,
+    unit: impl Fn(&S, &[u32]) -> A + Sync,
+    merge: impl Fn(&mut S, A),
+) {
+    match colouring.blocks() {
+        0 => {}
+        1 => {
+            let a = unit(state, colouring.block(0));
+            merge(state, a);
+        }
+        b => {
+            let st: &S = state;
+            let changes: Vec<A> = (0..b)
+                .into_par_iter()
+                .map(|k| unit(st, colouring.block(k)))
+                .collect();
+            for a in changes {
+                merge(state, a);
+            }
+        }
+    }
+    for k in 0..colouring.colours() {
+        let class = colouring.class(k);
+        if colouring.is_sequential(k) || class.len() < PARALLEL_MIN {
+            let a = unit(state, class);
+            merge(state, a);
+        } else {
+            let st: &S = state;
+            let changes: Vec<A> = class.par_chunks(TASK).map(|ids| unit(st, ids)).collect();
+            for a in changes {
+                merge(state, a);
+            }
         }
     }
 }
@@ -162,7 +211,7 @@ pub(crate) fn coloured_sweep_where(
         // SAFETY: within a parallel class no two contacts share a row or a mobile body
         // (`ContactColouring::build`); sequential classes run on one thread; `i` checked, body
         // indices checked in `update_shared`.
-        unsafe { update_shared(pr, i, pv, inv, mobile, omega) }
+        unsafe { update_shared(pr, i, pv, inv, mobile, omega) };
     });
 }
 
