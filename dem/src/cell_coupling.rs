@@ -71,8 +71,11 @@
 //! and the contact order (the slots): one Gauss–Seidel sweep, exact on the eliminated problem,
 //! in another order than the natural one, with the same bits on any number of threads. The
 //! contacts through the boundary are a few percent of a large cell's (about 2 % at 10⁴
-//! grains). (Sweeping each class in fixed chunks with `δ` frozen and the chunks' increments
-//! added in chunk order is also deterministic, but is a Jacobi step on the cell's rank-3 term.)
+//! grains). When the grains follow the cell within the step every contact is coupled and that
+//! one-thread pass would be the whole sweep: each block and each class is then swept in fixed
+//! units, each with its own copy of `δ`, the units' increments added in unit order after the
+//! phase ([`CellCoupling::sweep_coupled`]; deterministic, a Jacobi step on the cell's rank-3
+//! term between the units, Gauss–Seidel within them).
 
 use crate::cell::{Cell, CellControl, ComponentValues, Imposed, COMPONENTS};
 use crate::colouring::ContactColouring;
