@@ -422,6 +422,9 @@ struct FrameBodies {
     first_wall: usize,
 }
 
+/// The force and torque `(F, T)` the contacts exert on a wall.
+type WallLoad = (Vector, f64);
+
 /// Where a contact acts, from the record or the geometry.
 struct ContactGeometry {
     /// Body `a`'s index.
@@ -591,7 +594,7 @@ fn frame_contacts(
     fb: &FrameBodies,
     images: &Images,
     opts: &ReadOptions,
-) -> Result<(Vec<ContactState>, Vec<(Vector, f64)>), ReadError> {
+) -> Result<(Vec<ContactState>, Vec<WallLoad>), ReadError> {
     let grain_mu = opts.mu.unwrap_or(0.0);
     let wall_mu = opts.wall_mu.or(opts.mu).unwrap_or(0.0);
     let mut contacts = Vec::with_capacity(f.contacts.len());
