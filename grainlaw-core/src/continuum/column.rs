@@ -578,14 +578,13 @@ impl ColumnReport<'_> {
             cfg.cell,
         );
         let ts = rheology.units.time_s();
-        let mut s = Summary::new();
-        s.text("scenario", "continuum-column-collapse")
-            .text("solver", "gerris")
-            .text("solver_version", central.run.version.as_deref().unwrap_or(""))
-            .num("solver_wall_seconds", central.run.wall_seconds)
-            .text("law_file", &cfg.law_path)
-            .text("law", &cfg.law.law)
-            .set("law_parameters", parameters_json(&cfg.law))
+        let mut s = gerris::summary_head(
+            "continuum-column-collapse",
+            &central.run,
+            &cfg.law_path,
+            &cfg.law.law,
+        );
+        s.set("law_parameters", parameters_json(&cfg.law))
             .set(
                 "column",
                 json!({

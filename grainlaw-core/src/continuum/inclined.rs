@@ -621,14 +621,13 @@ fn inclined_summary(
     verdict: &RunVerdict,
 ) -> Summary {
     let rheology = &cfg.rheology;
-    let mut s = Summary::new();
-    s.text("scenario", "continuum-inclined-plane")
-        .text("solver", "gerris")
-        .text("solver_version", run.run.version.as_deref().unwrap_or(""))
-        .num("solver_wall_seconds", run.run.wall_seconds)
-        .text("law_file", &cfg.law_path)
-        .text("law", &cfg.law.law)
-        .num("slope_deg", cfg.slope_deg)
+    let mut s = gerris::summary_head(
+        "continuum-inclined-plane",
+        &run.run,
+        &cfg.law_path,
+        &cfg.law.law,
+    );
+    s.num("slope_deg", cfg.slope_deg)
         .num("depth_m", cfg.depth)
         .num("packing_fraction", cfg.phi)
         .num("inertial_number", cfg.i_theta)
