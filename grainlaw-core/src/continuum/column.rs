@@ -556,13 +556,21 @@ fn write_comparison(out: &mut OutputDir, c: Comparison) -> Result<Comparison> {
 
 /// Everything the summary and the report of a column run draw on.
 struct ColumnReport<'a> {
+    /// The plan run.
     plan: &'a ColumnPlan,
+    /// Its resolved inputs.
     cfg: &'a ColumnConfig,
+    /// The central Gerris run.
     central: &'a CaseResult,
+    /// What the central run measured.
     measures: &'a CentralMeasures,
+    /// The validity report ([`validity_report`]).
     validity: &'a Value,
+    /// The comparison with the DEM run, if any.
     comparison: Option<&'a Comparison>,
+    /// The band of the law's uncertainty, if run.
     band: Option<&'a BandResult>,
+    /// The verdict.
     verdict: &'a RunVerdict,
 }
 
