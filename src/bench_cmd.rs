@@ -246,6 +246,9 @@ fn preparation_name(prep: Preparation) -> &'static str {
     }
 }
 
+/// The Janssen-column race: per column size and preparation, grainlaw's settling over the
+/// seeds and LAMMPS' on the same initial columns when it is found (stages: the header →
+/// [`column_seeds`] per column → [`print_seed_totals`] → the footnote).
 fn columns(plan: &BenchPlan) -> Result<()> {
     let jobs: Vec<(usize, Preparation)> = plan
         .columns
@@ -258,11 +261,29 @@ fn columns(plan: &BenchPlan) -> Result<()> {
     }
     let lammps = crate::lammps_peer::find_lammps();
     let wall_limit = crate::lammps_peer::wall_limit()?;
+    print_columns_header(lammps.as_deref(), wall_limit);
+    for (n, prep) in jobs {
+        let totals = column_seeds(plan, n, prep, lammps.as_deref(), wall_limit)?;
+        if plan.seeds > 1 {
+            print_seed_totals(plan, n, prep, &totals, lammps.is_some());
+        }
+    }
+    println!(
+        "(capped: steps that stopped at the cap of {} sweeps (deposit) or {} sweeps in up to {} sub-steps (pour) with their best iterate;\n overlap/r: largest overlap over the smallest radius; h: the step range used, sub-steps included; a deposit starts from the\n weight-carrying impulses and adapts its step, halved after a capped step)",
+        ColumnRun::for_preparation(Preparation::Deposit).max_sweeps,
+        ColumnRun::for_preparation(Preparation::Pour).max_sweeps,
+        1u32 << ColumnRun::for_preparation(Preparation::Pour).max_halvings
+    );
+    Ok(())
+}
+
+/// The column table's title, what LAMMPS is (measured or quoted), and the column heads.
+fn print_columns_header(lammps: Option<&Path>, wall_limit: f64) {
     println!(
         "\nJanssen column settled to KE/PE < 1e-8 (radius 1–2 mm, μ = 0.5, box 40 mean diameters; one thread below {} grains, else all):",
         datasets::benchmarks::PARALLEL_FROM_GRAINS
     );
-    match &lammps {
+    match lammps {
         Some(lmp) => println!(
             "LAMMPS peer measured in this run ({}, one core, serial): the same initial column, gran/hooke/history, k_n = 2e5 m g/d, k_t = 2/7 k_n,\n restitution 0.2 between mean grains, h = t_c/{}, KE/PE checked every {} steps, at most {:.0} s wall (GRAINLAW_LAMMPS_TIMEOUT); ratio = grainlaw/LAMMPS",
             lmp.display(),
@@ -289,123 +310,152 @@ fn columns(plan: &BenchPlan) -> Result<()> {
         "LAMMPS (s)",
         "ratio"
     );
-    for (n, prep) in jobs {
-        let run = ColumnRun::for_column(prep, n);
-        // Over the seeds: grainlaw's seconds, and `(grainlaw s, LAMMPS s)` of each seed while
-        // every peer run settled (`peer_settled`; LAMMPS' total is the sum of the pairs').
-        let (mut ours, mut all_settled, mut capped) = (0.0, true, 0);
-        let (mut pairs, mut peer_settled): (Vec<(f64, f64)>, bool) = (Vec::new(), true);
-        for seed in 1..=plan.seeds.max(1) {
-            let r = settle_column(n, prep, &run, seed)?;
-            let total = r.total_seconds();
-            let peer = match &lammps {
-                Some(lmp) => {
-                    let w = datasets::benchmarks::janssen_column(n, prep, &run, seed)?;
-                    let column = crate::lammps_peer::PeerColumn::from_world(
-                        &w,
-                        1e-8,
-                        run.max_time,
-                        wall_limit,
-                    )?;
-                    let dir = std::env::temp_dir().join(format!(
-                        "grainlaw-lammps-{}-{n}-{prep:?}-{seed}",
-                        std::process::id()
-                    ));
-                    Some((crate::lammps_peer::run(lmp, &column, &dir)?, column))
-                }
-                None => None,
-            };
-            ours += total;
-            all_settled &= r.settle.settled;
-            capped += r.settle.unconverged_steps;
-            match peer.as_ref().map(|p| &p.0) {
-                Some(crate::lammps_peer::PeerOutcome::Ran(p)) if p.settled && peer_settled => {
-                    pairs.push((total, p.wall_seconds))
-                }
-                _ => peer_settled = false,
+}
+
+/// A column's results over the seeds.
+struct SeedTotals {
+    /// grainlaw's seconds.
+    ours: f64,
+    /// Whether every grainlaw run settled.
+    all_settled: bool,
+    /// grainlaw's capped steps.
+    capped: u64,
+    /// `(grainlaw s, LAMMPS s)` of each seed while every peer run settled.
+    pairs: Vec<(f64, f64)>,
+    /// Whether every peer run settled (LAMMPS' total is then the sum of the pairs').
+    peer_settled: bool,
+}
+
+/// Settles the column of `n` grains prepared by `prep` for each seed, with LAMMPS on the same
+/// initial column when it is found; prints a row per seed and returns the totals.
+fn column_seeds(
+    plan: &BenchPlan,
+    n: usize,
+    prep: Preparation,
+    lammps: Option<&Path>,
+    wall_limit: f64,
+) -> Result<SeedTotals> {
+    let run = ColumnRun::for_column(prep, n);
+    let mut t = SeedTotals {
+        ours: 0.0,
+        all_settled: true,
+        capped: 0,
+        pairs: Vec::new(),
+        peer_settled: true,
+    };
+    for seed in 1..=plan.seeds.max(1) {
+        let r = settle_column(n, prep, &run, seed)?;
+        let total = r.total_seconds();
+        let peer = match lammps {
+            Some(lmp) => {
+                let w = datasets::benchmarks::janssen_column(n, prep, &run, seed)?;
+                let column =
+                    crate::lammps_peer::PeerColumn::from_world(&w, 1e-8, run.max_time, wall_limit)?;
+                let dir = std::env::temp_dir().join(format!(
+                    "grainlaw-lammps-{}-{n}-{prep:?}-{seed}",
+                    std::process::id()
+                ));
+                Some((crate::lammps_peer::run(lmp, &column, &dir)?, column))
             }
-            let (reference, ratio) = peer_cells(peer.as_ref().map(|p| &p.0), n, total);
-            println!(
-                "{:>7} {:>8} {:>4} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
-                n,
-                preparation_name(prep),
-                seed,
-                r.settle.steps,
-                r.settle.mean_sweeps,
-                r.settle.unconverged_steps,
-                r.final_overlap_ratio,
-                r.solid_fraction,
-                {
-                    let [lo, hi] = r.settle.dt_range;
-                    if lo < hi {
-                        format!("{:.3}–{:.2}", lo * 1e3, hi * 1e3)
-                    } else {
-                        format!("{:.2}", lo * 1e3)
-                    }
-                },
-                total,
-                reference,
-                ratio,
-                if r.settle.settled {
-                    ""
-                } else {
-                    "  NOT settled"
-                }
-            );
-            if let Some((p, column)) = &peer {
-                peer_line(p, column);
+            None => None,
+        };
+        t.ours += total;
+        t.all_settled &= r.settle.settled;
+        t.capped += r.settle.unconverged_steps;
+        match peer.as_ref().map(|p| &p.0) {
+            Some(crate::lammps_peer::PeerOutcome::Ran(p)) if p.settled && t.peer_settled => {
+                t.pairs.push((total, p.wall_seconds))
             }
+            _ => t.peer_settled = false,
         }
-        if plan.seeds > 1 {
-            let theirs = pairs.iter().map(|p| p.1).sum::<f64>();
-            let (reference, ratio) = if peer_settled && lammps.is_some() {
-                (format!("{theirs:.1}"), format!("{:.3}", ours / theirs))
+        let (reference, ratio) = peer_cells(peer.as_ref().map(|p| &p.0), n, total);
+        println!(
+            "{:>7} {:>8} {:>4} {:>6} {:>7.1} {:>7} {:>9.4} {:>10.3} {:>11} {:>9.2} {:>14} {:>9}{}",
+            n,
+            preparation_name(prep),
+            seed,
+            r.settle.steps,
+            r.settle.mean_sweeps,
+            r.settle.unconverged_steps,
+            r.final_overlap_ratio,
+            r.solid_fraction,
+            {
+                let [lo, hi] = r.settle.dt_range;
+                if lo < hi {
+                    format!("{:.3}–{:.2}", lo * 1e3, hi * 1e3)
+                } else {
+                    format!("{:.2}", lo * 1e3)
+                }
+            },
+            total,
+            reference,
+            ratio,
+            if r.settle.settled {
+                ""
             } else {
-                ("–".into(), "–".into())
-            };
-            println!(
-                "{:>7} {:>8} {:>4} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9.2} {:>14} {:>9}{}",
-                n,
-                preparation_name(prep),
-                format!("1–{}", plan.seeds),
-                "",
-                "",
-                capped,
-                "",
-                "",
-                "total",
-                ours,
-                reference,
-                ratio,
-                if all_settled { "" } else { "  NOT all settled" }
-            );
-            if let Some(e) = RatioOfTotals::estimate(&pairs).filter(|_| peer_settled) {
-                println!(
-                    "        ratio of the totals {:.3}: standard error {:.3} over the {} seeds, 95 % interval {:.3}–{:.3} \
-                     (ratio estimator, t with {} degrees of freedom; {:.1}× to {} faster than LAMMPS)",
-                    e.ratio,
-                    e.standard_error,
-                    pairs.len(),
-                    e.interval[0],
-                    e.interval[1],
-                    pairs.len() - 1,
-                    1.0 / e.interval[1],
-                    if e.interval[0] > 0.0 {
-                        format!("{:.1}×", 1.0 / e.interval[0])
-                    } else {
-                        "any factor".to_string()
-                    },
-                );
+                "  NOT settled"
             }
+        );
+        if let Some((p, column)) = &peer {
+            peer_line(p, column);
         }
     }
+    Ok(t)
+}
+
+/// The row of a column's totals over the seeds, and the ratio of the totals with its interval
+/// when every peer run settled.
+fn print_seed_totals(
+    plan: &BenchPlan,
+    n: usize,
+    prep: Preparation,
+    t: &SeedTotals,
+    measured: bool,
+) {
+    let theirs = t.pairs.iter().map(|p| p.1).sum::<f64>();
+    let (reference, ratio) = if t.peer_settled && measured {
+        (format!("{theirs:.1}"), format!("{:.3}", t.ours / theirs))
+    } else {
+        ("–".into(), "–".into())
+    };
     println!(
-        "(capped: steps that stopped at the cap of {} sweeps (deposit) or {} sweeps in up to {} sub-steps (pour) with their best iterate;\n overlap/r: largest overlap over the smallest radius; h: the step range used, sub-steps included; a deposit starts from the\n weight-carrying impulses and adapts its step, halved after a capped step)",
-        ColumnRun::for_preparation(Preparation::Deposit).max_sweeps,
-        ColumnRun::for_preparation(Preparation::Pour).max_sweeps,
-        1u32 << ColumnRun::for_preparation(Preparation::Pour).max_halvings
+        "{:>7} {:>8} {:>4} {:>6} {:>7} {:>7} {:>9} {:>10} {:>11} {:>9.2} {:>14} {:>9}{}",
+        n,
+        preparation_name(prep),
+        format!("1–{}", plan.seeds),
+        "",
+        "",
+        t.capped,
+        "",
+        "",
+        "total",
+        t.ours,
+        reference,
+        ratio,
+        if t.all_settled {
+            ""
+        } else {
+            "  NOT all settled"
+        }
     );
-    Ok(())
+    if let Some(e) = RatioOfTotals::estimate(&t.pairs).filter(|_| t.peer_settled) {
+        println!(
+            "        ratio of the totals {:.3}: standard error {:.3} over the {} seeds, 95 % interval {:.3}–{:.3} \
+             (ratio estimator, t with {} degrees of freedom; {:.1}× to {} faster than LAMMPS)",
+            e.ratio,
+            e.standard_error,
+            t.pairs.len(),
+            e.interval[0],
+            e.interval[1],
+            t.pairs.len() - 1,
+            1.0 / e.interval[1],
+            if e.interval[0] > 0.0 {
+                format!("{:.1}×", 1.0 / e.interval[0])
+            } else {
+                "any factor".to_string()
+            },
+        );
+    }
 }
 
 /// The ratio of two totals over paired samples, `R = Σ x_i / Σ y_i` (here grainlaw's and LAMMPS'
@@ -893,9 +943,8 @@ pub fn z_score(a: f64, se_a: f64, b: f64, se_b: f64) -> f64 {
 /// reference case, labelled so), both on one core; one table of wall seconds (shear, total),
 /// seconds per unit shear strain, steps, μ ± SE, φ ± SE and the largest overlap, then the
 /// ratio LAMMPS / grainlaw of the seconds per unit strain with LAMMPS' settings beside it and
-/// the z-score of the two μ.
+/// the z-score of the two μ ([`rve_race`] per grain count).
 pub fn rve_rows(plan: &RvePlan) -> Result<()> {
-    use crate::lammps_rve_peer::{self as lr, PeerRve, RveOutcome};
     if plan.grains.is_empty() {
         return Ok(());
     }
@@ -912,42 +961,82 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
         }
     );
     for &n in &plan.grains {
-        let ours = grainlaw_rve(n, plan)?;
-        let c: datasets::config::SimpleShearConfig =
-            crate::scenarios::registry::config_of(&ours.loaded)?;
-        let peer = PeerRve::from_config(&c, plan.inertial, wall_limit)?;
-        let outcome = match &lammps {
-            Some(lmp) => {
-                let dir = std::env::temp_dir()
-                    .join(format!("grainlaw-lammps-rve-{}-{n}", std::process::id()));
-                Some(lr::run(lmp, &peer, &dir)?)
-            }
-            None => None,
-        };
-        println!(
-            "{:<18} {:>9} {:>9} {:>9} {:>15} {:>17} {:>17} {:>13}  verdict",
-            format!("{n} grains"),
-            "shear s",
-            "total s",
-            "s/strain",
-            "steps shear/all",
-            "μ ± SE",
-            "φ ± SE",
-            "overlap/R_min"
-        );
-        let ours_per_strain = ours.shear_seconds / plan.strain;
-        println!(
-            "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
-            "grainlaw",
-            ours.shear_seconds,
-            ours.total_seconds,
-            ours_per_strain,
-            format!("{}/{}", ours.shear_steps, ours.total_steps),
-            pm(ours.mu, ours.mu_se),
-            pm(ours.phi, ours.phi_se),
-            100.0 * ours.overlap_ratio,
-            ours.verdict
-        );
+        rve_race(n, plan, lammps.as_deref(), wall_limit)?;
+    }
+    println!("(overlap/R_min: largest overlap over the smallest radius, grainlaw at the start of every step, LAMMPS on its snapshots; LAMMPS' shear s is its loop time of the shear run)");
+    Ok(())
+}
+
+/// LAMMPS' side of a race: its seconds per unit shear strain, μ, SE(μ), and `measured` or
+/// `QUOTED`.
+type TheirRve = (f64, f64, f64, &'static str);
+
+/// One grain count of the race: grainlaw's run → LAMMPS' (or the quoted figures) → the
+/// seconds to a μ point of the target precision → the ratio and the z-score → grainlaw's
+/// settings.
+fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) -> Result<()> {
+    use crate::lammps_rve_peer::{self as lr, PeerRve, RveOutcome};
+    let ours = grainlaw_rve(n, plan)?;
+    let c: datasets::config::SimpleShearConfig =
+        crate::scenarios::registry::config_of(&ours.loaded)?;
+    let peer = PeerRve::from_config(&c, plan.inertial, wall_limit)?;
+    let outcome = match lammps {
+        Some(lmp) => {
+            let dir = std::env::temp_dir()
+                .join(format!("grainlaw-lammps-rve-{}-{n}", std::process::id()));
+            Some(lr::run(lmp, &peer, &dir)?)
+        }
+        None => None,
+    };
+    println!(
+        "{:<18} {:>9} {:>9} {:>9} {:>15} {:>17} {:>17} {:>13}  verdict",
+        format!("{n} grains"),
+        "shear s",
+        "total s",
+        "s/strain",
+        "steps shear/all",
+        "μ ± SE",
+        "φ ± SE",
+        "overlap/R_min"
+    );
+    let ours_per_strain = ours.shear_seconds / plan.strain;
+    println!(
+        "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
+        "grainlaw",
+        ours.shear_seconds,
+        ours.total_seconds,
+        ours_per_strain,
+        format!("{}/{}", ours.shear_steps, ours.total_steps),
+        pm(ours.mu, ours.mu_se),
+        pm(ours.phi, ours.phi_se),
+        100.0 * ours.overlap_ratio,
+        ours.verdict
+    );
+    let theirs = match &outcome {
+        Some(RveOutcome::Ran(r)) => lammps_rve_row(r, plan),
+        Some(RveOutcome::Failed { reason, dir }) => {
+            println!(
+                "{:<18} FAILED: {reason} (files kept in {})",
+                "LAMMPS",
+                dir.display()
+            );
+            None
+        }
+        None => quoted_rve_row(n, plan),
+    };
+    let theirs_to_se = match &outcome {
+        Some(RveOutcome::Ran(r)) if r.finished => seconds_to_precision(
+            r.log.compression_seconds,
+            r.log.shear_seconds,
+            plan.strain,
+            plan.average,
+            r.measure.mu_se,
+            TARGET_MU_SE,
+        ),
+        _ => f64::NAN,
+    };
+    print_precision(&ours, plan, theirs_to_se);
+    if let Some(t) = theirs {
         let m = &peer.model;
         let settings = format!(
             "κ = k_n/(P·1 m) = {:.0e} (k_n = {:.3e} N/m per m), dt = t_c/{} = {:.3} µs (t_c = {:.2} µs, two smallest grains), k_t/k_n = 2/7, e = {} (mean pair)",
@@ -958,144 +1047,135 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
             m.collision_time * 1e6,
             crate::lammps_peer::RESTITUTION
         );
-        let theirs = match &outcome {
-            Some(RveOutcome::Ran(r)) => {
-                let per_strain = r.log.shear_seconds / plan.strain;
-                println!(
-                    "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
-                    "LAMMPS",
-                    r.log.shear_seconds,
-                    r.wall_seconds,
-                    per_strain,
-                    format!("{}/{}", r.log.shear_steps, r.log.end_step),
-                    pm(r.measure.mu, r.measure.mu_se),
-                    pm(r.measure.phi, r.measure.phi_se),
-                    100.0 * r.overlap_ratio,
-                    if r.finished {
-                        "finished"
-                    } else {
-                        "NOT finished (wall-clock limit, GRAINLAW_LAMMPS_TIMEOUT)"
-                    }
-                );
-                println!(
-                    "{:<18} LAMMPS: compression {:.1} s, ⟨p_yy⟩ = {:.1} ± {:.1} Pa, I = {:.4}, Z = {:.2}, {} samples; overlap over {} snapshots",
-                    "",
-                    r.log.compression_seconds,
-                    r.measure.pn,
-                    r.measure.pn_se,
-                    r.measure.inertial_number,
-                    r.measure.z,
-                    r.measure.samples,
-                    lr::OVERLAP_SNAPSHOTS
-                );
-                r.finished
-                    .then_some((per_strain, r.measure.mu, r.measure.mu_se, "measured"))
-            }
-            Some(RveOutcome::Failed { reason, dir }) => {
-                println!(
-                    "{:<18} FAILED: {reason} (files kept in {})",
-                    "LAMMPS",
-                    dir.display()
-                );
-                None
-            }
-            None => {
-                let reference =
-                    n == 2000 && plan.inertial == 0.01 && plan.strain == 2.0 && plan.average == 1.0;
-                if reference {
-                    let q = &QUOTED_RVE;
-                    println!(
-                        "{:<18} {:>9.1} {:>9} {:>9.2} {:>15} {:>17} {:>17} {:>13}  quoted (hand measurement, 2026-12-05)",
-                        "LAMMPS (quoted)",
-                        q.seconds,
-                        "–",
-                        q.seconds_per_strain,
-                        format!("{}/–", q.steps),
-                        pm(q.mu, q.mu_se),
-                        format!("{:.3}", q.phi),
-                        "≤ 0.1 % d̄",
-                    );
-                    Some((q.seconds_per_strain, q.mu, q.mu_se, "QUOTED"))
-                } else {
-                    println!(
-                        "{:<18} no quoted figures for this case (only 2000 grains, I = 0.01, strain 2, the last 1 averaged)",
-                        "LAMMPS"
-                    );
-                    None
-                }
-            }
-        };
-        let ours_to_se = seconds_to_precision(
-            ours.prep_seconds,
-            ours.shear_seconds,
-            plan.strain,
-            plan.average,
-            ours.mu_se,
-            TARGET_MU_SE,
-        );
-        let theirs_to_se = match &outcome {
-            Some(RveOutcome::Ran(r)) if r.finished => seconds_to_precision(
-                r.log.compression_seconds,
-                r.log.shear_seconds,
-                plan.strain,
-                plan.average,
-                r.measure.mu_se,
-                TARGET_MU_SE,
-            ),
-            _ => f64::NAN,
-        };
-        println!(
-            "seconds to a μ point with SE {TARGET_MU_SE} (estimated: preparation + transient + the averaged strain that SE needs, SE ∝ 1/√strain): grainlaw {ours_to_se:.1} (verdict {}), {}",
-            ours.verdict,
-            if theirs_to_se.is_finite() {
-                format!(
-                    "LAMMPS {theirs_to_se:.1}, ratio LAMMPS/grainlaw {:.3}",
-                    theirs_to_se / ours_to_se
-                )
-            } else {
-                "LAMMPS not measured in this run".to_string()
-            }
-        );
-        if let Some((per_strain, mu, mu_se, how)) = theirs {
-            let z = z_score(mu, mu_se, ours.mu, ours.mu_se);
-            println!(
-                "ratio LAMMPS/grainlaw of the seconds per unit shear strain: {:.3} ({how}; LAMMPS gran/hooke/history at {settings}{});\n μ: z = {:.2} ({})",
-                per_strain / ours_per_strain,
-                if how == "QUOTED" {
-                    ", quoted: k_n = 1e7 N/m, dt = 7.6 µs ≈ t_c/12"
-                } else {
-                    ", σ_yy servo on the height"
-                },
-                z,
-                if !z.is_finite() {
-                    "a standard error is not known"
-                } else if z.abs() <= 2.0 {
-                    "the two μ agree within two combined standard errors"
-                } else {
-                    "the two μ DIFFER by more than two combined standard errors"
-                }
-            );
-        }
-        println!(
-            " grainlaw: `simple-shear` {} (travel_per_step {}, solver {} to tolerance {:e}, at most {} sweeps, cell control {}), one thread, h = {:.3} ms in the shear; shear s is its shear phase, total s the whole run with its measurement",
-            if plan.sets.is_empty() {
-                "defaults".to_string()
-            } else {
-                format!("with {}", plan.sets.join(" "))
-            },
-            c.travel_per_step,
-            c.solver.method.name(),
-            c.solver.tolerance,
-            c.solver.max_iterations,
-            c.cell_control.as_str(),
-            1e3 * c.shear_dt(peer.gamma_dot, peer.mean_diameter),
-        );
-        if let Some(f) = &ours.failure {
-            println!(" grainlaw's verdict: {f}");
-        }
+        print_rve_ratio(t, &ours, ours_per_strain, &settings);
     }
-    println!("(overlap/R_min: largest overlap over the smallest radius, grainlaw at the start of every step, LAMMPS on its snapshots; LAMMPS' shear s is its loop time of the shear run)");
+    println!(
+        " grainlaw: `simple-shear` {} (travel_per_step {}, solver {} to tolerance {:e}, at most {} sweeps, cell control {}), one thread, h = {:.3} ms in the shear; shear s is its shear phase, total s the whole run with its measurement",
+        if plan.sets.is_empty() {
+            "defaults".to_string()
+        } else {
+            format!("with {}", plan.sets.join(" "))
+        },
+        c.travel_per_step,
+        c.solver.method.name(),
+        c.solver.tolerance,
+        c.solver.max_iterations,
+        c.cell_control.as_str(),
+        1e3 * c.shear_dt(peer.gamma_dot, peer.mean_diameter),
+    );
+    if let Some(f) = &ours.failure {
+        println!(" grainlaw's verdict: {f}");
+    }
     Ok(())
+}
+
+/// The rows of a LAMMPS run of the race; its side when it finished.
+fn lammps_rve_row(r: &crate::lammps_rve_peer::RveRun, plan: &RvePlan) -> Option<TheirRve> {
+    let per_strain = r.log.shear_seconds / plan.strain;
+    println!(
+        "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
+        "LAMMPS",
+        r.log.shear_seconds,
+        r.wall_seconds,
+        per_strain,
+        format!("{}/{}", r.log.shear_steps, r.log.end_step),
+        pm(r.measure.mu, r.measure.mu_se),
+        pm(r.measure.phi, r.measure.phi_se),
+        100.0 * r.overlap_ratio,
+        if r.finished {
+            "finished"
+        } else {
+            "NOT finished (wall-clock limit, GRAINLAW_LAMMPS_TIMEOUT)"
+        }
+    );
+    println!(
+        "{:<18} LAMMPS: compression {:.1} s, ⟨p_yy⟩ = {:.1} ± {:.1} Pa, I = {:.4}, Z = {:.2}, {} samples; overlap over {} snapshots",
+        "",
+        r.log.compression_seconds,
+        r.measure.pn,
+        r.measure.pn_se,
+        r.measure.inertial_number,
+        r.measure.z,
+        r.measure.samples,
+        crate::lammps_rve_peer::OVERLAP_SNAPSHOTS
+    );
+    r.finished
+        .then_some((per_strain, r.measure.mu, r.measure.mu_se, "measured"))
+}
+
+/// Without LAMMPS: the quoted hand measurement's row for the reference case (2000 grains,
+/// I = 0.01, strain 2, the last 1 averaged), else a line saying there is none.
+fn quoted_rve_row(n: usize, plan: &RvePlan) -> Option<TheirRve> {
+    let reference = n == 2000 && plan.inertial == 0.01 && plan.strain == 2.0 && plan.average == 1.0;
+    if !reference {
+        println!(
+            "{:<18} no quoted figures for this case (only 2000 grains, I = 0.01, strain 2, the last 1 averaged)",
+            "LAMMPS"
+        );
+        return None;
+    }
+    let q = &QUOTED_RVE;
+    println!(
+        "{:<18} {:>9.1} {:>9} {:>9.2} {:>15} {:>17} {:>17} {:>13}  quoted (hand measurement, 2026-12-05)",
+        "LAMMPS (quoted)",
+        q.seconds,
+        "–",
+        q.seconds_per_strain,
+        format!("{}/–", q.steps),
+        pm(q.mu, q.mu_se),
+        format!("{:.3}", q.phi),
+        "≤ 0.1 % d̄",
+    );
+    Some((q.seconds_per_strain, q.mu, q.mu_se, "QUOTED"))
+}
+
+/// The estimated seconds to a μ point with SE [`TARGET_MU_SE`], grainlaw's and LAMMPS'
+/// (`theirs_to_se`, NaN when not measured).
+fn print_precision(ours: &OurRve, plan: &RvePlan, theirs_to_se: f64) {
+    let ours_to_se = seconds_to_precision(
+        ours.prep_seconds,
+        ours.shear_seconds,
+        plan.strain,
+        plan.average,
+        ours.mu_se,
+        TARGET_MU_SE,
+    );
+    println!(
+        "seconds to a μ point with SE {TARGET_MU_SE} (estimated: preparation + transient + the averaged strain that SE needs, SE ∝ 1/√strain): grainlaw {ours_to_se:.1} (verdict {}), {}",
+        ours.verdict,
+        if theirs_to_se.is_finite() {
+            format!(
+                "LAMMPS {theirs_to_se:.1}, ratio LAMMPS/grainlaw {:.3}",
+                theirs_to_se / ours_to_se
+            )
+        } else {
+            "LAMMPS not measured in this run".to_string()
+        }
+    );
+}
+
+/// The ratio LAMMPS/grainlaw of the seconds per unit shear strain, LAMMPS' `settings`, and
+/// the z-score of the two μ.
+fn print_rve_ratio(theirs: TheirRve, ours: &OurRve, ours_per_strain: f64, settings: &str) {
+    let (per_strain, mu, mu_se, how) = theirs;
+    let z = z_score(mu, mu_se, ours.mu, ours.mu_se);
+    println!(
+        "ratio LAMMPS/grainlaw of the seconds per unit shear strain: {:.3} ({how}; LAMMPS gran/hooke/history at {settings}{});\n μ: z = {:.2} ({})",
+        per_strain / ours_per_strain,
+        if how == "QUOTED" {
+            ", quoted: k_n = 1e7 N/m, dt = 7.6 µs ≈ t_c/12"
+        } else {
+            ", σ_yy servo on the height"
+        },
+        z,
+        if !z.is_finite() {
+            "a standard error is not known"
+        } else if z.abs() <= 2.0 {
+            "the two μ agree within two combined standard errors"
+        } else {
+            "the two μ DIFFER by more than two combined standard errors"
+        }
+    );
 }
 
 #[cfg(test)]

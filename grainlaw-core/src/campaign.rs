@@ -71,14 +71,19 @@ fn plan_error(plan: &Path, reason: impl Into<String>) -> CliError {
     }
 }
 
+/// The dotted key `prefix.k` (`k` alone at the top level).
+fn dotted(prefix: &str, k: &str) -> String {
+    if prefix.is_empty() {
+        k.to_string()
+    } else {
+        format!("{prefix}.{k}")
+    }
+}
+
 /// Flattens a `[set]` table into dotted `KEY=VALUE` arguments (a nested table is a dotted key).
 fn flatten(prefix: &str, t: &Table, out: &mut Vec<String>) {
     for (k, v) in t {
-        let key = if prefix.is_empty() {
-            k.clone()
-        } else {
-            format!("{prefix}.{k}")
-        };
+        let key = dotted(prefix, k);
         match v {
             Value::Table(sub) => flatten(&key, sub, out),
             v => out.push(format!("{key}={v}")),
@@ -177,11 +182,7 @@ fn flatten_sweep(
     path: &Path,
 ) -> Result<()> {
     for (k, v) in t {
-        let key = if prefix.is_empty() {
-            k.clone()
-        } else {
-            format!("{prefix}.{k}")
-        };
+        let key = dotted(prefix, k);
         match v {
             Value::Table(sub) => flatten_sweep(&key, sub, out, path)?,
             Value::Array(a) if !a.is_empty() => out.push((key, a.clone())),
@@ -605,12 +606,7 @@ fn numeric_leaves(prefix: &str, v: &serde_json::Value, out: &mut BTreeMap<String
         }
         serde_json::Value::Object(m) => {
             for (k, v) in m {
-                let key = if prefix.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{prefix}.{k}")
-                };
-                numeric_leaves(&key, v, out);
+                numeric_leaves(&dotted(prefix, k), v, out);
             }
         }
         _ => {}
@@ -636,8 +632,51 @@ const MERGED: &[(&str, &[LawWithFallback])] = &[(
     &[("mu-i", Some("mu-i-linear")), ("phi-i", None)],
 )];
 
-/// `--collect`: the campaign tables, the merged histories and their fits.
+/// `--collect`: the campaign tables, the merged histories and their fits (stages: every run
+/// finished → their summaries read → `campaign.csv`, `campaign_stats.csv`, the runouts → the
+/// merged tables and their fits).
 fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
+    check_all_finished(out, runs)?;
+    let done = read_finished(out, runs)?;
+    write_campaign_csv(out, plan, &done)?;
+    write_stats_csv(out, plan, &done)?;
+    write_runouts(out, &done)?;
+    println!(
+        "campaign: {} runs collected into {}/campaign.csv and campaign_stats.csv",
+        done.len(),
+        out.display()
+    );
+    // Merged tables: only runs that passed (exit 0, verdict ok when present).
+    let passed: Vec<&Finished> = done
+        .iter()
+        .filter(|f| f.code.unwrap_or(0) == 0 && f.verdict.as_deref().is_none_or(|v| v == "ok"))
+        .collect();
+    let left_out: Vec<String> = done
+        .iter()
+        .filter(|f| !passed.iter().any(|p| p.spec.index == f.spec.index))
+        .map(|f| format!("{:04}", f.spec.index))
+        .collect();
+    if !left_out.is_empty() {
+        println!(
+            "runs with a result refused or suspect (their points that passed their own checks are merged): {}",
+            abbreviate(&left_out)
+        );
+    }
+    let mut refused = Vec::new();
+    for (table, laws) in MERGED {
+        refused.extend(merge_and_fit(out, table, laws, &done, &passed)?);
+    }
+    if !refused.is_empty() {
+        return Err(CliError::FitRefused {
+            path: out.display().to_string(),
+            reason: format!("merged fits refused: {}", refused.join(", ")),
+        });
+    }
+    Ok(())
+}
+
+/// Refuses to collect a partial campaign: every run must be finished.
+fn check_all_finished(out: &Path, runs: &[RunSpec]) -> Result<()> {
     let missing: Vec<String> = runs
         .iter()
         .filter(|r| !matches!(run_state(out, r.index), RunState::Finished(_)))
@@ -654,6 +693,11 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
             ),
         });
     }
+    Ok(())
+}
+
+/// Each run's exit code, verdict and the numbers of its `summary.json`.
+fn read_finished(out: &Path, runs: &[RunSpec]) -> Result<Vec<Finished>> {
     let mut done = Vec::new();
     for r in runs {
         let path = run_dir(out, r.index).join("summary.json");
@@ -681,9 +725,11 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
             numbers,
         });
     }
-    write_campaign_csv(out, plan, &done)?;
-    write_stats_csv(out, plan, &done)?;
-    // Runs of `column-collapse`: the runout against the aspect ratio, r_∞(a).
+    Ok(done)
+}
+
+/// Runs of `column-collapse`: the runout against the aspect ratio, r_∞(a).
+fn write_runouts(out: &Path, done: &[Finished]) -> Result<()> {
     let collapses: Vec<crate::scenarios::column_collapse::CampaignRun> = done
         .iter()
         .filter(|f| f.numbers.contains_key("column.runout_m"))
@@ -703,93 +749,80 @@ fn collect(out: &Path, plan: &Plan, runs: &[RunSpec]) -> Result<()> {
             out.display()
         );
     }
-    println!(
-        "campaign: {} runs collected into {}/campaign.csv and campaign_stats.csv",
-        done.len(),
-        out.display()
-    );
-    // Merged tables: only runs that passed (exit 0, verdict ok when present).
-    let passed: Vec<&Finished> = done
-        .iter()
-        .filter(|f| f.code.unwrap_or(0) == 0 && f.verdict.as_deref().is_none_or(|v| v == "ok"))
-        .collect();
-    let left_out: Vec<String> = done
-        .iter()
-        .filter(|f| !passed.iter().any(|p| p.spec.index == f.spec.index))
-        .map(|f| format!("{:04}", f.spec.index))
-        .collect();
-    if !left_out.is_empty() {
-        println!(
-            "runs with a result refused or suspect (their points that passed their own checks are merged): {}",
-            abbreviate(&left_out)
-        );
-    }
-    let mut refused = Vec::new();
-    for (table, laws) in MERGED {
-        // A table with a `point_verdict` column is judged row by row: its passed rows are
-        // merged from every run that completed (exit 0 or 3); another table only from the runs
-        // that passed as a whole.
-        let files: Vec<(usize, PathBuf)> = done
-            .iter()
-            .filter(|f| {
-                let p = run_dir(out, f.spec.index).join(table);
-                if has_point_verdict(&p) {
-                    matches!(f.code, None | Some(0) | Some(3))
-                } else {
-                    passed.iter().any(|q| q.spec.index == f.spec.index)
-                }
-            })
-            .map(|f| (f.spec.index, run_dir(out, f.spec.index).join(table)))
-            .filter(|(_, p)| p.is_file())
-            .collect();
-        if files.is_empty() {
-            continue;
-        }
-        let merged = out.join(table);
-        merge_tables(&files, &merged)?;
-        println!(
-            "merged {table} of {} runs into {}",
-            files.len(),
-            merged.display()
-        );
-        let mut fitted_laws = Vec::new();
-        for (law, simpler) in *laws {
-            let mut tried = vec![*law];
-            tried.extend(simpler.iter());
-            let mut fitted = false;
-            for l in tried {
-                let law_out = out.join(format!("{}_law.json", l.replace('-', "_")));
-                match crate::fit_cmd::fit(l, &merged, Some(&law_out)) {
-                    Ok(cal) => {
-                        fitted_laws.push(cal);
-                        fitted = true;
-                        break;
-                    }
-                    // On merged data a fit that cannot be made (too few points passed their
-                    // checks, a column left empty) is a refusal of the campaign's result, not
-                    // bad input.
-                    Err(e @ (CliError::FitRefused { .. } | CliError::Input { .. })) => {
-                        println!("{l}: refused: {}", e.one_line());
-                    }
-                    Err(e) => return Err(e),
-                }
-            }
-            if !fitted {
-                refused.push(law.to_string());
-            }
-        }
-        if *table == "rheology.csv" {
-            let figure = write_rheology_figure(out, &files, &fitted_laws)?;
-            println!("figure of the merged points and laws: {}", figure.display());
-        }
-    }
-    if !refused.is_empty() {
-        return Err(CliError::FitRefused {
-            path: out.display().to_string(),
-            reason: format!("merged fits refused: {}", refused.join(", ")),
-        });
-    }
     Ok(())
+}
+
+/// Merges `table` over the runs and fits `laws` to it (the rheology's figure too); returns the
+/// laws refused. A table with a `point_verdict` column is judged row by row: its passed rows
+/// are merged from every run that completed (exit 0 or 3); another table only from the runs
+/// that `passed` as a whole.
+fn merge_and_fit(
+    out: &Path,
+    table: &str,
+    laws: &[LawWithFallback],
+    done: &[Finished],
+    passed: &[&Finished],
+) -> Result<Vec<String>> {
+    let files: Vec<(usize, PathBuf)> = done
+        .iter()
+        .filter(|f| {
+            let p = run_dir(out, f.spec.index).join(table);
+            if has_point_verdict(&p) {
+                matches!(f.code, None | Some(0) | Some(3))
+            } else {
+                passed.iter().any(|q| q.spec.index == f.spec.index)
+            }
+        })
+        .map(|f| (f.spec.index, run_dir(out, f.spec.index).join(table)))
+        .filter(|(_, p)| p.is_file())
+        .collect();
+    if files.is_empty() {
+        return Ok(Vec::new());
+    }
+    let merged = out.join(table);
+    merge_tables(&files, &merged)?;
+    println!(
+        "merged {table} of {} runs into {}",
+        files.len(),
+        merged.display()
+    );
+    let mut refused = Vec::new();
+    let mut fitted_laws = Vec::new();
+    for (law, simpler) in laws {
+        match fit_with_fallback(out, &merged, law, *simpler)? {
+            Some(cal) => fitted_laws.push(cal),
+            None => refused.push(law.to_string()),
+        }
+    }
+    if table == "rheology.csv" {
+        let figure = write_rheology_figure(out, &files, &fitted_laws)?;
+        println!("figure of the merged points and laws: {}", figure.display());
+    }
+    Ok(refused)
+}
+
+/// Fits `law` to the merged table, else its `simpler` form (`None` when both are refused). On
+/// merged data a fit that cannot be made (too few points passed their checks, a column left
+/// empty) is a refusal of the campaign's result, not bad input.
+fn fit_with_fallback(
+    out: &Path,
+    merged: &Path,
+    law: &'static str,
+    simpler: Option<&'static str>,
+) -> Result<Option<identify::CalibratedLaw>> {
+    let mut tried = vec![law];
+    tried.extend(simpler.iter());
+    for l in tried {
+        let law_out = out.join(format!("{}_law.json", l.replace('-', "_")));
+        match crate::fit_cmd::fit(l, merged, Some(&law_out)) {
+            Ok(cal) => return Ok(Some(cal)),
+            Err(e @ (CliError::FitRefused { .. } | CliError::Input { .. })) => {
+                println!("{l}: refused: {}", e.one_line());
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(None)
 }
 
 /// The points of the runs' `rheology.csv` tables, for the campaign's figure: `(μ points,

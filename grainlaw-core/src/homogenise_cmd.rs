@@ -103,7 +103,75 @@ pub struct HomogeniseOutcome {
 /// Reads the files, homogenises every snapshot, writes the outputs (CSV tables, figures, VTK
 /// series, `summary.json`; `docs/outputs.md` § "homogenise"); returns the report and the files.
 /// The one implementation behind `grainlaw homogenise` and the Python `grainlaw.homogenise`.
+///
+/// Stages: options checked → the files read → per-snapshot tables ([`SeriesTables`]) → the
+/// last snapshot's outputs ([`last_outputs`]), Janssen table, cell and simple-shear point →
+/// summary and report.
 pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
+    check_options(plan)?;
+    let snaps = readers::read(plan.format, &plan.files, &plan.options)
+        .map_err(|e| CliError::Usage(e.to_string()))?;
+    if plan.out.exists() && !plan.out.is_dir() {
+        return Err(CliError::Usage(format!(
+            "--out {}: is a file, not a directory",
+            plan.out.display()
+        )));
+    }
+    let mut out = OutputDir::create(&plan.out)?;
+    let started = std::time::Instant::now();
+    let mut series = SeriesTables::new();
+    let mut summary = summary_header(plan, &snaps);
+    for ext in &snaps {
+        series.add(&mut out, ext)?;
+    }
+    let (wall_names, last_lines) = series.finish(&mut out)?;
+    let last = snaps
+        .last()
+        .ok_or_else(|| CliError::Usage("homogenise: no snapshot read".into()))?;
+    last_outputs(&mut out, last, &mut summary)?;
+    janssen_table(&mut out, &snaps, &plan.options, &mut summary)?;
+    summary.set("walls", wall_names.into());
+    if let Some(c) = last.snapshot.cell {
+        summary
+            .set(
+                "cell_matrix_m",
+                vec![c.h[(0, 0)], c.h[(0, 1)], c.h[(1, 0)], c.h[(1, 1)]].into(),
+            )
+            .num("cell_area_m2", c.volume());
+    }
+    let rve = crate::rve::rve_point(&snaps)?;
+    if let Some(p) = &rve {
+        p.write(&mut out)?;
+        p.keys(&mut summary);
+    }
+    let s = &last.snapshot;
+    for w in &s.walls {
+        summary
+            .num(&format!("wall_{}_force_x_N", w.name), w.force.x)
+            .num(&format!("wall_{}_force_y_N", w.name), w.force.y);
+    }
+    summary.num("wall_seconds", started.elapsed().as_secs_f64());
+    out.write("summary.json", summary.to_json().as_bytes())?;
+    let mut lines = vec![format!("report: {}/", plan.out.display())];
+    lines.extend(last_lines);
+    for w in &s.walls {
+        lines.push(format!(
+            "wall {}: force ({:.6e}, {:.6e}) N",
+            w.name, w.force.x, w.force.y
+        ));
+    }
+    if let Some(p) = &rve {
+        lines.extend(p.lines());
+        refuse_rve(plan, p)?;
+    }
+    Ok(HomogeniseOutcome {
+        lines,
+        files: out.written().to_vec(),
+    })
+}
+
+/// Checks the plan's files and friction and inertia settings. Errors: [`CliError::Usage`].
+fn check_options(plan: &HomogenisePlan) -> Result<()> {
     if plan.files.is_empty() {
         return Err(CliError::Usage("homogenise: no input file".into()));
     }
@@ -126,58 +194,31 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
             "--inertia-factor must be finite and > 0".into(),
         ));
     }
-    let snaps = readers::read(plan.format, &plan.files, &plan.options)
-        .map_err(|e| CliError::Usage(e.to_string()))?;
-    if plan.out.exists() && !plan.out.is_dir() {
-        return Err(CliError::Usage(format!(
-            "--out {}: is a file, not a directory",
-            plan.out.display()
-        )));
+    Ok(())
+}
+
+/// A refused simple-shear point is an error ([`CliError::Verdict`]).
+fn refuse_rve(plan: &HomogenisePlan, p: &crate::rve::RvePoint) -> Result<()> {
+    if p.verdict == crate::verdict::Verdict::Refused {
+        return Err(CliError::Verdict {
+            dir: plan.out.display().to_string(),
+            reason: format!(
+                "the simple-shear point is refused (rheology.csv, point_verdict 2): {}",
+                p.checks
+                    .reasons
+                    .iter()
+                    .map(|r| r.message.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        });
     }
-    let mut out = OutputDir::create(&plan.out)?;
-    let started = std::time::Instant::now();
-    let mut table = CsvTable::new(
-        &[
-            &[
-                "step",
-                "time_s",
-                "grains",
-                "contacts",
-                "solid_fraction",
-                "z",
-                "z_without_rattlers",
-                "rattler_fraction",
-                "fabric_anisotropy",
-                "fabric_major_angle_rad",
-            ][..],
-            &STRESS_COLUMNS,
-            &[
-                "pressure_Pa",
-                "shear_stress_Pa",
-                "stress_ratio",
-                "mean_mobilisation",
-                "fraction_at_limit",
-            ],
-        ]
-        .concat(),
-    );
-    table
-        .comments
-        .push("whole-sample means per snapshot (grainlaw homogenise)".into());
-    let mut walls = CsvTable::new(&[
-        "step",
-        "wall",
-        "force_x_N",
-        "force_y_N",
-        "torque_Nm",
-        "contacts",
-    ]);
-    walls
-        .comments
-        .push("wall index: the order of `walls` in summary.json".into());
-    let mut vtk = VtkSeries::new();
-    let mut wall_names: Vec<String> = Vec::new();
-    let mut last_lines = Vec::new();
+    Ok(())
+}
+
+/// The summary's keys that describe the input: command, format, files, snapshots, the
+/// sources of the accelerations and of the velocity gradients.
+fn summary_header(plan: &HomogenisePlan, snaps: &[ExternalSnapshot]) -> Summary {
     let mut summary = Summary::new();
     summary
         .text("command", "homogenise")
@@ -216,13 +257,83 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
                 .into(),
         );
     }
-    for ext in &snaps {
+    summary
+}
+
+/// The tables of the series of snapshots: `snapshots.csv`, `walls.csv`, the VTK series, and
+/// the report lines of the last snapshot.
+struct SeriesTables {
+    /// `snapshots.csv`.
+    table: CsvTable,
+    /// `walls.csv`.
+    walls: CsvTable,
+    /// The VTK series.
+    vtk: VtkSeries,
+    /// The walls' names, in the order of their first appearance.
+    wall_names: Vec<String>,
+    /// The report lines of the last snapshot added.
+    last_lines: Vec<String>,
+}
+
+impl SeriesTables {
+    /// Empty tables with their columns and comments.
+    fn new() -> Self {
+        let mut table = CsvTable::new(
+            &[
+                &[
+                    "step",
+                    "time_s",
+                    "grains",
+                    "contacts",
+                    "solid_fraction",
+                    "z",
+                    "z_without_rattlers",
+                    "rattler_fraction",
+                    "fabric_anisotropy",
+                    "fabric_major_angle_rad",
+                ][..],
+                &STRESS_COLUMNS,
+                &[
+                    "pressure_Pa",
+                    "shear_stress_Pa",
+                    "stress_ratio",
+                    "mean_mobilisation",
+                    "fraction_at_limit",
+                ],
+            ]
+            .concat(),
+        );
+        table
+            .comments
+            .push("whole-sample means per snapshot (grainlaw homogenise)".into());
+        let mut walls = CsvTable::new(&[
+            "step",
+            "wall",
+            "force_x_N",
+            "force_y_N",
+            "torque_Nm",
+            "contacts",
+        ]);
+        walls
+            .comments
+            .push("wall index: the order of `walls` in summary.json".into());
+        SeriesTables {
+            table,
+            walls,
+            vtk: VtkSeries::new(),
+            wall_names: Vec::new(),
+            last_lines: Vec::new(),
+        }
+    }
+
+    /// Adds one snapshot: its row, its `grains_STEP.csv`, its walls' rows, its VTK frame.
+    fn add(&mut self, out: &mut OutputDir, ext: &ExternalSnapshot) -> Result<()> {
         let s = &ext.snapshot;
         let (row, grains) = snapshot_row(ext)?;
         let (phi, z) = (row[4], row[5]);
         let whole_total = Tensor2::new(row[10], row[11], row[12], row[13]);
         let inv = stress_invariants(&whole_total);
-        table.push(row);
+        self.table.push(row);
         let mut g =
             CsvTable::new(&[&["id", "x_m", "y_m", "radius_m"][..], &STRESS_COLUMNS].concat());
         g.comments.push(format!(
@@ -238,13 +349,13 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
             r.extend(t4(&gs.inertia));
             g.push(r);
         }
-        g.write(&mut out, &format!("grains_{}.csv", s.step))?;
+        g.write(out, &format!("grains_{}.csv", s.step))?;
         for w in &s.walls {
-            let k = match wall_names.iter().position(|n| n == &w.name) {
+            let k = match self.wall_names.iter().position(|n| n == &w.name) {
                 Some(k) => k,
                 None => {
-                    wall_names.push(w.name.clone());
-                    wall_names.len() - 1
+                    self.wall_names.push(w.name.clone());
+                    self.wall_names.len() - 1
                 }
             };
             let nc = s
@@ -252,7 +363,7 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
                 .iter()
                 .filter(|c| c.body_a == w.body || c.body_b == w.body)
                 .count();
-            walls.push(vec![
+            self.walls.push(vec![
                 s.step as f64,
                 k as f64,
                 w.force.x,
@@ -261,8 +372,8 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
                 nc as f64,
             ]);
         }
-        vtk.add_frame(&mut out, s)?;
-        last_lines = vec![
+        self.vtk.add_frame(out, s)?;
+        self.last_lines = vec![
             format!(
                 "step {} (t = {:.6} s): {} grains, {} contacts, φ = {:.4}, Z = {:.3}, accelerations: {}",
                 s.step, s.time, grains.len(), s.contacts.len(), phi, z, ext.accelerations.name()
@@ -273,68 +384,19 @@ pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
                 inv.pressure, inv.friction.map_or("-".into(), |f| format!("{f:.4}"))
             ),
         ];
+        Ok(())
     }
-    table.write(&mut out, "snapshots.csv")?;
-    if !wall_names.is_empty() {
-        walls.write(&mut out, "walls.csv")?;
-    }
-    vtk.finish(&mut out)?;
-    let last = snaps
-        .last()
-        .ok_or_else(|| CliError::Usage("homogenise: no snapshot read".into()))?;
-    last_outputs(&mut out, last, &mut summary)?;
-    janssen_table(&mut out, &snaps, &plan.options, &mut summary)?;
-    summary.set("walls", wall_names.clone().into());
-    if let Some(c) = last.snapshot.cell {
-        summary
-            .set(
-                "cell_matrix_m",
-                vec![c.h[(0, 0)], c.h[(0, 1)], c.h[(1, 0)], c.h[(1, 1)]].into(),
-            )
-            .num("cell_area_m2", c.volume());
-    }
-    let rve = crate::rve::rve_point(&snaps)?;
-    if let Some(p) = &rve {
-        p.write(&mut out)?;
-        p.keys(&mut summary);
-    }
-    let s = &last.snapshot;
-    for w in &s.walls {
-        summary
-            .num(&format!("wall_{}_force_x_N", w.name), w.force.x)
-            .num(&format!("wall_{}_force_y_N", w.name), w.force.y);
-    }
-    summary.num("wall_seconds", started.elapsed().as_secs_f64());
-    out.write("summary.json", summary.to_json().as_bytes())?;
-    let mut lines = vec![format!("report: {}/", plan.out.display())];
-    lines.extend(last_lines);
-    for w in &s.walls {
-        lines.push(format!(
-            "wall {}: force ({:.6e}, {:.6e}) N",
-            w.name, w.force.x, w.force.y
-        ));
-    }
-    if let Some(p) = &rve {
-        lines.extend(p.lines());
-        if p.verdict == crate::verdict::Verdict::Refused {
-            return Err(CliError::Verdict {
-                dir: plan.out.display().to_string(),
-                reason: format!(
-                    "the simple-shear point is refused (rheology.csv, point_verdict 2): {}",
-                    p.checks
-                        .reasons
-                        .iter()
-                        .map(|r| r.message.as_str())
-                        .collect::<Vec<_>>()
-                        .join("; ")
-                ),
-            });
+
+    /// Writes `snapshots.csv`, `walls.csv` (when there are walls) and the VTK series; returns
+    /// the walls' names and the last snapshot's report lines.
+    fn finish(self, out: &mut OutputDir) -> Result<(Vec<String>, Vec<String>)> {
+        self.table.write(out, "snapshots.csv")?;
+        if !self.wall_names.is_empty() {
+            self.walls.write(out, "walls.csv")?;
         }
+        self.vtk.finish(out)?;
+        Ok((self.wall_names, self.last_lines))
     }
-    Ok(HomogeniseOutcome {
-        lines,
-        files: out.written().to_vec(),
-    })
 }
 
 /// The row of `snapshots.csv` of one snapshot (whole-sample means: solid fraction,
@@ -467,11 +529,32 @@ pub fn bench_homogenise(n: usize, dir: &std::path::Path) -> Result<(usize, f64, 
     Ok((contacts, (t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64()))
 }
 
-/// The outputs of the last snapshot: profiles, coarse fields, mobilisation, figures, summary keys.
+/// The outputs of the last snapshot: summary keys ([`last_summary_keys`]), the stress by
+/// slice, the walls' stress profiles, the mobilisation, the coarse-grained fields and the
+/// picture of the grains.
 fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summary) -> Result<()> {
     let s = &ext.snapshot;
     let grains = grain_stresses(s)?;
-    let whole = mean_stress(s, &grains, &Region::Whole)?;
+    last_summary_keys(ext, &grains, summary)?;
+    let d = mean_diameter(s);
+    slice_profile(out, s, &grains, d)?;
+    wall_profiles(out, s, d)?;
+    mobilisation_outputs(out, s, summary)?;
+    if d > 0.0 {
+        coarse_fields(out, s, &grains, d)?;
+    }
+    grains_figure(out, s, &grains)
+}
+
+/// The summary's whole-sample keys of the last snapshot: counts, solid fraction,
+/// coordination, fabric, mean stress and its parts, invariants.
+fn last_summary_keys(
+    ext: &ExternalSnapshot,
+    grains: &[homogenise::GrainStress],
+    summary: &mut Summary,
+) -> Result<()> {
+    let s = &ext.snapshot;
+    let whole = mean_stress(s, grains, &Region::Whole)?;
     let counting = ContactCounting::default();
     let inv = stress_invariants(&whole.total);
     let z = coordination(s, &Region::Whole, &counting)?;
@@ -504,86 +587,107 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
         .num("pressure_Pa", inv.pressure)
         .num("shear_stress_Pa", inv.shear_stress)
         .num("stress_ratio", inv.friction.unwrap_or(f64::NAN));
-    let d = mean_diameter(s);
-    // vertical stress by horizontal slices of two mean diameters
-    if let Some((_, _, y0, y1)) = grain_extent(s) {
-        let h = 2.0 * d;
-        let k = ((y1 - y0) / h).ceil().max(1.0) as usize;
-        let edges: Vec<f64> = (0..=k).map(|i| y0 + i as f64 * h).collect();
-        let prof = slice_stress_profile(s, &grains, &edges)?;
+    Ok(())
+}
+
+/// `stress_profile.csv` and `.png`: the mean stress in horizontal slices of two mean
+/// diameters `d` (nothing without grains).
+fn slice_profile(
+    out: &mut OutputDir,
+    s: &Snapshot,
+    grains: &[homogenise::GrainStress],
+    d: f64,
+) -> Result<()> {
+    let Some((_, _, y0, y1)) = grain_extent(s) else {
+        return Ok(());
+    };
+    let h = 2.0 * d;
+    let k = ((y1 - y0) / h).ceil().max(1.0) as usize;
+    let edges: Vec<f64> = (0..=k).map(|i| y0 + i as f64 * h).collect();
+    let prof = slice_stress_profile(s, grains, &edges)?;
+    let mut t = CsvTable::new(&[
+        "y_m",
+        "sigma_xx_Pa",
+        "sigma_xy_Pa",
+        "sigma_yx_Pa",
+        "sigma_yy_Pa",
+        "solid_area_fraction",
+    ]);
+    t.comments.push(format!(
+        "mean stress in horizontal slices of {h:e} m, step {}",
+        s.step
+    ));
+    let mut pts = Vec::new();
+    for (w, r) in edges.windows(2).zip(&prof) {
+        let y = 0.5 * (w[0] + w[1]);
+        let mut row = vec![y];
+        row.extend(t4(&r.total));
+        row.push(r.grain_area / r.area);
+        t.push(row);
+        pts.push((-r.total[(1, 1)], y));
+    }
+    t.write(out, "stress_profile.csv")?;
+    let mut plot = XyPlot::new(
+        "vertical stress by slice",
+        Axis::new("−σyy (Pa)"),
+        Axis::new("y (m)"),
+    );
+    plot.series.push(Series::new(
+        "−σyy",
+        Style::LinePoints,
+        crate::plot::colormap::viridis(0.2),
+        pts,
+    ));
+    draw_xy(out, "stress_profile.png", &plot)
+}
+
+/// `wall_profile_NAME.csv`: the stress profile along each wall (clumps left out) in depth
+/// bins of two mean diameters `d` along gravity (nothing without gravity).
+fn wall_profiles(out: &mut OutputDir, s: &Snapshot, d: f64) -> Result<()> {
+    let Ok(axis) = DepthAxis::from_gravity(s) else {
+        return Ok(());
+    };
+    let top = grain_extent(s).map(|e| e.3 - e.2).unwrap_or(0.0);
+    let width = 2.0 * d;
+    let count = ((top / width).ceil() as usize).max(1);
+    let Ok(bins) = DepthBins::new(axis, width, count) else {
+        return Ok(());
+    };
+    for w in &s.walls {
+        if matches!(w.geometry, WallGeometry::Clump { .. }) {
+            continue;
+        }
+        let Ok(p) = wall_stress_profile(s, &w.name, &bins) else {
+            continue;
+        };
         let mut t = CsvTable::new(&[
-            "y_m",
-            "sigma_xx_Pa",
-            "sigma_xy_Pa",
-            "sigma_yx_Pa",
-            "sigma_yy_Pa",
-            "solid_area_fraction",
+            "depth_m",
+            "normal_stress_Pa",
+            "shear_stress_Pa",
+            "contacts",
+            "mean_mobilisation",
         ]);
         t.comments.push(format!(
-            "mean stress in horizontal slices of {h:e} m, step {}",
-            s.step
+            "wall `{}`, step {}, bins of {width:e} m along gravity; one wall's stresses, tension positive: the table a Janssen fit reads is janssen.csv (grainlaw fit janssen janssen.csv)",
+            w.name, s.step
         ));
-        let mut pts = Vec::new();
-        for (w, r) in edges.windows(2).zip(&prof) {
-            let y = 0.5 * (w[0] + w[1]);
-            let mut row = vec![y];
-            row.extend(t4(&r.total));
-            row.push(r.grain_area / r.area);
-            t.push(row);
-            pts.push((-r.total[(1, 1)], y));
+        for b in &p {
+            t.push(vec![
+                b.depth(),
+                b.normal_stress,
+                b.shear_stress,
+                b.contacts as f64,
+                b.mean_mobilisation.unwrap_or(f64::NAN),
+            ]);
         }
-        t.write(out, "stress_profile.csv")?;
-        let mut plot = XyPlot::new(
-            "vertical stress by slice",
-            Axis::new("−σyy (Pa)"),
-            Axis::new("y (m)"),
-        );
-        plot.series.push(Series::new(
-            "−σyy",
-            Style::LinePoints,
-            crate::plot::colormap::viridis(0.2),
-            pts,
-        ));
-        draw_xy(out, "stress_profile.png", &plot)?;
+        t.write(out, &format!("wall_profile_{}.csv", sanitize(&w.name)))?;
     }
-    // wall stress profiles along walls not perpendicular to gravity
-    if let Ok(axis) = DepthAxis::from_gravity(s) {
-        let top = grain_extent(s).map(|e| e.3 - e.2).unwrap_or(0.0);
-        let width = 2.0 * d;
-        let count = ((top / width).ceil() as usize).max(1);
-        if let Ok(bins) = DepthBins::new(axis, width, count) {
-            for w in &s.walls {
-                if matches!(w.geometry, WallGeometry::Clump { .. }) {
-                    continue;
-                }
-                let Ok(p) = wall_stress_profile(s, &w.name, &bins) else {
-                    continue;
-                };
-                let mut t = CsvTable::new(&[
-                    "depth_m",
-                    "normal_stress_Pa",
-                    "shear_stress_Pa",
-                    "contacts",
-                    "mean_mobilisation",
-                ]);
-                t.comments.push(format!(
-                    "wall `{}`, step {}, bins of {width:e} m along gravity; one wall's stresses, tension positive: the table a Janssen fit reads is janssen.csv (grainlaw fit janssen janssen.csv)",
-                    w.name, s.step
-                ));
-                for b in &p {
-                    t.push(vec![
-                        b.depth(),
-                        b.normal_stress,
-                        b.shear_stress,
-                        b.contacts as f64,
-                        b.mean_mobilisation.unwrap_or(f64::NAN),
-                    ]);
-                }
-                t.write(out, &format!("wall_profile_{}.csv", sanitize(&w.name)))?;
-            }
-        }
-    }
-    // force polarisation: mobilisation of friction (needs a friction coefficient)
+    Ok(())
+}
+
+/// Force polarisation: the mobilisation of friction (it needs a friction coefficient), its
+/// summary keys and `mobilisation.csv` (its histogram).
+fn mobilisation_outputs(out: &mut OutputDir, s: &Snapshot, summary: &mut Summary) -> Result<()> {
     let mob: Vec<f64> = contact_mobilisations(s, &ContactClass::All)?
         .into_iter()
         .map(|(_, m)| m)
@@ -603,47 +707,63 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
         }
         t.write(out, "mobilisation.csv")?;
     }
-    // Gaussian coarse-grained fields, width one mean diameter, nodes every half diameter
-    if d > 0.0 {
-        let grid = Grid::covering(s, 0.5 * d, 5.0 * d)?;
-        if grid.nx * grid.ny <= 4_000_000 {
-            let f = coarse_grain(s, &grains, &grid, d, 5.0)?;
-            let mut t = CsvTable::new(&[
-                "x_m",
-                "y_m",
-                "density_kg_m3",
-                "velocity_x_m_s",
-                "velocity_y_m_s",
-                "sigma_xx_Pa",
-                "sigma_xy_Pa",
-                "sigma_yx_Pa",
-                "sigma_yy_Pa",
+    Ok(())
+}
+
+/// `coarse.csv`: Gaussian coarse-grained fields of width one mean diameter `d`, nodes every
+/// half diameter (left out above 4 million nodes).
+fn coarse_fields(
+    out: &mut OutputDir,
+    s: &Snapshot,
+    grains: &[homogenise::GrainStress],
+    d: f64,
+) -> Result<()> {
+    let grid = Grid::covering(s, 0.5 * d, 5.0 * d)?;
+    if grid.nx * grid.ny > 4_000_000 {
+        return Ok(());
+    }
+    let f = coarse_grain(s, grains, &grid, d, 5.0)?;
+    let mut t = CsvTable::new(&[
+        "x_m",
+        "y_m",
+        "density_kg_m3",
+        "velocity_x_m_s",
+        "velocity_y_m_s",
+        "sigma_xx_Pa",
+        "sigma_xy_Pa",
+        "sigma_yx_Pa",
+        "sigma_yy_Pa",
+    ]);
+    t.comments.push(format!(
+        "Gaussian coarse graining, width {d:e} m, cutoff 5 widths, step {}",
+        s.step
+    ));
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let x = grid.node(i, j);
+            let st = f.stress.at(i, j);
+            t.push(vec![
+                x.x,
+                x.y,
+                f.density[[j, i]],
+                f.velocity_x[[j, i]],
+                f.velocity_y[[j, i]],
+                st[(0, 0)],
+                st[(0, 1)],
+                st[(1, 0)],
+                st[(1, 1)],
             ]);
-            t.comments.push(format!(
-                "Gaussian coarse graining, width {d:e} m, cutoff 5 widths, step {}",
-                s.step
-            ));
-            for j in 0..grid.ny {
-                for i in 0..grid.nx {
-                    let x = grid.node(i, j);
-                    let st = f.stress.at(i, j);
-                    t.push(vec![
-                        x.x,
-                        x.y,
-                        f.density[[j, i]],
-                        f.velocity_x[[j, i]],
-                        f.velocity_y[[j, i]],
-                        st[(0, 0)],
-                        st[(0, 1)],
-                        st[(1, 0)],
-                        st[(1, 1)],
-                    ]);
-                }
-            }
-            t.write(out, "coarse.csv")?;
         }
     }
-    // the picture: grains coloured by their pressure, force chains
+    t.write(out, "coarse.csv")
+}
+
+/// `grains.png`: the grains coloured by their pressure, and the force chains.
+fn grains_figure(
+    out: &mut OutputDir,
+    s: &Snapshot,
+    grains: &[homogenise::GrainStress],
+) -> Result<()> {
     let p: Vec<f64> = grains.iter().map(|g| -g.total.trace() / 2.0).collect();
     let hi = p.iter().cloned().fold(0.0f64, f64::max);
     draw_particles(
@@ -666,8 +786,7 @@ fn last_outputs(out: &mut OutputDir, ext: &ExternalSnapshot, summary: &mut Summa
             width_px: 900,
             overlays: Vec::new(),
         },
-    )?;
-    Ok(())
+    )
 }
 
 /// The two side walls of a column: the vertical line walls whose normals point to +x (left)

@@ -18,6 +18,19 @@ fn read_text(path: &Path) -> PyResult<String> {
         .map_err(|e| OutputError::new_err(format!("{}: {e}", path.display())))
 }
 
+/// Runs `f` with the GIL released: its error as the Python error of [`cli_err`], a panic as
+/// that of [`panic_err`].
+fn detached<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce() -> grainlaw_core::error::Result<T> + Send,
+) -> PyResult<T> {
+    match py.detach(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f))) {
+        Err(p) => Err(panic_err(p)),
+        Ok(Err(e)) => Err(cli_err(py, e)),
+        Ok(Ok(o)) => Ok(o),
+    }
+}
+
 /// The columns of a numeric CSV the run wrote, as arrays (absent file: None).
 fn table<'py>(py: Python<'py>, path: &Path) -> PyResult<Option<Bound<'py, PyDict>>> {
     if !path.is_file() {
@@ -193,14 +206,8 @@ pub fn continuum<'py>(
                     "slope_deg and depth are options of the inclined-plane case",
                 ));
             }
-            let r = py.detach(|| {
-                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| column_collapse(&plan)))
-            });
-            match r {
-                Err(p) => return Err(panic_err(p)),
-                Ok(Err(e)) => return Err(cli_err(py, e)),
-                Ok(Ok(o)) => (o.lines, o.warnings, o.verdict, dir),
-            }
+            let o = detached(py, || column_collapse(&plan))?;
+            (o.lines, o.warnings, o.verdict, dir)
         }
         "inclined-plane" => {
             let dir = out
@@ -228,14 +235,8 @@ pub fn continuum<'py>(
                     "aspect_ratio, half_width, domain, t_end and band are options of the column-collapse case",
                 ));
             }
-            let r = py.detach(|| {
-                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| inclined_plane(&plan)))
-            });
-            match r {
-                Err(p) => return Err(panic_err(p)),
-                Ok(Err(e)) => return Err(cli_err(py, e)),
-                Ok(Ok(o)) => (o.lines, o.warnings, o.verdict, dir),
-            }
+            let o = detached(py, || inclined_plane(&plan))?;
+            (o.lines, o.warnings, o.verdict, dir)
         }
         other => {
             return Err(input(format!(

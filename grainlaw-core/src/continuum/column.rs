@@ -160,11 +160,128 @@ impl Setup {
     }
 }
 
+/// The resolved inputs of a column run: the law, the DEM run, the set-up and the rheology.
+struct ColumnConfig {
+    /// The law file, as given.
+    law_path: String,
+    /// The law.
+    law: CalibratedLaw,
+    /// The DEM run to compare with.
+    dem: Option<DemColumn>,
+    /// The law's grain diameter `d` (m).
+    d_m: f64,
+    /// Gravity (m/s²).
+    g: f64,
+    /// Packing fraction `φ` of the continuum.
+    phi: f64,
+    /// Side of a cell (units of `R₀`).
+    cell: f64,
+    /// The law as Gerris runs it.
+    rheology: GerrisRheology,
+    /// The resolved set-up.
+    setup: Setup,
+    /// Warnings so far.
+    warnings: Vec<String>,
+}
+
+/// What the central run measured for the report and summary.
+struct CentralMeasures {
+    /// Relative change of the grains' area over the run.
+    mass_change: f64,
+    /// The front at the end (units of `R₀`).
+    end_front: f64,
+    /// The height at `x = 0` at the end (units of `R₀`).
+    end_height: f64,
+    /// Front speed at the end (`R₀` per unit `t*`).
+    speed: f64,
+}
+
 /// Runs the column collapse of `plan` (module documentation). Errors: [`CliError::Input`] /
 /// [`CliError::Usage`] for bad input (exit 2), [`CliError::ExternalSolver`] when Gerris is
 /// missing or fails (exit 3, the case left in `OUT/gerris`), [`CliError::Io`] for files.
+///
+/// Stages: config ([`resolve_config`]) → the central Gerris run → its tables → checks →
+/// comparison with the DEM → band → figures → summary and report.
 pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
     crate::plot::init_font();
+    let mut cfg = resolve_config(plan)?;
+    check_column_out(plan)?;
+    let started = std::time::Instant::now();
+    let mut out = OutputDir::create(&plan.out)?;
+    let gerris_cmd = gerris::command(plan.gerris.as_deref());
+    let comments = run_comments(plan, &cfg);
+    let central = run_case(
+        &cfg.rheology,
+        &cfg.setup,
+        plan.level,
+        &comments,
+        &plan.out.join("gerris"),
+        &gerris_cmd,
+    )?;
+    let (front_rows, cont_profiles) = write_central(&mut out, &central, &cfg)?;
+    let (checks, measures, validity) = check_central(&mut cfg, &central);
+    let comparison = match &cfg.dem {
+        Some(d) => Some(write_comparison(
+            &mut out,
+            compare(d, &front_rows, &cont_profiles, &cfg.setup),
+        )?),
+        None => None,
+    };
+    let band = if plan.band {
+        Some(run_band(
+            plan,
+            &cfg.rheology,
+            &cfg.setup,
+            &central,
+            &comments,
+            &gerris_cmd,
+            cfg.dem.as_ref(),
+            &mut out,
+        )?)
+    } else {
+        None
+    };
+    front_figure(
+        &mut out,
+        &front_rows,
+        cfg.dem.as_ref(),
+        band.as_ref(),
+        &cfg.setup,
+    )?;
+    profiles_figure(&mut out, &cont_profiles, cfg.dem.as_ref(), &cfg.setup)?;
+    let verdict = RunVerdict {
+        run: checks,
+        laws: Vec::new(),
+        allow_suspect: plan.allow_suspect,
+    };
+    let report = ColumnReport {
+        plan,
+        cfg: &cfg,
+        central: &central,
+        measures: &measures,
+        validity: &validity,
+        comparison: comparison.as_ref(),
+        band: band.as_ref(),
+        verdict: &verdict,
+    };
+    let mut s = report.summary();
+    s.num("wall_seconds", started.elapsed().as_secs_f64());
+    s.text("grainlaw_version", identify::law::GRAINLAW_VERSION);
+    out.write("summary.json", s.to_json().as_bytes())?;
+    let lines = report.lines();
+    Ok(ColumnOutcome {
+        lines,
+        warnings: cfg.warnings,
+        verdict,
+        summary: serde_json::from_str(&s.to_json()).unwrap_or(Value::Null),
+        dir: plan.out.clone(),
+    })
+}
+
+/// Reads the law and the DEM run and resolves the set-up of `plan` (aspect ratio, `R₀`, `φ`,
+/// domain, end, reference instants) and the rheology. Errors: [`CliError::Usage`] for a bad
+/// setting, those of the readers for bad files.
+fn resolve_config(plan: &ColumnPlan) -> Result<ColumnConfig> {
     let law_path = plan.law.display().to_string();
     let law = load_continuum_law(&plan.law)?;
     let dem = plan.dem.as_deref().map(DemColumn::read).transpose()?;
@@ -210,22 +327,7 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
         })?;
     let g = ds.map_or(9.81, |s| s.gravity_m_s2);
     if let Some(s) = ds {
-        let rel = |a: f64, b: f64| (a - b).abs() / b;
-        if rel(d_m, s.mean_diameter_m) > 0.05 {
-            warnings.push(format!(
-                "the law's grain diameter d = {d_m:.4e} m differs from the DEM grains' {:.4e} m by {:.0} %: the law is used with its own d (D = d/R0 = {:.4})",
-                s.mean_diameter_m,
-                100.0 * rel(d_m, s.mean_diameter_m),
-                d_m / r0
-            ));
-        }
-        let rho = law.constant("rho_s").unwrap_or(f64::NAN);
-        if rel(rho, s.grain_density_kg_m3) > 0.05 {
-            warnings.push(format!(
-                "the law's grain density {rho} kg/m³ differs from the DEM grains' {} kg/m³",
-                s.grain_density_kg_m3
-            ));
-        }
+        dem_grain_warnings(&law, s, d_m, r0, &mut warnings);
     }
     let domain = plan.domain.unwrap_or_else(|| default_domain(a));
     if !(domain.is_finite() && domain > 1.2 * a.max(1.0)) {
@@ -262,7 +364,50 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
             "the run ends at t* = {end_t_star}: the reference instants after it are left out"
         ));
     }
-    // never into a DEM run's (or another scenario's) directory: its files would be replaced
+    Ok(ColumnConfig {
+        law_path,
+        law,
+        dem,
+        d_m,
+        g,
+        phi,
+        cell,
+        rheology,
+        setup,
+        warnings,
+    })
+}
+
+/// Warnings when the law's grains (diameter `d_m`, density) differ from the DEM run's by more
+/// than 5 %.
+fn dem_grain_warnings(
+    law: &CalibratedLaw,
+    s: &dem_column::ColumnSummary,
+    d_m: f64,
+    r0: f64,
+    warnings: &mut Vec<String>,
+) {
+    let rel = |a: f64, b: f64| (a - b).abs() / b;
+    if rel(d_m, s.mean_diameter_m) > 0.05 {
+        warnings.push(format!(
+            "the law's grain diameter d = {d_m:.4e} m differs from the DEM grains' {:.4e} m by {:.0} %: the law is used with its own d (D = d/R0 = {:.4})",
+            s.mean_diameter_m,
+            100.0 * rel(d_m, s.mean_diameter_m),
+            d_m / r0
+        ));
+    }
+    let rho = law.constant("rho_s").unwrap_or(f64::NAN);
+    if rel(rho, s.grain_density_kg_m3) > 0.05 {
+        warnings.push(format!(
+            "the law's grain density {rho} kg/m³ differs from the DEM grains' {} kg/m³",
+            s.grain_density_kg_m3
+        ));
+    }
+}
+
+/// Refuses an output directory that is the DEM run's (its files would be replaced) or that
+/// holds another scenario's run.
+fn check_column_out(plan: &ColumnPlan) -> Result<()> {
     if let Some(d) = &plan.dem {
         if same_dir(d, &plan.out) {
             return Err(CliError::Usage(format!(
@@ -271,33 +416,35 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
             )));
         }
     }
-    crate::output::dir::check_out_dir(&plan.out, "continuum-column-collapse")?;
-    let started = std::time::Instant::now();
-    let mut out = OutputDir::create(&plan.out)?;
-    let gerris_cmd = gerris::command(plan.gerris.as_deref());
-    let case_dir = plan.out.join("gerris");
-    let comments = vec![
-        format!(
-            "grainlaw {} continuum column-collapse: the {} law of {law_path}",
-            identify::law::GRAINLAW_VERSION,
-            law.law
-        ),
-        format!(
-            "column a = H0/R0 = {a}, R0 = {r0} m, level {} in a domain of {domain} R0 (cells {cell} R0)",
-            plan.level
-        ),
-    ];
-    let central = run_case(
-        &rheology,
-        &setup,
-        plan.level,
-        &comments,
-        &case_dir,
-        &gerris_cmd,
-    )?;
+    crate::output::dir::check_out_dir(&plan.out, "continuum-column-collapse")
+}
 
-    // -- outputs of the central run
-    let ts = rheology.units.time_s();
+/// The comment lines at the head of the Gerris case.
+fn run_comments(plan: &ColumnPlan, cfg: &ColumnConfig) -> Vec<String> {
+    vec![
+        format!(
+            "grainlaw {} continuum column-collapse: the {} law of {}",
+            identify::law::GRAINLAW_VERSION,
+            cfg.law.law,
+            cfg.law_path
+        ),
+        format!(
+            "column a = H0/R0 = {}, R0 = {} m, level {} in a domain of {} R0 (cells {} R0)",
+            cfg.setup.aspect_ratio, cfg.setup.half_width_m, plan.level, cfg.setup.domain, cfg.cell
+        ),
+    ]
+}
+
+/// Writes the central run's `front.csv` and `profiles.csv` (SI units); returns the front rows
+/// and the profiles by label.
+fn write_central(
+    out: &mut OutputDir,
+    central: &CaseResult,
+    cfg: &ColumnConfig,
+) -> Result<(Vec<FrontRow>, std::collections::BTreeMap<String, Profile>)> {
+    let setup = &cfg.setup;
+    let r0 = setup.half_width_m;
+    let ts = cfg.rheology.units.time_s();
     let front_rows: Vec<FrontRow> = central
         .front
         .iter()
@@ -319,7 +466,7 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
         }
     }
     dem_column::write_front(
-        &mut out,
+        out,
         &front_rows,
         &format!(
             "continuum (Gerris) column collapse: front x_f where the height exceeds {:.4e} m (max(d, cell)); t* = t sqrt(g/H0)",
@@ -327,13 +474,18 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
         ),
     )?;
     dem_column::write_profiles(
-        &mut out,
+        out,
         &profile_rows,
         "continuum (Gerris) column collapse: height of the grains h(x) = sum of T dy over each column of cells, at the reference instants and at the end (label end)",
     )?;
     let cont_profiles = dem_column::group_profiles(profile_rows.clone());
+    Ok((front_rows, cont_profiles))
+}
 
-    // -- checks
+/// The checks of the central run (mass, domain, validity range; warnings into `cfg`), what
+/// it measured, and the validity report.
+fn check_central(cfg: &mut ColumnConfig, central: &CaseResult) -> (Checks, CentralMeasures, Value) {
+    let (domain, cell, r0) = (cfg.setup.domain, cfg.cell, cfg.setup.half_width_m);
     let mut checks = Checks::new();
     let mass_change = (central.area.1 - central.area.0) / central.area.0;
     checks.at_most(
@@ -364,187 +516,201 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
         );
     }
     let validity = validity_report(
-        &rheology,
+        &cfg.rheology,
         &central.inertial,
-        &setup,
+        &cfg.setup,
         &mut checks,
-        &mut warnings,
+        &mut cfg.warnings,
     );
-
-    // -- comparison with the DEM
-    let comparison = dem
-        .as_ref()
-        .map(|d| compare(d, &front_rows, &cont_profiles, &setup));
-    if let Some(c) = &comparison {
-        dem_column::write_rows(
-            &mut out,
-            "comparison.csv",
-            &c.rows,
-            "continuum minus DEM at each reference instant and at rest (rest: DEM at rest, continuum at its end); x_f where the height exceeds the threshold; h differences over the DEM's bins up to the larger front",
-        )?;
-        out.write(
-            "comparison.json",
-            (serde_json::to_string_pretty(&c.to_json())
-                .map_err(|e| CliError::io(out.file("comparison.json"), e))?
-                + "\n")
-                .as_bytes(),
-        )?;
-    }
-
-    // -- the band of the law's uncertainty
-    let band = if plan.band {
-        Some(run_band(
-            plan,
-            &rheology,
-            &setup,
-            &central,
-            &comments,
-            &gerris_cmd,
-            dem.as_ref(),
-            &mut out,
-        )?)
-    } else {
-        None
-    };
-
-    // -- figures
-    front_figure(&mut out, &front_rows, dem.as_ref(), band.as_ref(), &setup)?;
-    profiles_figure(&mut out, &cont_profiles, dem.as_ref(), &setup)?;
-
-    // -- summary and report
-    let verdict = RunVerdict {
-        run: checks,
-        laws: Vec::new(),
-        allow_suspect: plan.allow_suspect,
-    };
-    let end_front = central.front.last().map_or(f64::NAN, |p| p.1);
-    let speed = front_speed(&central.front, setup.time_scale());
-    let mut s = Summary::new();
-    s.text("scenario", "continuum-column-collapse")
-        .text("solver", "gerris")
-        .text("solver_version", central.run.version.as_deref().unwrap_or(""))
-        .num("solver_wall_seconds", central.run.wall_seconds)
-        .text("law_file", &law_path)
-        .text("law", &law.law)
-        .set("law_parameters", parameters_json(&law))
-        .set(
-            "column",
-            json!({
-                "initial_half_width_m": r0,
-                "initial_height_m": a * r0,
-                "aspect_ratio": a,
-                "mean_diameter_m": d_m,
-                "gravity_m_s2": g,
-                "grain_density_kg_m3": rheology.grain_density_kg_m3(),
-                "initial_packing_fraction": phi,
-                "runout_m": end_front * r0,
-                "final_height_m": central.profiles.iter().find(|p| p.0 == "end").and_then(|p| p.2.first()).map_or(f64::NAN, |p| p.1) * r0,
-                "end_time_s": end_t_star * a.sqrt() * ts,
-                "end_t_star": end_t_star,
-                "front_speed_at_end_m_s": speed * r0 / ts / a.sqrt(),
-                "reference_instants_t_star": setup.references.iter().map(|r| r.1).collect::<Vec<_>>(),
-            }),
-        )
-        .set(
-            "gerris",
-            json!({
-                "case": "gerris/column.gfs",
-                "level": plan.level,
-                "domain_R0": domain,
-                "cell_R0": cell,
-                "cell_over_d": cell / rheology.grain_diameter(),
-                "front_threshold_m": setup.threshold * r0,
-                "units": rheology.units,
-                "grain_diameter_over_R0": rheology.grain_diameter(),
-                "regularisation": rheology.regularisation,
-                "light_phase": LightPhase::default(),
-                "grain_area_change": mass_change,
-                "max_speed_at_end_m_s": central.end_speed * rheology.units.velocity_m_s(),
-            }),
-        )
-        .set("validity", validity.clone());
-    if let Some(c) = &comparison {
-        s.set("comparison", c.to_json());
-        s.text(
-            "dem_dir",
-            &dem.as_ref()
-                .map(|d| d.dir.display().to_string())
-                .unwrap_or_default(),
-        );
-    }
-    if let Some(b) = &band {
-        s.set("band", b.json.clone());
-    }
-    verdict.keys(&mut s);
-    s.set(
-        "warnings",
-        Value::Array(warnings.iter().map(|w| Value::from(w.as_str())).collect()),
-    );
-    s.num("wall_seconds", started.elapsed().as_secs_f64());
-    s.text("grainlaw_version", identify::law::GRAINLAW_VERSION);
-    out.write("summary.json", s.to_json().as_bytes())?;
-
-    let mut lines = vec![format!("report: {}/", plan.out.display())];
-    lines.push(format!(
-        "law {} of {law_path}: {}",
-        law.law,
-        law.parameters
-            .iter()
-            .map(|p| format!("{} = {:.4}", p.name, p.value))
-            .collect::<Vec<_>>()
-            .join(", ")
-    ));
-    lines.push(format!(
-        "column a = {a}, R0 = {:.4} m, φ = {phi:.3}, d/R0 = {:.4}; Gerris level {} in {domain} R0 (cell {cell:.4} R0 = {:.2} d), {:.1} s",
-        r0,
-        rheology.grain_diameter(),
-        plan.level,
-        cell / rheology.grain_diameter(),
-        central.run.wall_seconds
-    ));
-    lines.push(format!(
-        "front x_f/R0 at t* = {}: {}",
-        setup
-            .references
-            .iter()
-            .map(|r| format!("{}", r.1))
-            .collect::<Vec<_>>()
-            .join(", "),
-        setup
-            .references
-            .iter()
-            .map(|r| format!(
-                "{:.2}",
-                interpolate(&central.front, r.1 * setup.time_scale())
-            ))
-            .collect::<Vec<_>>()
-            .join(", ")
-    ));
-    lines.push(format!(
-        "at t* = {end_t_star}: x_f = {:.3} R0, h(0) = {:.3} R0, front speed {:.3} R0 per unit t*",
-        end_front,
-        central
+    let measures = CentralMeasures {
+        mass_change,
+        end_front: central.front.last().map_or(f64::NAN, |p| p.1),
+        end_height: central
             .profiles
             .iter()
             .find(|p| p.0 == "end")
             .and_then(|p| p.2.first())
             .map_or(f64::NAN, |p| p.1),
-        speed
-    ));
-    if let Some(c) = &comparison {
-        lines.extend(c.lines());
+        speed: front_speed(&central.front, cfg.setup.time_scale()),
+    };
+    (checks, measures, validity)
+}
+
+/// Writes `comparison.csv` and `comparison.json` of `c`; returns it.
+fn write_comparison(out: &mut OutputDir, c: Comparison) -> Result<Comparison> {
+    dem_column::write_rows(
+        out,
+        "comparison.csv",
+        &c.rows,
+        "continuum minus DEM at each reference instant and at rest (rest: DEM at rest, continuum at its end); x_f where the height exceeds the threshold; h differences over the DEM's bins up to the larger front",
+    )?;
+    out.write(
+        "comparison.json",
+        (serde_json::to_string_pretty(&c.to_json())
+            .map_err(|e| CliError::io(out.file("comparison.json"), e))?
+            + "\n")
+            .as_bytes(),
+    )?;
+    Ok(c)
+}
+
+/// Everything the summary and the report of a column run draw on.
+struct ColumnReport<'a> {
+    /// The plan run.
+    plan: &'a ColumnPlan,
+    /// Its resolved inputs.
+    cfg: &'a ColumnConfig,
+    /// The central Gerris run.
+    central: &'a CaseResult,
+    /// What the central run measured.
+    measures: &'a CentralMeasures,
+    /// The validity report ([`validity_report`]).
+    validity: &'a Value,
+    /// The comparison with the DEM run, if any.
+    comparison: Option<&'a Comparison>,
+    /// The band of the law's uncertainty, if run.
+    band: Option<&'a BandResult>,
+    /// The verdict.
+    verdict: &'a RunVerdict,
+}
+
+impl ColumnReport<'_> {
+    /// `summary.json` without its wall time and version.
+    fn summary(&self) -> Summary {
+        let (cfg, central, m) = (self.cfg, self.central, self.measures);
+        let (rheology, setup) = (&cfg.rheology, &cfg.setup);
+        let (a, r0, domain, cell) = (
+            setup.aspect_ratio,
+            setup.half_width_m,
+            setup.domain,
+            cfg.cell,
+        );
+        let ts = rheology.units.time_s();
+        let mut s = gerris::summary_head(
+            "continuum-column-collapse",
+            &central.run,
+            &cfg.law_path,
+            &cfg.law.law,
+        );
+        s.set("law_parameters", parameters_json(&cfg.law))
+            .set(
+                "column",
+                json!({
+                    "initial_half_width_m": r0,
+                    "initial_height_m": a * r0,
+                    "aspect_ratio": a,
+                    "mean_diameter_m": cfg.d_m,
+                    "gravity_m_s2": cfg.g,
+                    "grain_density_kg_m3": rheology.grain_density_kg_m3(),
+                    "initial_packing_fraction": cfg.phi,
+                    "runout_m": m.end_front * r0,
+                    "final_height_m": m.end_height * r0,
+                    "end_time_s": setup.end_t_star * a.sqrt() * ts,
+                    "end_t_star": setup.end_t_star,
+                    "front_speed_at_end_m_s": m.speed * r0 / ts / a.sqrt(),
+                    "reference_instants_t_star": setup.references.iter().map(|r| r.1).collect::<Vec<_>>(),
+                }),
+            )
+            .set(
+                "gerris",
+                json!({
+                    "case": "gerris/column.gfs",
+                    "level": self.plan.level,
+                    "domain_R0": domain,
+                    "cell_R0": cell,
+                    "cell_over_d": cell / rheology.grain_diameter(),
+                    "front_threshold_m": setup.threshold * r0,
+                    "units": rheology.units,
+                    "grain_diameter_over_R0": rheology.grain_diameter(),
+                    "regularisation": rheology.regularisation,
+                    "light_phase": LightPhase::default(),
+                    "grain_area_change": m.mass_change,
+                    "max_speed_at_end_m_s": central.end_speed * rheology.units.velocity_m_s(),
+                }),
+            )
+            .set("validity", self.validity.clone());
+        if let Some(c) = self.comparison {
+            s.set("comparison", c.to_json());
+            s.text(
+                "dem_dir",
+                &cfg.dem
+                    .as_ref()
+                    .map(|d| d.dir.display().to_string())
+                    .unwrap_or_default(),
+            );
+        }
+        if let Some(b) = self.band {
+            s.set("band", b.json.clone());
+        }
+        self.verdict.keys(&mut s);
+        s.set(
+            "warnings",
+            Value::Array(
+                cfg.warnings
+                    .iter()
+                    .map(|w| Value::from(w.as_str()))
+                    .collect(),
+            ),
+        );
+        s
     }
-    if let Some(b) = &band {
-        lines.extend(b.lines.clone());
+
+    /// The report printed on stdout.
+    fn lines(&self) -> Vec<String> {
+        let (plan, cfg, central, m) = (self.plan, self.cfg, self.central, self.measures);
+        let (law, rheology, setup) = (&cfg.law, &cfg.rheology, &cfg.setup);
+        let (a, domain, cell) = (setup.aspect_ratio, setup.domain, cfg.cell);
+        let mut lines = vec![format!("report: {}/", plan.out.display())];
+        lines.push(format!(
+            "law {} of {}: {}",
+            law.law,
+            cfg.law_path,
+            law.parameters
+                .iter()
+                .map(|p| format!("{} = {:.4}", p.name, p.value))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        lines.push(format!(
+            "column a = {a}, R0 = {:.4} m, φ = {:.3}, d/R0 = {:.4}; Gerris level {} in {domain} R0 (cell {cell:.4} R0 = {:.2} d), {:.1} s",
+            setup.half_width_m,
+            cfg.phi,
+            rheology.grain_diameter(),
+            plan.level,
+            cell / rheology.grain_diameter(),
+            central.run.wall_seconds
+        ));
+        lines.push(format!(
+            "front x_f/R0 at t* = {}: {}",
+            setup
+                .references
+                .iter()
+                .map(|r| format!("{}", r.1))
+                .collect::<Vec<_>>()
+                .join(", "),
+            setup
+                .references
+                .iter()
+                .map(|r| format!(
+                    "{:.2}",
+                    interpolate(&central.front, r.1 * setup.time_scale())
+                ))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        lines.push(format!(
+            "at t* = {}: x_f = {:.3} R0, h(0) = {:.3} R0, front speed {:.3} R0 per unit t*",
+            setup.end_t_star, m.end_front, m.end_height, m.speed
+        ));
+        if let Some(c) = self.comparison {
+            lines.extend(c.lines());
+        }
+        if let Some(b) = self.band {
+            lines.extend(b.lines.clone());
+        }
+        lines.extend(self.verdict.lines());
+        lines
     }
-    lines.extend(verdict.lines());
-    Ok(ColumnOutcome {
-        lines,
-        warnings,
-        verdict,
-        summary: serde_json::from_str(&s.to_json()).unwrap_or(Value::Null),
-        dir: plan.out.clone(),
-    })
 }
 
 /// Whether `a` and `b` name the same directory (both canonicalised when they exist).
@@ -940,6 +1106,34 @@ struct BandResult {
     lines: Vec<String>,
 }
 
+/// What the band's Gerris runs gave: the central run and the others by label.
+struct BandRuns<'a> {
+    /// The central run.
+    central: &'a CaseResult,
+    /// The other runs by their set's label (`axis{k}±`).
+    by_label: std::collections::BTreeMap<String, CaseResult>,
+    /// Number of principal axes.
+    n_axes: usize,
+}
+
+impl BandRuns<'_> {
+    /// The band of the quantity `f` of a run (`None` when the central value is not finite).
+    fn band_of(&self, f: &dyn Fn(&CaseResult) -> f64) -> Option<Band> {
+        let value_of = |label: &str| -> Option<f64> { self.by_label.get(label).map(f) };
+        let pairs: Vec<(Option<f64>, Option<f64>)> = (0..self.n_axes)
+            .map(|a| {
+                (
+                    value_of(&format!("axis{}+", a + 1)),
+                    value_of(&format!("axis{}-", a + 1)),
+                )
+            })
+            .collect();
+        Band::of(f(self.central), &pairs)
+    }
+}
+
+/// Runs the band of the law's uncertainty: the sets along the covariance's principal axes
+/// (stages: the runs → the front's band → the instants → `band.csv` → the report).
 #[allow(clippy::too_many_arguments)]
 fn run_band(
     plan: &ColumnPlan,
@@ -952,6 +1146,82 @@ fn run_band(
     out: &mut OutputDir,
 ) -> Result<BandResult> {
     let sets = band::parameter_sets(&rheology.law, &rheology.law_path)?;
+    let (by_label, skipped) = run_band_cases(plan, rheology, setup, comments, gerris_cmd, &sets)?;
+    let runs = BandRuns {
+        central,
+        by_label,
+        n_axes: sets
+            .iter()
+            .skip(1)
+            .filter_map(|s| s.axis.map(|a| a.0))
+            .max()
+            .map_or(0, |m| m + 1),
+    };
+    let k = setup.time_scale();
+    let r0 = setup.half_width_m;
+    let front: Vec<(f64, Band)> = central
+        .front
+        .iter()
+        .filter_map(|&(t, _)| {
+            runs.band_of(&|c: &CaseResult| interpolate(&c.front, t) * r0)
+                .map(|b| (t / k, b))
+        })
+        .collect();
+    let (rows, inside_count) = band_instants(&runs, setup, dem);
+    write_band_csv(out, &front)?;
+    let run_list: Vec<Value> = sets
+        .iter()
+        .map(|s| {
+            let r = if s.label == "central" {
+                Some(central)
+            } else {
+                runs.by_label.get(&s.label)
+            };
+            json!({
+                "label": s.label,
+                "parameters": s.values,
+                "run": r.is_some(),
+                "runout_m": r.map(|c| c.front.last().map_or(f64::NAN, |p| p.1) * r0),
+            })
+        })
+        .collect();
+    let verdict_line = band_verdict_line(dem, inside_count);
+    let mut lines = vec![format!(
+        "band of the law's uncertainty: {} runs ({} sets, {} skipped as unphysical) along the covariance's principal axes at the law's {:.0} % interval",
+        runs.by_label.len() + 1,
+        sets.len(),
+        skipped.len(),
+        100.0 * rheology.law.fit.confidence
+    )];
+    lines.extend(rows.iter().map(|r| band_row_line(r, r0)));
+    lines.push(verdict_line.clone());
+    Ok(BandResult {
+        front,
+        json: json!({
+            "method": "2p+1 runs: the law's estimate and ± t sqrt(lambda_k) e_k along the covariance's principal axes (t of the law's intervals); band = central ± sqrt(sum_k ((f+ - f-)/2)^2)",
+            "confidence": rheology.law.fit.confidence,
+            "runs": run_list,
+            "skipped": skipped,
+            "instants": rows,
+            "dem_inside": inside_count.0,
+            "dem_compared": inside_count.1,
+            "verdict": verdict_line,
+        }),
+        lines,
+    })
+}
+
+/// Runs the band's sets other than the central one, `plan.jobs` Gerris runs at once, each in
+/// `OUT/band/LABEL`; returns the runs and the sets skipped as unphysical. The first failed
+/// run's error is returned.
+fn run_band_cases(
+    plan: &ColumnPlan,
+    rheology: &GerrisRheology,
+    setup: &Setup,
+    comments: &[String],
+    gerris_cmd: &Path,
+    sets: &[ParameterSet],
+) -> Result<(std::collections::BTreeMap<String, CaseResult>, Vec<String>)> {
     let others: Vec<&ParameterSet> = sets.iter().skip(1).collect();
     let mut skipped = Vec::new();
     let mut jobs: Vec<(&ParameterSet, GerrisRheology)> = Vec::new();
@@ -990,35 +1260,19 @@ fn run_band(
     for (label, r) in results {
         by_label.insert(label, r?);
     }
+    Ok((by_label, skipped))
+}
+
+/// The band of the front at the reference instants and at the end, with the DEM's front
+/// placed in it: the rows of `band.json`'s `instants` and `(inside, compared)`.
+fn band_instants(
+    runs: &BandRuns,
+    setup: &Setup,
+    dem: Option<&DemColumn>,
+) -> (Vec<Value>, (usize, usize)) {
     let k = setup.time_scale();
     let r0 = setup.half_width_m;
-    let n_axes = others
-        .iter()
-        .filter_map(|s| s.axis.map(|a| a.0))
-        .max()
-        .map_or(0, |m| m + 1);
-    let value_of =
-        |label: &str, f: &dyn Fn(&CaseResult) -> f64| -> Option<f64> { by_label.get(label).map(f) };
-    let band_of = |f: &dyn Fn(&CaseResult) -> f64| -> Option<Band> {
-        let pairs: Vec<(Option<f64>, Option<f64>)> = (0..n_axes)
-            .map(|a| {
-                (
-                    value_of(&format!("axis{}+", a + 1), f),
-                    value_of(&format!("axis{}-", a + 1), f),
-                )
-            })
-            .collect();
-        Band::of(f(central), &pairs)
-    };
-    let front: Vec<(f64, Band)> = central
-        .front
-        .iter()
-        .filter_map(|&(t, _)| {
-            band_of(&|c: &CaseResult| interpolate(&c.front, t) * r0).map(|b| (t / k, b))
-        })
-        .collect();
     let mut rows = Vec::new();
-    let mut lines = Vec::new();
     let mut inside_count = (0usize, 0usize);
     let dem_front: Vec<(f64, f64)> = dem
         .map(|d| d.front.iter().map(|r| (r.t_star, r.x_f_m)).collect())
@@ -1041,7 +1295,7 @@ fn run_band(
                 interpolate(&c.front, t * k) * r0
             }
         };
-        if let Some(b) = band_of(&f) {
+        if let Some(b) = runs.band_of(&f) {
             let inside = dem_x.map(|x| b.contains(x));
             if let Some(i) = inside {
                 inside_count.1 += 1;
@@ -1056,7 +1310,12 @@ fn run_band(
             }));
         }
     }
-    // band.csv: t*, central, low, high of x_f on the central run's history
+    (rows, inside_count)
+}
+
+/// Writes `band.csv`: `t*`, central, low, high and envelope of `x_f` on the central run's
+/// history.
+fn write_band_csv(out: &mut OutputDir, front: &[(f64, Band)]) -> Result<()> {
     let mut table = crate::output::CsvTable::new(&[
         "t_star",
         "x_f_central_m",
@@ -1068,7 +1327,7 @@ fn run_band(
     table.comments.push(
         "band of the front from the law's covariance: central ± sqrt(sum over principal axes of ((x_f(+) - x_f(-))/2)^2) (docs/continuum.md §5)".into(),
     );
-    for (t, b) in &front {
+    for (t, b) in front {
         table.push(vec![
             *t,
             b.central,
@@ -1078,24 +1337,12 @@ fn run_band(
             b.envelope_high,
         ]);
     }
-    table.write(out, "band.csv")?;
-    let runs: Vec<Value> = sets
-        .iter()
-        .map(|s| {
-            let r = if s.label == "central" {
-                Some(central)
-            } else {
-                by_label.get(&s.label)
-            };
-            json!({
-                "label": s.label,
-                "parameters": s.values,
-                "run": r.is_some(),
-                "runout_m": r.map(|c| c.front.last().map_or(f64::NAN, |p| p.1) * r0),
-            })
-        })
-        .collect();
-    let verdict_line = if dem.is_some() {
+    table.write(out, "band.csv")
+}
+
+/// The band's verdict: at how many instants the DEM front lies inside the band.
+fn band_verdict_line(dem: Option<&DemColumn>, inside_count: (usize, usize)) -> String {
+    if dem.is_some() {
         format!(
             "band verdict: the DEM front lies inside the law's band at {} of {} instants compared (the reference instants{}){}",
             inside_count.0,
@@ -1105,49 +1352,29 @@ fn run_band(
         )
     } else {
         "band: no DEM run given (--dem) to place in it".to_string()
-    };
-    lines.push(format!(
-        "band of the law's uncertainty: {} runs ({} sets, {} skipped as unphysical) along the covariance's principal axes at the law's {:.0} % interval",
-        by_label.len() + 1,
-        sets.len(),
-        skipped.len(),
-        100.0 * rheology.law.fit.confidence
-    ));
-    for r in &rows {
-        lines.push(format!(
-            "  {:<9} x_f/R0 {:.2} [{:.2}, {:.2}]{}",
-            match r["label"].as_str().unwrap_or("") {
-                "end" => "r∞ (end)",
-                l => l,
-            },
-            r["x_f_central_m"].as_f64().unwrap_or(f64::NAN) / r0,
-            r["x_f_low_m"].as_f64().unwrap_or(f64::NAN) / r0,
-            r["x_f_high_m"].as_f64().unwrap_or(f64::NAN) / r0,
-            match (r["x_f_dem_m"].as_f64(), r["dem_inside"].as_bool()) {
-                (Some(x), Some(i)) => format!(
-                    "; DEM {:.2} {}",
-                    x / r0,
-                    if i { "inside" } else { "OUTSIDE" }
-                ),
-                _ => String::new(),
-            }
-        ));
     }
-    lines.push(verdict_line.clone());
-    Ok(BandResult {
-        front,
-        json: json!({
-            "method": "2p+1 runs: the law's estimate and ± t sqrt(lambda_k) e_k along the covariance's principal axes (t of the law's intervals); band = central ± sqrt(sum_k ((f+ - f-)/2)^2)",
-            "confidence": rheology.law.fit.confidence,
-            "runs": runs,
-            "skipped": skipped,
-            "instants": rows,
-            "dem_inside": inside_count.0,
-            "dem_compared": inside_count.1,
-            "verdict": verdict_line,
-        }),
-        lines,
-    })
+}
+
+/// The report line of one instant of the band (`r` a row of [`band_instants`]).
+fn band_row_line(r: &Value, r0: f64) -> String {
+    format!(
+        "  {:<9} x_f/R0 {:.2} [{:.2}, {:.2}]{}",
+        match r["label"].as_str().unwrap_or("") {
+            "end" => "r∞ (end)",
+            l => l,
+        },
+        r["x_f_central_m"].as_f64().unwrap_or(f64::NAN) / r0,
+        r["x_f_low_m"].as_f64().unwrap_or(f64::NAN) / r0,
+        r["x_f_high_m"].as_f64().unwrap_or(f64::NAN) / r0,
+        match (r["x_f_dem_m"].as_f64(), r["dem_inside"].as_bool()) {
+            (Some(x), Some(i)) => format!(
+                "; DEM {:.2} {}",
+                x / r0,
+                if i { "inside" } else { "OUTSIDE" }
+            ),
+            _ => String::new(),
+        }
+    )
 }
 
 fn front_figure(

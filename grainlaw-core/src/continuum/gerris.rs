@@ -10,6 +10,7 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use crate::error::{CliError, Result};
+use crate::output::Summary;
 
 /// The Gerris 2D solver's command when none is given.
 pub const DEFAULT_GERRIS: &str = "gerris2D";
@@ -118,4 +119,17 @@ pub fn command(given: Option<&Path>) -> PathBuf {
 /// Whether `gerris` can be started (for tests that need it).
 pub fn available(gerris: &Path) -> bool {
     version(gerris).is_some()
+}
+
+/// The first keys of the summary of a continuum case run by Gerris: `scenario`, `solver`,
+/// `solver_version`, `solver_wall_seconds`, `law_file` and `law` (the law's name).
+pub fn summary_head(scenario: &str, run: &GerrisRun, law_file: &str, law: &str) -> Summary {
+    let mut s = Summary::new();
+    s.text("scenario", scenario)
+        .text("solver", "gerris")
+        .text("solver_version", run.version.as_deref().unwrap_or(""))
+        .num("solver_wall_seconds", run.wall_seconds)
+        .text("law_file", law_file)
+        .text("law", law);
+    s
 }

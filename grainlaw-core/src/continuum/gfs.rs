@@ -49,6 +49,14 @@ pub struct ColumnCase {
     pub comments: Vec<String>,
 }
 
+/// The provenance comments of a case, one `# ` line each.
+fn comment_block(comments: &[String]) -> String {
+    comments
+        .iter()
+        .map(|c| format!("# {}\n", sanitize_comment(c)))
+        .collect()
+}
+
 impl ColumnCase {
     /// Side of the finest cells (units of `R₀`), `domain/2^level`.
     pub fn cell_size(&self) -> f64 {
@@ -60,10 +68,7 @@ impl ColumnCase {
         let r = &self.rheology;
         let l = &self.light;
         let lit = |v: f64| c_literal(v);
-        let mut s = String::new();
-        for c in &self.comments {
-            s.push_str(&format!("# {}\n", sanitize_comment(c)));
-        }
+        let mut s = comment_block(&self.comments);
         s.push_str(&format!(
             "# Units (Gerris): length R0 = {r0:e} m, gravity g = {g} m/s^2, density rho_b = phi rho_s = {rb} kg/m^3;\n\
              # time sqrt(R0/g) = {ts:e} s, t* = t sqrt(g/H0) = t_Gerris/sqrt(a); pressure rho_b g R0 = {pu:e} Pa;\n\
@@ -166,10 +171,7 @@ impl InclinedCase {
     pub fn to_gfs(&self) -> Result<String> {
         let r = &self.rheology;
         let lit = |v: f64| c_literal(v);
-        let mut s = String::new();
-        for c in &self.comments {
-            s.push_str(&format!("# {}\n", sanitize_comment(c)));
-        }
+        let mut s = comment_block(&self.comments);
         s.push_str(&format!(
             "# Units (Gerris): length H = {h:e} m, gravity g = {g} m/s^2, density rho_b = phi rho_s = {rb} kg/m^3;\n\
              # velocity sqrt(g H) = {vu:e} m/s; pressure rho_b g H = {pu:e} Pa. I = sqrt(2) D2 D/sqrt(phi P), D = d/H = {d:e}, phi = {phi}.\n\

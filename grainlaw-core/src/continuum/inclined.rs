@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 use identify::continuum::BagnoldFlow;
+use identify::law::CalibratedLaw;
 
 use super::column::interpolate;
 use super::dem_column::{read_rows, write_rows};
@@ -185,10 +186,120 @@ struct DemRow {
     velocity_bagnold_m_s: f64,
 }
 
+/// The resolved inputs of an inclined-plane run: the law, the DEM run, the layer and the
+/// analytic Bagnold flow of the law on the slope.
+struct InclinedConfig {
+    /// The law file, as given.
+    law_path: String,
+    /// The law.
+    law: CalibratedLaw,
+    /// The DEM run to compare with.
+    dem: Option<DemFlow>,
+    /// Warnings so far.
+    warnings: Vec<String>,
+    /// The law's grain diameter `d` (m).
+    d_m: f64,
+    /// Slope (degrees).
+    slope_deg: f64,
+    /// Slope `θ` (radians).
+    theta: f64,
+    /// Depth of the layer `H` (m).
+    depth: f64,
+    /// Packing fraction `φ` of the layer.
+    phi: f64,
+    /// The law as Gerris runs it.
+    rheology: GerrisRheology,
+    /// The inertial number of steady flow on the slope, `μ(I_θ) = tan θ`.
+    i_theta: f64,
+    /// The analytic steady flow of the law.
+    flow: BagnoldFlow,
+    /// Velocity unit of the case (m/s).
+    uv: f64,
+    /// The analytic surface velocity (Gerris units).
+    u_surface_g: f64,
+}
+
+/// The Gerris run of the layer, read back and set against the analytic profile.
+struct InclinedRun {
+    /// The run.
+    run: gerris::GerrisRun,
+    /// Gerris' last step, when its log gives one.
+    steps: Option<u64>,
+    /// `(z, u)` of Gerris (Gerris units, averaged along the slope).
+    gerris_profile: Vec<(f64, f64)>,
+    /// Largest `|u_Gerris − u_Bagnold|` over the analytic surface velocity.
+    max_err: f64,
+    /// RMS of `u_Gerris − u_Bagnold` over the analytic surface velocity.
+    rms_err: f64,
+    /// The rows of `profile.csv`.
+    table: Vec<ProfileRow>,
+}
+
+impl InclinedRun {
+    /// Gerris' surface velocity (m/s).
+    fn surface_velocity(&self, uv: f64) -> f64 {
+        self.gerris_profile.last().map_or(f64::NAN, |p| p.1) * uv
+    }
+}
+
 /// Runs the inclined plane of `plan` (module documentation). Errors as
 /// [`super::column::column_collapse`]; a slope without steady flow for the law is bad input.
+///
+/// Stages: config ([`resolve_inclined`]) → the Gerris run → its profile against Bagnold's →
+/// checks → comparison with the DEM → figure → summary and report.
 pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
     crate::plot::init_font();
+    let mut cfg = resolve_inclined(plan)?;
+    if let Some(d) = &plan.dem {
+        if super::column::same_dir(d, &plan.out) {
+            return Err(CliError::Usage(format!(
+                "--out {}: is the DEM run's directory (--dem): choose another",
+                plan.out.display()
+            )));
+        }
+    }
+    crate::output::dir::check_out_dir(&plan.out, "continuum-inclined-plane")?;
+    let mut out = OutputDir::create(&plan.out)?;
+    let run = run_inclined_case(plan, &cfg)?;
+    write_rows(
+        &mut out,
+        "profile.csv",
+        &run.table,
+        "steady flow down the slope: Gerris (averaged along the slope, cell centres) and the analytic Bagnold profile of the same law; height above the base",
+    )?;
+    let checks = inclined_checks(&mut cfg, run.steps);
+    let (dem_rows, dem_json) = dem_comparison(&cfg, &run.gerris_profile);
+    if !dem_rows.is_empty() {
+        write_rows(
+            &mut out,
+            "comparison.csv",
+            &dem_rows,
+            "the DEM's time-averaged velocity profile against Gerris (interpolated) and the analytic Bagnold profile, at the DEM's bins",
+        )?;
+    }
+    velocity_figure(&mut out, plan, &cfg, &run.table)?;
+    let verdict = RunVerdict {
+        run: checks,
+        laws: Vec::new(),
+        allow_suspect: plan.allow_suspect,
+    };
+    let s = inclined_summary(plan, &cfg, &run, dem_json.as_ref(), &verdict);
+    out.write("summary.json", s.to_json().as_bytes())?;
+    let lines = inclined_lines(plan, &cfg, &run, dem_json.as_ref(), &verdict);
+    Ok(InclinedOutcome {
+        lines,
+        warnings: cfg.warnings,
+        verdict,
+        summary: serde_json::from_str(&s.to_json()).unwrap_or(Value::Null),
+        gerris_profile: run.gerris_profile,
+        max_relative_error: run.max_err,
+    })
+}
+
+/// Reads the law and the DEM run and resolves the layer of `plan` (slope, depth, `φ`), the
+/// rheology and the law's steady flow on the slope. Errors: [`CliError::Usage`] for a bad
+/// setting, [`CliError::Input`] for a slope without steady flow.
+fn resolve_inclined(plan: &InclinedPlan) -> Result<InclinedConfig> {
     let law_path = plan.law.display().to_string();
     let law = load_continuum_law(&plan.law)?;
     let dem = plan.dem.as_deref().map(read_dem).transpose()?;
@@ -254,28 +365,42 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
         })?;
     let uv = rheology.units.velocity_m_s();
     let u_surface_g = flow.surface_velocity() / uv;
-    if let Some(d) = &plan.dem {
-        if super::column::same_dir(d, &plan.out) {
-            return Err(CliError::Usage(format!(
-                "--out {}: is the DEM run's directory (--dem): choose another",
-                plan.out.display()
-            )));
-        }
-    }
-    crate::output::dir::check_out_dir(&plan.out, "continuum-inclined-plane")?;
-    let mut out = OutputDir::create(&plan.out)?;
+    Ok(InclinedConfig {
+        law_path,
+        law,
+        dem,
+        warnings,
+        d_m,
+        slope_deg,
+        theta,
+        depth,
+        phi,
+        rheology,
+        i_theta,
+        flow,
+        uv,
+        u_surface_g,
+    })
+}
+
+/// Writes the case into `OUT/gerris` (stale snapshots removed), runs Gerris to steady flow,
+/// reads its end snapshot and sets its profile against the analytic one.
+fn run_inclined_case(plan: &InclinedPlan, cfg: &InclinedConfig) -> Result<InclinedRun> {
     let case_dir = plan.out.join("gerris");
     let case = InclinedCase {
-        rheology: rheology.clone(),
-        slope_rad: theta,
+        rheology: cfg.rheology.clone(),
+        slope_rad: cfg.theta,
         level: plan.level,
-        initial_surface_velocity: 2.0 * u_surface_g,
-        steady_tolerance: STEADY_TOLERANCE * u_surface_g,
+        initial_surface_velocity: 2.0 * cfg.u_surface_g,
+        steady_tolerance: STEADY_TOLERANCE * cfg.u_surface_g,
         max_steps: MAX_STEPS,
         comments: vec![format!(
-            "grainlaw {} continuum inclined-plane: the {} law of {law_path}; slope {slope_deg} deg, H = {depth} m, level {}",
+            "grainlaw {} continuum inclined-plane: the {} law of {}; slope {} deg, H = {} m, level {}",
             identify::law::GRAINLAW_VERSION,
-            law.law,
+            cfg.law.law,
+            cfg.law_path,
+            cfg.slope_deg,
+            cfg.depth,
             plan.level
         )],
     };
@@ -298,20 +423,9 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
     }
     let snap = Snapshot::read(&endp)?;
     let steps = last_step(&case_dir.join("gerris.log"));
-    // average along the slope: one value per row of cells
-    let mut rows: Vec<(f64, f64, f64)> = Vec::new(); // (y, sum u, n)
-    for c in &snap.cells {
-        match rows.iter_mut().find(|r| (r.0 - c.y).abs() < 1e-9) {
-            Some(r) => {
-                r.1 += c.u;
-                r.2 += 1.0;
-            }
-            None => rows.push((c.y, c.u, 1.0)),
-        }
-    }
-    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let gerris_profile: Vec<(f64, f64)> = rows.iter().map(|r| (r.0, r.1 / r.2)).collect();
-    let analytic = |z: f64| flow.velocity(z * depth) / uv;
+    let gerris_profile = along_slope_average(&snap);
+    let (depth, uv, u_surface_g) = (cfg.depth, cfg.uv, cfg.u_surface_g);
+    let analytic = |z: f64| cfg.flow.velocity(z * depth) / uv;
     let max_err = gerris_profile
         .iter()
         .map(|&(z, u)| (u - analytic(z)).abs())
@@ -329,15 +443,38 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
         .map(|&(z, u)| ProfileRow {
             height_m: z * depth,
             velocity_gerris_m_s: u * uv,
-            velocity_bagnold_m_s: flow.velocity(z * depth),
+            velocity_bagnold_m_s: cfg.flow.velocity(z * depth),
         })
         .collect();
-    write_rows(
-        &mut out,
-        "profile.csv",
-        &table,
-        "steady flow down the slope: Gerris (averaged along the slope, cell centres) and the analytic Bagnold profile of the same law; height above the base",
-    )?;
+    Ok(InclinedRun {
+        run,
+        steps,
+        gerris_profile,
+        max_err,
+        rms_err,
+        table,
+    })
+}
+
+/// The snapshot's velocity averaged along the slope: one `(y, u)` per row of cells, by `y`.
+fn along_slope_average(snap: &Snapshot) -> Vec<(f64, f64)> {
+    let mut rows: Vec<(f64, f64, f64)> = Vec::new(); // (y, sum u, n)
+    for c in &snap.cells {
+        match rows.iter_mut().find(|r| (r.0 - c.y).abs() < 1e-9) {
+            Some(r) => {
+                r.1 += c.u;
+                r.2 += 1.0;
+            }
+            None => rows.push((c.y, c.u, 1.0)),
+        }
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    rows.iter().map(|r| (r.0, r.1 / r.2)).collect()
+}
+
+/// The checks of the run: steady flow reached, the slope's `I` inside the law's calibrated
+/// range (a warning into `cfg` when not).
+fn inclined_checks(cfg: &mut InclinedConfig, steps: Option<u64>) -> Checks {
     let mut checks = Checks::new();
     if steps.is_some_and(|s| s + 10 >= MAX_STEPS) {
         checks.fail(
@@ -350,9 +487,10 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
             ),
         );
     }
-    if let Some(limit) = rheology.validity_max() {
+    let i_theta = cfg.i_theta;
+    if let Some(limit) = cfg.rheology.validity_max() {
         if i_theta > limit {
-            warnings.push(format!(
+            cfg.warnings.push(format!(
                 "the slope's I = {i_theta:.3} is above the law's calibrated range (I ≤ {limit:.3}, {:.1} × the limit): the whole layer flows on the law's extrapolation",
                 i_theta / limit
             ));
@@ -365,7 +503,18 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
             );
         }
     }
-    let dem_rows: Vec<DemRow> = dem
+    checks
+}
+
+/// The DEM's profile against Gerris' and Bagnold's: the rows of `comparison.csv` and the
+/// summary's `dem` object (both empty without a DEM run).
+fn dem_comparison(
+    cfg: &InclinedConfig,
+    gerris_profile: &[(f64, f64)],
+) -> (Vec<DemRow>, Option<Value>) {
+    let (depth, uv, flow) = (cfg.depth, cfg.uv, &cfg.flow);
+    let dem_rows: Vec<DemRow> = cfg
+        .dem
         .as_ref()
         .map(|d| {
             d.profile
@@ -373,13 +522,13 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
                 .map(|&(z, u)| DemRow {
                     height_m: z,
                     velocity_dem_m_s: u,
-                    velocity_gerris_m_s: interpolate(&gerris_profile, z / depth) * uv,
+                    velocity_gerris_m_s: interpolate(gerris_profile, z / depth) * uv,
                     velocity_bagnold_m_s: flow.velocity(z),
                 })
                 .collect()
         })
         .unwrap_or_default();
-    let dem_json = dem.as_ref().map(|d| {
+    let dem_json = cfg.dem.as_ref().map(|d| {
         let us = d.profile.iter().map(|p| p.1).fold(f64::NAN, f64::max);
         let rms = (dem_rows
             .iter()
@@ -397,17 +546,22 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
             "dem_packing_fraction": d.packing_fraction,
         })
     });
-    if !dem_rows.is_empty() {
-        write_rows(
-            &mut out,
-            "comparison.csv",
-            &dem_rows,
-            "the DEM's time-averaged velocity profile against Gerris (interpolated) and the analytic Bagnold profile, at the DEM's bins",
-        )?;
-    }
-    // figure
+    (dem_rows, dem_json)
+}
+
+/// `velocity.png`: Bagnold's profile, Gerris' and the DEM's.
+fn velocity_figure(
+    out: &mut OutputDir,
+    plan: &InclinedPlan,
+    cfg: &InclinedConfig,
+    table: &[ProfileRow],
+) -> Result<()> {
+    let (law, i_theta) = (&cfg.law, cfg.i_theta);
     let mut plot = XyPlot::new(
-        &format!("Steady flow down a {slope_deg}° slope: μ(I) in Gerris, Bagnold, DEM"),
+        &format!(
+            "Steady flow down a {}° slope: μ(I) in Gerris, Bagnold, DEM",
+            cfg.slope_deg
+        ),
         Axis::new("velocity along the slope u (m/s)"),
         Axis::new("height above the base z (m)"),
     );
@@ -416,7 +570,11 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
         &format!("Bagnold, analytic (I = {i_theta:.3})"),
         Style::Line,
         PALETTE[6],
-        flow.profile(200).into_iter().map(|(z, u)| (u, z)).collect(),
+        cfg.flow
+            .profile(200)
+            .into_iter()
+            .map(|(z, u)| (u, z))
+            .collect(),
     ));
     plot.series.push(Series::new(
         &format!(
@@ -431,7 +589,7 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
             .map(|r| (r.velocity_gerris_m_s, r.height_m))
             .collect(),
     ));
-    if let Some(d) = &dem {
+    if let Some(d) = &cfg.dem {
         plot.series.push(Series::new(
             "DEM (inclined-flow, time average)",
             Style::Points,
@@ -440,84 +598,105 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
         ));
     }
     plot.notes.push(format!(
-        "{}: {}; φ = {phi:.3}, H = {:.2} mm, d = {:.2} mm",
+        "{}: {}; φ = {:.3}, H = {:.2} mm, d = {:.2} mm",
         law.law,
         law.parameters
             .iter()
             .map(|p| format!("{} = {:.3}", p.name, p.value))
             .collect::<Vec<_>>()
             .join(", "),
-        depth * 1e3,
-        d_m * 1e3
+        cfg.phi,
+        cfg.depth * 1e3,
+        cfg.d_m * 1e3
     ));
-    draw_xy(&mut out, "velocity.png", &plot)?;
-    let verdict = RunVerdict {
-        run: checks,
-        laws: Vec::new(),
-        allow_suspect: plan.allow_suspect,
-    };
-    let mut s = Summary::new();
-    s.text("scenario", "continuum-inclined-plane")
-        .text("solver", "gerris")
-        .text("solver_version", run.version.as_deref().unwrap_or(""))
-        .num("solver_wall_seconds", run.wall_seconds)
-        .text("law_file", &law_path)
-        .text("law", &law.law)
-        .num("slope_deg", slope_deg)
-        .num("depth_m", depth)
-        .num("packing_fraction", phi)
-        .num("inertial_number", i_theta)
-        .num("bagnold_surface_velocity_m_s", flow.surface_velocity())
-        .num(
-            "gerris_surface_velocity_m_s",
-            gerris_profile.last().map_or(f64::NAN, |p| p.1) * uv,
-        )
-        .num("max_relative_error_vs_bagnold", max_err)
-        .num("rms_relative_error_vs_bagnold", rms_err)
+    draw_xy(out, "velocity.png", &plot)
+}
+
+/// `summary.json` of the run.
+fn inclined_summary(
+    plan: &InclinedPlan,
+    cfg: &InclinedConfig,
+    run: &InclinedRun,
+    dem_json: Option<&Value>,
+    verdict: &RunVerdict,
+) -> Summary {
+    let rheology = &cfg.rheology;
+    let mut s = gerris::summary_head(
+        "continuum-inclined-plane",
+        &run.run,
+        &cfg.law_path,
+        &cfg.law.law,
+    );
+    s.num("slope_deg", cfg.slope_deg)
+        .num("depth_m", cfg.depth)
+        .num("packing_fraction", cfg.phi)
+        .num("inertial_number", cfg.i_theta)
+        .num("bagnold_surface_velocity_m_s", cfg.flow.surface_velocity())
+        .num("gerris_surface_velocity_m_s", run.surface_velocity(cfg.uv))
+        .num("max_relative_error_vs_bagnold", run.max_err)
+        .num("rms_relative_error_vs_bagnold", run.rms_err)
         .set(
             "gerris",
             json!({
                 "case": "gerris/inclined.gfs",
                 "level": plan.level,
                 "cells_across": 1u32 << plan.level,
-                "steps": steps,
+                "steps": run.steps,
                 "units": rheology.units,
                 "grain_diameter_over_H": rheology.grain_diameter(),
                 "regularisation": rheology.regularisation,
             }),
         );
-    if let Some(j) = &dem_json {
+    if let Some(j) = dem_json {
         s.set("dem", j.clone());
     }
     verdict.keys(&mut s);
     s.set(
         "warnings",
-        Value::Array(warnings.iter().map(|w| Value::from(w.as_str())).collect()),
+        Value::Array(
+            cfg.warnings
+                .iter()
+                .map(|w| Value::from(w.as_str()))
+                .collect(),
+        ),
     );
     s.text("grainlaw_version", identify::law::GRAINLAW_VERSION);
-    out.write("summary.json", s.to_json().as_bytes())?;
+    s
+}
+
+/// The report printed on stdout.
+fn inclined_lines(
+    plan: &InclinedPlan,
+    cfg: &InclinedConfig,
+    run: &InclinedRun,
+    dem_json: Option<&Value>,
+    verdict: &RunVerdict,
+) -> Vec<String> {
     let mut lines = vec![
         format!("report: {}/", plan.out.display()),
         format!(
-            "{} on a {slope_deg}° slope (tan θ = {:.4}): I = {i_theta:.4}; layer H = {:.2} mm = {:.1} d, φ = {phi:.3}",
-            law.law,
-            theta.tan(),
-            depth * 1e3,
-            depth / d_m
+            "{} on a {}° slope (tan θ = {:.4}): I = {:.4}; layer H = {:.2} mm = {:.1} d, φ = {:.3}",
+            cfg.law.law,
+            cfg.slope_deg,
+            cfg.theta.tan(),
+            cfg.i_theta,
+            cfg.depth * 1e3,
+            cfg.depth / cfg.d_m,
+            cfg.phi
         ),
         format!(
             "Gerris level {} ({} cells across), {} steps, {:.1} s: surface velocity {:.4} m/s, Bagnold {:.4} m/s; largest difference {:.2e} of it (RMS {:.2e})",
             plan.level,
             1u32 << plan.level,
-            steps.map_or("?".into(), |s| s.to_string()),
-            run.wall_seconds,
-            gerris_profile.last().map_or(f64::NAN, |p| p.1) * uv,
-            flow.surface_velocity(),
-            max_err,
-            rms_err
+            run.steps.map_or("?".into(), |s| s.to_string()),
+            run.run.wall_seconds,
+            run.surface_velocity(cfg.uv),
+            cfg.flow.surface_velocity(),
+            run.max_err,
+            run.rms_err
         ),
     ];
-    if let Some(j) = &dem_json {
+    if let Some(j) = dem_json {
         lines.push(format!(
             "DEM surface velocity {:.4} m/s; RMS difference Gerris − DEM {:.4} m/s ({:.0} % of the DEM's surface velocity)",
             j["dem_surface_velocity_m_s"].as_f64().unwrap_or(f64::NAN),
@@ -526,14 +705,7 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
         ));
     }
     lines.extend(verdict.lines());
-    Ok(InclinedOutcome {
-        lines,
-        warnings,
-        verdict,
-        summary: serde_json::from_str(&s.to_json()).unwrap_or(Value::Null),
-        gerris_profile,
-        max_relative_error: max_err,
-    })
+    lines
 }
 
 /// The last `step: N` of Gerris' progress lines in `log`.

@@ -52,8 +52,8 @@ pub const PALETTE: [RGBColor; 7] = [
     RGBColor(80, 80, 80),
 ];
 
-/// Boxed error of a drawing closure.
-pub type DrawResult = std::result::Result<(), Box<dyn std::error::Error>>;
+/// Boxed error of a drawing closure (and what it returns, nothing by default).
+pub type DrawResult<T = ()> = std::result::Result<T, Box<dyn std::error::Error>>;
 
 /// Draws a `size` PNG named `name` in `out` with `draw`, atomically.
 pub fn render<F>(out: &mut OutputDir, name: &str, size: (u32, u32), draw: F) -> Result<()>

@@ -109,22 +109,24 @@ pub struct Band {
 impl Band {
     /// A band from points `(x, lo, hi)`.
     pub fn between(label: &str, color: RGBColor, pts: &[(f64, f64, f64)]) -> Self {
-        let mut outline: Vec<(f64, f64)> = pts.iter().map(|&(x, lo, _)| (x, lo)).collect();
-        outline.extend(pts.iter().rev().map(|&(x, _, hi)| (x, hi)));
-        Self {
-            label: label.to_string(),
-            color,
-            outline: outline
-                .into_iter()
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-                .collect(),
-        }
+        Self::outlined(label, color, pts, |a, b| (a, b))
     }
 
     /// A band from points `(y, x_lo, x_hi)` (for profiles drawn with x as the value).
     pub fn between_x(label: &str, color: RGBColor, pts: &[(f64, f64, f64)]) -> Self {
-        let mut outline: Vec<(f64, f64)> = pts.iter().map(|&(y, lo, _)| (lo, y)).collect();
-        outline.extend(pts.iter().rev().map(|&(y, _, hi)| (hi, y)));
+        Self::outlined(label, color, pts, |a, b| (b, a))
+    }
+
+    /// The band of points `(s, lo, hi)`, `place(s, v)` the drawn point of value `v` at `s`:
+    /// the lower curve forward then the upper one backward, non-finite points left out.
+    fn outlined(
+        label: &str,
+        color: RGBColor,
+        pts: &[(f64, f64, f64)],
+        place: impl Fn(f64, f64) -> (f64, f64),
+    ) -> Self {
+        let mut outline: Vec<(f64, f64)> = pts.iter().map(|&(s, lo, _)| place(s, lo)).collect();
+        outline.extend(pts.iter().rev().map(|&(s, _, hi)| place(s, hi)));
         Self {
             label: label.to_string(),
             color,
@@ -319,10 +321,13 @@ impl XyPlot {
         }
     }
 
+    /// Draws the figure into `area` on the coordinates `xr`, `yr` (linear or logarithmic)
+    /// spanning `ranges`: the mesh → the bands → each series with its error bars → the legend
+    /// → the notes.
     fn draw_generic<XR, YR>(
         &self,
         area: &DrawingArea<BitMapBackend, Shift>,
-        ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+        ranges: ((f64, f64), (f64, f64)),
         xr: XR,
         yr: YR,
     ) -> DrawResult
@@ -341,8 +346,30 @@ impl XyPlot {
             builder.caption(&self.title, font(TITLE_SIZE));
         }
         let mut chart = builder.build_cartesian_2d(xr, yr)?;
+        self.draw_mesh(&mut chart, ranges)?;
+        let mut labelled = self.draw_bands(&mut chart)?;
+        for s in &self.series {
+            self.draw_error_bars(&mut chart, s, ranges)?;
+            labelled |= draw_series(&mut chart, s)?;
+        }
+        if labelled {
+            self.draw_legend(&mut chart)?;
+        }
+        self.draw_notes(area, &chart)
+    }
+
+    /// The axes, their labels and the grid; a logarithmic axis spanning less than a decade
+    /// labels every tick.
+    fn draw_mesh<'a, 'b: 'a, X, Y>(
+        &self,
+        chart: &mut XyChart<'a, 'b, X, Y>,
+        ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+    ) -> DrawResult
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
         let (xlog, ylog) = (self.x.log, self.y.log);
-        // a logarithmic axis spanning less than a decade labels every tick
         let within_decade = |a: f64, b: f64| a.max(b) < 10.0 * a.min(b);
         let (xall, yall) = (within_decade(x0, x1), within_decade(y0, y1));
         let xf = move |v: &f64| match (xlog, xall) {
@@ -365,6 +392,15 @@ impl XyPlot {
             .x_label_formatter(&xf)
             .y_label_formatter(&yf)
             .draw()?;
+        Ok(())
+    }
+
+    /// The bands, shaded; whether one is in the legend.
+    fn draw_bands<'a, 'b: 'a, X, Y>(&self, chart: &mut XyChart<'a, 'b, X, Y>) -> DrawResult<bool>
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
         let mut labelled = false;
         for b in &self.bands {
             let c = b.color;
@@ -379,114 +415,155 @@ impl XyPlot {
                 });
             }
         }
-        for s in &self.series {
-            let c = s.color;
-            let (xlo, ylo) = (x0.min(x1), y0.min(y1));
-            for (x, y, ex, ey) in s.error_bars() {
-                // on a logarithmic axis a bar reaching zero or below is cut at the axis
-                let low = |v: f64, e: f64, log: bool, floor: f64| {
-                    if log && v - e <= 0.0 {
-                        floor
-                    } else {
-                        v - e
-                    }
-                };
-                if ey > 0.0 {
-                    chart.draw_series(std::iter::once(ErrorBar::new_vertical(
-                        x,
-                        low(y, ey, ylog, ylo),
-                        y,
-                        y + ey,
-                        c.stroke_width(2),
-                        10,
-                    )))?;
-                }
-                if ex > 0.0 {
-                    chart.draw_series(std::iter::once(ErrorBar::new_horizontal(
-                        y,
-                        low(x, ex, xlog, xlo),
-                        x,
-                        x + ex,
-                        c.stroke_width(2),
-                        10,
-                    )))?;
-                }
+        Ok(labelled)
+    }
+
+    /// The error bars of series `s` on the chart spanning `ranges`; on a logarithmic axis a
+    /// bar reaching zero or below is cut at the axis.
+    fn draw_error_bars<'a, 'b: 'a, X, Y>(
+        &self,
+        chart: &mut XyChart<'a, 'b, X, Y>,
+        s: &Series,
+        ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+    ) -> DrawResult
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let (xlog, ylog) = (self.x.log, self.y.log);
+        let c = s.color;
+        let (xlo, ylo) = (x0.min(x1), y0.min(y1));
+        let low = |v: f64, e: f64, log: bool, floor: f64| {
+            if log && v - e <= 0.0 {
+                floor
+            } else {
+                v - e
             }
-            let anno = match s.style {
-                Style::Line | Style::Thin | Style::LinePoints => {
-                    let w = if s.style == Style::Thin { 1 } else { 3 };
-                    if s.style == Style::LinePoints {
-                        chart.draw_series(s.xy.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
-                    }
-                    let a = chart.draw_series(LineSeries::new(s.xy.clone(), c.stroke_width(w)))?;
-                    Some((a, s.style))
-                }
-                Style::Dashed => {
-                    let pts = dash(&s.xy, |p| chart.as_coord_spec().translate(p));
-                    let mut a = None;
-                    for seg in pts {
-                        a = Some(chart.draw_series(LineSeries::new(seg, c.stroke_width(2)))?);
-                    }
-                    a.map(|a| (a, s.style))
-                }
-                Style::Points => Some((
-                    chart.draw_series(s.xy.iter().map(|&p| Circle::new(p, 4, c.filled())))?,
-                    s.style,
-                )),
-                Style::Circles => Some((
-                    chart
-                        .draw_series(s.xy.iter().map(|&p| Circle::new(p, 5, c.stroke_width(2))))?,
-                    s.style,
-                )),
-            };
-            if let (Some((a, style)), false) = (anno, s.label.is_empty()) {
-                labelled = true;
-                a.label(s.label.as_str()).legend(
-                    move |(x, y)| -> DynElement<'static, BitMapBackend, (i32, i32)> {
-                        match style {
-                            Style::Points => Circle::new((x + 11, y), 4, c.filled()).into_dyn(),
-                            Style::Circles => {
-                                Circle::new((x + 11, y), 5, c.stroke_width(2)).into_dyn()
-                            }
-                            Style::Dashed => {
-                                PathElement::new(vec![(x, y), (x + 8, y)], c.stroke_width(2))
-                                    .into_dyn()
-                            }
-                            _ => PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(3))
-                                .into_dyn(),
-                        }
-                    },
-                );
+        };
+        for (x, y, ex, ey) in s.error_bars() {
+            if ey > 0.0 {
+                chart.draw_series(std::iter::once(ErrorBar::new_vertical(
+                    x,
+                    low(y, ey, ylog, ylo),
+                    y,
+                    y + ey,
+                    c.stroke_width(2),
+                    10,
+                )))?;
             }
-        }
-        if labelled {
-            // a legend in the upper left goes below the notes drawn there
-            let position = match (&self.legend, self.notes.len()) {
-                (LegendAt::UpperLeft, n) if n > 0 => LegendAt::Coordinate(5, 10 + 22 * n as i32),
-                (l, _) => l.clone(),
-            };
-            chart
-                .configure_series_labels()
-                .position(position)
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(150, 150, 150))
-                .label_font(font(16.0))
-                .draw()?;
-        }
-        if !self.notes.is_empty() {
-            // Pixel ranges are absolute; `area.draw` takes coordinates relative to the area.
-            let (px, py) = chart.plotting_area().get_pixel_range();
-            let (ax, ay) = area.get_base_pixel();
-            for (k, n) in self.notes.iter().enumerate() {
-                area.draw(&Text::new(
-                    n.clone(),
-                    (px.start - ax + 12, py.start - ay + 10 + 22 * k as i32),
-                    font(16.0),
-                ))?;
+            if ex > 0.0 {
+                chart.draw_series(std::iter::once(ErrorBar::new_horizontal(
+                    y,
+                    low(x, ex, xlog, xlo),
+                    x,
+                    x + ex,
+                    c.stroke_width(2),
+                    10,
+                )))?;
             }
         }
         Ok(())
     }
+
+    /// The legend (one in the upper left goes below the notes drawn there).
+    fn draw_legend<'a, 'b: 'a, X, Y>(&self, chart: &mut XyChart<'a, 'b, X, Y>) -> DrawResult
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let position = match (&self.legend, self.notes.len()) {
+            (LegendAt::UpperLeft, n) if n > 0 => LegendAt::Coordinate(5, 10 + 22 * n as i32),
+            (l, _) => l.clone(),
+        };
+        chart
+            .configure_series_labels()
+            .position(position)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(150, 150, 150))
+            .label_font(font(16.0))
+            .draw()?;
+        Ok(())
+    }
+
+    /// The notes, in the upper left of the plotting area.
+    fn draw_notes<'a, 'b: 'a, X, Y>(
+        &self,
+        area: &DrawingArea<BitMapBackend, Shift>,
+        chart: &XyChart<'a, 'b, X, Y>,
+    ) -> DrawResult
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        if self.notes.is_empty() {
+            return Ok(());
+        }
+        // Pixel ranges are absolute; `area.draw` takes coordinates relative to the area.
+        let (px, py) = chart.plotting_area().get_pixel_range();
+        let (ax, ay) = area.get_base_pixel();
+        for (k, n) in self.notes.iter().enumerate() {
+            area.draw(&Text::new(
+                n.clone(),
+                (px.start - ax + 12, py.start - ay + 10 + 22 * k as i32),
+                font(16.0),
+            ))?;
+        }
+        Ok(())
+    }
+}
+
+/// The chart an [`XyPlot`] draws on.
+type XyChart<'a, 'b, X, Y> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<X, Y>>;
+
+/// Draws series `s` in its style; whether it is in the legend.
+fn draw_series<'a, 'b: 'a, X, Y>(chart: &mut XyChart<'a, 'b, X, Y>, s: &Series) -> DrawResult<bool>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let c = s.color;
+    let anno = match s.style {
+        Style::Line | Style::Thin | Style::LinePoints => {
+            let w = if s.style == Style::Thin { 1 } else { 3 };
+            if s.style == Style::LinePoints {
+                chart.draw_series(s.xy.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
+            }
+            let a = chart.draw_series(LineSeries::new(s.xy.clone(), c.stroke_width(w)))?;
+            Some((a, s.style))
+        }
+        Style::Dashed => {
+            let pts = dash(&s.xy, |p| chart.as_coord_spec().translate(p));
+            let mut a = None;
+            for seg in pts {
+                a = Some(chart.draw_series(LineSeries::new(seg, c.stroke_width(2)))?);
+            }
+            a.map(|a| (a, s.style))
+        }
+        Style::Points => Some((
+            chart.draw_series(s.xy.iter().map(|&p| Circle::new(p, 4, c.filled())))?,
+            s.style,
+        )),
+        Style::Circles => Some((
+            chart.draw_series(s.xy.iter().map(|&p| Circle::new(p, 5, c.stroke_width(2))))?,
+            s.style,
+        )),
+    };
+    let Some((a, style)) = anno.filter(|_| !s.label.is_empty()) else {
+        return Ok(false);
+    };
+    a.label(s.label.as_str()).legend(
+        move |(x, y)| -> DynElement<'static, BitMapBackend, (i32, i32)> {
+            match style {
+                Style::Points => Circle::new((x + 11, y), 4, c.filled()).into_dyn(),
+                Style::Circles => Circle::new((x + 11, y), 5, c.stroke_width(2)).into_dyn(),
+                Style::Dashed => {
+                    PathElement::new(vec![(x, y), (x + 8, y)], c.stroke_width(2)).into_dyn()
+                }
+                _ => PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(3)).into_dyn(),
+            }
+        },
+    );
+    Ok(true)
 }
 
 /// Splits a polyline into dashes of about 10 px drawn, 6 px skipped.

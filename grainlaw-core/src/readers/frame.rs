@@ -312,7 +312,16 @@ pub fn build_snapshots(
         .zip(acc)
         .zip(times)
         .zip(gradients)
-        .map(|(((f, (a, src)), t), l)| build_one(f, a, src, t, dt_all, l, opts))
+        .map(|(((f, (acc, src)), time), gradient)| {
+            let extras = FrameExtras {
+                acc,
+                src,
+                time,
+                dt: dt_all,
+                gradient,
+            };
+            build_one(f, extras, opts)
+        })
         .collect()
 }
 
@@ -388,13 +397,52 @@ fn to_cell_frame(f: &mut Frame, c: &FrameCell) -> Result<(), ReadError> {
     Ok(())
 }
 
+/// What [`build_one`] adds to a frame: its accelerations, their source, its time, the time
+/// step and the velocity gradient of its cell.
+struct FrameExtras {
+    /// `(a, α)` per grain, in the frame's order.
+    acc: Vec<(Vector, f64)>,
+    /// Where the accelerations come from.
+    src: AccelerationSource,
+    /// The frame's time (s), when known.
+    time: Option<f64>,
+    /// The time step (s), when known.
+    dt: Option<f64>,
+    /// The velocity gradient from the cell's deformation, when known.
+    gradient: Option<Mat>,
+}
+
+/// The bodies of a frame: grains first, then walls.
+struct FrameBodies {
+    /// Body index of each grain id.
+    index: HashMap<u64, u32>,
+    /// The bodies.
+    bodies: Vec<BodyState>,
+    /// Index of the first wall in `bodies`.
+    first_wall: usize,
+}
+
+/// The force and torque `(F, T)` the contacts exert on a wall.
+type WallLoad = (Vector, f64);
+
+/// Where a contact acts, from the record or the geometry.
+struct ContactGeometry {
+    /// Body `a`'s index.
+    ia: u32,
+    /// Unit normal from `a` to `b`.
+    normal: Vector,
+    /// Gap (m), `NaN` when the record gives the normal of a wall contact.
+    gap: f64,
+    /// Contact point (m).
+    point: Vector,
+}
+
+/// Builds the snapshot of frame `f`: the frame moved to its cell's frame (biperiodic cell) →
+/// the bodies → the contacts and the walls' forces → the snapshot with its cell and velocity
+/// gradient (from the cell's deformation, else fitted to the grains' velocities).
 fn build_one(
     mut f: Frame,
-    acc: Vec<(Vector, f64)>,
-    src: AccelerationSource,
-    time: Option<f64>,
-    dt: Option<f64>,
-    gradient: Option<Mat>,
+    extras: FrameExtras,
     opts: &ReadOptions,
 ) -> Result<ExternalSnapshot, ReadError> {
     let biperiodic = f.cell.filter(FrameCell::biperiodic);
@@ -402,9 +450,82 @@ fn build_one(
         to_cell_frame(&mut f, c)?;
     }
     let images = Images::of(&f)?;
+    let fb = frame_bodies(&f, &extras.acc)?;
+    let (contacts, wall_force) = frame_contacts(&f, &fb, &images, opts)?;
+    let walls = f
+        .walls
+        .iter()
+        .enumerate()
+        .map(|(k, w)| WallState {
+            body: (fb.first_wall + k) as u32,
+            name: w.name.clone(),
+            geometry: w.geometry.clone(),
+            force: wall_force[k].0,
+            torque: wall_force[k].1,
+        })
+        .collect();
+    let grain_ids = f.grains.iter().map(|g| g.id).collect();
+    let periodic_x = match f.cell {
+        Some(c) if c.periodic == [true, false] => Some([c.origin.x, c.origin.x + c.lx]),
+        Some(_) => None,
+        None => f.periodic_x,
+    };
+    let cell = match &biperiodic {
+        Some(c) => Some(cell_of(&f, c, extras.gradient.unwrap_or_else(Mat::zeros))?),
+        None => None,
+    };
+    let mut snapshot = Snapshot {
+        step: f.step,
+        time: extras.time.unwrap_or(f.step as f64),
+        dt: extras
+            .dt
+            .filter(|d| *d > 0.0 && d.is_finite())
+            .unwrap_or(1.0),
+        gravity: Vector::new(opts.gravity[0], opts.gravity[1]),
+        periodic_x,
+        cell,
+        bodies: fb.bodies,
+        contacts,
+        walls,
+    };
+    let velocity_gradient = match (&biperiodic, extras.gradient) {
+        (None, _) => None,
+        (Some(_), Some(_)) => Some(GradientSource::CellDeformation),
+        (Some(c), None) => Some(fit_cell_gradient(&f, c, &mut snapshot)?),
+    };
+    Ok(ExternalSnapshot {
+        snapshot,
+        grain_ids,
+        accelerations: extras.src,
+        velocity_gradient,
+        source: f.source,
+    })
+}
+
+/// Sets the cell's velocity gradient of `snapshot` to the mass-weighted affine fit of the
+/// grain velocities over the cell, when the grains determine it (else leaves it zero).
+fn fit_cell_gradient(
+    f: &Frame,
+    c: &FrameCell,
+    snapshot: &mut Snapshot,
+) -> Result<GradientSource, ReadError> {
+    Ok(
+        match velocity_gradient(snapshot, &Region::Whole, VelocityWeight::Mass) {
+            Ok(fit) => {
+                snapshot.cell = Some(cell_of(f, c, fit.gradient)?);
+                GradientSource::VelocityProfile
+            }
+            Err(_) => GradientSource::Zero,
+        },
+    )
+}
+
+/// The bodies of `f`: its grains (with accelerations `acc`; ids unique, radius, mass and
+/// inertia positive), then its walls (fixed: infinite mass).
+fn frame_bodies(f: &Frame, acc: &[(Vector, f64)]) -> Result<FrameBodies, ReadError> {
     let mut index: HashMap<u64, u32> = HashMap::with_capacity(f.grains.len());
     let mut bodies = Vec::with_capacity(f.grains.len() + f.walls.len());
-    for (g, (a, w)) in f.grains.iter().zip(&acc) {
+    for (g, (a, w)) in f.grains.iter().zip(acc) {
         if index.insert(g.id, bodies.len() as u32).is_some() {
             return Err(content(
                 &f.source,
@@ -458,12 +579,28 @@ fn build_one(
             thickness: 1.0,
         });
     }
-    let mu = opts.mu.unwrap_or(0.0);
+    Ok(FrameBodies {
+        index,
+        bodies,
+        first_wall,
+    })
+}
+
+/// The contacts of `f` (force split into normal and tangential parts, status from the
+/// friction coefficient of `opts`) and the force and torque `(F, T)` the contacts exert on
+/// each wall.
+fn frame_contacts(
+    f: &Frame,
+    fb: &FrameBodies,
+    images: &Images,
+    opts: &ReadOptions,
+) -> Result<(Vec<ContactState>, Vec<WallLoad>), ReadError> {
+    let grain_mu = opts.mu.unwrap_or(0.0);
     let wall_mu = opts.wall_mu.or(opts.mu).unwrap_or(0.0);
     let mut contacts = Vec::with_capacity(f.contacts.len());
     let mut wall_force = vec![(Vector::zeros(), 0.0); f.walls.len()];
     for c in &f.contacts {
-        let ib = *index.get(&c.b).ok_or_else(|| {
+        let ib = *fb.index.get(&c.b).ok_or_else(|| {
             content(
                 &f.source,
                 format!(
@@ -472,75 +609,14 @@ fn build_one(
                 ),
             )
         })?;
-        let gb = &bodies[ib as usize];
-        let (cb, rb) = (gb.position, gb.radius);
-        let (ia, normal, gap, point) = match c.a {
-            Other::Grain(id) => {
-                let ia = *index.get(&id).ok_or_else(|| {
-                    content(
-                        &f.source,
-                        format!("a contact names grain {id}, which is not in the snapshot"),
-                    )
-                })?;
-                if ia == ib {
-                    return Err(content(
-                        &f.source,
-                        format!("grain {id} in contact with itself"),
-                    ));
-                }
-                let ga = &bodies[ia as usize];
-                let d = images.min(cb - ga.position);
-                let dist = d.norm();
-                let n = match c.normal {
-                    Some(n) => n,
-                    None if dist > 0.0 => d / dist,
-                    None => {
-                        return Err(content(
-                            &f.source,
-                            format!("grains {id} and {} have the same centre: no normal", c.b),
-                        ))
-                    }
-                };
-                let gap = dist - ga.radius - rb;
-                let x = c.point.unwrap_or(cb - n * (rb + 0.5 * gap));
-                (ia, n, gap, x)
-            }
-            Other::Wall(k) => {
-                let w = f.walls.get(k).ok_or_else(|| {
-                    content(
-                        &f.source,
-                        format!("a contact names wall {k}, which does not exist"),
-                    )
-                })?;
-                let (n, gap) = match (&w.geometry, c.normal) {
-                    (_, Some(n)) => (n, f64::NAN),
-                    (WallGeometry::Line { point, normal }, None) => {
-                        let s = (cb - point).dot(normal);
-                        (normal * s.signum(), s.abs() - rb)
-                    }
-                    (WallGeometry::Segment { a, b }, None) => {
-                        let e = b - a;
-                        let t = ((cb - a).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
-                        let d = cb - (a + e * t);
-                        let dist = d.norm();
-                        if dist == 0.0 {
-                            return Err(content(
-                                &f.source,
-                                format!("grain {} centred on wall `{}`", c.b, w.name),
-                            ));
-                        }
-                        (d / dist, dist - rb)
-                    }
-                    (WallGeometry::Clump { .. }, None) => {
-                        return Err(content(
-                            &f.source,
-                            "clump walls need the contact normal".into(),
-                        ))
-                    }
-                };
-                let x = c.point.unwrap_or(cb - n * rb);
-                ((first_wall + k) as u32, n, gap, x)
-            }
+        let ContactGeometry {
+            ia,
+            normal,
+            gap,
+            point,
+        } = match c.a {
+            Other::Grain(id) => grain_contact_geometry(f, c, id, ib, fb, images)?,
+            Other::Wall(k) => wall_contact_geometry(f, c, k, ib, fb)?,
         };
         if (normal.norm() - 1.0).abs() > 1e-6 {
             return Err(content(
@@ -550,11 +626,12 @@ fn build_one(
         }
         let t = Vector::new(-normal.y, normal.x);
         let (fn_, ft) = (c.force.dot(&normal), c.force.dot(&t));
-        let ca = bodies[ia as usize].position;
+        let ca = fb.bodies[ia as usize].position;
+        let cb = fb.bodies[ib as usize].position;
         let lever_a = images.min(point - ca);
         let lever_b = images.min(point - cb);
         let mu = match c.a {
-            Other::Grain(_) => mu,
+            Other::Grain(_) => grain_mu,
             Other::Wall(_) => wall_mu,
         };
         let status = if fn_ == 0.0 && ft == 0.0 {
@@ -582,59 +659,105 @@ fn build_one(
             lever_b,
         });
     }
-    let walls = f
-        .walls
-        .iter()
-        .enumerate()
-        .map(|(k, w)| WallState {
-            body: (first_wall + k) as u32,
-            name: w.name.clone(),
-            geometry: w.geometry.clone(),
-            force: wall_force[k].0,
-            torque: wall_force[k].1,
-        })
-        .collect();
-    let grain_ids = f.grains.iter().map(|g| g.id).collect();
-    let periodic_x = match f.cell {
-        Some(c) if c.periodic == [true, false] => Some([c.origin.x, c.origin.x + c.lx]),
-        Some(_) => None,
-        None => f.periodic_x,
-    };
-    let cell = match &biperiodic {
-        Some(c) => Some(cell_of(&f, c, gradient.unwrap_or_else(Mat::zeros))?),
-        None => None,
-    };
-    let mut snapshot = Snapshot {
-        step: f.step,
-        time: time.unwrap_or(f.step as f64),
-        dt: dt.filter(|d| *d > 0.0 && d.is_finite()).unwrap_or(1.0),
-        gravity: Vector::new(opts.gravity[0], opts.gravity[1]),
-        periodic_x,
-        cell,
-        bodies,
-        contacts,
-        walls,
-    };
-    let velocity_gradient = match (&biperiodic, gradient) {
-        (None, _) => None,
-        (Some(_), Some(_)) => Some(GradientSource::CellDeformation),
-        (Some(c), None) => {
-            // the mass-weighted affine fit of the grain velocities over the cell, when the
-            // grains determine it
-            match velocity_gradient(&snapshot, &Region::Whole, VelocityWeight::Mass) {
-                Ok(fit) => {
-                    snapshot.cell = Some(cell_of(&f, c, fit.gradient)?);
-                    Some(GradientSource::VelocityProfile)
-                }
-                Err(_) => Some(GradientSource::Zero),
-            }
+    Ok((contacts, wall_force))
+}
+
+/// The geometry of contact `c` between grain `id` and grain `c.b` (body `ib`): the normal
+/// from the record or the nearest image of the centres, the gap, the point (the record's, or
+/// mid-gap on the line of centres).
+fn grain_contact_geometry(
+    f: &Frame,
+    c: &ContactRecord,
+    id: u64,
+    ib: u32,
+    fb: &FrameBodies,
+    images: &Images,
+) -> Result<ContactGeometry, ReadError> {
+    let gb = &fb.bodies[ib as usize];
+    let (cb, rb) = (gb.position, gb.radius);
+    let ia = *fb.index.get(&id).ok_or_else(|| {
+        content(
+            &f.source,
+            format!("a contact names grain {id}, which is not in the snapshot"),
+        )
+    })?;
+    if ia == ib {
+        return Err(content(
+            &f.source,
+            format!("grain {id} in contact with itself"),
+        ));
+    }
+    let ga = &fb.bodies[ia as usize];
+    let d = images.min(cb - ga.position);
+    let dist = d.norm();
+    let normal = match c.normal {
+        Some(n) => n,
+        None if dist > 0.0 => d / dist,
+        None => {
+            return Err(content(
+                &f.source,
+                format!("grains {id} and {} have the same centre: no normal", c.b),
+            ))
         }
     };
-    Ok(ExternalSnapshot {
-        snapshot,
-        grain_ids,
-        accelerations: src,
-        velocity_gradient,
-        source: f.source,
+    let gap = dist - ga.radius - rb;
+    let point = c.point.unwrap_or(cb - normal * (rb + 0.5 * gap));
+    Ok(ContactGeometry {
+        ia,
+        normal,
+        gap,
+        point,
+    })
+}
+
+/// The geometry of contact `c` between wall `k` and grain `c.b` (body `ib`): the normal from
+/// the record (gap unknown) or the wall's line or segment, the point (the record's, or on the
+/// grain's surface).
+fn wall_contact_geometry(
+    f: &Frame,
+    c: &ContactRecord,
+    k: usize,
+    ib: u32,
+    fb: &FrameBodies,
+) -> Result<ContactGeometry, ReadError> {
+    let gb = &fb.bodies[ib as usize];
+    let (cb, rb) = (gb.position, gb.radius);
+    let w = f.walls.get(k).ok_or_else(|| {
+        content(
+            &f.source,
+            format!("a contact names wall {k}, which does not exist"),
+        )
+    })?;
+    let (normal, gap) = match (&w.geometry, c.normal) {
+        (_, Some(n)) => (n, f64::NAN),
+        (WallGeometry::Line { point, normal }, None) => {
+            let s = (cb - point).dot(normal);
+            (normal * s.signum(), s.abs() - rb)
+        }
+        (WallGeometry::Segment { a, b }, None) => {
+            let e = b - a;
+            let t = ((cb - a).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
+            let d = cb - (a + e * t);
+            let dist = d.norm();
+            if dist == 0.0 {
+                return Err(content(
+                    &f.source,
+                    format!("grain {} centred on wall `{}`", c.b, w.name),
+                ));
+            }
+            (d / dist, dist - rb)
+        }
+        (WallGeometry::Clump { .. }, None) => {
+            return Err(content(
+                &f.source,
+                "clump walls need the contact normal".into(),
+            ))
+        }
+    };
+    Ok(ContactGeometry {
+        ia: (fb.first_wall + k) as u32,
+        normal,
+        gap,
+        point: c.point.unwrap_or(cb - normal * rb),
     })
 }
