@@ -330,10 +330,9 @@ impl SeriesTables {
     fn add(&mut self, out: &mut OutputDir, ext: &ExternalSnapshot) -> Result<()> {
         let s = &ext.snapshot;
         let (row, grains) = snapshot_row(ext)?;
-        let (phi, z) = (row[4], row[5]);
-        let whole_total = Tensor2::new(row[10], row[11], row[12], row[13]);
+        let (phi, z, whole_total) = (row.phi, row.z, row.whole_total);
         let inv = stress_invariants(&whole_total);
-        self.table.push(row);
+        self.table.push(row.values);
         let mut g =
             CsvTable::new(&[&["id", "x_m", "y_m", "radius_m"][..], &STRESS_COLUMNS].concat());
         g.comments.push(format!(
@@ -402,7 +401,22 @@ impl SeriesTables {
 /// The row of `snapshots.csv` of one snapshot (whole-sample means: solid fraction,
 /// coordination, fabric, mean stress and its parts, invariants, mobilisation) and the per-grain
 /// stresses.
-pub fn snapshot_row(ext: &ExternalSnapshot) -> Result<(Vec<f64>, Vec<homogenise::GrainStress>)> {
+/// One snapshot's row of the series table ([`snapshot_row`]): its values in the table's column
+/// order, with the ones the report reads kept by name.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesRow {
+    /// The row's values, in the series table's column order.
+    pub values: Vec<f64>,
+    /// Solid fraction of the whole sample (1).
+    pub phi: f64,
+    /// Coordination number `Z` (contacts per grain, rattlers included).
+    pub z: f64,
+    /// Whole-sample mean stress, total (Pa, tension positive).
+    pub whole_total: Tensor2,
+}
+
+/// The series row of one snapshot ([`SeriesRow`]) and its grains' mean stresses.
+pub fn snapshot_row(ext: &ExternalSnapshot) -> Result<(SeriesRow, Vec<homogenise::GrainStress>)> {
     let s = &ext.snapshot;
     let counting = ContactCounting::default();
     let grains = grain_stresses(s)?;
@@ -438,7 +452,15 @@ pub fn snapshot_row(ext: &ExternalSnapshot) -> Result<(Vec<f64>, Vec<homogenise:
         ms.mean.unwrap_or(f64::NAN),
         ms.fraction_at_limit.unwrap_or(f64::NAN),
     ]);
-    Ok((row, grains))
+    Ok((
+        SeriesRow {
+            values: row,
+            phi,
+            z: z.z,
+            whole_total: whole.total,
+        },
+        grains,
+    ))
 }
 
 /// A synthetic LAMMPS snapshot for the benchmark: `n` disks of radius 0.5 mm on a square
