@@ -20,7 +20,7 @@
 //!    is reported instead and flagged.
 
 use datasets::config::JanssenConfig;
-use datasets::phases::{PhaseStats, RunUntilRest};
+use datasets::phases::PhaseStats;
 use dem::math::Vector;
 use homogenise::state::solid_fraction;
 use homogenise::Region;
@@ -193,27 +193,13 @@ impl PhasedRun for Column<'_> {
         Ok(match k {
             DEPOSIT => {
                 c.deposit.solver.apply(&mut world.params);
-                plan(
-                    "deposit",
-                    Stop::UntilRest(RunUntilRest {
-                        min_time: 0.0,
-                        max_time: c.deposit.max_time,
-                        rest_energy: c.deposit.rest_energy,
-                    }),
-                )
+                plan("deposit", Stop::UntilRest(c.deposit.until_rest()))
             }
             // Relaxation at the scenario's time step, tight tolerance.
             RELAX => {
                 world.params.dt = c.dt;
                 c.relax.solver.apply(&mut world.params);
-                plan(
-                    "relax",
-                    Stop::UntilRest(RunUntilRest {
-                        min_time: c.relax.min_time,
-                        max_time: c.relax.max_time,
-                        rest_energy: c.relax.rest_energy,
-                    }),
-                )
+                plan("relax", Stop::UntilRest(c.relax.until_rest()))
             }
             // Release: the floor is lowered slowly so that the column slides along the walls
             // (Coulomb conditions at the wall contacts).
