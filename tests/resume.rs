@@ -7,8 +7,8 @@
 
 mod common;
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use common::{assert_same_outputs, stderr};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -26,10 +26,6 @@ fn grainlaw(args: &[&str], extra: &[&Path]) -> Output {
         cmd.arg(p);
     }
     cmd.output().expect("grainlaw runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 /// A run that finished: exit 0, or 3 when its verdict refused a result (the 60-grain column's
@@ -50,51 +46,6 @@ fn error_line(o: &Output) -> String {
         .rfind(|l| l.starts_with("error:"))
         .unwrap_or_default()
         .to_string()
-}
-
-/// Every file under `dir` (relative path → bytes).
-fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(
-                    p.strip_prefix(dir).unwrap().to_path_buf(),
-                    std::fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    out
-}
-
-/// `a` and `b` hold the same files with the same bytes; `summary.json` the same keys and
-/// values in the same order, `wall_seconds` aside.
-fn assert_same_outputs(a: &Path, b: &Path) {
-    let (fa, fb) = (files(a), files(b));
-    let names = |f: &BTreeMap<PathBuf, Vec<u8>>| f.keys().cloned().collect::<Vec<_>>();
-    assert_eq!(names(&fa), names(&fb), "different files");
-    for (name, bytes) in &fa {
-        if name == Path::new("summary.json") {
-            continue;
-        }
-        assert!(bytes == &fb[name], "{} differs", name.display());
-    }
-    let summary = |f: &BTreeMap<PathBuf, Vec<u8>>| -> Vec<(String, Value)> {
-        let v: serde_json::Map<String, Value> =
-            serde_json::from_slice(&f[Path::new("summary.json")]).unwrap();
-        v.into_iter().filter(|(k, _)| k != "wall_seconds").collect()
-    };
-    let (sa, sb) = (summary(&fa), summary(&fb));
-    assert_eq!(sa.len(), sb.len());
-    for ((ka, va), (kb, vb)) in sa.iter().zip(&sb) {
-        assert_eq!(ka, kb, "keys in another order");
-        assert_eq!(va, vb, "summary key {ka} differs");
-    }
 }
 
 /// An uninterrupted run of [`SCENARIO`] into `dir`.

@@ -3,9 +3,10 @@
 //! as an uninterrupted one, its solver-sensitivity samples included, and its checks are named
 //! `simple_shear.*`.
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::{assert_same_outputs, files, grainlaw, run_stopped_and_resumed, stderr};
+use std::path::Path;
 
 /// A tiny run: 50 grains, a short compression (13 grain times, 26 steps), one shear run of
 /// strain 0.6 (60 steps of 0.01), the last 12 averaged (too few to test steadiness).
@@ -31,40 +32,6 @@ const TINY: &[&str] = &[
     "cell_affine=false",
     "-q",
 ];
-
-fn grainlaw(args: &[&str], dir: Option<&Path>) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_grainlaw"));
-    // a fixed date: the provenance of laws written by a run and by its resumed twin agree
-    cmd.env("SOURCE_DATE_EPOCH", "1767225600").args(args);
-    if let Some(d) = dir {
-        cmd.arg("--out").arg(d);
-    }
-    cmd.output().expect("grainlaw runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
-}
-
-/// Every file under `dir` (relative path → bytes).
-fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(
-                    p.strip_prefix(dir).unwrap().to_path_buf(),
-                    std::fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    out
-}
 
 /// Negative pressure, an empty list of inertial numbers, I ≤ 0, too few inertial numbers for
 /// the laws the plan fits, a `leave_out` naming a law it does not fit: one `error:` line naming
@@ -146,19 +113,9 @@ fn resume_is_bit_identical() {
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     // the tiny run's verdict refuses its laws (one point, too short to be steady): exit 3,
     // the same for the uninterrupted and the resumed run
-    let o = grainlaw(TINY, Some(&a));
-    let code = o.status.code();
-    assert!(matches!(code, Some(0) | Some(3)), "{}", stderr(&o));
-    let o = grainlaw(&[TINY, &["--stop-after-steps", "50"]].concat(), Some(&b));
-    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
-    let o = grainlaw(&["run", "--resume", b.to_str().unwrap(), "-q"], None);
-    assert_eq!(o.status.code(), code, "{}", stderr(&o));
-    let (fa, fb) = (files(&a), files(&b));
-    assert_eq!(
-        fa.keys().collect::<Vec<_>>(),
-        fb.keys().collect::<Vec<_>>(),
-        "different files"
-    );
+    run_stopped_and_resumed(TINY, "50", &a, &b);
+    assert_same_outputs(&a, &b);
+    let fa = files(&a);
     assert!(fa.contains_key(Path::new("history_I1.csv")));
     // 20 steps of the averaging window, evenly spread, were solved again with the cell
     // (`dem::World::last_step_problem`): every `s = max(1, ⌊w/20⌋)`-th step of the window's
@@ -195,19 +152,6 @@ fn resume_is_bit_identical() {
         !checks.iter().any(|c| c.starts_with("shear_cell.")),
         "{checks:?}"
     );
-    for (name, bytes) in &fa {
-        if name == Path::new("summary.json") {
-            let strip = |v: &[u8]| -> serde_json::Map<String, serde_json::Value> {
-                let mut m: serde_json::Map<String, serde_json::Value> =
-                    serde_json::from_slice(v).unwrap();
-                m.remove("wall_seconds");
-                m
-            };
-            assert_eq!(strip(bytes), strip(&fb[name]), "summary.json differs");
-        } else {
-            assert!(bytes == &fb[name], "{} differs", name.display());
-        }
-    }
 }
 
 /// The tiny run's arguments with `extra` settings after its own (the last setting of a key

@@ -387,6 +387,39 @@ impl PhaseProgress {
     }
 }
 
+/// The scales a phase judges its steps by: the energy scale of the rest criterion
+/// ([`energy_scale`]), the load energy scale of the energy balance (kept in the phase's
+/// progress, so a resumed phase keeps its own) and the smallest grain radius.
+struct PhaseScales {
+    energy: f64,
+    e_load: f64,
+    min_radius: f64,
+}
+
+impl PhaseScales {
+    /// The scales of `world` for the phase of `progress`.
+    fn of(world: &World, progress: &mut PhaseProgress) -> Self {
+        let energy = energy_scale(world);
+        let e_load = *progress
+            .e_load
+            .get_or_insert_with(|| load_energy_scale(world));
+        Self {
+            energy,
+            e_load,
+            min_radius: min_grain_radius(world),
+        }
+    }
+
+    /// One step with its accounting ([`accounted_step`]).
+    fn step(
+        &self,
+        world: &mut World,
+        progress: &mut PhaseProgress,
+    ) -> Result<StepReport, dem::DemError> {
+        accounted_step(world, progress, self.e_load, self.min_radius)
+    }
+}
+
 /// One step with its accounting: solve, time, overlap and energy balance. A step whose solve
 /// does not converge is done again in sub-steps as the solver parameters allow
 /// ([`step_subdivided_checked`]); the step's energy residual is the sum of its kept sub-steps'
@@ -436,11 +469,7 @@ pub fn continue_until_rest(
     progress: &mut PhaseProgress,
     mut on_step: impl FnMut(&World, &StepReport, &PhaseProgress) -> bool,
 ) -> Result<PhaseStats, dem::DemError> {
-    let scale = energy_scale(world);
-    let e_load = *progress
-        .e_load
-        .get_or_insert_with(|| load_energy_scale(world));
-    let min_radius = min_grain_radius(world);
+    let sc = PhaseScales::of(world, progress);
     let dt = world.params.dt;
     let max_steps = (run.max_time / dt).ceil() as u64;
     let min_steps = (run.min_time / dt).ceil() as u64;
@@ -452,8 +481,8 @@ pub fn continue_until_rest(
         if progress.steps() >= max_steps {
             break;
         }
-        let r = accounted_step(world, progress, e_load, min_radius)?;
-        let ratio = translational_energy(world) / scale;
+        let r = sc.step(world, progress)?;
+        let ratio = translational_energy(world) / sc.energy;
         progress.stats.final_energy_ratio = ratio;
         if ratio < run.rest_energy && r.solver.converged {
             progress.quiet_steps += 1;
@@ -485,19 +514,15 @@ pub fn continue_steps(
     progress: &mut PhaseProgress,
     mut on_step: impl FnMut(&World, &StepReport, &PhaseProgress) -> bool,
 ) -> Result<PhaseStats, dem::DemError> {
-    let scale = energy_scale(world);
-    let e_load = *progress
-        .e_load
-        .get_or_insert_with(|| load_energy_scale(world));
-    let min_radius = min_grain_radius(world);
+    let sc = PhaseScales::of(world, progress);
     while progress.steps() < steps {
-        let r = accounted_step(world, progress, e_load, min_radius)?;
-        progress.stats.final_energy_ratio = translational_energy(world) / scale;
+        let r = sc.step(world, progress)?;
+        progress.stats.final_energy_ratio = translational_energy(world) / sc.energy;
         if !on_step(world, &r, progress) {
             break;
         }
     }
-    progress.stats.final_energy_ratio = translational_energy(world) / scale;
+    progress.stats.final_energy_ratio = translational_energy(world) / sc.energy;
     Ok(progress.stats)
 }
 

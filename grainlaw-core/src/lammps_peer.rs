@@ -51,7 +51,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use dem::collider::{rotate, Shape};
-use dem::{BodyKind, World};
+use dem::{Body, BodyKind, World};
 
 use crate::error::{CliError, Result};
 
@@ -169,6 +169,24 @@ fn bad(reason: impl Into<String>) -> CliError {
     CliError::Usage(format!("LAMMPS peer: {}", reason.into()))
 }
 
+/// The density of disk grains `grains` (that of `first`, one of them; an error if another
+/// differs), their radii (m) and masses per metre of thickness `ρ π r²` (kg/m).
+pub(crate) fn disk_masses(
+    first: &Body,
+    grains: &[&Body],
+) -> std::result::Result<(f64, Vec<f64>, Vec<f64>), &'static str> {
+    let density = first.density;
+    if grains.iter().any(|b| b.density != density) {
+        return Err("grains of different densities");
+    }
+    let radii: Vec<f64> = grains.iter().map(|b| b.radius).collect();
+    let masses: Vec<f64> = radii
+        .iter()
+        .map(|r| density * std::f64::consts::PI * r * r)
+        .collect();
+    Ok((density, radii, masses))
+}
+
 impl PeerColumn {
     /// The column of `w` (grains of one density and material, floor `y = 0` with normal `+y`,
     /// walls with normals `±x`, gravity along `−y`), settled to `KE / PE < target` within
@@ -244,15 +262,7 @@ impl PeerColumn {
         let (Some(gm), Some(wm), Some(first)) = (grain_mat, wall_mat, grains.first()) else {
             return Err(bad("no grains"));
         };
-        let density = first.density;
-        if grains.iter().any(|b| b.density != density) {
-            return Err(bad("grains of different densities"));
-        }
-        let radii: Vec<f64> = grains.iter().map(|b| b.radius).collect();
-        let masses: Vec<f64> = radii
-            .iter()
-            .map(|r| density * std::f64::consts::PI * r * r)
-            .collect();
+        let (density, radii, masses) = disk_masses(first, &grains).map_err(bad)?;
         let gravity = -g.y;
         Ok(PeerColumn {
             centres: grains
@@ -383,13 +393,11 @@ write_dump all custom {dump_file} id x y radius
 
     /// Writes `column.data` and `in.column` into `dir`; returns the input's path.
     pub fn write_input(&self, dir: &Path) -> Result<PathBuf> {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
-        let data = dir.join("column.data");
-        std::fs::write(&data, self.data_file()).map_err(|e| CliError::io(&data, e))?;
-        let input = dir.join("in.column");
-        std::fs::write(&input, self.input_script("column.data", "final.dump"))
-            .map_err(|e| CliError::io(&input, e))?;
-        Ok(input)
+        write_input_files(
+            dir,
+            ("column.data", &self.data_file()),
+            ("in.column", &self.input_script("column.data", "final.dump")),
+        )
     }
 }
 
@@ -529,19 +537,60 @@ pub fn wall_limit() -> Result<f64> {
     }
 }
 
-/// The outcome of a peer run.
+/// The outcome of a LAMMPS peer run whose finished run is `R` (a [`PeerRun`] of the column,
+/// [`crate::lammps_rve_peer::RveRun`] of the representative volume).
 #[derive(Debug, Clone, PartialEq)]
-pub enum PeerOutcome {
-    /// The run ended and printed its final state (settled or not: see [`PeerRun::settled`]).
-    Ran(PeerRun),
-    /// The run failed (could not start, non-zero exit, unreadable log): the reason, and the
-    /// directory kept for inspection.
+pub enum Outcome<R> {
+    /// The run ended and its output was read (settled or finished or not: see the run).
+    Ran(R),
+    /// The run failed (could not start, non-zero exit, unreadable log or output): the reason,
+    /// and the directory kept for inspection.
     Failed {
         /// One line.
         reason: String,
         /// Where the input and log are.
         dir: PathBuf,
     },
+}
+
+/// The outcome of a column's peer run (settled or not: see [`PeerRun::settled`]).
+pub type PeerOutcome = Outcome<PeerRun>;
+
+/// Writes a peer's data file and input script, each `(name, text)`, into `dir` (created);
+/// returns the input's path.
+pub(crate) fn write_input_files(
+    dir: &Path,
+    (data_name, data_text): (&str, &str),
+    (input_name, input_text): (&str, &str),
+) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
+    let data = dir.join(data_name);
+    std::fs::write(&data, data_text).map_err(|e| CliError::io(&data, e))?;
+    let input = dir.join(input_name);
+    std::fs::write(&input, input_text).map_err(|e| CliError::io(&input, e))?;
+    Ok(input)
+}
+
+/// Runs `lmp -in input` in `dir` ([`run_lmp`], the input already written there) and reads the
+/// finished run with `read(wall_seconds, log text)`: [`Outcome::Ran`] and `dir` removed when
+/// it was read, [`Outcome::Failed`] with the reason and `dir` kept when the run or the reading
+/// failed.
+pub(crate) fn run_and_read<R>(
+    lmp: &Path,
+    dir: &Path,
+    input: &str,
+    read: impl FnOnce(f64, &str) -> std::result::Result<R, String>,
+) -> Outcome<R> {
+    match run_lmp(lmp, dir, input).and_then(|(wall_seconds, log)| read(wall_seconds, &log)) {
+        Ok(r) => {
+            let _ = std::fs::remove_dir_all(dir);
+            Outcome::Ran(r)
+        }
+        Err(reason) => Outcome::Failed {
+            reason,
+            dir: dir.to_path_buf(),
+        },
+    }
 }
 
 /// A finished peer run.
@@ -601,43 +650,28 @@ pub(crate) fn run_lmp(
 /// the result. `dir` is removed after a run that ended, kept after a failure.
 pub fn run(lmp: &Path, column: &PeerColumn, dir: &Path) -> Result<PeerOutcome> {
     column.write_input(dir)?;
-    let failed = |reason: String| {
-        Ok(PeerOutcome::Failed {
-            reason,
-            dir: dir.to_path_buf(),
-        })
-    };
-    let (wall_seconds, log) = match run_lmp(lmp, dir, "in.column") {
-        Ok(r) => r,
-        Err(why) => return failed(why),
-    };
-    let parsed = match parse_log(&log) {
-        Ok(p) => p,
-        Err(e) => return failed(e.to_string()),
-    };
-    let dump = match std::fs::read_to_string(dir.join("final.dump"))
-        .map_err(|e| bad(format!("final.dump: {e}")))
-        .and_then(|t| parse_dump(&t))
-    {
-        Ok(d) if d.len() == column.radii.len() => d,
-        Ok(d) => {
-            return failed(format!(
+    Ok(run_and_read(lmp, dir, "in.column", |wall_seconds, log| {
+        let parsed = parse_log(log).map_err(|e| e.to_string())?;
+        let dump = std::fs::read_to_string(dir.join("final.dump"))
+            .map_err(|e| bad(format!("final.dump: {e}")))
+            .and_then(|t| parse_dump(&t))
+            .map_err(|e| e.to_string())?;
+        if dump.len() != column.radii.len() {
+            return Err(format!(
                 "final.dump holds {} grains, {} were written",
-                d.len(),
+                dump.len(),
                 column.radii.len()
-            ))
+            ));
         }
-        Err(e) => return failed(e.to_string()),
-    };
-    let grains: Vec<([f64; 2], f64)> = dump.iter().map(|&(_, c, r)| (c, r)).collect();
-    let r_min = column.radii.iter().copied().fold(f64::INFINITY, f64::min);
-    let overlap = largest_overlap(&grains, column.floor, column.x_left, column.x_right);
-    let _ = std::fs::remove_dir_all(dir);
-    Ok(PeerOutcome::Ran(PeerRun {
-        wall_seconds,
-        settled: parsed.energy_ratio < column.target,
-        log: parsed,
-        overlap_ratio: overlap / r_min,
+        let grains: Vec<([f64; 2], f64)> = dump.iter().map(|&(_, c, r)| (c, r)).collect();
+        let r_min = column.radii.iter().copied().fold(f64::INFINITY, f64::min);
+        let overlap = largest_overlap(&grains, column.floor, column.x_left, column.x_right);
+        Ok(PeerRun {
+            wall_seconds,
+            settled: parsed.energy_ratio < column.target,
+            log: parsed,
+            overlap_ratio: overlap / r_min,
+        })
     }))
 }
 

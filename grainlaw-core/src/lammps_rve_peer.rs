@@ -80,7 +80,7 @@ use dem::math::Vector as Vect;
 use dem::BodyKind;
 
 use crate::error::{CliError, Result};
-use crate::lammps_peer::{run_lmp, ContactModel};
+use crate::lammps_peer::{disk_masses, run_and_read, write_input_files, ContactModel, Outcome};
 use crate::readers::{read_lammps, ReadOptions};
 use crate::scenarios::simple_shear::{CellSamples, RheologyPoint};
 
@@ -171,15 +171,7 @@ impl PeerRve {
         let Some(first) = grains.first() else {
             return Err(bad("no grains"));
         };
-        let density = first.density;
-        if grains.iter().any(|b| b.density != density) {
-            return Err(bad("grains of different densities"));
-        }
-        let radii: Vec<f64> = grains.iter().map(|b| b.radius).collect();
-        let masses: Vec<f64> = radii
-            .iter()
-            .map(|r| density * std::f64::consts::PI * r * r)
-            .collect();
+        let (density, radii, masses) = disk_masses(first, &grains).map_err(bad)?;
         let d = crate::scenarios::common::mean_diameter(&w);
         let (p, rho) = (c.pressure, c.grain.density);
         Ok(PeerRve {
@@ -367,13 +359,11 @@ print \"GRAINLAW_END step $(step)\"
 
     /// Writes `rve.data` and `in.rve` into `dir`; returns the input's path.
     pub fn write_input(&self, dir: &Path) -> Result<PathBuf> {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::io(dir, e))?;
-        let data = dir.join("rve.data");
-        std::fs::write(&data, self.data_file()).map_err(|e| CliError::io(&data, e))?;
-        let input = dir.join("in.rve");
-        std::fs::write(&input, self.input_script("rve.data", "overlap.dump"))
-            .map_err(|e| CliError::io(&input, e))?;
-        Ok(input)
+        write_input_files(
+            dir,
+            ("rve.data", &self.data_file()),
+            ("in.rve", &self.input_script("rve.data", "overlap.dump")),
+        )
     }
 }
 
@@ -669,56 +659,30 @@ pub struct RveRun {
     pub overlap_ratio: f64,
 }
 
-/// The outcome of a peer run.
-#[derive(Debug, Clone, PartialEq)]
-pub enum RveOutcome {
-    /// The run ended and its log was read (finished or not: [`RveRun::finished`]).
-    Ran(RveRun),
-    /// The run failed (could not start, non-zero exit, unreadable log or samples): the reason,
-    /// and the directory kept for inspection.
-    Failed {
-        /// One line.
-        reason: String,
-        /// Where the input and log are.
-        dir: PathBuf,
-    },
-}
+/// The outcome of a representative volume's peer run (finished or not: see
+/// [`RveRun::finished`]).
+pub type RveOutcome = Outcome<RveRun>;
 
 /// Writes the RVE's input into `dir`, runs `lmp -in in.rve` there on one core and reads the
 /// result. `dir` is removed after a run that was read, kept after a failure.
 pub fn run(lmp: &Path, rve: &PeerRve, dir: &Path) -> Result<RveOutcome> {
     rve.write_input(dir)?;
-    let failed = |reason: String| {
-        Ok(RveOutcome::Failed {
-            reason,
-            dir: dir.to_path_buf(),
+    Ok(run_and_read(lmp, dir, "in.rve", |wall_seconds, text| {
+        let log = parse_log(text).map_err(|e| e.to_string())?;
+        let finished = log.end_step == rve.compression_steps() + rve.shear_steps()
+            && log.shear_steps == rve.shear_steps();
+        let measure = log
+            .measure(rve)
+            .map_err(|e| format!("the window's samples: {e}"))?;
+        let overlap_ratio = largest_overlap_ratio(&dir.join("overlap.dump"))
+            .map_err(|e| format!("overlap.dump: {e}"))?;
+        Ok(RveRun {
+            wall_seconds,
+            log,
+            finished,
+            measure,
+            overlap_ratio,
         })
-    };
-    let (wall_seconds, text) = match run_lmp(lmp, dir, "in.rve") {
-        Ok(r) => r,
-        Err(why) => return failed(why),
-    };
-    let log = match parse_log(&text) {
-        Ok(l) => l,
-        Err(e) => return failed(e.to_string()),
-    };
-    let finished = log.end_step == rve.compression_steps() + rve.shear_steps()
-        && log.shear_steps == rve.shear_steps();
-    let measure = match log.measure(rve) {
-        Ok(m) => m,
-        Err(e) => return failed(format!("the window's samples: {e}")),
-    };
-    let overlap_ratio = match largest_overlap_ratio(&dir.join("overlap.dump")) {
-        Ok(o) => o,
-        Err(e) => return failed(format!("overlap.dump: {e}")),
-    };
-    let _ = std::fs::remove_dir_all(dir);
-    Ok(RveOutcome::Ran(RveRun {
-        wall_seconds,
-        log,
-        finished,
-        measure,
-        overlap_ratio,
     }))
 }
 

@@ -1,5 +1,9 @@
-//! Run arguments shared by the command-line tests.
+//! Run arguments and helpers shared by the command-line tests.
 #![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 /// `grainlaw run shear-cell -q` on a small cell: 60 grains, 10 diameters long, short runs
 /// (strain 0.6, the last 0.3 averaged) after a 0.05 s compression, about a second; the target
@@ -35,4 +39,81 @@ pub fn small_shear_cell<'a>(list: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
         .chain([list, "--set", LEAVE_OUT_RHEOLOGY])
         .chain(extra.iter().copied())
         .collect()
+}
+
+/// `grainlaw ARGS [--out DIR]` at a fixed date (`SOURCE_DATE_EPOCH`): the provenance of the
+/// laws written by a run and by its resumed twin agree.
+pub fn grainlaw(args: &[&str], dir: Option<&Path>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_grainlaw"));
+    cmd.env("SOURCE_DATE_EPOCH", "1767225600").args(args);
+    if let Some(d) = dir {
+        cmd.arg("--out").arg(d);
+    }
+    cmd.output().expect("grainlaw runs")
+}
+
+/// The standard error of a finished command, as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// Every file under `dir` (relative path → bytes).
+pub fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(
+                    p.strip_prefix(dir).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// `a` and `b` hold the same files with the same bytes; `summary.json` the same keys and
+/// values in the same order, `wall_seconds` aside.
+pub fn assert_same_outputs(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    let names = |f: &BTreeMap<PathBuf, Vec<u8>>| f.keys().cloned().collect::<Vec<_>>();
+    assert_eq!(names(&fa), names(&fb), "different files");
+    for (name, bytes) in &fa {
+        if name == Path::new("summary.json") {
+            continue;
+        }
+        assert!(bytes == &fb[name], "{} differs", name.display());
+    }
+    let summary = |f: &BTreeMap<PathBuf, Vec<u8>>| -> Vec<(String, serde_json::Value)> {
+        let v: serde_json::Map<String, serde_json::Value> =
+            serde_json::from_slice(&f[Path::new("summary.json")]).unwrap();
+        v.into_iter().filter(|(k, _)| k != "wall_seconds").collect()
+    };
+    let (sa, sb) = (summary(&fa), summary(&fb));
+    assert_eq!(sa.len(), sb.len());
+    for ((ka, va), (kb, vb)) in sa.iter().zip(&sb) {
+        assert_eq!(ka, kb, "keys in another order");
+        assert_eq!(va, vb, "summary key {ka} differs");
+    }
+}
+
+/// Runs `args` (a `grainlaw run` without `--out`) into `a` uninterrupted, then into `b`
+/// stopped after `stop_after` steps (exit 130) and resumed: the resumed run ends with the
+/// uninterrupted one's exit code, 0 or 3 (a refused or suspect verdict).
+pub fn run_stopped_and_resumed(args: &[&str], stop_after: &str, a: &Path, b: &Path) {
+    let o = grainlaw(args, Some(a));
+    let code = o.status.code();
+    assert!(matches!(code, Some(0) | Some(3)), "{}", stderr(&o));
+    let o = grainlaw(
+        &[args, &["--stop-after-steps", stop_after]].concat(),
+        Some(b),
+    );
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let o = grainlaw(&["run", "--resume", b.to_str().unwrap(), "-q"], None);
+    assert_eq!(o.status.code(), code, "{}", stderr(&o));
 }

@@ -330,6 +330,58 @@ pub fn check_dt(key: &str, dt: f64, max: f64) -> Result<f64> {
     Ok(dt)
 }
 
+/// An averaging window `key` over the end of a run: positive and finite, and at most the
+/// run's length `total` (named `total_key` in the error, with its `unit`, e.g. `" s"` or
+/// `""`).
+pub fn check_average(
+    key: &str,
+    window: f64,
+    total_key: &str,
+    total: f64,
+    unit: &str,
+) -> Result<()> {
+    positive(key, window)?;
+    if window > total {
+        return Err(DatasetError::invalid(
+            key,
+            format!(
+                "must not exceed {total_key} ({}{unit}), got {}",
+                num(total),
+                num(window)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The shear strain of a shear run, `strain` > 0, and its averaged end `average_strain` > 0 and
+/// at most `strain` ([`check_average`]).
+pub fn check_strain_window(strain: f64, average_strain: f64) -> Result<()> {
+    positive("strain", strain)?;
+    check_average("average_strain", average_strain, "strain", strain, "")
+}
+
+/// The target inertial numbers `inertial_numbers` of a shear scenario named `scenario`: at
+/// least one (the error points at `grainlaw scenarios --show SCENARIO`), at most 100, and each
+/// accepted by `each` (given its key `inertial_numbers[i]` and value).
+pub fn check_inertial_numbers(
+    inertial_numbers: &[f64],
+    scenario: &str,
+    each: impl Fn(&str, f64) -> Result<f64>,
+) -> Result<()> {
+    if inertial_numbers.is_empty() {
+        return Err(DatasetError::invalid(
+            "inertial_numbers",
+            format!("is empty: give at least one inertial number (what each law needs: `grainlaw scenarios --show {scenario}`)"),
+        ));
+    }
+    limits::at_most("inertial_numbers", inertial_numbers.len(), 100)?;
+    for (i, &v) in inertial_numbers.iter().enumerate() {
+        each(&format!("inertial_numbers[{i}]"), v)?;
+    }
+    Ok(())
+}
+
 /// The keys of a biperiodic cell's isotropic compression, shared by `simple-shear` and
 /// `biaxial`: `dt_max` > 0, `control_inertial_number` in [10⁻⁶, 0.1] (the cap of the cell's
 /// strain rate under stress control), `compression_time` > 0 and at most

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use super::common::SolverSpec;
 use crate::error::{at_least, num, positive, Result};
 use crate::limits;
+use crate::phases::RunUntilRest;
 
 /// A deposition by gravity: grains placed without overlap above the floor fall and settle.
 ///
@@ -27,6 +28,16 @@ pub struct DepositSpec {
 }
 
 impl DepositSpec {
+    /// The deposit's run until rest: from the start (no shortest time) to at most `max_time`,
+    /// at rest below `rest_energy`.
+    pub fn until_rest(&self) -> RunUntilRest {
+        RunUntilRest {
+            min_time: 0.0,
+            max_time: self.max_time,
+            rest_energy: self.rest_energy,
+        }
+    }
+
     /// Checks every field; `prefix` is the table's key and `dt` (s) the scenario's time step,
     /// which the deposition divides by `substeps` (at most [`limits::MAX_SUBSTEPS`], and at most
     /// [`limits::MAX_STEPS`] steps up to `max_time`).
@@ -66,6 +77,16 @@ pub struct RelaxSpec {
 }
 
 impl RelaxSpec {
+    /// The relaxation's run until rest: `min_time` to `max_time`, at rest below
+    /// `rest_energy`.
+    pub fn until_rest(&self) -> RunUntilRest {
+        RunUntilRest {
+            min_time: self.min_time,
+            max_time: self.max_time,
+            rest_energy: self.rest_energy,
+        }
+    }
+
     /// Checks every field; `prefix` is the table's key and `dt` (s) the time step of the
     /// relaxation (at most [`limits::MAX_STEPS`] steps up to `max_time`).
     pub fn validate(&self, prefix: &str, dt: f64) -> Result<()> {

@@ -4,7 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::common::{
-    check_dt, check_dt_gravity, check_periodic_cell, FrictionSpec, GrainSpec, SolverSpec,
+    check_average, check_dt, check_dt_gravity, check_periodic_cell, FrictionSpec, GrainSpec,
+    SolverSpec,
 };
 use crate::error::{at_least, in_range, num, positive, DatasetError, Result};
 use crate::limits;
@@ -64,17 +65,7 @@ impl InclinedFlowConfig {
         check_dt("dt", self.dt, self.duration)?;
         check_dt_gravity("dt", self.dt, self.grain.radius_min())?;
         limits::steps("dt", "duration / dt", self.duration, self.dt)?;
-        positive("average", self.average)?;
-        if self.average > self.duration {
-            return Err(DatasetError::invalid(
-                "average",
-                format!(
-                    "must not exceed duration ({} s), got {}",
-                    num(self.duration),
-                    num(self.average)
-                ),
-            ));
-        }
+        check_average("average", self.average, "duration", self.duration, " s")?;
         self.solver.validate("solver")?;
         at_least("profile_bins", self.profile_bins, 2)?;
         limits::at_most("profile_bins", self.profile_bins, limits::MAX_BINS)?;

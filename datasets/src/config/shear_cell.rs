@@ -4,7 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{check_periodic_cell, FrictionSpec, GrainSpec, SolverSpec};
+use super::common::{
+    check_inertial_numbers, check_periodic_cell, check_strain_window, FrictionSpec, GrainSpec,
+    SolverSpec,
+};
 use crate::error::{in_range, num, positive, DatasetError, Result};
 use crate::limits;
 
@@ -122,28 +125,10 @@ impl ShearCellConfig {
         )?;
         self.friction.validate("friction")?;
         limits::pressure("pressure", self.pressure)?;
-        if self.inertial_numbers.is_empty() {
-            return Err(DatasetError::invalid(
-                "inertial_numbers",
-                "is empty: give at least one inertial number (what each law needs: `grainlaw scenarios --show shear-cell`)",
-            ));
-        }
-        limits::at_most("inertial_numbers", self.inertial_numbers.len(), 100)?;
-        for (i, &v) in self.inertial_numbers.iter().enumerate() {
-            in_range(&format!("inertial_numbers[{i}]"), v, 1e-6, 2.0)?;
-        }
-        positive("strain", self.strain)?;
-        positive("average_strain", self.average_strain)?;
-        if self.average_strain > self.strain {
-            return Err(DatasetError::invalid(
-                "average_strain",
-                format!(
-                    "must not exceed strain ({}), got {}",
-                    num(self.strain),
-                    num(self.average_strain)
-                ),
-            ));
-        }
+        check_inertial_numbers(&self.inertial_numbers, "shear-cell", |k, v| {
+            in_range(k, v, 1e-6, 2.0)
+        })?;
+        check_strain_window(self.strain, self.average_strain)?;
         limits::at_most(
             "velocity_corrections",
             self.velocity_corrections,

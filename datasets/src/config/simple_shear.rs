@@ -4,7 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::common::{CellControlMode, GrainSpec, SolverSpec};
+use super::common::{
+    check_inertial_numbers, check_strain_window, CellControlMode, GrainSpec, SolverSpec,
+};
 use crate::error::{in_range, non_negative, num, positive, DatasetError, Result};
 use crate::limits;
 
@@ -180,34 +182,16 @@ impl SimpleShearConfig {
             ));
         }
         limits::pressure("pressure", self.pressure)?;
-        if self.inertial_numbers.is_empty() {
-            return Err(DatasetError::invalid(
-                "inertial_numbers",
-                "is empty: give at least one inertial number (what each law needs: `grainlaw scenarios --show simple-shear`)",
-            ));
-        }
-        limits::at_most("inertial_numbers", self.inertial_numbers.len(), 100)?;
-        for (i, &v) in self.inertial_numbers.iter().enumerate() {
+        check_inertial_numbers(&self.inertial_numbers, "simple-shear", |k, v| {
             if !(v.is_finite() && v > 0.0) {
                 return Err(DatasetError::invalid(
-                    format!("inertial_numbers[{i}]"),
+                    k,
                     format!("must be > 0, got {}", num(v)),
                 ));
             }
-            in_range(&format!("inertial_numbers[{i}]"), v, 1e-5, 1.0)?;
-        }
-        positive("strain", self.strain)?;
-        positive("average_strain", self.average_strain)?;
-        if self.average_strain > self.strain {
-            return Err(DatasetError::invalid(
-                "average_strain",
-                format!(
-                    "must not exceed strain ({}), got {}",
-                    num(self.strain),
-                    num(self.average_strain)
-                ),
-            ));
-        }
+            in_range(k, v, 1e-5, 1.0)
+        })?;
+        check_strain_window(self.strain, self.average_strain)?;
         in_range("travel_per_step", self.travel_per_step, 1e-4, 0.5)?;
         if let Some(dt) = self.dt_max {
             positive("dt_max", dt)?;

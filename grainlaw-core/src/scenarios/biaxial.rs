@@ -37,10 +37,9 @@ use identify::mohr_coulomb::{fit_mohr_coulomb_supported, YieldData};
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
-use super::cell_base::{CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
+use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
 use super::common::{
-    fit_keys, mean_diameter, parameter_lines, short_number, solver_keys, strain_bins, Stop,
-    VtkFrames,
+    fit_keys, mean_diameter, parameter_lines, short_number, strain_bins, Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::rows::{self, serde_rows, table_row};
@@ -56,49 +55,37 @@ use crate::verdict::{
     export_law, max_solid_fraction, remove_stale_law, Checks, RunVerdict, Verdict, WindowStats,
 };
 
-table_row! {
+cell_history_row! {
     /// One step of the axial compression: a row of `history_p{k}.csv`.
     struct HistoryRow {
-        /// Time (s).
-        t: "t_s",
-        /// `ε_a = −ln(H/H₀)` (compression positive).
-        axial_strain: "axial_strain",
-        /// `ε_v = −ln(V/V₀)` (positive in contraction).
-        volumetric_strain: "volumetric_strain",
-        /// Whole-cell mean stress Σ_xx (Pa, tension positive).
-        sxx: "sigma_xx_Pa",
-        /// Σ_yy (Pa).
-        syy: "sigma_yy_Pa",
-        /// Σ_xy (Pa).
-        sxy: "sigma_xy_Pa",
-        /// Strain rate of the cell D_xx (1/s).
-        dxx: "D_xx_1_s",
-        /// D_yy (1/s).
-        dyy: "D_yy_1_s",
-        /// D_xy (1/s).
-        dxy: "D_xy_1_s",
-        /// Mean pressure `p = −tr Σ/2` (Pa).
-        p: "p_Pa",
-        /// Deviator q (Pa).
-        q: "q_Pa",
-        /// q/p of the step.
-        sin_phi_mob: "sin_phi_mob",
-        /// Solid fraction.
-        phi: "phi",
-        /// Coordination over force-carrying contacts.
-        z: "Z",
-        /// Fabric anisotropy `a = 2 (F₁ − F₂)`.
-        fabric_anisotropy: "fabric_anisotropy",
-        /// Inertial number of the step (NaN without pressure).
-        inertial: "I",
-        /// Re-solves of the step by the cell control.
-        cell_corrections: "cell_corrections",
-        /// Major direction of the fabric from x (degrees).
-        fabric_angle_deg: "fabric_angle_deg",
-        /// `q_a = (Σ_xx − Σ_yy)/2` (Pa).
-        q_axial: "q_axial_Pa",
-        /// The imposed lateral stress after the outer correction (Pa).
-        target_sxx: "target_sigma_xx_Pa",
+        head {
+            /// Time (s).
+            t: "t_s",
+            /// `ε_a = −ln(H/H₀)` (compression positive).
+            axial_strain: "axial_strain",
+            /// `ε_v = −ln(V/V₀)` (positive in contraction).
+            volumetric_strain: "volumetric_strain",
+        }
+        tail {
+            /// q/p of the step.
+            sin_phi_mob: "sin_phi_mob",
+            /// Solid fraction.
+            phi: "phi",
+            /// Coordination over force-carrying contacts.
+            z: "Z",
+            /// Fabric anisotropy `a = 2 (F₁ − F₂)`.
+            fabric_anisotropy: "fabric_anisotropy",
+            /// Inertial number of the step (NaN without pressure).
+            inertial: "I",
+            /// Re-solves of the step by the cell control.
+            cell_corrections: "cell_corrections",
+            /// Major direction of the fabric from x (degrees).
+            fabric_angle_deg: "fabric_angle_deg",
+            /// `q_a = (Σ_xx − Σ_yy)/2` (Pa).
+            q_axial: "q_axial_Pa",
+            /// The imposed lateral stress after the outer correction (Pa).
+            target_sxx: "target_sigma_xx_Pa",
+        }
     }
 }
 
@@ -869,14 +856,6 @@ impl PhasedRun for Biaxial<'_> {
             t: w.time,
             axial_strain: -(cell.h[(1, 1)] / st.run.h0).ln(),
             volumetric_strain: -(cell.volume() / st.run.v0).ln(),
-            sxx: s[(0, 0)],
-            syy: s[(1, 1)],
-            sxy: s[(0, 1)],
-            dxx: cs.strain_rate[(0, 0)],
-            dyy: cs.strain_rate[(1, 1)],
-            dxy: cs.strain_rate[(0, 1)],
-            p: pm,
-            q: cs.deviator,
             sin_phi_mob: if pm > 0.0 { cs.deviator / pm } else { f64::NAN },
             phi: cs.solid_fraction,
             z: cs.coordination,
@@ -886,6 +865,7 @@ impl PhasedRun for Biaxial<'_> {
             fabric_angle_deg: angle.to_degrees(),
             q_axial: 0.5 * (s[(0, 0)] - s[(1, 1)]),
             target_sxx: st.target,
+            ..HistoryRow::of_cell(&cs)
         });
         Ok(())
     }
@@ -1697,18 +1677,18 @@ fn analyse(
     let (sd_data, sd_line) = fit_dilatancy(c, dilatancy, &judged.dilat, &provenance, &mut rep)?;
     figures(rep.out, pressures, rows, bins, mc_line, (&sd_data, sd_line))?;
     let Report {
-        mut s,
+        s,
         headline,
         verdict,
         ..
     } = rep;
-    solver_keys(&mut s, all);
-    judged.windows.keys(&mut s, "window");
-    Ok(RunOutcome {
-        summary: s,
+    Ok(RunOutcome::windowed(
+        s,
+        all,
+        &judged.windows,
         headline,
         verdict,
-    })
+    ))
 }
 
 /// The figures of one biaxial benchmark row ([`bench_rve`]).

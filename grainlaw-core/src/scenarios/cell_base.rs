@@ -114,3 +114,64 @@ impl<H: TableRow, R: TableRow> CellRecord<H, R> {
         }
     }
 }
+
+/// Declares the per-step history row of a cell scenario ([`table_row!`](super::rows::table_row)):
+/// the scenario's own leading columns (`head`), then the whole-cell columns every cell
+/// scenario writes in this order — mean stress Σ_xx, Σ_yy, Σ_xy (Pa, tension positive), strain
+/// rate of the cell D_xx, D_yy, D_xy (1/s), mean pressure `p = −tr Σ/2` and deviator `q` (Pa) —
+/// then its own trailing columns (`tail`). The row gets `of_cell(cs)`: those whole-cell columns
+/// from a [`homogenise::cell::CellState`], every other column 0 (fill them with
+/// `HistoryRow { t, .., ..HistoryRow::of_cell(&cs) }`).
+macro_rules! cell_history_row {
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident {
+            head { $( $(#[$hmeta:meta])* $hfield:ident : $hheader:literal ),* $(,)? }
+            tail { $( $(#[$tmeta:meta])* $tfield:ident : $theader:literal ),* $(,)? }
+        }
+    ) => {
+        $crate::scenarios::rows::table_row! {
+            $(#[$meta])*
+            $vis struct $name {
+                $( $(#[$hmeta])* $hfield: $hheader, )*
+                /// Whole-cell mean stress Σ_xx (Pa, tension positive).
+                sxx: "sigma_xx_Pa",
+                /// Σ_yy (Pa).
+                syy: "sigma_yy_Pa",
+                /// Σ_xy (Pa).
+                sxy: "sigma_xy_Pa",
+                /// Strain rate of the cell D_xx (1/s).
+                dxx: "D_xx_1_s",
+                /// D_yy (1/s).
+                dyy: "D_yy_1_s",
+                /// D_xy (1/s).
+                dxy: "D_xy_1_s",
+                /// Mean pressure `p = −tr Σ/2` (Pa).
+                p: "p_Pa",
+                /// Deviator q (Pa).
+                q: "q_Pa",
+                $( $(#[$tmeta])* $tfield: $theader, )*
+            }
+        }
+
+        impl $name {
+            /// A row with the whole-cell columns of `cs` (stress, strain rate, p, q), every
+            /// other column 0.
+            fn of_cell(cs: &homogenise::cell::CellState) -> Self {
+                let (s, d) = (cs.stress, cs.strain_rate);
+                Self {
+                    sxx: s[(0, 0)],
+                    syy: s[(1, 1)],
+                    sxy: s[(0, 1)],
+                    dxx: d[(0, 0)],
+                    dyy: d[(1, 1)],
+                    dxy: d[(0, 1)],
+                    p: cs.pressure,
+                    q: cs.deviator,
+                    ..Self::default()
+                }
+            }
+        }
+    };
+}
+pub(crate) use cell_history_row;

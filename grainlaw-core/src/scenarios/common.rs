@@ -9,12 +9,33 @@ use datasets::phases::{
 use dem::{StepReport, World};
 use serde::{Deserialize, Serialize};
 
-use super::PhaseEnv;
+use super::{PhaseEnv, RunOutcome};
 pub use crate::checkpoint::Stop;
 use crate::error::{CliError, Result};
 use crate::output::vtk::VtkSeries;
 use crate::output::{OutputDir, Summary};
 use crate::progress::{warn, Phase};
+
+impl RunOutcome {
+    /// The outcome of a run that averaged over windows: the summary `s` with the solver keys of
+    /// all its phases `all` ([`solver_keys`]) and then the numerics of its windows
+    /// (`window_*`, [`crate::verdict::WindowStats::keys`]), the `headline` and the `verdict`.
+    pub fn windowed(
+        mut s: Summary,
+        all: &PhaseStats,
+        windows: &crate::verdict::WindowStats,
+        headline: Vec<String>,
+        verdict: crate::verdict::RunVerdict,
+    ) -> Self {
+        solver_keys(&mut s, all);
+        windows.keys(&mut s, "window");
+        Self {
+            summary: s,
+            headline,
+            verdict,
+        }
+    }
+}
 
 /// Runs `world` through one phase with a progress bar, from `progress` (default for a new
 /// phase; kept up to date, so that a checkpoint can save it). `each` is called after every step

@@ -258,6 +258,18 @@ struct LawFits<'a, 'b> {
 /// The curve a fit draws (when its law passed) and the notes of its figure.
 type LawCurve = (Option<FittedCurve>, Vec<String>);
 
+/// A law that could not be fitted: its check `PREFIX.LAW_fit` (`prefix`, `law` the law's file
+/// name, `mu_i` or `phi_i`) refused in the run's verdict with `reason`.
+fn refuse_fit(verdict: &mut RunVerdict, prefix: &str, law: &str, reason: String) {
+    verdict.run.fail(
+        &format!("{prefix}.{law}_fit"),
+        Verdict::Refused,
+        f64::NAN,
+        f64::NAN,
+        reason,
+    );
+}
+
 /// The parts of [`LawFits`] a fit uses, borrowed apart.
 type Parts<'c, 'b> = (
     &'c RheologySeries,
@@ -344,11 +356,10 @@ impl<'b> LawFits<'_, 'b> {
                 warn(&format!(
                     "μ(I) fit failed ({e}); its linear form is left out (leave_out)"
                 ));
-                verdict.run.fail(
-                    &format!("{}.mu_i_fit", inp.check_prefix),
-                    Verdict::Refused,
-                    f64::NAN,
-                    f64::NAN,
+                refuse_fit(
+                    verdict,
+                    inp.check_prefix,
+                    "mu_i",
                     format!("no μ(I) law could be fitted: {e}"),
                 );
             }
@@ -389,11 +400,10 @@ impl<'b> LawFits<'_, 'b> {
                     warn(&format!("linear μ(I) fit failed too: {e2}"));
                     s.text("mu_i_linear_fit_error", &e2.to_string());
                     crate::verdict::remove_stale_law(out, "mu_i")?;
-                    verdict.run.fail(
-                        &format!("{}.mu_i_fit", inp.check_prefix),
-                        Verdict::Refused,
-                        f64::NAN,
-                        f64::NAN,
+                    refuse_fit(
+                        verdict,
+                        inp.check_prefix,
+                        "mu_i",
                         format!("no μ(I) law could be fitted: {e2}"),
                     );
                     mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
@@ -441,11 +451,10 @@ impl<'b> LawFits<'_, 'b> {
                 warn(&format!("φ(I) fit failed: {e}"));
                 s.text("phi_i_fit_error", &e.to_string());
                 crate::verdict::remove_stale_law(out, "phi_i")?;
-                verdict.run.fail(
-                    &format!("{}.phi_i_fit", inp.check_prefix),
-                    Verdict::Refused,
-                    f64::NAN,
-                    f64::NAN,
+                refuse_fit(
+                    verdict,
+                    inp.check_prefix,
+                    "phi_i",
                     format!("the φ(I) fit failed: {e}"),
                 );
                 phi_notes.push("no φ(I) law fitted (phi_i_fit_error)".into());

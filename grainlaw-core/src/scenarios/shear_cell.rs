@@ -26,8 +26,7 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{
-    add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, solver_keys, Stop,
-    VtkFrames,
+    add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, Stop, VtkFrames,
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::rows::{self, serde_rows, table_row, TableRow};
@@ -111,6 +110,20 @@ impl PointJudgement {
         verdict.run.extend(&phi);
         (mu, phi, verdict)
     }
+}
+
+/// [`judge_points`] of a scenario's own runs, with the bound of φ of its grains' radius spread
+/// ([`max_solid_fraction`]), and the checks of both laws and the run's verdict
+/// ([`PointJudgement::law_checks`], `allow_suspect` as the run says).
+pub(crate) fn judge_runs(
+    scenario: &str,
+    run_checks: &[RunCheckData],
+    radius_spread: f64,
+    allow_suspect: bool,
+) -> (PointJudgement, Checks, Checks, RunVerdict) {
+    let judged = judge_points(scenario, run_checks, max_solid_fraction(radius_spread));
+    let (mu, phi, verdict) = judged.law_checks(allow_suspect);
+    (judged, mu, phi, verdict)
 }
 
 /// Judges every point of a rheology ([`PointJudgement`]), its checks named after `scenario`. A
@@ -955,18 +968,13 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     // Checks (crate::verdict): per run, the numerics of its averaging window and the measured
     // I against its target (all laws); the steady state of μ (μ(I)) and of φ with its bound
     // (φ(I)).
-    let judged = judge_points(
+    let (judged, mu_checks, phi_checks, mut verdict) = judge_runs(
         "shear_cell",
         &run_checks,
-        max_solid_fraction(c.grain.radius_spread),
+        c.grain.radius_spread,
+        ctl.allow_suspect,
     );
-    let (mu_checks, phi_checks, mut verdict) = judged.law_checks(ctl.allow_suspect);
-    let PointJudgement {
-        common,
-        points: point_verdicts,
-        windows,
-        ..
-    } = judged;
+    let (common, point_verdicts, windows) = (judged.common, judged.points, judged.windows);
     let d = mean_diameter(&world);
     VtkFrames::new(f64::INFINITY, 1).finish(&mut ctx.out, &world)?;
     let grain = GrainScale {
@@ -1040,13 +1048,7 @@ pub fn run(c: &ShearCellConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> R
     )?;
     draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, pw], (1950, 650))?;
     profile_figures(&mut ctx.out, &world, &profiles, &is)?;
-    solver_keys(&mut s, &all);
-    windows.keys(&mut s, "window");
-    Ok(RunOutcome {
-        summary: s,
-        headline,
-        verdict,
-    })
+    Ok(RunOutcome::windowed(s, &all, &windows, headline, verdict))
 }
 
 /// The bulk of the cell: the slice two diameters away from each wall.

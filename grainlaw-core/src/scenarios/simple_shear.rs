@@ -22,19 +22,18 @@ use identify::mu_i::RheologySeries;
 
 use serde::{Deserialize, Serialize};
 
-use super::cell_base::{CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
-use super::common::{mean_diameter, solver_keys, strain_bins, Stop, VtkFrames};
+use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
+use super::common::{mean_diameter, strain_bins, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
 use super::rows::{self, table_row};
 use super::sensitivity::{record, resolved_pair};
-use super::shear_cell::{judge_points, PointJudgement, RunCheckData};
+use super::shear_cell::{judge_runs, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::verdict::max_solid_fraction;
 
 /// Re-solved samples of an averaging window, spread evenly over it (at least this many; every
 /// step of a shorter window): each such step is solved again to
@@ -53,45 +52,33 @@ fn resolves(j: u64, len: u64) -> bool {
     j % every == every - 1
 }
 
-table_row! {
+cell_history_row! {
     /// One step of a shear run: a row of `history_I{k}.csv`.
     struct HistoryRow {
-        /// Time (s).
-        t: "t_s",
-        /// Shear strain γ of the run.
-        shear_strain: "shear_strain",
-        /// Whole-cell mean stress Σ_xx (Pa, tension positive).
-        sxx: "sigma_xx_Pa",
-        /// Σ_yy (Pa).
-        syy: "sigma_yy_Pa",
-        /// Σ_xy (Pa).
-        sxy: "sigma_xy_Pa",
-        /// Strain rate of the cell D_xx (1/s).
-        dxx: "D_xx_1_s",
-        /// D_yy (1/s).
-        dyy: "D_yy_1_s",
-        /// D_xy (1/s).
-        dxy: "D_xy_1_s",
-        /// `−tr Σ/2` (Pa).
-        p: "p_Pa",
-        /// Deviator (Pa).
-        q: "q_Pa",
-        /// Solid fraction.
-        phi: "phi",
-        /// Coordination.
-        z: "Z",
-        /// Fabric F_xx.
-        fabric_xx: "fabric_xx",
-        /// Fabric F_yy.
-        fabric_yy: "fabric_yy",
-        /// Fabric F_xy.
-        fabric_xy: "fabric_xy",
-        /// `γ̇ d / √(−Σ_yy/ρ)` (NaN without normal stress).
-        inertial: "I",
-        /// `|Σ_xy|/(−Σ_yy)`.
-        mu: "mu",
-        /// Re-solves of the step by the cell control.
-        cell_corrections: "cell_corrections",
+        head {
+            /// Time (s).
+            t: "t_s",
+            /// Shear strain γ of the run.
+            shear_strain: "shear_strain",
+        }
+        tail {
+            /// Solid fraction.
+            phi: "phi",
+            /// Coordination.
+            z: "Z",
+            /// Fabric F_xx.
+            fabric_xx: "fabric_xx",
+            /// Fabric F_yy.
+            fabric_yy: "fabric_yy",
+            /// Fabric F_xy.
+            fabric_xy: "fabric_xy",
+            /// `γ̇ d / √(−Σ_yy/ρ)` (NaN without normal stress).
+            inertial: "I",
+            /// `|Σ_xy|/(−Σ_yy)`.
+            mu: "mu",
+            /// Re-solves of the step by the cell control.
+            cell_corrections: "cell_corrections",
+        }
     }
 }
 
@@ -459,14 +446,6 @@ impl PhasedRun for Shear<'_> {
         st.cell.history.push(HistoryRow {
             t: w.time,
             shear_strain: st.run.gamma_dot * st.run.dt * st.run.n as f64,
-            sxx: s[(0, 0)],
-            syy: s[(1, 1)],
-            sxy: s[(0, 1)],
-            dxx: cs.strain_rate[(0, 0)],
-            dyy: cs.strain_rate[(1, 1)],
-            dxy: cs.strain_rate[(0, 1)],
-            p: cs.pressure,
-            q: cs.deviator,
             phi: cs.solid_fraction,
             z: cs.coordination,
             fabric_xx: cs.fabric[(0, 0)],
@@ -475,6 +454,7 @@ impl PhasedRun for Shear<'_> {
             inertial: i,
             mu,
             cell_corrections: r.cell_corrections as f64,
+            ..HistoryRow::of_cell(&cs)
         });
         Ok(())
     }
@@ -636,17 +616,13 @@ pub fn run(
     } = state;
     // Checks (crate::verdict), as in the shear cell: per point, the numerics of its averaging
     // window, I against its target, steady μ and φ, φ below its bound.
-    let judged = judge_points(
+    let (judged, mu_checks, phi_checks, mut verdict) = judge_runs(
         "simple_shear",
         &run_checks,
-        max_solid_fraction(c.grain.radius_spread),
+        c.grain.radius_spread,
+        ctl.allow_suspect,
     );
-    let (mu_checks, phi_checks, mut verdict) = judged.law_checks(ctl.allow_suspect);
-    let PointJudgement {
-        points: point_verdicts,
-        windows,
-        ..
-    } = judged;
+    let (point_verdicts, windows) = (judged.points, judged.windows);
     frames.finish(&mut ctx.out, &world)?;
     let d = mean_diameter(&world);
     let grain = GrainScale {
@@ -725,13 +701,7 @@ pub fn run(
     }
     ph.legend = LegendAt::UpperRight;
     draw_row(&mut ctx.out, "rheology.png", &[pmu, pphi, ph], (1950, 650))?;
-    solver_keys(&mut s, &all);
-    windows.keys(&mut s, "window");
-    Ok(RunOutcome {
-        summary: s,
-        headline,
-        verdict,
-    })
+    Ok(RunOutcome::windowed(s, &all, &windows, headline, verdict))
 }
 
 /// Standard errors usable as fit weights: all finite and positive, or `None` (unweighted).
@@ -742,6 +712,7 @@ fn weights_if_usable(se: Vec<f64>) -> Option<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scenarios::shear_cell::judge_points;
     use crate::verdict::{Verdict, WindowStats};
 
     /// A history whose μ is 0.6 over the first bin of shear strain, 0.8 over the second and

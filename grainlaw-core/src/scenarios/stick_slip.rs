@@ -5,7 +5,6 @@
 //! then regular), friction at the walls and between grains (load–unload cycles).
 
 use datasets::config::StickSlipConfig;
-use datasets::phases::RunUntilRest;
 use dem::math::Vector;
 
 use datasets::phases::PhaseStats;
@@ -136,11 +135,7 @@ impl PhasedRun for Push<'_> {
             st.weights.push(grain_weight(world));
             Ok(Some(PhasePlan {
                 name: format!("deposit {case}"),
-                stop: Stop::UntilRest(RunUntilRest {
-                    min_time: 0.0,
-                    max_time: c.deposit.max_time,
-                    rest_energy: c.deposit.rest_energy,
-                }),
+                stop: Stop::UntilRest(c.deposit.until_rest()),
             }))
         } else {
             world.params.dt = c.dt;

@@ -17,7 +17,7 @@
 //! continuum comparison: `summary.json` (object `column`), `front.csv`, `profiles.csv`.
 
 use datasets::config::ColumnCollapseConfig;
-use datasets::phases::{PhaseProgress, PhaseStats, RunUntilRest};
+use datasets::phases::{PhaseProgress, PhaseStats};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -205,11 +205,7 @@ impl PhasedRun for Collapse<'_> {
         Ok(match k {
             DEPOSIT => Some(PhasePlan {
                 name: "deposit".into(),
-                stop: Stop::UntilRest(RunUntilRest {
-                    min_time: 0.0,
-                    max_time: c.deposit.max_time,
-                    rest_energy: c.deposit.rest_energy,
-                }),
+                stop: Stop::UntilRest(c.deposit.until_rest()),
             }),
             COLLAPSE => {
                 st.deposited = grain_count(world);
@@ -234,11 +230,7 @@ impl PhasedRun for Collapse<'_> {
                 self.sample_front(st, world);
                 Some(PhasePlan {
                     name: "collapse".into(),
-                    stop: Stop::UntilRest(RunUntilRest {
-                        min_time: c.collapse.min_time,
-                        max_time: c.collapse.max_time,
-                        rest_energy: c.collapse.rest_energy,
-                    }),
+                    stop: Stop::UntilRest(c.collapse.until_rest()),
                 })
             }
             _ => None,

@@ -20,7 +20,7 @@
 //!    is reported instead and flagged.
 
 use datasets::config::JanssenConfig;
-use datasets::phases::{PhaseStats, RunUntilRest};
+use datasets::phases::PhaseStats;
 use dem::math::Vector;
 use homogenise::state::solid_fraction;
 use homogenise::Region;
@@ -193,27 +193,13 @@ impl PhasedRun for Column<'_> {
         Ok(match k {
             DEPOSIT => {
                 c.deposit.solver.apply(&mut world.params);
-                plan(
-                    "deposit",
-                    Stop::UntilRest(RunUntilRest {
-                        min_time: 0.0,
-                        max_time: c.deposit.max_time,
-                        rest_energy: c.deposit.rest_energy,
-                    }),
-                )
+                plan("deposit", Stop::UntilRest(c.deposit.until_rest()))
             }
             // Relaxation at the scenario's time step, tight tolerance.
             RELAX => {
                 world.params.dt = c.dt;
                 c.relax.solver.apply(&mut world.params);
-                plan(
-                    "relax",
-                    Stop::UntilRest(RunUntilRest {
-                        min_time: c.relax.min_time,
-                        max_time: c.relax.max_time,
-                        rest_energy: c.relax.rest_energy,
-                    }),
-                )
+                plan("relax", Stop::UntilRest(c.relax.until_rest()))
             }
             // Release: the floor is lowered slowly so that the column slides along the walls
             // (Coulomb conditions at the wall contacts).
@@ -613,6 +599,22 @@ fn report_fit(
     Ok(headline)
 }
 
+/// The solve keys of one phase `phase` (`release`, `relax`) from its statistics `st`:
+/// `PHASE_unconverged_steps`, `PHASE_energy_growth_steps`, `PHASE_worst_error` and
+/// `PHASE_worst_error_without_gap_shifts`.
+fn solve_keys<'s>(s: &'s mut Summary, phase: &str, st: &PhaseStats) -> &'s mut Summary {
+    s.int(&format!("{phase}_unconverged_steps"), st.unconverged_steps)
+        .int(
+            &format!("{phase}_energy_growth_steps"),
+            st.energy_growth_steps,
+        )
+        .num(&format!("{phase}_worst_error"), st.worst_error)
+        .num(
+            &format!("{phase}_worst_error_without_gap_shifts"),
+            st.worst_error_without_gap_shifts,
+        )
+}
+
 /// Stage "report": the summary keys of each phase (deposit, relaxation, release and
 /// measurement) and of the last step.
 fn phase_keys(
@@ -637,23 +639,11 @@ fn phase_keys(
         .num("relaxed_bottom_load_over_weight", relaxed_load)
         .num("release_floor_drop_m", c.release.floor_drop)
         .num("release_speed_m_s", c.release.speed)
-        .int("release_steps", release.steps)
-        .int("release_unconverged_steps", release.unconverged_steps)
-        .int("release_energy_growth_steps", release.energy_growth_steps)
-        .num("release_worst_error", release.worst_error)
-        .num(
-            "release_worst_error_without_gap_shifts",
-            release.worst_error_without_gap_shifts,
-        )
+        .int("release_steps", release.steps);
+    solve_keys(s, "release", &release)
         .int("relax_steps", relax.steps)
-        .num("relax_time_s", relax.simulated_time)
-        .int("relax_unconverged_steps", relax.unconverged_steps)
-        .int("relax_energy_growth_steps", relax.energy_growth_steps)
-        .num("relax_worst_error", relax.worst_error)
-        .num(
-            "relax_worst_error_without_gap_shifts",
-            relax.worst_error_without_gap_shifts,
-        )
+        .num("relax_time_s", relax.simulated_time);
+    solve_keys(s, "relax", &relax)
         .flag("relax_at_rest", relax.at_rest)
         .num("final_kinetic_energy_ratio", relax.final_energy_ratio)
         .num("final_solver_error", final_report.solver.error)
