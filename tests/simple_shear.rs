@@ -372,6 +372,8 @@ fn grains_following_the_cell_within_the_step_stop_the_ringing_of_its_stress() {
                 "--set",
                 "solver.max_iterations=100",
                 "--set",
+                "travel_per_step=0.02", // the step its figures were measured at
+                "--set",
                 affine,
                 "-q",
             ],
@@ -407,6 +409,8 @@ fn a_cell_control_that_runs_away_fails_its_run_at_the_step() {
                 "simple-shear",
                 "--set",
                 "grain.radius_mean=2.5e-3",
+                "--set",
+                "travel_per_step=0.02", // the step its figures were measured at
                 "--set",
                 "grain.radius_spread=0.5e-3",
                 "--set",
