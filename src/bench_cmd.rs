@@ -938,12 +938,12 @@ pub fn z_score(a: f64, se_a: f64, b: f64, se_b: f64) -> f64 {
 }
 
 /// The representative-volume race (`grainlaw bench --rve N ...`): per grain count, grainlaw's
-/// `simple-shear` scenario ([`grainlaw_rve`]) and LAMMPS on the same initial grains
+/// `simple-shear` scenario (`grainlaw_rve`) and LAMMPS on the same initial grains
 /// ([`crate::lammps_rve_peer`]) when it is found (else the quoted hand measurement of the
 /// reference case, labelled so), both on one core; one table of wall seconds (shear, total),
 /// seconds per unit shear strain, steps, μ ± SE, φ ± SE and the largest overlap, then the
 /// ratio LAMMPS / grainlaw of the seconds per unit strain with LAMMPS' settings beside it and
-/// the z-score of the two μ ([`rve_race`] per grain count).
+/// the z-score of the two μ (`rve_race` per grain count).
 pub fn rve_rows(plan: &RvePlan) -> Result<()> {
     if plan.grains.is_empty() {
         return Ok(());

@@ -5,7 +5,7 @@
 //! until kinetic / potential energy < 10⁻⁸ (`KE = Σ ½ m |v|² + ½ I ω²`, `PE = Σ m g y` above the
 //! floor). Two preparations:
 //!
-//! - [`Preparation::Pour`]: the grains start on loose rows ([`crate::generators::rain`]) and
+//! - [`Preparation::Pour`]: the grains start on loose rows ([`crate::generators::rain()`]) and
 //!   fall: the whole column compacts (the protocol of a soft-contact code's pour);
 //! - [`Preparation::Deposit`]: sequential geometric deposition
 //!   ([`crate::generators::deposition`]), then the engine relaxes the packing under gravity.

@@ -90,7 +90,7 @@ fn mean_diameter(s: &Snapshot) -> f64 {
     }
 }
 
-/// What [`homogenise`] did: the report lines and the files it wrote.
+/// What [`homogenise()`] did: the report lines and the files it wrote.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HomogeniseOutcome {
     /// The report printed by the command line (last snapshot's state, wall forces).
@@ -104,8 +104,8 @@ pub struct HomogeniseOutcome {
 /// series, `summary.json`; `docs/outputs.md` § "homogenise"); returns the report and the files.
 /// The one implementation behind `grainlaw homogenise` and the Python `grainlaw.homogenise`.
 ///
-/// Stages: options checked → the files read → per-snapshot tables ([`SeriesTables`]) → the
-/// last snapshot's outputs ([`last_outputs`]), Janssen table, cell and simple-shear point →
+/// Stages: options checked → the files read → per-snapshot tables (`SeriesTables`) → the
+/// last snapshot's outputs (`last_outputs`), Janssen table, cell and simple-shear point →
 /// summary and report.
 pub fn homogenise(plan: &HomogenisePlan) -> Result<HomogeniseOutcome> {
     check_options(plan)?;

@@ -67,7 +67,7 @@
 //! `l_x, l_y, xy`, and the mean contacts per grain (`compute contact/atom`). Over the last
 //! `average_strain`, per sample `μ = |p_xy| / p_yy`, `φ = Σ π r² / (l_x l_y)`, and their means
 //! with block-averaged standard errors by the scenario's own code
-//! ([`crate::scenarios::simple_shear::RheologyPoint`], `homogenise::averaging::block_average`).
+//! (`crate::scenarios::simple_shear::RheologyPoint`, `homogenise::averaging::block_average`).
 //! The largest overlap is measured on [`OVERLAP_SNAPSHOTS`] snapshots spread over the whole run
 //! (`dump custom`, read by [`crate::readers::read_lammps`]).
 
@@ -538,7 +538,7 @@ pub struct RveMeasure {
 impl RveLog {
     /// The measure over the rows of the last `rve.average_strain` of the shear (a row's strain
     /// is `γ̇ h` times its steps since the shear started), by the scenario's
-    /// [`RheologyPoint::of`]: means with block-averaged standard errors.
+    /// `RheologyPoint::of`: means with block-averaged standard errors.
     pub fn measure(&self, rve: &PeerRve) -> Result<RveMeasure> {
         let area = rve.grain_area();
         let per_step = rve.gamma_dot * rve.model.dt;

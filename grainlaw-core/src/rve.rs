@@ -2,8 +2,8 @@
 //! snapshots of a biperiodic cell, e.g. LAMMPS dumps of a `fix deform xy erate ... remap v`
 //! run): the point of μ(I), φ(I) that grainlaw's own `simple-shear` scenario makes for one
 //! inertial number, with the same samples, averages, checks and table
-//! ([`crate::scenarios::simple_shear::RheologyPoint`], [`crate::scenarios::shear_cell::judge_points`],
-//! [`crate::scenarios::shear_cell::write_rheology_table`]).
+//! (`crate::scenarios::simple_shear::RheologyPoint`, `crate::scenarios::shear_cell::judge_points`,
+//! `crate::scenarios::shear_cell::write_rheology_table`).
 //!
 //! Per snapshot, the whole-cell state ([`homogenise::cell::cell_state`]: mean stress over the
 //! cell of area `det h`, kinetic stress of the velocity fluctuations about the cell's affine

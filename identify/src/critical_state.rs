@@ -339,7 +339,7 @@ fn cluster_covariance(x: &[f64], residuals: &[f64], sample: &[usize]) -> (DMatri
 
 /// Fits `sin φ_mob = sin φ_cv + β sin ψ` (module documentation). With the samples of the points
 /// given (`data.sample`, two or more) and a cluster-robust variance over the samples
-/// ([`cluster_covariance`]) larger than the least-squares one for either parameter, each
+/// (`cluster_covariance`) larger than the least-squares one for either parameter, each
 /// standard error is the larger of the two, with the cluster-robust correlation and Student's
 /// `t` at `G − 1` degrees of freedom: the points of one sample are correlated (consecutive windows of
 /// one test), and least squares alone takes them as independent.

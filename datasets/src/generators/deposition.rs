@@ -37,7 +37,7 @@ pub struct Deposition {
     /// Centres (m), in the order of the radii.
     pub centres: Vec<Vector>,
     /// Supports of each grain: the floor alone, or the grain it rolled over and the one (or the
-    /// wall) that stopped it. A grain left after [`MAX_MOVES`] rolls keeps its last pivot only.
+    /// wall) that stopped it. A grain left after `MAX_MOVES` rolls keeps its last pivot only.
     pub supports: Vec<[Option<Support>; 2]>,
 }
 

@@ -200,7 +200,7 @@ struct CentralMeasures {
 /// [`CliError::Usage`] for bad input (exit 2), [`CliError::ExternalSolver`] when Gerris is
 /// missing or fails (exit 3, the case left in `OUT/gerris`), [`CliError::Io`] for files.
 ///
-/// Stages: config ([`resolve_config`]) → the central Gerris run → its tables → checks →
+/// Stages: config (`resolve_config`) → the central Gerris run → its tables → checks →
 /// comparison with the DEM → band → figures → summary and report.
 pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
     crate::plot::init_font();

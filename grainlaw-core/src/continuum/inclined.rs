@@ -245,7 +245,7 @@ impl InclinedRun {
 /// Runs the inclined plane of `plan` (module documentation). Errors as
 /// [`super::column::column_collapse`]; a slope without steady flow for the law is bad input.
 ///
-/// Stages: config ([`resolve_inclined`]) → the Gerris run → its profile against Bagnold's →
+/// Stages: config (`resolve_inclined`) → the Gerris run → its profile against Bagnold's →
 /// checks → comparison with the DEM → figure → summary and report.
 pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
     crate::plot::init_font();

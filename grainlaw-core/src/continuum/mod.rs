@@ -8,7 +8,7 @@
 //! - [`gerris`]: running `gerris2D` (missing or failing: exit 3, the case left in place);
 //! - [`snapshot`]: Gerris' text snapshots, the height profile and front of the VOF tracer;
 //! - [`dem_column`]: the DEM `column-collapse` run's `summary.json`, `front.csv`, `profiles.csv`;
-//! - [`column`]: the column collapse end to end, its comparison with DEM, its figures;
+//! - [`column`](mod@column): the column collapse end to end, its comparison with DEM, its figures;
 //! - [`band`]: the law's covariance carried through the run;
 //! - [`inclined`]: steady flow down a slope against Bagnold's profile and DEM.
 

@@ -24,10 +24,10 @@
 //! The cell is the box of the per-atom block's header, as LAMMPS writes it: orthogonal
 //! (`ITEM: BOX BOUNDS pp ff pp`, lines `lo hi`) or triclinic (`ITEM: BOX BOUNDS xy xz yz pp pp
 //! pp`, lines `lo_bound hi_bound tilt`, turned into the box's edges by the conversion of the
-//! LAMMPS documentation, [`parse_box`]), periodic or not along x and y by its flags; every pair
+//! LAMMPS documentation, `parse_box`), periodic or not along x and y by its flags; every pair
 //! takes the minimum image of that cell (`frame` module). Refused: a periodic cell tilted
 //! beyond [`MAX_TILT_RATIO`], a 3D dump (z not periodic, z tilts, atoms off the plane z = 0),
-//! and a series whose atom count or kind of box changes ([`check_series`]).
+//! and a series whose atom count or kind of box changes (`check_series`).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};

@@ -138,7 +138,7 @@ const COMPRESSION_TAIL: f64 = 0.2;
 /// compression only).
 const SEGMENT_STRAIN: f64 = 0.005;
 /// Relative error `max(|⟨Σ_xx⟩ + p₀|, |⟨Σ_yy⟩ + p₀|)/p₀` of the stress reached by the isotropic
-/// compression (means over its last [`COMPRESSION_TAIL`]) above which the sample is suspect.
+/// compression (means over its last `COMPRESSION_TAIL`) above which the sample is suspect.
 /// The explicit control of a massless cell on rigid grains holds the stress of a jammed
 /// packing only through the impulses of its deformation (`dem::cell`): the stress of a step
 /// scatters by tens of % of p₀ and its mean sits 10–15 % on the tensile side of the target
@@ -264,7 +264,7 @@ table_row! {
     }
 }
 
-/// What the isotropic compression reached (means over its last [`COMPRESSION_TAIL`]), kept
+/// What the isotropic compression reached (means over its last `COMPRESSION_TAIL`), kept
 /// until the axial compression closes the pressure's row.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 struct Compressed {

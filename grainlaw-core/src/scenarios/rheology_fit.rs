@@ -3,7 +3,7 @@
 //! and 95 % bands on the figures, the summary keys, the printed parameters with their
 //! intervals, and the laws exported under their verdicts ([`crate::verdict::export_law`]).
 //! One implementation for every scenario that measures μ(I) and φ(I); the figures
-//! ([`rheology_plot`]) are also those of a campaign's merged points (`crate::campaign`).
+//! (`rheology_plot`) are also those of a campaign's merged points (`crate::campaign`).
 
 use identify::law::{GrainScale, Provenance};
 use identify::mu_i::{fit_mu_i, fit_mu_i_linear, fit_phi_i, RheologySeries};
@@ -467,7 +467,7 @@ impl<'b> LawFits<'_, 'b> {
 
 /// Fits μ(I) and φ(I) to `series` (those the plan does not leave out), writes the laws that
 /// pass (or their `.rejected.json`), records refusals in `verdict`, the keys in `s`, the printed
-/// lines in `headline`; returns the μ(I) and φ(I) figures ([`rheology_plot`]). Every point
+/// lines in `headline`; returns the μ(I) and φ(I) figures (`rheology_plot`). Every point
 /// enters the fits (a point failing its own checks makes the laws fail theirs).
 pub(crate) fn fit_mu_phi(
     out: &mut OutputDir,

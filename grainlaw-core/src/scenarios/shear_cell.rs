@@ -414,7 +414,7 @@ struct ShearState {
     #[serde(default)]
     tightenings: u32,
     /// Mean cost per step of the last phase's solves, in sweeps
-    /// ([`PhaseStats::mean_solve_cost`], [`needs_tightening`]).
+    /// ([`PhaseStats::mean_solve_cost`], `needs_tightening`).
     #[serde(default, alias = "lead_sweeps")]
     phase_cost: f64,
 }
@@ -460,13 +460,13 @@ fn needs_tightening(s: &Sensitivity, sweeps: f64, max_sweeps: usize) -> bool {
 }
 
 /// Largest mean sweeps per step of a lead stage, as a fraction of the sweep cap, after which
-/// [`needs_tightening`] may tighten the tolerance.
+/// `needs_tightening` may tighten the tolerance.
 pub const TIGHTEN_MAX_SWEEPS: f64 = 0.2;
 
-/// Standard errors of the mean added to a lead stage's measured changes ([`needs_tightening`]).
+/// Standard errors of the mean added to a lead stage's measured changes (`needs_tightening`).
 pub const TIGHTEN_Z: f64 = 2.0;
 
-/// Fewest re-solved samples of a lead stage on which [`needs_tightening`] decides.
+/// Fewest re-solved samples of a lead stage on which `needs_tightening` decides.
 pub const TIGHTEN_MIN_SAMPLES: u64 = 4;
 
 /// Which part of which run phase `k ≥ 1` is.
