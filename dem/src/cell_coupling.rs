@@ -83,7 +83,9 @@ use crate::contact::{ContactGeometry, ContactRow};
 use crate::local::Delassus2;
 use crate::math::Spatial;
 use crate::math::Tensor;
-use crate::parallel::{coloured_sweep_where, coloured_units, update_shared, Shared, TASK};
+use crate::parallel::{
+    coloured_sweep_where, coloured_units, shared_sweep_inputs, update_shared, TASK,
+};
 use crate::sweep::update;
 use rayon::prelude::*;
 
@@ -423,14 +425,7 @@ impl CellCoupling {
         mobile: &[bool],
         omega: f64,
     ) {
-        assert_eq!(
-            colouring.order.len() + colouring.block_order.len(),
-            rows.len(),
-            "colouring of other rows"
-        );
-        assert!(vel.len() == inv.len() && vel.len() == mobile.len());
-        let n_rows = rows.len();
-        let (pr, pv) = (Shared(rows.as_mut_ptr()), Shared(vel.as_mut_ptr()));
+        let (n_rows, pr, pv) = shared_sweep_inputs(rows, colouring, vel, inv, mobile);
         let this = &*self;
         let mut delta = self.delta;
         coloured_units(

@@ -195,14 +195,7 @@ pub(crate) fn coloured_sweep_where(
     omega: f64,
     keep: impl Fn(usize) -> bool + Sync,
 ) {
-    assert_eq!(
-        colouring.order.len() + colouring.block_order.len(),
-        rows.len(),
-        "colouring of other rows"
-    );
-    assert!(vel.len() == inv.len() && vel.len() == mobile.len());
-    let n_rows = rows.len();
-    let (pr, pv) = (Shared(rows.as_mut_ptr()), Shared(vel.as_mut_ptr()));
+    let (n_rows, pr, pv) = shared_sweep_inputs(rows, colouring, vel, inv, mobile);
     for_each_coloured(colouring, |i| {
         assert!(i < n_rows);
         if !keep(i) {
@@ -213,6 +206,29 @@ pub(crate) fn coloured_sweep_where(
         // indices checked in `update_shared`.
         unsafe { update_shared(pr, i, pv, inv, mobile, omega) };
     });
+}
+
+/// The checked inputs of a colour-ordered sweep as shared pointers: the colouring is of `rows`
+/// and the bodies' arrays agree in length; returns the row count and the rows' and velocities'
+/// pointers (dereferenced only under the colouring's exclusivity, [`update_shared`]).
+pub(crate) fn shared_sweep_inputs(
+    rows: &mut [ContactRow],
+    colouring: &ContactColouring,
+    vel: &mut [Spatial],
+    inv: &[Spatial],
+    mobile: &[bool],
+) -> (usize, Shared<ContactRow>, Shared<Spatial>) {
+    assert_eq!(
+        colouring.order.len() + colouring.block_order.len(),
+        rows.len(),
+        "colouring of other rows"
+    );
+    assert!(vel.len() == inv.len() && vel.len() == mobile.len());
+    (
+        rows.len(),
+        Shared(rows.as_mut_ptr()),
+        Shared(vel.as_mut_ptr()),
+    )
 }
 
 /// `v ← v_free + M⁻¹ Hᵀ R` by scattering each contact's impulse onto its two bodies, contacts

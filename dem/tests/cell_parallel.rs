@@ -129,80 +129,12 @@ fn coupled_steps_have_the_same_bits_on_one_and_two_threads() {
     assert!(lyy != 0.0, "the cell did not move");
 }
 
-/// One step of the sheared crystal (24 × 24, after 3 steps) solved to 10⁻¹⁰ in colour order
-/// with the coupled contacts last (parallel, two threads) and in natural order (one thread):
+/// One step of the sheared crystal (24 × 24, the grains following the cell when `affine`,
+/// after 3 steps) solved to 10⁻¹⁰ in parallel (two threads) and in natural order (one thread):
 /// both converge, and the cell's `L⁺_yy ℓ` and every body's velocity agree to 10⁻⁷ of the
-/// shear's velocity scale `γ̇ ℓ` (ℓ the cell's height), the stress `σ_yy` to 10⁻⁶ of P
-/// (measured 2026-12: 1.3·10⁻⁹, 1.6·10⁻⁹ and 5.9·10⁻⁹, in 339 and 355 sweeps: different
-/// orders of one Gauss–Seidel, each within 10⁻¹⁰ of the solution).
-#[test]
-fn the_parallel_coupled_sweep_solves_the_same_step() {
-    let mut start = sheared_crystal(24, false, 1e-8, 20_000);
-    for _ in 0..3 {
-        start.step().unwrap();
-    }
-    let solve = |parallel: bool| {
-        let mut w = start.clone();
-        w.params.solver.parallel = parallel;
-        w.params.solver.tolerance = 1e-10;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(if parallel { 2 } else { 1 })
-            .build()
-            .unwrap();
-        let r = pool.install(|| w.step().unwrap());
-        assert!(r.solver.converged, "parallel {parallel}: {:?}", r.solver);
-        w
-    };
-    let (seq, par) = (solve(false), solve(true));
-    let (cs, cp) = (seq.cell().unwrap(), par.cell().unwrap());
-    let gd = cs.l[(0, 1)];
-    let scale = gd * cs.h[(1, 1)];
-    let dl = (cs.l[(1, 1)] - cp.l[(1, 1)]).abs() * cs.h[(1, 1)];
-    assert!(
-        dl <= 1e-7 * scale,
-        "L_yy {} vs {}",
-        cs.l[(1, 1)],
-        cp.l[(1, 1)]
-    );
-    let dv = seq
-        .bodies
-        .iter()
-        .zip(&par.bodies)
-        .map(|(a, b)| (a.velocity - b.velocity).norm())
-        .fold(0.0, f64::max);
-    assert!(dv <= 1e-7 * scale, "velocities differ by {dv:e} m/s");
-    let (ss, sp) = (seq.cell_stress().unwrap(), par.cell_stress().unwrap());
-    assert!(
-        (ss[(1, 1)] - sp[(1, 1)]).abs() <= 1e-6 * P,
-        "σ_yy {} vs {}",
-        ss[(1, 1)],
-        sp[(1, 1)]
-    );
-}
-
-/// The grains following the cell within the step couple every contact to the cell: the
-/// parallel sweep then runs in fixed units with a Jacobi step on the cell's term between them
-/// (`CellCoupling::sweep_coupled`). After 4 steps of the 2304-grain crystal the state's bits,
-/// `h` and `L` are the same on one and two threads, and the cell moved.
-#[test]
-fn steps_with_the_grains_following_the_cell_have_the_same_bits_on_one_and_two_threads() {
-    let (one, sweeps, contacts) = run_on_with(1, 4, true);
-    assert!(sweeps > 4 * 10, "the solves must do work: {sweeps} sweeps");
-    assert!(contacts >= 4096, "a step with {contacts} contacts");
-    let (two, _, _) = run_on_with(2, 4, true);
-    assert!(one == two, "two threads differ from one");
-    let lyy = f64::from_bits(one[one.len() - 1]);
-    assert!(lyy != 0.0, "the cell did not move");
-}
-
-/// One step of the sheared crystal with the grains following the cell (24 × 24, after 3
-/// steps) solved to 10⁻¹⁰ by the unit sweep (parallel, two threads) and by the natural-order
-/// Gauss–Seidel (one thread): both converge to the same step, the cell's `L⁺_yy ℓ` and every
-/// body's velocity within 10⁻⁷ of `γ̇ ℓ`, `σ_yy` within 10⁻⁶ of P (the Jacobi step between the
-/// units changes the iterates, not the solution).
-#[test]
-fn the_unit_sweep_solves_the_same_step_as_gauss_seidel() {
-    let mut start = sheared_crystal_with(24, false, 1e-8, 20_000, true);
+/// shear's velocity scale `γ̇ ℓ` (ℓ the cell's height), the stress `σ_yy` to 10⁻⁶ of P.
+fn assert_parallel_solves_the_same_step(affine: bool) {
+    let mut start = sheared_crystal_with(24, false, 1e-8, 20_000, affine);
     for _ in 0..3 {
         start.step().unwrap();
     }
@@ -242,4 +174,40 @@ fn the_unit_sweep_solves_the_same_step_as_gauss_seidel() {
         ss[(1, 1)],
         sp[(1, 1)]
     );
+}
+
+/// One step of the sheared crystal (24 × 24, after 3 steps) solved to 10⁻¹⁰ in colour order
+/// with the coupled contacts last (parallel, two threads) and in natural order (one thread):
+/// both converge, and the cell's `L⁺_yy ℓ` and every body's velocity agree to 10⁻⁷ of the
+/// shear's velocity scale `γ̇ ℓ` (ℓ the cell's height), the stress `σ_yy` to 10⁻⁶ of P
+/// (measured 2026-12: 1.3·10⁻⁹, 1.6·10⁻⁹ and 5.9·10⁻⁹, in 339 and 355 sweeps: different
+/// orders of one Gauss–Seidel, each within 10⁻¹⁰ of the solution).
+#[test]
+fn the_parallel_coupled_sweep_solves_the_same_step() {
+    assert_parallel_solves_the_same_step(false);
+}
+
+/// The grains following the cell within the step couple every contact to the cell: the
+/// parallel sweep then runs in fixed units with a Jacobi step on the cell's term between them
+/// (`CellCoupling::sweep_coupled`). After 4 steps of the 2304-grain crystal the state's bits,
+/// `h` and `L` are the same on one and two threads, and the cell moved.
+#[test]
+fn steps_with_the_grains_following_the_cell_have_the_same_bits_on_one_and_two_threads() {
+    let (one, sweeps, contacts) = run_on_with(1, 4, true);
+    assert!(sweeps > 4 * 10, "the solves must do work: {sweeps} sweeps");
+    assert!(contacts >= 4096, "a step with {contacts} contacts");
+    let (two, _, _) = run_on_with(2, 4, true);
+    assert!(one == two, "two threads differ from one");
+    let lyy = f64::from_bits(one[one.len() - 1]);
+    assert!(lyy != 0.0, "the cell did not move");
+}
+
+/// One step of the sheared crystal with the grains following the cell (24 × 24, after 3
+/// steps) solved to 10⁻¹⁰ by the unit sweep (parallel, two threads) and by the natural-order
+/// Gauss–Seidel (one thread): both converge to the same step, the cell's `L⁺_yy ℓ` and every
+/// body's velocity within 10⁻⁷ of `γ̇ ℓ`, `σ_yy` within 10⁻⁶ of P (the Jacobi step between the
+/// units changes the iterates, not the solution).
+#[test]
+fn the_unit_sweep_solves_the_same_step_as_gauss_seidel() {
+    assert_parallel_solves_the_same_step(true);
 }
