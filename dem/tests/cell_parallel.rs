@@ -22,12 +22,8 @@ const P: f64 = 100.0;
 /// biperiodic cell at pitch `2R`, μ = 0.3, sheared at `γ̇ = I √(P/ρ)/d` (I = 0.05) with
 /// L_xx = 0 and σ_yy = −P held by the implicit control (gain `10 γ̇/P`, rate cap γ̇); time
 /// step from a relative travel of 0.02 R a step, solved by Gauss–Seidel alone.
-fn sheared_crystal(n: usize, parallel: bool, tolerance: f64, max_iterations: usize) -> World {
-    sheared_crystal_with(n, parallel, tolerance, max_iterations, false)
-}
-
-/// [`sheared_crystal`] with the grains following the cell within the step when `affine`
-/// (`CellControl::affine`: every contact coupled to the cell).
+/// With `affine`, the grains follow the cell within the step (`CellControl::affine`: every
+/// contact coupled to the cell).
 fn sheared_crystal_with(
     n: usize,
     parallel: bool,
