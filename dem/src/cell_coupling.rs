@@ -92,23 +92,6 @@ use rayon::prelude::*;
 /// No coupling slot.
 const NONE: u32 = u32::MAX;
 
-/// `base_s + Σ_κ B_sκ δ_κ`: the affine velocity of coupled slot `s` for the change `delta`.
-#[inline]
-fn this_affine(
-    base: &[[f64; 2]],
-    coef: &[[[f64; 2]; 3]],
-    s: usize,
-    delta: &ComponentValues,
-) -> [f64; 2] {
-    let (b, c) = (&base[s], &coef[s]);
-    let mut a = *b;
-    for k in 0..3 {
-        a[0] += c[k][0] * delta[k];
-        a[1] += c[k][1] * delta[k];
-    }
-    a
-}
-
 /// The cell's stress-controlled components as unknowns of one step's contact problem (module
 /// documentation): the contacts through the cell's boundary, their coupling coefficients, and
 /// the current change `δ` of `L`.
@@ -266,7 +249,13 @@ impl CellCoupling {
     /// `Σ_κ B_cκ δ_κ` of slot `s` for the change `delta`.
     #[inline]
     fn affine_of(&self, s: usize, delta: &ComponentValues) -> [f64; 2] {
-        this_affine(&self.base, &self.coef, s, delta)
+        let (b, c) = (&self.base[s], &self.coef[s]);
+        let mut a = *b;
+        for k in 0..3 {
+            a[0] += c[k][0] * delta[k];
+            a[1] += c[k][1] * delta[k];
+        }
+        a
     }
 
     /// Sets `δ` from the impulses in `rows` and every coupled row's affine velocity from it.
@@ -471,13 +460,13 @@ impl CellCoupling {
         self.delta = delta;
         // Every row's affine velocity from the final δ: a function of the row alone, so the
         // rows are set concurrently with the same bits on any thread count.
-        let slot = &self.slot;
+        let this = &*self;
         rows.par_iter_mut()
             .with_min_len(TASK)
             .enumerate()
             .for_each(|(i, row)| {
-                if slot[i] != NONE {
-                    row.affine = this_affine(&self.base, &self.coef, slot[i] as usize, &delta);
+                if this.slot[i] != NONE {
+                    row.affine = this.affine_of(this.slot[i] as usize, &delta);
                 }
             });
     }

@@ -95,35 +95,18 @@ pub(crate) unsafe fn update_shared(
 
 /// Runs `f(i)` for every contact `i`: first the blocks' interiors (blocks concurrently, each in
 /// ascending order), then the colour classes in turn, the contacts of a parallel class
-/// concurrently.
+/// concurrently ([`coloured_units`] without a state between the units).
 #[inline]
 fn for_each_coloured(colouring: &ContactColouring, f: impl Fn(usize) + Sync) {
-    match colouring.blocks() {
-        0 => {}
-        1 => colouring.block(0).iter().for_each(|&i| f(i as usize)),
-        b => (0..b).into_par_iter().for_each(|k| {
-            for &i in colouring.block(k) {
-                f(i as usize);
-            }
-        }),
-    }
-    for k in 0..colouring.colours() {
-        let class = colouring.class(k);
-        if colouring.is_sequential(k) || class.len() < PARALLEL_MIN {
-            for &i in class {
-                f(i as usize);
-            }
-        } else {
-            class
-                .par_iter()
-                .with_min_len(TASK)
-                .for_each(|&i| f(i as usize));
-        }
-    }
+    coloured_units(
+        colouring,
+        &mut (),
+        |_, ids| ids.iter().for_each(|&i| f(i as usize)),
+        |_, ()| {},
+    );
 }
 
-/// The colour-ordered traversal of [`for_each_coloured`] in fixed *units* with a state `S`
-/// between them: the blocks' interiors (one unit per block, concurrently), then each colour
+/// The colour-ordered traversal in fixed *units* with a state `S` between them: the blocks' interiors (one unit per block, concurrently), then each colour
 /// class in turn (one unit if it is sequential or smaller than [`PARALLEL_MIN`], else chunks
 /// of [`TASK`] contacts, concurrently). Every unit of a phase reads the state as it was at the
 /// phase's start and returns its change `A`; the changes are merged into the state in unit
