@@ -154,6 +154,38 @@ fn resume_is_bit_identical() {
     );
 }
 
+/// The window's re-solves run beside the run on a second thread
+/// (`grainlaw_core::scenarios::sensitivity::ResolveQueue`) and are recorded in sample order:
+/// the tiny run on one thread and on two writes the same files, byte for byte (`wall_seconds`
+/// aside), its solver-sensitivity sums included.
+#[test]
+fn re_solves_beside_the_run_give_the_same_numbers_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |threads: &str, out: &Path| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+            .env("SOURCE_DATE_EPOCH", "1767225600")
+            .env("RAYON_NUM_THREADS", threads)
+            .args(TINY)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .expect("grainlaw runs");
+        assert!(
+            matches!(o.status.code(), Some(0) | Some(3)),
+            "{threads} threads: {}",
+            stderr(&o)
+        );
+    };
+    let (a, b) = (dir.path().join("one"), dir.path().join("two"));
+    run("1", &a);
+    run("2", &b);
+    assert_same_outputs(&a, &b);
+    let summary: serde_json::Value =
+        serde_json::from_slice(&files(&b)[Path::new("summary.json")]).unwrap();
+    let resolved = summary["window_resolved_samples"].as_u64().unwrap();
+    assert!(resolved >= 10, "{resolved} re-solved samples");
+}
+
 /// The tiny run's arguments with `extra` settings after its own (the last setting of a key
 /// holds).
 fn tiny_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {

@@ -43,7 +43,6 @@ use super::common::{
 };
 use super::phased::{drive, PhasedRun, RunControl};
 use super::rows::{self, serde_rows, table_row};
-use super::sensitivity::{record, resolved_pair};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
@@ -835,9 +834,9 @@ impl PhasedRun for Biaxial<'_> {
             .n
             .is_multiple_of((st.run.steps / SENSITIVITY_SAMPLES).max(1))
         {
-            let resolved =
-                resolved_pair(w, |snap| Some(axial_pair(&cell_state(snap).ok()?.stress)));
-            record(&mut st.cell.window.sensitivity, axial_pair(&s), resolved);
+            st.cell.resolve_sample(w, axial_pair(&s), |snap| {
+                Some(axial_pair(&cell_state(snap).ok()?.stress))
+            });
         }
         let Some(cell) = w.cell().copied() else {
             return Ok(());
@@ -868,6 +867,10 @@ impl PhasedRun for Biaxial<'_> {
             ..HistoryRow::of_cell(&cs)
         });
         Ok(())
+    }
+
+    fn settle(&self, st: &mut State) {
+        st.cell.settle();
     }
 
     fn leave(

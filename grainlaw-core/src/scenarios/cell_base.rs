@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{implicit_cell_control, VtkFrames};
 use super::rows::{serde_rows, TableRow};
+use super::sensitivity::{PairOf, ResolveQueue};
 use crate::verdict::WindowStats;
 
 /// Gain of the explicit cell control as a fraction of its stability limit `Δt/(ρ d²)`
@@ -100,6 +101,10 @@ pub struct CellRecord<H: TableRow, R: TableRow> {
     /// Numerics of the current window.
     #[serde(default)]
     pub window: WindowStats,
+    /// The window's re-solves not yet recorded in `window.sensitivity` (never saved: the
+    /// phases settle them before a checkpoint, [`super::phased::PhasedRun::settle`]).
+    #[serde(skip)]
+    pub resolves: ResolveQueue,
 }
 
 impl<H: TableRow, R: TableRow> CellRecord<H, R> {
@@ -111,7 +116,21 @@ impl<H: TableRow, R: TableRow> CellRecord<H, R> {
             history: Vec::new(),
             frames,
             window: WindowStats::default(),
+            resolves: ResolveQueue::default(),
         }
+    }
+
+    /// Re-solves the window's sample that `w` holds, whose stress pair as run is `run`
+    /// ([`ResolveQueue::submit`]; recorded into `window.sensitivity` at once or by
+    /// [`CellRecord::settle`]).
+    pub fn resolve_sample(&mut self, w: &dem::World, run: [f64; 2], pair: PairOf) {
+        self.resolves
+            .submit(&mut self.window.sensitivity, w, run, pair);
+    }
+
+    /// Records the pending re-solves into `window.sensitivity`, in sample order.
+    pub fn settle(&mut self) {
+        self.resolves.settle(&mut self.window.sensitivity);
     }
 }
 

@@ -184,6 +184,11 @@ pub trait PhasedRun {
         progress: &PhaseProgress,
     ) -> Result<()>;
 
+    /// Finishes what the steps left running beside the run (re-solves of sampled steps,
+    /// [`super::sensitivity::ResolveQueue`]) so that `state` is complete: called before a
+    /// checkpoint is written and before [`PhasedRun::leave`]. Nothing to do by default.
+    fn settle(&self, _state: &mut Self::State) {}
+
     /// Ends phase `k` with its statistics.
     fn leave(
         &self,
@@ -281,6 +286,7 @@ pub fn drive<P: PhasedRun>(
                         .stop_after_steps
                         .is_some_and(|n| ctl.steps_this_run >= n);
                 if stop || ctl.due() {
+                    run.settle(st);
                     let cp = RunCheckpoint {
                         format: checkpoint::FORMAT.to_string(),
                         grainlaw_version: env!("CARGO_PKG_VERSION").to_string(),
@@ -310,6 +316,7 @@ pub fn drive<P: PhasedRun>(
                 Ok(())
             },
         )?;
+        run.settle(&mut state);
         run.leave(k, &mut state, &mut ctx.out, &mut world, &stats)?;
         ctl.phase_times.push(PhaseTime {
             name: plan.name.clone(),

@@ -25,6 +25,9 @@
 //! counted apart (`Sensitivity::near`, Janssen's own count): they measure the stress but do not
 //! stand in for the loaded contacts' proxy, whose scale they were not judged on.
 
+use std::collections::VecDeque;
+use std::sync::mpsc::{channel, Receiver};
+
 use dem::fc::{fc_error, solve_by, FcOptions, NewtonParams, SolverMethod};
 use dem::{Snapshot, World};
 
@@ -158,6 +161,68 @@ pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<([f64; 2], 
         }
         Resolved::Failed => s.add(run, None),
         Resolved::Unavailable => s.unavailable += 1,
+    }
+}
+
+/// The stress pair a window measures on a state (`None`: the state cannot be measured), as
+/// [`resolved_pair`] takes it: a plain function, so that a re-solve can run on another thread.
+pub type PairOf = fn(&Snapshot) -> Option<[f64; 2]>;
+
+/// A sample's re-solved stress pair with whether it reached the tolerance ([`resolved_pair`]).
+pub type ResolvedPair = Resolved<([f64; 2], bool)>;
+
+/// The re-solves of a window's samples, run beside the simulation.
+///
+/// A sample's re-solve ([`resolved_pair`]) reads only the world as the sampled step left it, so
+/// it can run on a copy of that world while the run goes on: with two or more threads in
+/// rayon's pool, [`ResolveQueue::submit`] hands the copy to the pool (`rayon::spawn`: the
+/// re-solve takes a thread the run's sweeps leave idle, and a parallel sweep that needs it
+/// runs its units on the calling thread) and [`ResolveQueue::settle`] records the outcomes in
+/// the order the samples were taken. Each outcome is a function of its copy alone, so the
+/// recorded sums are the same, bit for bit, as when every re-solve is made in line (one
+/// thread: [`ResolveQueue::submit`] records at once). Settle before reading the window's
+/// [`Sensitivity`] and before a checkpoint: pending re-solves are not saved.
+#[derive(Default)]
+pub struct ResolveQueue {
+    /// The samples submitted and not yet recorded: the stress as run, the outcome's channel.
+    pending: VecDeque<([f64; 2], Receiver<ResolvedPair>)>,
+}
+
+impl std::fmt::Debug for ResolveQueue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ResolveQueue({} pending)", self.pending.len())
+    }
+}
+
+impl ResolveQueue {
+    /// Re-solves the sample the world `w` now holds (its stress as run: `run`) and records it
+    /// into `s`: at once with one thread, else on a copy of `w` beside the run (recorded by
+    /// [`ResolveQueue::settle`]).
+    pub fn submit(&mut self, s: &mut Sensitivity, w: &World, run: [f64; 2], pair: PairOf) {
+        if self.pending.is_empty() && rayon::current_num_threads() < 2 {
+            record(s, run, resolved_pair(w, pair));
+            return;
+        }
+        let world = w.clone();
+        let (tx, rx) = channel();
+        rayon::spawn(move || {
+            // the receiver is gone only when the window was dropped unsettled: nothing to keep
+            let _ = tx.send(resolved_pair(&world, pair));
+        });
+        self.pending.push_back((run, rx));
+    }
+
+    /// Waits for the pending re-solves and records them into `s` in the order submitted (a
+    /// re-solve whose thread died is recorded as failed).
+    pub fn settle(&mut self, s: &mut Sensitivity) {
+        while let Some((run, rx)) = self.pending.pop_front() {
+            record(s, run, rx.recv().unwrap_or(Resolved::Failed));
+        }
+    }
+
+    /// Number of re-solves submitted and not yet recorded.
+    pub fn pending(&self) -> usize {
+        self.pending.len()
     }
 }
 

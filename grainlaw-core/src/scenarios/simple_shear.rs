@@ -26,7 +26,6 @@ use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION,
 use super::common::{mean_diameter, strain_bins, Stop, VtkFrames};
 use super::phased::{drive, PhasedRun, RunControl};
 use super::rows::{self, table_row};
-use super::sensitivity::{record, resolved_pair};
 use super::shear_cell::{judge_runs, RunCheckData};
 use super::{PhaseEnv, RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -421,15 +420,10 @@ impl PhasedRun for Shear<'_> {
                 st.run.avg_steps,
             )
         {
-            let resolved = resolved_pair(w, |snap| {
+            st.cell.resolve_sample(w, [s[(0, 1)], s[(1, 1)]], |snap| {
                 let s = cell_state(snap).ok()?.stress;
                 Some([s[(0, 1)], s[(1, 1)]])
             });
-            record(
-                &mut st.cell.window.sensitivity,
-                [s[(0, 1)], s[(1, 1)]],
-                resolved,
-            );
         }
         let d = mean_diameter(w);
         let pn = -s[(1, 1)];
@@ -457,6 +451,10 @@ impl PhasedRun for Shear<'_> {
             ..HistoryRow::of_cell(&cs)
         });
         Ok(())
+    }
+
+    fn settle(&self, st: &mut State) {
+        st.cell.settle();
     }
 
     fn leave(
