@@ -48,6 +48,8 @@ fn bad_inputs_are_refused_with_one_line() {
         // checked before the run, not learnt after it: μ(I) needs 5 inertial numbers
         ("inertial_numbers=[0.05, 0.1, 0.2]", "inertial_numbers"),
         (r#"leave_out=["wall-law"]"#, "leave_out[0]"),
+        ("sensitivity_samples=0", "sensitivity_samples"),
+        ("sensitivity_samples=1001", "sensitivity_samples"),
     ] {
         let o = grainlaw(&["run", "simple-shear", "--set", set], None);
         assert_eq!(o.status.code(), Some(2), "{set}: {}", stderr(&o));
@@ -157,7 +159,7 @@ fn resume_is_bit_identical() {
 /// The window's re-solves run beside the run on a second thread
 /// (`grainlaw_core::scenarios::sensitivity::ResolveQueue`) and are recorded in sample order:
 /// the tiny run on one thread and on two writes the same files, byte for byte (`wall_seconds`
-/// aside), its solver-sensitivity sums included.
+/// aside), its solver-sensitivity sums included; `sensitivity_samples` sets how many.
 #[test]
 fn re_solves_beside_the_run_give_the_same_numbers_on_one_and_two_threads() {
     let dir = tempfile::tempdir().unwrap();
@@ -166,6 +168,7 @@ fn re_solves_beside_the_run_give_the_same_numbers_on_one_and_two_threads() {
             .env("SOURCE_DATE_EPOCH", "1767225600")
             .env("RAYON_NUM_THREADS", threads)
             .args(TINY)
+            .args(["--set", "sensitivity_samples=12"])
             .arg("--out")
             .arg(out)
             .output()
@@ -182,8 +185,12 @@ fn re_solves_beside_the_run_give_the_same_numbers_on_one_and_two_threads() {
     assert_same_outputs(&a, &b);
     let summary: serde_json::Value =
         serde_json::from_slice(&files(&b)[Path::new("summary.json")]).unwrap();
-    let resolved = summary["window_resolved_samples"].as_u64().unwrap();
-    assert!(resolved >= 10, "{resolved} re-solved samples");
+    // `sensitivity_samples = 12` of the window's `w` steps: every `max(1, ⌊w/12⌋)`-th
+    let w = summary["window_steps"].as_u64().unwrap();
+    let tried = summary["window_resolved_samples"].as_u64().unwrap()
+        + summary["window_unresolved_samples"].as_u64().unwrap();
+    assert_eq!(tried, w / (w / 12).max(1), "window {w}");
+    assert!(tried >= 12, "{tried} samples");
 }
 
 /// The tiny run's arguments with `extra` settings after its own (the last setting of a key

@@ -34,20 +34,17 @@ use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 
-/// Re-solved samples of an averaging window, spread evenly over it (at least this many; every
-/// step of a shorter window): each such step is solved again to
+/// Whether window step `j` (0-based) of a window of `len` steps is re-solved: `samples`
+/// (`sensitivity_samples`, 20 by default) spread evenly over the window, the last step of each
+/// stride (every step of a shorter window). Each such step is solved again to
 /// [`crate::verdict::SENSITIVITY_TOLERANCE`] with the cell's stress-controlled component
-/// (`dem::World::last_step_problem`) and the cell's stress taken both ways, the window's solver
+/// (`dem::World::last_step_problem`) and the cell's stress taken both ways: the window's solver
 /// sensitivity of μ = |Σσ_xy| / (−Σσ_yy) and of σ_yy ([`crate::verdict::Sensitivity`]), judged
 /// against a quarter of their statistical errors ([`crate::verdict::SENSITIVITY_SE_FRACTION`]).
-/// A fixed number, not a fraction of the steps: a re-solve to 10⁻⁸ of a dense step costs
-/// hundreds of the run's own loose solves.
-const SENSITIVITY_SAMPLES: u64 = 20;
-
-/// Whether window step `j` (0-based) of a window of `len` steps is re-solved
-/// ([`SENSITIVITY_SAMPLES`] evenly spread, the last step of each stride).
-fn resolves(j: u64, len: u64) -> bool {
-    let every = (len / SENSITIVITY_SAMPLES).max(1);
+/// A fixed number, not a fraction of the steps: a re-solve of a dense step costs hundreds of the
+/// run's own loose solves.
+fn resolves(j: u64, len: u64, samples: u64) -> bool {
+    let every = (len / samples.max(1)).max(1);
     j % every == every - 1
 }
 
@@ -418,6 +415,7 @@ impl PhasedRun for Shear<'_> {
             && resolves(
                 st.run.n + st.run.avg_steps - st.run.steps - 1,
                 st.run.avg_steps,
+                self.c.sensitivity_samples,
             )
         {
             st.cell.resolve_sample(w, [s[(0, 1)], s[(1, 1)]], |snap| {
