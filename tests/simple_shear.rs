@@ -193,6 +193,57 @@ fn re_solves_beside_the_run_give_the_same_numbers_on_one_and_two_threads() {
     assert!(tried >= 12, "{tried} samples");
 }
 
+/// Two runs on the two threads of one rayon pool (as a caller's pool or a campaign's threads
+/// may hold them): each hands its re-solves to the pool and, while it waits for them, runs the
+/// pool's pending work, so that neither waits for the other forever; both write what the
+/// command line writes on one thread.
+#[test]
+fn runs_on_every_thread_of_a_pool_do_not_wait_for_each_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let sets: Vec<String> = TINY[2..TINY.len() - 1]
+        .chunks(2)
+        .map(|kv| kv[1].to_string())
+        .chain(["sensitivity_samples=12".to_string()])
+        .collect();
+    let stop = || std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let run = |name: &str| {
+        grainlaw::api::run_scenario(
+            "simple-shear",
+            &sets,
+            &dir.path().join(name),
+            true,
+            false,
+            stop(),
+        )
+        .map(|o| o.summary.get_f64("window_resolved_mu_change"))
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let (a, b) = pool.install(|| rayon::join(|| run("a"), || run("b")));
+    let (a, b) = (a.unwrap(), b.unwrap());
+    assert!(a.is_some_and(f64::is_finite), "{a:?}");
+    assert_eq!(a, b);
+    // the command line on one thread: the same sums
+    let cli = dir.path().join("cli");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .env("RAYON_NUM_THREADS", "1")
+        .args(TINY)
+        .args(["--set", "sensitivity_samples=12", "--out"])
+        .arg(&cli)
+        .output()
+        .unwrap();
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(3)),
+        "{}",
+        stderr(&o)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&files(&cli)[Path::new("summary.json")]).unwrap();
+    assert_eq!(summary["window_resolved_mu_change"].as_f64(), a);
+}
+
 /// The tiny run's arguments with `extra` settings after its own (the last setting of a key
 /// holds).
 fn tiny_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {

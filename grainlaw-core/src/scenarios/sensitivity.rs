@@ -26,7 +26,7 @@
 //! stand in for the loaded contacts' proxy, whose scale they were not judged on.
 
 use std::collections::VecDeque;
-use std::sync::mpsc::{channel, Receiver};
+use std::sync::mpsc::{channel, Receiver, TryRecvError};
 
 use dem::fc::{fc_error, solve_by, FcOptions, NewtonParams, SolverMethod};
 use dem::{Snapshot, World};
@@ -168,6 +168,26 @@ pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<([f64; 2], 
 /// [`resolved_pair`] takes it: a plain function, so that a re-solve can run on another thread.
 pub type PairOf = fn(&Snapshot) -> Option<[f64; 2]>;
 
+/// The outcome of a re-solve handed to rayon's pool. Called from a thread of the pool (a run
+/// inside a caller's pool), it runs the pool's pending work meanwhile (`rayon::yield_now`), its
+/// own re-solve included, so that runs waiting on all the pool's threads cannot wait for each
+/// other (test `runs_on_every_thread_of_a_pool_do_not_wait_for_each_other`: a blocking wait
+/// hangs there); once the pool has nothing to run (the re-solve runs elsewhere) or from outside
+/// the pool, it blocks until the outcome comes. A re-solve whose thread died is failed.
+fn wait_for(rx: &Receiver<ResolvedPair>) -> ResolvedPair {
+    loop {
+        match rx.try_recv() {
+            Ok(outcome) => return outcome,
+            Err(TryRecvError::Disconnected) => return Resolved::Failed,
+            Err(TryRecvError::Empty) => {
+                if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                    return rx.recv().unwrap_or(Resolved::Failed);
+                }
+            }
+        }
+    }
+}
+
 /// A sample's re-solved stress pair with whether it reached the tolerance ([`resolved_pair`]).
 pub type ResolvedPair = Resolved<([f64; 2], bool)>;
 
@@ -216,7 +236,7 @@ impl ResolveQueue {
     /// re-solve whose thread died is recorded as failed).
     pub fn settle(&mut self, s: &mut Sensitivity) {
         while let Some((run, rx)) = self.pending.pop_front() {
-            record(s, run, rx.recv().unwrap_or(Resolved::Failed));
+            record(s, run, wait_for(&rx));
         }
     }
 
