@@ -226,8 +226,8 @@ fn interface_reader_on_a_recorded_gerris_snapshot() {
 fn bagnold_case(law: &str, slope_deg: f64, phi: f64, out: &Path) -> (f64, usize) {
     let mut plan = InclinedPlan::new(fixture(law), out.to_path_buf());
     plan.slope_deg = Some(slope_deg);
-    plan.packing_fraction = Some(phi);
-    plan.level = 6;
+    plan.inputs.packing_fraction = Some(phi);
+    plan.inputs.level = 6;
     let o = inclined_plane(&plan).unwrap();
     println!("{}", o.lines.join("\n"));
     assert!(o.verdict.passes(), "{:?}", o.verdict.lines());

@@ -12,12 +12,12 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_csv_table, table_row};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{OutputDir, Summary};
+use crate::output::Summary;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 
 /// One phase per arrangement (rectangular, triangular, cannonball), each settling its own
@@ -49,14 +49,8 @@ impl PhasedRun for Stacks<'_> {
         Arrangement::ALL.len()
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        _env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut StacksState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut StacksState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let Enter { k, world, .. } = at;
         let c = self.c;
         let kind = Arrangement::ALL[k];
         *world = datasets::build::arrangement(c, kind)?;
@@ -72,26 +66,18 @@ impl PhasedRun for Stacks<'_> {
         }))
     }
 
-    fn step(
-        &self,
-        _k: usize,
-        st: &mut StacksState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        _r: &dem::StepReport,
-        _p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut StacksState, at: Step<'_>) -> Result<()> {
+        let Step { out, world: w, .. } = at;
         st.vtk.maybe(out, w)
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut StacksState,
-        out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut StacksState, at: Leave<'_>) -> Result<()> {
+        let Leave {
+            k,
+            out,
+            world,
+            stats,
+        } = at;
         let name = Arrangement::ALL[k].name();
         st.all.merge(stats);
         std::mem::replace(&mut st.vtk, VtkFrames::new(f64::INFINITY, 1)).finish(out, world)?;

@@ -41,10 +41,10 @@ use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION,
 use super::common::{
     fit_keys, mean_diameter, parameter_lines, short_number, strain_bins, Stop, VtkFrames,
 };
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_rows, table_row};
 use super::sensitivity::{record, resolved_pair};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
@@ -720,14 +720,8 @@ impl PhasedRun for Biaxial<'_> {
         self.per_pressure() * self.pressures.len()
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        _env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut State,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut State, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let Enter { k, world, .. } = at;
         let c = self.c;
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];
@@ -798,15 +792,14 @@ impl PhasedRun for Biaxial<'_> {
         }
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut State, at: Step<'_>) -> Result<()> {
+        let Step {
+            k,
+            out,
+            world: w,
+            report: r,
+            progress: p,
+        } = at;
         let (i, part) = self.part(k);
         if i + 1 == self.pressures.len() && matches!(part, Part::Axial(_)) {
             st.cell.frames.maybe(out, w)?;
@@ -870,14 +863,13 @@ impl PhasedRun for Biaxial<'_> {
         Ok(())
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut State, at: Leave<'_>) -> Result<()> {
+        let Leave {
+            k,
+            out,
+            world,
+            stats,
+        } = at;
         st.cell.all.merge(stats);
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];

@@ -28,10 +28,10 @@ use serde::{Deserialize, Serialize};
 use super::common::{
     add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, Stop, VtkFrames,
 };
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_rows, table_row, TableRow};
 use super::sensitivity::{record, Resolved};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{CsvTable, OutputDir, Summary};
@@ -517,14 +517,8 @@ impl PhasedRun for Shear<'_> {
         1 + self.targets.len() * (self.lead_stages() + 1)
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut ShearState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut ShearState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let Enter { k, env, world } = at;
         let c = self.c;
         if k == 0 {
             world.params.dt = c.dt_max;
@@ -632,15 +626,14 @@ impl PhasedRun for Shear<'_> {
         }))
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut ShearState,
-        _out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut ShearState, at: Step<'_>) -> Result<()> {
+        let Step {
+            k,
+            world: w,
+            report: r,
+            progress: p,
+            ..
+        } = at;
         if k == 0 {
             return Ok(());
         }
@@ -682,14 +675,10 @@ impl PhasedRun for Shear<'_> {
         Ok(())
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut ShearState,
-        _out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut ShearState, at: Leave<'_>) -> Result<()> {
+        let Leave {
+            k, world, stats, ..
+        } = at;
         st.all.merge(stats);
         st.phase_cost = stats.mean_solve_cost();
         if k == 0 || self.stage(k).lead.is_some() {

@@ -12,7 +12,6 @@
 //! data cannot support).
 
 use datasets::config::SimpleShearConfig;
-use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed};
 use dem::math::Tensor as Mat;
 use homogenise::averaging::block_average;
@@ -24,14 +23,14 @@ use serde::{Deserialize, Serialize};
 
 use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
 use super::common::{mean_diameter, strain_bins, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, table_row};
 use super::sensitivity::{record, resolved_pair};
 use super::shear_cell::{judge_runs, RunCheckData};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{OutputDir, Summary};
+use crate::output::Summary;
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 
@@ -350,14 +349,8 @@ impl PhasedRun for Shear<'_> {
         1 + self.targets.len()
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        _env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut State,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut State, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let Enter { k, world, .. } = at;
         let c = self.c;
         let d = mean_diameter(world);
         if k == 0 {
@@ -396,15 +389,14 @@ impl PhasedRun for Shear<'_> {
         }))
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut State, at: Step<'_>) -> Result<()> {
+        let Step {
+            k,
+            out,
+            world: w,
+            report: r,
+            progress: p,
+        } = at;
         st.cell.frames.maybe(out, w)?;
         if k == 0 {
             return Ok(());
@@ -459,14 +451,13 @@ impl PhasedRun for Shear<'_> {
         Ok(())
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut State, at: Leave<'_>) -> Result<()> {
+        let Leave {
+            k,
+            out,
+            world,
+            stats,
+        } = at;
         st.cell.all.merge(stats);
         if k == 0 {
             return Ok(());

@@ -11,12 +11,12 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_csv_table, table_row};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{OutputDir, Summary};
+use crate::output::Summary;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_column, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
@@ -108,14 +108,8 @@ impl PhasedRun for Push<'_> {
         2 * self.c.cases.list().len()
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        _env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut PushState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut PushState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let Enter { k, world, .. } = at;
         let c = self.c;
         let case = k / 2;
         let (name, friction) = &c.cases.list()[case];
@@ -151,15 +145,14 @@ impl PhasedRun for Push<'_> {
         }
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut PushState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut PushState, at: Step<'_>) -> Result<()> {
+        let Step {
+            k,
+            out,
+            world: w,
+            report: r,
+            progress: p,
+        } = at;
         if !k.is_multiple_of(2) {
             st.force.push(-w.contact_force(st.bottom).0.y);
             // The force statistics are over the second half of the push (`leave`).
@@ -170,14 +163,13 @@ impl PhasedRun for Push<'_> {
         Ok(())
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut PushState,
-        out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut PushState, at: Leave<'_>) -> Result<()> {
+        let Leave {
+            k,
+            out,
+            world,
+            stats,
+        } = at;
         st.all.merge(stats);
         if k.is_multiple_of(2) {
             return Ok(());

@@ -17,13 +17,13 @@
 //! continuum comparison: `summary.json` (object `column`), `front.csv`, `profiles.csv`.
 
 use datasets::config::ColumnCollapseConfig;
-use datasets::phases::{PhaseProgress, PhaseStats};
+use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::{CliError, Result};
 use crate::output::{CsvTable, OutputDir, Summary};
@@ -193,14 +193,8 @@ impl PhasedRun for Collapse<'_> {
         2
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut CollapseState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut CollapseState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let Enter { k, env, world } = at;
         let c = self.c;
         Ok(match k {
             DEPOSIT => Some(PhasePlan {
@@ -237,15 +231,14 @@ impl PhasedRun for Collapse<'_> {
         })
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut CollapseState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut CollapseState, at: Step<'_>) -> Result<()> {
+        let Step {
+            k,
+            out,
+            world: w,
+            report: r,
+            progress: p,
+        } = at;
         if k != COLLAPSE {
             return Ok(());
         }
@@ -275,14 +268,10 @@ impl PhasedRun for Collapse<'_> {
         st.vtk.maybe(out, w)
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut CollapseState,
-        _out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut CollapseState, at: Leave<'_>) -> Result<()> {
+        let Leave {
+            k, world, stats, ..
+        } = at;
         match k {
             DEPOSIT => st.deposit = *stats,
             _ => {
