@@ -39,7 +39,8 @@ pub struct BodyState {
     pub acceleration: Vector,
     /// Mean angular acceleration over the step, `(ω⁺ − ω⁻)/h` (rad/s²).
     pub angular_acceleration: f64,
-    /// Mass (kg); `f64::INFINITY` for a wall whose motion is imposed.
+    /// Mass (kg); `m = ρ π R² · thickness` for a disk; `f64::INFINITY` for a wall whose motion is
+    /// imposed.
     #[serde(with = "crate::serde_float")]
     pub mass: f64,
     /// Moment of inertia about the centre (kg·m²); `I = m R²/2` for a disk.
