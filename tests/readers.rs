@@ -4,6 +4,8 @@
 //! by hand in LMGC90's layout (`datasets/external/lmgc90`); the plain format against analytic
 //! answers; errors naming file and line.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -50,23 +52,6 @@ fn thermo() -> Vec<(u64, Vec<f64>)> {
         .collect()
 }
 
-/// Σ_i S_i of LAMMPS' `compute stress/atom NULL pair` columns (xx, yy, xy) of a per-atom dump.
-fn lammps_stress_sum(step: u64) -> [f64; 3] {
-    let text = readers::read_text(&data("lammps").join(format!("atoms.{step}.dump.gz"))).unwrap();
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("ITEM: ATOMS"));
-    let header: Vec<&str> = lines.next().unwrap().split_whitespace().skip(2).collect();
-    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
-    let (xx, yy, xy) = (col("c_s[1]"), col("c_s[2]"), col("c_s[4]"));
-    let mut s = [0.0; 3];
-    for l in lines {
-        let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
-        s[0] += v[xx];
-        s[1] += v[yy];
-        s[2] += v[xy];
-    }
-    s
-}
-
 /// `Σ_p V_p Σ_c,p` over the grains, counting grain–grain contacts only (N·m).
 fn pair_moment(s: &dem::Snapshot) -> Tensor2 {
     let mut pairs = s.clone();
@@ -98,7 +83,8 @@ fn lammps_contact_stress_equals_lammps_pair_virial() {
         // 2D SI units: tension positive like grainlaw, first index the branch: its xy is
         // grainlaw's yx (grainlaw's first index is the force).
         let m = pair_moment(s);
-        let l = lammps_stress_sum(s.step);
+        let l =
+            common::lammps_stress_sum(&data("lammps").join(format!("atoms.{}.dump.gz", s.step)));
         let ours = [m[(0, 0)], m[(1, 1)], m[(1, 0)]];
         let scale = l.iter().map(|v| v * v).sum::<f64>().sqrt();
         let worst = (0..3).map(|k| (ours[k] - l[k]).abs()).fold(0.0, f64::max) / scale;

@@ -56,23 +56,8 @@ impl std::ops::DerefMut for Body {
 impl Body {
     /// A free disk grain at rest: `m = ρ π R² t`, `I = m R² / 2`.
     pub fn disk(position: Vector, radius: f64, density: f64, thickness: f64) -> Self {
-        let mass = density * std::f64::consts::PI * radius * radius * thickness;
         Body {
-            state: BodyState {
-                kind: BodyKind::Grain,
-                name: String::new(),
-                position,
-                angle: 0.0,
-                velocity: Vector::zeros(),
-                omega: 0.0,
-                acceleration: Vector::zeros(),
-                angular_acceleration: 0.0,
-                mass,
-                inertia: 0.5 * mass * radius * radius,
-                radius,
-                density,
-                thickness,
-            },
+            state: BodyState::disk(position, radius, density, thickness),
             dofs: [Dof::Free; 3],
             applied_force: Vector::zeros(),
             applied_torque: 0.0,
@@ -83,21 +68,7 @@ impl Body {
     /// A wall body whose motion is fully imposed (velocity `velocity`, no rotation).
     pub fn wall(name: &str, position: Vector, velocity: Vector) -> Self {
         Body {
-            state: BodyState {
-                kind: BodyKind::Wall,
-                name: name.to_string(),
-                position,
-                angle: 0.0,
-                velocity,
-                omega: 0.0,
-                acceleration: Vector::zeros(),
-                angular_acceleration: 0.0,
-                mass: f64::INFINITY,
-                inertia: f64::INFINITY,
-                radius: 0.0,
-                density: 0.0,
-                thickness: 1.0,
-            },
+            state: BodyState::wall(name, position, velocity),
             dofs: [Dof::Imposed; 3],
             applied_force: Vector::zeros(),
             applied_torque: 0.0,

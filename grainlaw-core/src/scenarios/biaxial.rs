@@ -721,7 +721,7 @@ impl PhasedRun for Biaxial<'_> {
     }
 
     fn enter(&self, st: &mut State, at: Enter<'_>) -> Result<Option<PhasePlan>> {
-        let Enter { k, world, .. } = at;
+        let (k, world) = (at.k, at.world);
         let c = self.c;
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];
@@ -750,10 +750,10 @@ impl PhasedRun for Biaxial<'_> {
                     steps: (c.compression_time / dt).ceil() as u64,
                     ..Default::default()
                 };
-                Ok(Some(PhasePlan {
-                    name: format!("compress p0={p0}"),
-                    stop: Stop::Steps(st.run.steps),
-                }))
+                Ok(Some(PhasePlan::new(
+                    format!("compress p0={p0}"),
+                    Stop::Steps(st.run.steps),
+                )))
             }
             Part::Axial(j) => {
                 let rate = c.axial_rate(p0);
@@ -784,22 +784,16 @@ impl PhasedRun for Biaxial<'_> {
                 if steps == 0 {
                     return Ok(None);
                 }
-                Ok(Some(PhasePlan {
-                    name: format!("axial p0={p0} ({}/{})", j + 1, self.segments()),
-                    stop: Stop::Steps(steps),
-                }))
+                Ok(Some(PhasePlan::new(
+                    format!("axial p0={p0} ({}/{})", j + 1, self.segments()),
+                    Stop::Steps(steps),
+                )))
             }
         }
     }
 
     fn step(&self, st: &mut State, at: Step<'_>) -> Result<()> {
-        let Step {
-            k,
-            out,
-            world: w,
-            report: r,
-            progress: p,
-        } = at;
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         let (i, part) = self.part(k);
         if i + 1 == self.pressures.len() && matches!(part, Part::Axial(_)) {
             st.cell.frames.maybe(out, w)?;
@@ -864,12 +858,7 @@ impl PhasedRun for Biaxial<'_> {
     }
 
     fn leave(&self, st: &mut State, at: Leave<'_>) -> Result<()> {
-        let Leave {
-            k,
-            out,
-            world,
-            stats,
-        } = at;
+        let (k, out, world, stats) = (at.k, at.out, at.world, at.stats);
         st.cell.all.merge(stats);
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];

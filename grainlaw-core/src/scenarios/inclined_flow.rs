@@ -26,7 +26,7 @@ use crate::plot::colormap::Scale;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::verdict::{max_solid_fraction, Checks, RunVerdict, WindowStats};
+use crate::verdict::{max_solid_fraction, Checks, WindowStats};
 
 /// Relative difference of the window halves of the mean velocity that matters for a steady
 /// flow (1; [`crate::verdict::halves_drift`]).
@@ -142,20 +142,11 @@ impl PhasedRun for Flow<'_> {
     type State = FlowState;
 
     fn enter(&self, _st: &mut FlowState, _at: Enter<'_>) -> Result<Option<PhasePlan>> {
-        Ok(Some(PhasePlan {
-            name: "flow".into(),
-            stop: Stop::Steps(self.steps()),
-        }))
+        Ok(Some(PhasePlan::new("flow", Stop::Steps(self.steps()))))
     }
 
     fn step(&self, st: &mut FlowState, at: Step<'_>) -> Result<()> {
-        let Step {
-            out,
-            world: w,
-            report: r,
-            progress: p,
-            ..
-        } = at;
+        let (out, w, r, p) = (at.out, at.world, at.report, at.progress);
         let c = self.c;
         let avg_from = ((c.duration - c.average) / c.dt).round() as u64;
         let sample_every = ((0.002 / c.dt).round() as u64).max(1);
@@ -180,7 +171,7 @@ impl PhasedRun for Flow<'_> {
     }
 
     fn leave(&self, st: &mut FlowState, at: Leave<'_>) -> Result<()> {
-        let Leave { stats, .. } = at;
+        let stats = at.stats;
         st.stats = *stats;
         Ok(())
     }
@@ -485,12 +476,5 @@ pub fn run(
             100.0 * fluid
         ),
     ];
-    Ok(RunOutcome {
-        summary: s,
-        headline,
-        verdict: RunVerdict {
-            run: checks,
-            ..Default::default()
-        },
-    })
+    Ok(RunOutcome::without_laws(s, headline, checks))
 }

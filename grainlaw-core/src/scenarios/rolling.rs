@@ -134,14 +134,14 @@ impl PhasedRun for Roll<'_> {
 
     fn enter(&self, _st: &mut RollState, _at: Enter<'_>) -> Result<Option<PhasePlan>> {
         let c = self.c;
-        Ok(Some(PhasePlan {
-            name: "roll".into(),
-            stop: Stop::Steps((c.duration / c.dt).round().max(1.0) as u64),
-        }))
+        Ok(Some(PhasePlan::new(
+            "roll",
+            Stop::Steps((c.duration / c.dt).round().max(1.0) as u64),
+        )))
     }
 
     fn step(&self, st: &mut RollState, at: Step<'_>) -> Result<()> {
-        let Step { out, world: w, .. } = at;
+        let (out, w) = (at.out, at.world);
         let snap = w.snapshot();
         let gs = homogenise::grain_stresses(&snap)?;
         let gr = gs
@@ -174,7 +174,7 @@ impl PhasedRun for Roll<'_> {
     }
 
     fn leave(&self, st: &mut RollState, at: Leave<'_>) -> Result<()> {
-        let Leave { stats, .. } = at;
+        let stats = at.stats;
         st.stats = *stats;
         Ok(())
     }
@@ -477,14 +477,7 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             |t| format!("{key} = {e:.2e} against the exact answer (limit {t:.0e})"),
         );
     }
-    Ok(RunOutcome {
-        summary: s,
-        headline,
-        verdict: crate::verdict::RunVerdict {
-            run: checks,
-            ..Default::default()
-        },
-    })
+    Ok(RunOutcome::without_laws(s, headline, checks))
 }
 
 /// Relative error of the acceleration, or of the mean stress, against the exact answer above

@@ -518,14 +518,14 @@ impl PhasedRun for Shear<'_> {
     }
 
     fn enter(&self, st: &mut ShearState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
-        let Enter { k, env, world } = at;
+        let (k, env, world) = (at.k, at.env, at.world);
         let c = self.c;
         if k == 0 {
             world.params.dt = c.dt_max;
-            return Ok(Some(PhasePlan {
-                name: "compress".into(),
-                stop: Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
-            }));
+            return Ok(Some(PhasePlan::new(
+                "compress",
+                Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
+            )));
         }
         let stage = self.stage(k);
         let i_target = self.targets[stage.target];
@@ -620,20 +620,11 @@ impl PhasedRun for Shear<'_> {
         st.lead = LeadAverages::default();
         st.lead_sensitivity = Sensitivity::default();
         st.window.reset();
-        Ok(Some(PhasePlan {
-            name,
-            stop: Stop::Steps(steps),
-        }))
+        Ok(Some(PhasePlan::new(name, Stop::Steps(steps))))
     }
 
     fn step(&self, st: &mut ShearState, at: Step<'_>) -> Result<()> {
-        let Step {
-            k,
-            world: w,
-            report: r,
-            progress: p,
-            ..
-        } = at;
+        let (k, w, r, p) = (at.k, at.world, at.report, at.progress);
         if k == 0 {
             return Ok(());
         }
@@ -676,9 +667,7 @@ impl PhasedRun for Shear<'_> {
     }
 
     fn leave(&self, st: &mut ShearState, at: Leave<'_>) -> Result<()> {
-        let Leave {
-            k, world, stats, ..
-        } = at;
+        let (k, world, stats) = (at.k, at.world, at.stats);
         st.all.merge(stats);
         st.phase_cost = stats.mean_solve_cost();
         if k == 0 || self.stage(k).lead.is_some() {

@@ -350,7 +350,7 @@ impl PhasedRun for Shear<'_> {
     }
 
     fn enter(&self, st: &mut State, at: Enter<'_>) -> Result<Option<PhasePlan>> {
-        let Enter { k, world, .. } = at;
+        let (k, world) = (at.k, at.world);
         let c = self.c;
         let d = mean_diameter(world);
         if k == 0 {
@@ -358,10 +358,10 @@ impl PhasedRun for Shear<'_> {
             world.params.dt = dt;
             world.cell_control = Some(self.control(dt, d, None));
             world.validate(1e-9)?;
-            return Ok(Some(PhasePlan {
-                name: "compress".into(),
-                stop: Stop::Steps(c.compression_steps(d)),
-            }));
+            return Ok(Some(PhasePlan::new(
+                "compress",
+                Stop::Steps(c.compression_steps(d)),
+            )));
         }
         let i = self.targets[k - 1];
         let gamma_dot = i * (c.pressure / c.grain.density).sqrt() / d;
@@ -383,20 +383,11 @@ impl PhasedRun for Shear<'_> {
         };
         st.cell.history.clear();
         st.cell.window.reset();
-        Ok(Some(PhasePlan {
-            name: format!("I={i}"),
-            stop: Stop::Steps(steps),
-        }))
+        Ok(Some(PhasePlan::new(format!("I={i}"), Stop::Steps(steps))))
     }
 
     fn step(&self, st: &mut State, at: Step<'_>) -> Result<()> {
-        let Step {
-            k,
-            out,
-            world: w,
-            report: r,
-            progress: p,
-        } = at;
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         st.cell.frames.maybe(out, w)?;
         if k == 0 {
             return Ok(());
@@ -452,12 +443,7 @@ impl PhasedRun for Shear<'_> {
     }
 
     fn leave(&self, st: &mut State, at: Leave<'_>) -> Result<()> {
-        let Leave {
-            k,
-            out,
-            world,
-            stats,
-        } = at;
+        let (k, out, world, stats) = (at.k, at.out, at.world, at.stats);
         st.cell.all.merge(stats);
         if k == 0 {
             return Ok(());

@@ -194,13 +194,13 @@ impl PhasedRun for Collapse<'_> {
     }
 
     fn enter(&self, st: &mut CollapseState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
-        let Enter { k, env, world } = at;
+        let (k, env, world) = (at.k, at.env, at.world);
         let c = self.c;
         Ok(match k {
-            DEPOSIT => Some(PhasePlan {
-                name: "deposit".into(),
-                stop: Stop::UntilRest(c.deposit.until_rest()),
-            }),
+            DEPOSIT => Some(PhasePlan::new(
+                "deposit",
+                Stop::UntilRest(c.deposit.until_rest()),
+            )),
             COLLAPSE => {
                 st.deposited = grain_count(world);
                 let released = datasets::build::column_collapse_release(c, world)?;
@@ -222,23 +222,17 @@ impl PhasedRun for Collapse<'_> {
                 );
                 self.record_profile(st, world, "t0".into(), 0.0);
                 self.sample_front(st, world);
-                Some(PhasePlan {
-                    name: "collapse".into(),
-                    stop: Stop::UntilRest(c.collapse.until_rest()),
-                })
+                Some(PhasePlan::new(
+                    "collapse",
+                    Stop::UntilRest(c.collapse.until_rest()),
+                ))
             }
             _ => None,
         })
     }
 
     fn step(&self, st: &mut CollapseState, at: Step<'_>) -> Result<()> {
-        let Step {
-            k,
-            out,
-            world: w,
-            report: r,
-            progress: p,
-        } = at;
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         if k != COLLAPSE {
             return Ok(());
         }
@@ -269,9 +263,7 @@ impl PhasedRun for Collapse<'_> {
     }
 
     fn leave(&self, st: &mut CollapseState, at: Leave<'_>) -> Result<()> {
-        let Leave {
-            k, world, stats, ..
-        } = at;
+        let (k, world, stats) = (at.k, at.world, at.stats);
         match k {
             DEPOSIT => st.deposit = *stats,
             _ => {

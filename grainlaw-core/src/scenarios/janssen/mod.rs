@@ -176,14 +176,9 @@ impl PhasedRun for Column<'_> {
     }
 
     fn enter(&self, st: &mut ColumnState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
-        let Enter { k, env, world } = at;
+        let (k, env, world) = (at.k, at.env, at.world);
         let c = self.c;
-        let plan = |name: &str, stop| {
-            Some(PhasePlan {
-                name: name.into(),
-                stop,
-            })
-        };
+        let plan = |name: &str, stop| Some(PhasePlan::new(name, stop));
         Ok(match k {
             DEPOSIT => {
                 c.deposit.solver.apply(&mut world.params);
@@ -236,13 +231,7 @@ impl PhasedRun for Column<'_> {
     }
 
     fn step(&self, st: &mut ColumnState, at: Step<'_>) -> Result<()> {
-        let Step {
-            k,
-            out,
-            world: w,
-            report: r,
-            progress: p,
-        } = at;
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         let measured = k == MEASURE;
         st.measured.step(measured, w, r, &p.stats);
         if measured {
@@ -286,9 +275,7 @@ impl PhasedRun for Column<'_> {
     }
 
     fn leave(&self, st: &mut ColumnState, at: Leave<'_>) -> Result<()> {
-        let Leave {
-            k, world, stats, ..
-        } = at;
+        let (k, world, stats) = (at.k, at.world, at.stats);
         match k {
             DEPOSIT => {
                 st.deposit = *stats;
