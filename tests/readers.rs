@@ -187,11 +187,11 @@ fn lammps_forces_give_accelerations_and_symmetric_stress() {
     );
 }
 
-#[test]
-fn lmgc90_hand_written_sample() {
-    let d = data("lmgc90");
+/// The two steps of the LMGC90 run in `d` (bodies file `bodies`, `DOF.OUT.1`–`2`,
+/// `Vloc_Rloc.OUT.1`–`2`), read with grain density `density` (kg/m³) and friction `mu`.
+fn lmgc90_pair(d: &Path, bodies: &str, density: f64, mu: f64) -> Vec<readers::ExternalSnapshot> {
     let files: Vec<PathBuf> = [
-        "BODIES.DAT",
+        bodies,
         "DOF.OUT.1",
         "DOF.OUT.2",
         "Vloc_Rloc.OUT.1",
@@ -201,11 +201,16 @@ fn lmgc90_hand_written_sample() {
     .map(|f| d.join(f))
     .collect();
     let opts = ReadOptions {
-        density: Some(1000.0),
-        mu: Some(0.5),
+        density: Some(density),
+        mu: Some(mu),
         ..Default::default()
     };
-    let snaps = readers::read_lmgc90(&files, &opts).unwrap();
+    readers::read_lmgc90(&files, &opts).unwrap()
+}
+
+#[test]
+fn lmgc90_hand_written_sample() {
+    let snaps = lmgc90_pair(&data("lmgc90"), "BODIES.DAT", 1000.0, 0.5);
     assert_eq!(snaps.len(), 2);
     assert_eq!(
         snaps[0].accelerations,
@@ -270,22 +275,7 @@ fn lmgc90_real_run_matches_lmgc90_positions_and_reactions() {
     let d = data("lmgc90/real");
     for bodies in ["BODIES.DAT", "BODIES.OUT"] {
         // the pre-processor's BODIES.DAT (`axe1=`) and LMGC90's own BODIES.OUT (`ax1 =`)
-        let files: Vec<PathBuf> = [
-            bodies,
-            "DOF.OUT.1",
-            "DOF.OUT.2",
-            "Vloc_Rloc.OUT.1",
-            "Vloc_Rloc.OUT.2",
-        ]
-        .iter()
-        .map(|f| d.join(f))
-        .collect();
-        let opts = ReadOptions {
-            density: Some(2500.0),
-            mu: Some(0.3),
-            ..Default::default()
-        };
-        let snaps = readers::read_lmgc90(&files, &opts).unwrap();
+        let snaps = lmgc90_pair(&d, bodies, 2500.0, 0.3);
         assert_eq!(snaps.len(), 2);
         for (k, ext) in snaps.iter().enumerate() {
             let s = &ext.snapshot;

@@ -267,6 +267,15 @@ impl<'b> LawFits<'_, 'b> {
         })
     }
 
+    /// A fit that failed with `error`: the error under `error_key` in the summary, the stale
+    /// law `file` (`mu_i`, `phi_i`) removed, its check refused with `reason`.
+    fn failed(&mut self, error_key: &str, error: &str, file: &str, reason: String) -> Result<()> {
+        self.s.text(error_key, error);
+        crate::verdict::remove_stale_law(self.out, file)?;
+        refuse_fit(self.verdict, self.inp.check_prefix, file, reason);
+        Ok(())
+    }
+
     /// Stage "fit" of μ(I): the full law, or its linear form when the full one is refused or
     /// left out.
     fn mu(&mut self) -> Result<LawCurve> {
@@ -350,14 +359,8 @@ impl<'b> LawFits<'_, 'b> {
                 }
                 Err(e2) => {
                     warn(&format!("linear μ(I) fit failed too: {e2}"));
-                    self.s.text("mu_i_linear_fit_error", &e2.to_string());
-                    crate::verdict::remove_stale_law(self.out, "mu_i")?;
-                    refuse_fit(
-                        self.verdict,
-                        inp.check_prefix,
-                        "mu_i",
-                        format!("no μ(I) law could be fitted: {e2}"),
-                    );
+                    let reason = format!("no μ(I) law could be fitted: {e2}");
+                    self.failed("mu_i_linear_fit_error", &e2.to_string(), "mu_i", reason)?;
                     mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
                 }
             }
@@ -392,14 +395,8 @@ impl<'b> LawFits<'_, 'b> {
             }
             Some(Err(e)) => {
                 warn(&format!("φ(I) fit failed: {e}"));
-                self.s.text("phi_i_fit_error", &e.to_string());
-                crate::verdict::remove_stale_law(self.out, "phi_i")?;
-                refuse_fit(
-                    self.verdict,
-                    inp.check_prefix,
-                    "phi_i",
-                    format!("the φ(I) fit failed: {e}"),
-                );
+                let reason = format!("the φ(I) fit failed: {e}");
+                self.failed("phi_i_fit_error", &e.to_string(), "phi_i", reason)?;
                 phi_notes.push("no φ(I) law fitted (phi_i_fit_error)".into());
                 None
             }
