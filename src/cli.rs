@@ -307,20 +307,20 @@ fn continuum_cmd(cmd: ContinuumCommand) -> Result<()> {
                 .out
                 .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-column-collapse"));
             let mut plan = crate::continuum::ColumnPlan::new(a.law, out);
-            plan.dem = a.dem;
+            plan.inputs.dem = a.dem;
             plan.aspect_ratio = a.aspect_ratio;
             plan.half_width_m = a.half_width;
-            plan.packing_fraction = a.packing_fraction;
-            plan.level = a.level;
+            plan.inputs.packing_fraction = a.packing_fraction;
+            plan.inputs.level = a.level;
             plan.domain = a.domain;
             plan.end_t_star = a.t_end;
-            plan.viscosity_cap = a.viscosity_cap;
+            plan.inputs.viscosity_cap = a.viscosity_cap;
             plan.band = a.band;
             plan.jobs = a
                 .jobs
                 .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-            plan.gerris = a.gerris;
-            plan.allow_suspect = a.allow_suspect;
+            plan.inputs.gerris = a.gerris;
+            plan.inputs.allow_suspect = a.allow_suspect;
             let o = crate::continuum::column_collapse(&plan)?;
             (o.lines, o.warnings, o.verdict, o.dir, a.quiet)
         }
@@ -330,14 +330,14 @@ fn continuum_cmd(cmd: ContinuumCommand) -> Result<()> {
                 .out
                 .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-inclined-plane"));
             let mut plan = crate::continuum::InclinedPlan::new(a.law, out.clone());
-            plan.dem = a.dem;
+            plan.inputs.dem = a.dem;
             plan.slope_deg = a.slope_deg;
             plan.depth_m = a.depth;
-            plan.packing_fraction = a.packing_fraction;
-            plan.level = a.level;
-            plan.viscosity_cap = a.viscosity_cap;
-            plan.gerris = a.gerris;
-            plan.allow_suspect = a.allow_suspect;
+            plan.inputs.packing_fraction = a.packing_fraction;
+            plan.inputs.level = a.level;
+            plan.inputs.viscosity_cap = a.viscosity_cap;
+            plan.inputs.gerris = a.gerris;
+            plan.inputs.allow_suspect = a.allow_suspect;
             let o = crate::continuum::inclined_plane(&plan)?;
             (o.lines, o.warnings, o.verdict, out, a.quiet)
         }

@@ -10,8 +10,10 @@
 //! Fits that succeed but hold a parameter at its bound print it as such, not as an estimate.
 //! Fits refused on data that were read (exit code 3) are in `tests/fit_refusals.rs`.
 
+mod common;
+
 use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use toml::{Table, Value};
@@ -90,7 +92,10 @@ fn failure(r: &Row, cwd: &Path) -> Option<String> {
     if !out.stdout.is_empty() {
         why.push(format!("stdout: {}", String::from_utf8_lossy(&out.stdout)));
     }
-    if walk(cwd).iter().any(|p| p.ends_with("summary.json")) {
+    if common::walk(cwd)
+        .iter()
+        .any(|p| p.ends_with("summary.json"))
+    {
         why.push("left a summary.json".into());
     }
     if why.is_empty() {
@@ -115,21 +120,6 @@ fn run_table(rows: &[Row], cwd: &Path) {
         rows.len(),
         failures.join("\n")
     );
-}
-
-fn walk(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    if let Ok(rd) = std::fs::read_dir(dir) {
-        for e in rd.flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                out.extend(walk(&p));
-            } else {
-                out.push(p);
-            }
-        }
-    }
-    out
 }
 
 fn builtin(name: &str) -> &'static str {

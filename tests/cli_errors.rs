@@ -1,16 +1,11 @@
 //! Bad input gives one line on stderr naming the key, file or line, exit code 2, no panic, and
 //! no `summary.json` (`docs/cli.md`).
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn grainlaw(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("the grainlaw binary runs")
-}
+use common::grainlaw_in as grainlaw;
+
+use std::path::Path;
 
 /// Runs `args` and checks: exit code 2, nothing on stdout, exactly one line on stderr that starts
 /// with `error:` and contains every `needle`, no panic message, no summary.json under `cwd`.
@@ -43,26 +38,11 @@ fn check_bad(args: &[&str], needles: &[&str], cwd: &Path) {
         "{args:?}: stdout {}",
         String::from_utf8_lossy(&out.stdout)
     );
-    let leftover: Vec<_> = walk(cwd)
+    let leftover: Vec<_> = common::walk(cwd)
         .into_iter()
         .filter(|p| p.ends_with("summary.json"))
         .collect();
     assert!(leftover.is_empty(), "{args:?}: left {leftover:?}");
-}
-
-fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
-    let mut out = Vec::new();
-    if let Ok(rd) = std::fs::read_dir(dir) {
-        for e in rd.flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                out.extend(walk(&p));
-            } else {
-                out.push(p);
-            }
-        }
-    }
-    out
 }
 
 #[test]

@@ -1,15 +1,10 @@
 //! `grainlaw scenarios`, `fit` and `solve-fc` on small inputs with known answers.
 
-use std::process::Command;
+mod common;
+
+use common::grainlaw_here as grainlaw;
 
 use serde_json::Value;
-
-fn grainlaw(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 #[test]
 fn scenarios_lists_and_shows_every_builtin() {

@@ -3,6 +3,10 @@
 //! the column collapse against Staron's contact dynamics, and bad input (`docs/continuum.md`).
 //! The tests that run Gerris skip, saying so, when `gerris2D` is not installed (CI installs it).
 
+mod common;
+
+use common::grainlaw_in as grainlaw;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -25,14 +29,6 @@ fn gerris_or_skip(test: &str) -> bool {
         eprintln!("{test}: SKIPPED: gerris2D is not installed (apt-get install gerris)");
     }
     ok
-}
-
-fn grainlaw(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("the grainlaw binary runs")
 }
 
 /// The number written right after `prefix` in `text` (up to a delimiter).
@@ -226,8 +222,8 @@ fn interface_reader_on_a_recorded_gerris_snapshot() {
 fn bagnold_case(law: &str, slope_deg: f64, phi: f64, out: &Path) -> (f64, usize) {
     let mut plan = InclinedPlan::new(fixture(law), out.to_path_buf());
     plan.slope_deg = Some(slope_deg);
-    plan.packing_fraction = Some(phi);
-    plan.level = 6;
+    plan.inputs.packing_fraction = Some(phi);
+    plan.inputs.level = 6;
     let o = inclined_plane(&plan).unwrap();
     println!("{}", o.lines.join("\n"));
     assert!(o.verdict.passes(), "{:?}", o.verdict.lines());

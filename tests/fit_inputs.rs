@@ -10,11 +10,11 @@
 //!   about the delimiter, three triaxial points suffice with `# cohesion = 0`, Windows line
 //!   endings and a UTF-8 byte-order mark (spreadsheet exports) are read.
 
+mod common;
+
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::{Command, Output};
-
-use serde_json::Value;
 
 fn grainlaw(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_grainlaw"))
@@ -37,18 +37,7 @@ fn fit(dir: &Path, law: &str, file: &str) -> (i32, String, Vec<(String, f64)>) {
     let code = o.status.code().unwrap_or(-1);
     let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
     let params = if code == 0 {
-        let v: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-        v["parameters"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|p| {
-                (
-                    p["name"].as_str().unwrap().to_string(),
-                    p["value"].as_f64().unwrap(),
-                )
-            })
-            .collect()
+        common::law_parameters(&out)
     } else {
         assert!(
             !out.exists(),

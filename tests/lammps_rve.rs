@@ -4,6 +4,10 @@
 //! numbers; LAMMPS boxes of every kind (orthogonal, triclinic, periodic per axis) and the
 //! dumps the reader refuses.
 
+mod common;
+
+use common::grainlaw_here as grainlaw;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -62,23 +66,6 @@ fn pair_moment(s: &dem::Snapshot) -> Tensor2 {
         .fold(Tensor2::zeros(), |m, g| m + g.contact * g.volume)
 }
 
-/// Σ_i of LAMMPS' per-atom `compute stress/atom NULL pair` columns (xx, yy, xy) of a dump.
-fn lammps_stress_sum(path: &Path) -> [f64; 3] {
-    let text = readers::read_text(path).unwrap();
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("ITEM: ATOMS"));
-    let header: Vec<&str> = lines.next().unwrap().split_whitespace().skip(2).collect();
-    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
-    let (xx, yy, xy) = (col("c_s[1]"), col("c_s[2]"), col("c_s[4]"));
-    let mut s = [0.0; 3];
-    for l in lines {
-        let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
-        s[0] += v[xx];
-        s[1] += v[yy];
-        s[2] += v[xy];
-    }
-    s
-}
-
 #[test]
 fn tilted_biperiodic_contact_stress_equals_lammps_stress_atom() {
     // Two snapshots written at the setup of a `run 0` (forces, positions and cell of one
@@ -118,7 +105,7 @@ fn tilted_biperiodic_contact_stress_equals_lammps_stress_atom() {
             .iter()
             .find(|p| p.to_string_lossy().contains("atoms."))
             .unwrap();
-        let lammps = lammps_stress_sum(atoms);
+        let lammps = common::lammps_stress_sum(atoms);
         let scale = lammps.iter().map(|v| v * v).sum::<f64>().sqrt();
         for k in 0..3 {
             assert!(
@@ -258,13 +245,6 @@ fn a_single_snapshot_takes_its_shear_rate_from_the_grain_velocities() {
         all[0].velocity_gradient,
         Some(GradientSource::CellDeformation)
     );
-}
-
-fn grainlaw(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .args(args)
-        .output()
-        .unwrap()
 }
 
 #[test]
@@ -478,117 +458,66 @@ fn dumps_grainlaw_cannot_read_are_refused_naming_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let one_line = |e: &str| e.trim_end().lines().count() == 1;
+    // two disks 2 mm apart at rest in the box `bounds`, pushed apart, dumped at `step`
+    let still = |step: u64, bounds: &str| {
+        two_disks(
+            dir.path(),
+            step,
+            bounds,
+            [0.001, 0.001],
+            [0.003, 0.001],
+            1e-3,
+            [1.0, 0.0],
+        )
+    };
+    // a dump written as `text`
+    let dump = |name: &str, text: &str| {
+        let f = dir.path().join(name);
+        std::fs::write(&f, text).unwrap();
+        f
+    };
+    // the files refused with exit 2, the error naming the place `at` and saying `what`
+    let refused = |files: &[PathBuf], at: &str, what: &str| {
+        let (code, err) = homogenise_files(files, &out);
+        assert_eq!(code, Some(2), "{err}");
+        assert!(err.contains(at) && err.contains(what), "{err}");
+        err
+    };
     // a cell tilted beyond LAMMPS' limit (|xy| ≤ l_x / 2): 6 mm on 10 mm
-    let files = two_disks(
-        dir.path(),
+    let files = still(
         1,
         "ITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.016 0.006\n0 0.01 0\n-0.0005 0.0005 0",
-        [0.001, 0.001],
-        [0.003, 0.001],
-        1e-3,
-        [1.0, 0.0],
     );
-    let (code, err) = homogenise_files(&files, &out);
-    assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("atoms.1.dump:5:") && err.contains("0.600 of its x length"),
-        "{err}"
-    );
+    let err = refused(&files, "atoms.1.dump:5:", "0.600 of its x length");
     assert!(one_line(&err), "{err}");
     // 3D dumps: a non-periodic z, a z tilt, atoms off the plane
-    let (code, err) = homogenise_files(
-        &two_disks(
-            dir.path(),
-            2,
-            "ITEM: BOX BOUNDS pp pp ff\n0 0.01\n0 0.01\n0 0.01",
-            [0.001, 0.001],
-            [0.003, 0.001],
-            1e-3,
-            [1.0, 0.0],
-        ),
-        &out,
+    let three_d = "3D is not supported yet";
+    let files = still(2, "ITEM: BOX BOUNDS pp pp ff\n0 0.01\n0 0.01\n0 0.01");
+    refused(&files, "atoms.2.dump:5:", three_d);
+    let files = still(
+        3,
+        "ITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0.001\n0 0.01 0",
     );
-    assert_eq!(code, Some(2));
-    assert!(
-        err.contains("atoms.2.dump:5:") && err.contains("3D is not supported yet"),
-        "{err}"
-    );
-    let (code, err) = homogenise_files(
-        &two_disks(
-            dir.path(),
-            3,
-            "ITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0.001\n0 0.01 0",
-            [0.001, 0.001],
-            [0.003, 0.001],
-            1e-3,
-            [1.0, 0.0],
-        ),
-        &out,
-    );
-    assert_eq!(code, Some(2));
-    assert!(
-        err.contains("atoms.3.dump:5:") && err.contains("3D is not supported yet"),
-        "{err}"
-    );
-    let z = dir.path().join("atoms.4.dump");
-    std::fs::write(&z, "ITEM: TIMESTEP\n4\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 0.01\n0 0.01\n0 0.01\nITEM: ATOMS id x y z vx vy omegaz radius mass\n1 0.001 0.001 0.005 0 0 0 0.001 0.008\n2 0.003 0.001 0.006 0 0 0 0.001 0.008\n").unwrap();
-    let (code, err) = homogenise_files(&[z], &out);
-    assert_eq!(code, Some(2));
-    assert!(
-        err.contains("atoms.4.dump:11:") && err.contains("3D is not supported yet"),
-        "{err}"
-    );
+    refused(&files, "atoms.3.dump:5:", three_d);
+    let z = dump("atoms.4.dump", "ITEM: TIMESTEP\n4\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 0.01\n0 0.01\n0 0.01\nITEM: ATOMS id x y z vx vy omegaz radius mass\n1 0.001 0.001 0.005 0 0 0 0.001 0.008\n2 0.003 0.001 0.006 0 0 0 0.001 0.008\n");
+    refused(&[z], "atoms.4.dump:11:", three_d);
     // a dump without a column the reader needs
-    let nm = dir.path().join("atoms.5.dump");
-    std::fs::write(&nm, "ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0\n0 0.01 0\nITEM: ATOMS id x y vx vy omegaz radius\n1 0.001 0.001 0 0 0 0.001\n").unwrap();
-    let (code, err) = homogenise_files(&[nm], &out);
-    assert_eq!(code, Some(2));
-    assert!(
-        err.contains("atoms.5.dump:9:") && err.contains("no column `mass`"),
-        "{err}"
-    );
+    let nm = dump("atoms.5.dump", "ITEM: TIMESTEP\n5\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0\n0 0.01 0\nITEM: ATOMS id x y vx vy omegaz radius\n1 0.001 0.001 0 0 0 0.001\n");
+    refused(&[nm], "atoms.5.dump:9:", "no column `mass`");
     // a series whose grain count changes, and one whose cell changes kind
-    let mut files = two_disks(
-        dir.path(),
-        10,
-        "ITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0\n0 0.01 0",
-        [0.001, 0.001],
-        [0.003, 0.001],
-        1e-3,
-        [1.0, 0.0],
-    );
-    let three = dir.path().join("atoms.20.dump");
-    std::fs::write(&three, "ITEM: TIMESTEP\n20\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0\n0 0.01 0\nITEM: ATOMS id x y vx vy omegaz radius mass\n1 0.001 0.001 0 0 0 0.001 0.008\n2 0.003 0.001 0 0 0 0.001 0.008\n3 0.005 0.005 0 0 0 0.001 0.008\n").unwrap();
-    files.push(three);
-    let (code, err) = homogenise_files(&files, &out);
-    assert_eq!(code, Some(2));
-    assert!(
-        err.contains("atoms.20.dump:4:") && err.contains("has 3 atoms where step 10"),
-        "{err}"
-    );
-    let mut files = two_disks(
-        dir.path(),
-        30,
-        "ITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0\n0 0.01 0",
-        [0.001, 0.001],
-        [0.003, 0.001],
-        1e-3,
-        [1.0, 0.0],
-    );
-    files.extend(two_disks(
-        dir.path(),
+    let flat = "ITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0\n0 0.01 0";
+    let mut files = still(10, flat);
+    files.push(dump("atoms.20.dump", "ITEM: TIMESTEP\n20\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS xy xz yz pp pp pp\n0 0.01 0\n0 0.01 0\n0 0.01 0\nITEM: ATOMS id x y vx vy omegaz radius mass\n1 0.001 0.001 0 0 0 0.001 0.008\n2 0.003 0.001 0 0 0 0.001 0.008\n3 0.005 0.005 0 0 0 0.001 0.008\n"));
+    refused(&files, "atoms.20.dump:4:", "has 3 atoms where step 10");
+    let mut files = still(30, flat);
+    files.extend(still(
         40,
         "ITEM: BOX BOUNDS pp ff pp\n0 0.01\n0 0.01\n0 0.01",
-        [0.001, 0.001],
-        [0.003, 0.001],
-        1e-3,
-        [1.0, 0.0],
     ));
-    let (code, err) = homogenise_files(&files, &out);
-    assert_eq!(code, Some(2));
-    assert!(
-        err.contains("atoms.40.dump:5:") && err.contains("the cell changes within the series"),
-        "{err}"
+    let err = refused(
+        &files,
+        "atoms.40.dump:5:",
+        "the cell changes within the series",
     );
     assert!(one_line(&err), "{err}");
 }

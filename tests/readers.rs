@@ -4,6 +4,8 @@
 //! by hand in LMGC90's layout (`datasets/external/lmgc90`); the plain format against analytic
 //! answers; errors naming file and line.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -50,23 +52,6 @@ fn thermo() -> Vec<(u64, Vec<f64>)> {
         .collect()
 }
 
-/// Σ_i S_i of LAMMPS' `compute stress/atom NULL pair` columns (xx, yy, xy) of a per-atom dump.
-fn lammps_stress_sum(step: u64) -> [f64; 3] {
-    let text = readers::read_text(&data("lammps").join(format!("atoms.{step}.dump.gz"))).unwrap();
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("ITEM: ATOMS"));
-    let header: Vec<&str> = lines.next().unwrap().split_whitespace().skip(2).collect();
-    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
-    let (xx, yy, xy) = (col("c_s[1]"), col("c_s[2]"), col("c_s[4]"));
-    let mut s = [0.0; 3];
-    for l in lines {
-        let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
-        s[0] += v[xx];
-        s[1] += v[yy];
-        s[2] += v[xy];
-    }
-    s
-}
-
 /// `Σ_p V_p Σ_c,p` over the grains, counting grain–grain contacts only (N·m).
 fn pair_moment(s: &dem::Snapshot) -> Tensor2 {
     let mut pairs = s.clone();
@@ -98,7 +83,8 @@ fn lammps_contact_stress_equals_lammps_pair_virial() {
         // 2D SI units: tension positive like grainlaw, first index the branch: its xy is
         // grainlaw's yx (grainlaw's first index is the force).
         let m = pair_moment(s);
-        let l = lammps_stress_sum(s.step);
+        let l =
+            common::lammps_stress_sum(&data("lammps").join(format!("atoms.{}.dump.gz", s.step)));
         let ours = [m[(0, 0)], m[(1, 1)], m[(1, 0)]];
         let scale = l.iter().map(|v| v * v).sum::<f64>().sqrt();
         let worst = (0..3).map(|k| (ours[k] - l[k]).abs()).fold(0.0, f64::max) / scale;
@@ -201,11 +187,11 @@ fn lammps_forces_give_accelerations_and_symmetric_stress() {
     );
 }
 
-#[test]
-fn lmgc90_hand_written_sample() {
-    let d = data("lmgc90");
+/// The two steps of the LMGC90 run in `d` (bodies file `bodies`, `DOF.OUT.1`–`2`,
+/// `Vloc_Rloc.OUT.1`–`2`), read with grain density `density` (kg/m³) and friction `mu`.
+fn lmgc90_pair(d: &Path, bodies: &str, density: f64, mu: f64) -> Vec<readers::ExternalSnapshot> {
     let files: Vec<PathBuf> = [
-        "BODIES.DAT",
+        bodies,
         "DOF.OUT.1",
         "DOF.OUT.2",
         "Vloc_Rloc.OUT.1",
@@ -215,11 +201,16 @@ fn lmgc90_hand_written_sample() {
     .map(|f| d.join(f))
     .collect();
     let opts = ReadOptions {
-        density: Some(1000.0),
-        mu: Some(0.5),
+        density: Some(density),
+        mu: Some(mu),
         ..Default::default()
     };
-    let snaps = readers::read_lmgc90(&files, &opts).unwrap();
+    readers::read_lmgc90(&files, &opts).unwrap()
+}
+
+#[test]
+fn lmgc90_hand_written_sample() {
+    let snaps = lmgc90_pair(&data("lmgc90"), "BODIES.DAT", 1000.0, 0.5);
     assert_eq!(snaps.len(), 2);
     assert_eq!(
         snaps[0].accelerations,
@@ -284,22 +275,7 @@ fn lmgc90_real_run_matches_lmgc90_positions_and_reactions() {
     let d = data("lmgc90/real");
     for bodies in ["BODIES.DAT", "BODIES.OUT"] {
         // the pre-processor's BODIES.DAT (`axe1=`) and LMGC90's own BODIES.OUT (`ax1 =`)
-        let files: Vec<PathBuf> = [
-            bodies,
-            "DOF.OUT.1",
-            "DOF.OUT.2",
-            "Vloc_Rloc.OUT.1",
-            "Vloc_Rloc.OUT.2",
-        ]
-        .iter()
-        .map(|f| d.join(f))
-        .collect();
-        let opts = ReadOptions {
-            density: Some(2500.0),
-            mu: Some(0.3),
-            ..Default::default()
-        };
-        let snaps = readers::read_lmgc90(&files, &opts).unwrap();
+        let snaps = lmgc90_pair(&d, bodies, 2500.0, 0.3);
         assert_eq!(snaps.len(), 2);
         for (k, ext) in snaps.iter().enumerate() {
             let s = &ext.snapshot;

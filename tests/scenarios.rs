@@ -1,6 +1,8 @@
 //! Short versions of every scenario, run through the binary: they finish, write the files the
 //! contract names, and the paper's qualitative facts hold.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -57,18 +59,7 @@ fn refit(dir: &Path, law: &str, file: &str) -> (i32, Vec<(String, f64)>) {
         .expect("grainlaw runs");
     let code = o.status.code().unwrap_or(-1);
     let params = if code == 0 {
-        let v: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-        v["parameters"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|p| {
-                (
-                    p["name"].as_str().unwrap().to_string(),
-                    p["value"].as_f64().unwrap(),
-                )
-            })
-            .collect()
+        common::law_parameters(&out)
     } else {
         Vec::new()
     };

@@ -16,33 +16,16 @@ pub enum Dof {
     Imposed,
 }
 
-/// A rigid body. Geometry lives in the colliders attached to it (`collider.rs`).
+/// A rigid body: its state (what a snapshot shows of it, [`BodyState`]: kind, name, position,
+/// angle, velocities, accelerations, mass, inertia, radius, density, thickness), whose fields
+/// it shows as its own (`body.position`, through `Deref`), and its control (degrees of
+/// freedom, applied loads, gravity). Geometry lives in the colliders attached to it
+/// (`collider.rs`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Body {
-    /// Grain or wall.
-    pub kind: BodyKind,
-    /// Name (walls); empty for grains.
-    pub name: String,
-    /// Centre of mass (m).
-    pub position: Vector,
-    /// Rotation angle (rad, counter-clockwise).
-    pub angle: f64,
-    /// Velocity (m/s).
-    pub velocity: Vector,
-    /// Angular velocity (rad/s).
-    pub omega: f64,
-    /// Mass (kg); `m = ρ π R² · thickness` for a disk; infinite for a fixed wall.
-    #[serde(with = "crate::serde_float")]
-    pub mass: f64,
-    /// Moment of inertia about the centre (kg·m²); `I = m R² / 2` for a disk.
-    #[serde(with = "crate::serde_float")]
-    pub inertia: f64,
-    /// Disk radius (m) for grains, 0 otherwise.
-    pub radius: f64,
-    /// Density (kg/m³) for grains, 0 otherwise.
-    pub density: f64,
-    /// Thickness along z (m).
-    pub thickness: f64,
+    /// The body's state (serialised with the body's own fields, flat).
+    #[serde(flatten)]
+    pub state: BodyState,
     /// Control of x, y, rotation.
     pub dofs: [Dof; 3],
     /// Constant applied force (N) on free degrees of freedom, besides gravity (e.g. a
@@ -52,57 +35,44 @@ pub struct Body {
     pub applied_torque: f64,
     /// Whether gravity acts on the free degrees of freedom of this body.
     pub gravity: bool,
-    /// Mean acceleration over the last step (m/s²), `(v⁺ − v⁻)/h`.
-    pub acceleration: Vector,
-    /// Mean angular acceleration over the last step (rad/s²).
-    pub angular_acceleration: f64,
+}
+
+impl std::ops::Deref for Body {
+    type Target = BodyState;
+
+    #[inline]
+    fn deref(&self) -> &BodyState {
+        &self.state
+    }
+}
+
+impl std::ops::DerefMut for Body {
+    #[inline]
+    fn deref_mut(&mut self) -> &mut BodyState {
+        &mut self.state
+    }
 }
 
 impl Body {
     /// A free disk grain at rest: `m = ρ π R² t`, `I = m R² / 2`.
     pub fn disk(position: Vector, radius: f64, density: f64, thickness: f64) -> Self {
-        let mass = density * std::f64::consts::PI * radius * radius * thickness;
         Body {
-            kind: BodyKind::Grain,
-            name: String::new(),
-            position,
-            angle: 0.0,
-            velocity: Vector::zeros(),
-            omega: 0.0,
-            mass,
-            inertia: 0.5 * mass * radius * radius,
-            radius,
-            density,
-            thickness,
+            state: BodyState::disk(position, radius, density, thickness),
             dofs: [Dof::Free; 3],
             applied_force: Vector::zeros(),
             applied_torque: 0.0,
             gravity: true,
-            acceleration: Vector::zeros(),
-            angular_acceleration: 0.0,
         }
     }
 
     /// A wall body whose motion is fully imposed (velocity `velocity`, no rotation).
     pub fn wall(name: &str, position: Vector, velocity: Vector) -> Self {
         Body {
-            kind: BodyKind::Wall,
-            name: name.to_string(),
-            position,
-            angle: 0.0,
-            velocity,
-            omega: 0.0,
-            mass: f64::INFINITY,
-            inertia: f64::INFINITY,
-            radius: 0.0,
-            density: 0.0,
-            thickness: 1.0,
+            state: BodyState::wall(name, position, velocity),
             dofs: [Dof::Imposed; 3],
             applied_force: Vector::zeros(),
             applied_torque: 0.0,
             gravity: false,
-            acceleration: Vector::zeros(),
-            angular_acceleration: 0.0,
         }
     }
 
@@ -149,21 +119,7 @@ impl From<&Body> for BodyState {
     /// The body as a snapshot shows it: its state after a step, without its control (degrees
     /// of freedom, applied loads, gravity switch).
     fn from(b: &Body) -> Self {
-        BodyState {
-            kind: b.kind,
-            name: b.name.clone(),
-            position: b.position,
-            angle: b.angle,
-            velocity: b.velocity,
-            omega: b.omega,
-            acceleration: b.acceleration,
-            angular_acceleration: b.angular_acceleration,
-            mass: b.mass,
-            inertia: b.inertia,
-            radius: b.radius,
-            density: b.density,
-            thickness: b.thickness,
-        }
+        b.state.clone()
     }
 }
 

@@ -179,6 +179,18 @@ pub struct ContactSet {
 }
 
 impl ContactSet {
+    /// Each contact's solver row with its geometry, in order.
+    pub fn rows_with_geometry(&self) -> impl Iterator<Item = (&ContactRow, &ContactGeometry)> {
+        self.rows.iter().zip(&self.geometry)
+    }
+
+    /// Each contact's solver row (to change) with its geometry, in order.
+    pub fn rows_with_geometry_mut(
+        &mut self,
+    ) -> impl Iterator<Item = (&mut ContactRow, &ContactGeometry)> {
+        self.rows.iter_mut().zip(&self.geometry)
+    }
+
     /// Number of contacts.
     pub fn len(&self) -> usize {
         self.rows.len()

@@ -1458,7 +1458,8 @@ mod tests {
                     let kick =
                         Vector::new(rng.random_range(-0.02..0.02), rng.random_range(-0.02..0.02));
                     body.velocity = body.velocity * 0.9 + kick;
-                    body.position += body.velocity * dt;
+                    let v = body.velocity;
+                    body.position += v * dt;
                     if let Some(p) = periodic {
                         body.position.x = p.wrap(body.position.x);
                     }
@@ -1540,7 +1541,8 @@ mod tests {
             assert_eq!(keys, brute_force(&bodies, gap, dt, None), "call {call}");
             found += keys.len();
             for b in bodies.iter_mut().skip(1) {
-                b.position += b.velocity * dt;
+                let v = b.velocity;
+                b.position += v * dt;
             }
         }
         assert!(found > 1000, "{found}");

@@ -39,7 +39,8 @@ pub struct BodyState {
     pub acceleration: Vector,
     /// Mean angular acceleration over the step, `(ω⁺ − ω⁻)/h` (rad/s²).
     pub angular_acceleration: f64,
-    /// Mass (kg); `f64::INFINITY` for a wall whose motion is imposed.
+    /// Mass (kg); `m = ρ π R² · thickness` for a disk; `f64::INFINITY` for a wall whose motion is
+    /// imposed.
     #[serde(with = "crate::serde_float")]
     pub mass: f64,
     /// Moment of inertia about the centre (kg·m²); `I = m R²/2` for a disk.
@@ -54,6 +55,46 @@ pub struct BodyState {
 }
 
 impl BodyState {
+    /// A disk grain at rest: `m = ρ π R² t`, `I = m R² / 2`.
+    pub fn disk(position: Vector, radius: f64, density: f64, thickness: f64) -> Self {
+        let mass = density * std::f64::consts::PI * radius * radius * thickness;
+        BodyState {
+            kind: BodyKind::Grain,
+            name: String::new(),
+            position,
+            angle: 0.0,
+            velocity: Vector::zeros(),
+            omega: 0.0,
+            acceleration: Vector::zeros(),
+            angular_acceleration: 0.0,
+            mass,
+            inertia: 0.5 * mass * radius * radius,
+            radius,
+            density,
+            thickness,
+        }
+    }
+
+    /// A wall whose motion is imposed (infinite mass and inertia), moving at `velocity`
+    /// without rotation, thickness 1.
+    pub fn wall(name: &str, position: Vector, velocity: Vector) -> Self {
+        BodyState {
+            kind: BodyKind::Wall,
+            name: name.to_string(),
+            position,
+            angle: 0.0,
+            velocity,
+            omega: 0.0,
+            acceleration: Vector::zeros(),
+            angular_acceleration: 0.0,
+            mass: f64::INFINITY,
+            inertia: f64::INFINITY,
+            radius: 0.0,
+            density: 0.0,
+            thickness: 1.0,
+        }
+    }
+
     /// Volume of a grain, `V_p = π R² · thickness` (m³); 0 for walls.
     pub fn volume(&self) -> f64 {
         std::f64::consts::PI * self.radius * self.radius * self.thickness

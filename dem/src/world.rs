@@ -264,13 +264,7 @@ impl World {
     fn measure_cell_stress(&self, cell: &Cell) -> Tensor {
         let h = self.impulse_dt();
         let mut m = Tensor::zeros();
-        for (row, geo) in self
-            .state
-            .contacts
-            .rows
-            .iter()
-            .zip(&self.state.contacts.geometry)
-        {
+        for (row, geo) in self.state.contacts.rows_with_geometry() {
             if row.r == [0.0, 0.0] {
                 continue;
             }
@@ -718,13 +712,7 @@ impl World {
                 .map(f64::to_bits),
             );
         }
-        for (row, g) in self
-            .state
-            .contacts
-            .rows
-            .iter()
-            .zip(&self.state.contacts.geometry)
-        {
+        for (row, g) in self.state.contacts.rows_with_geometry() {
             f.extend([g.key, row.r[0].to_bits(), row.r[1].to_bits()]);
         }
         f
@@ -1196,9 +1184,7 @@ impl World {
         let contacts = self
             .state
             .contacts
-            .rows
-            .iter()
-            .zip(&self.state.contacts.geometry)
+            .rows_with_geometry()
             .zip(&self.state.contacts.status)
             .map(|((row, geo), st)| ContactState {
                 body_a: row.a,

@@ -183,6 +183,16 @@ pub struct PhasePlan {
     pub stop: Stop,
 }
 
+impl PhasePlan {
+    /// The phase `name` stopping at `stop`.
+    pub fn new(name: impl Into<String>, stop: Stop) -> Self {
+        PhasePlan {
+            name: name.into(),
+            stop,
+        }
+    }
+}
+
 /// Where a run stands: inside phase `phase`, planned as `plan`, with `progress`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Cursor {

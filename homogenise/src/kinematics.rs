@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{HomogeniseError, Result};
 use crate::region::Region;
 use crate::tensor::{deviator, outer, skew_part, symmetric_part};
-use crate::validate::check_snapshot;
+use crate::validate::{check_snapshot, unit_normal};
 
 /// Weight of each grain in the velocity fit, multiplied by its area fraction inside the region.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -156,14 +156,7 @@ pub fn wall_driven_velocity_gradient(
             })
         }
     };
-    let nn = n.norm();
-    if !(nn.is_finite() && nn > 0.0) {
-        return Err(HomogeniseError::InvalidParameter {
-            name: "normal",
-            reason: "must be a finite non-zero vector".into(),
-        });
-    }
-    let n = n / nn;
+    let n = unit_normal(n)?;
     let (ba, bb) = (
         &snapshot.bodies[wa.body as usize],
         &snapshot.bodies[wb.body as usize],

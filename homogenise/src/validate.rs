@@ -10,6 +10,19 @@ fn finite_vec(v: &Vector) -> bool {
     v.x.is_finite() && v.y.is_finite()
 }
 
+/// The unit vector `n / |n|` of the parameter `normal`; an error when `n` is not a finite
+/// non-zero vector.
+pub(crate) fn unit_normal(n: Vector) -> Result<Vector> {
+    let nn = n.norm();
+    if !(nn.is_finite() && nn > 0.0) {
+        return Err(HomogeniseError::InvalidParameter {
+            name: "normal",
+            reason: "must be a finite non-zero vector".into(),
+        });
+    }
+    Ok(n / nn)
+}
+
 /// Checks the snapshot: finite time step and gravity; grains with finite kinematics and
 /// positive finite radius, mass, moment of inertia and thickness; contacts with body indices in
 /// range, a unit normal, finite forces, levers and friction coefficient.

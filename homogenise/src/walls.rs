@@ -23,7 +23,7 @@ use crate::depth::DepthBins;
 use crate::error::{positive, HomogeniseError, Result};
 use crate::mobilisation::COULOMB_LIMIT;
 use crate::region::grain_extent;
-use crate::validate::check_snapshot;
+use crate::validate::{check_snapshot, unit_normal};
 
 /// The wall of that name.
 pub fn find_wall<'a>(snapshot: &'a Snapshot, name: &str) -> Result<&'a WallState> {
@@ -382,14 +382,7 @@ pub fn near_wall_profile(snapshot: &Snapshot, spec: &NearWallSpec) -> Result<Nea
             }
         }
     };
-    let nn = n.norm();
-    if !(nn.is_finite() && nn > 0.0) {
-        return Err(HomogeniseError::InvalidParameter {
-            name: "normal",
-            reason: "must be a finite non-zero vector".into(),
-        });
-    }
-    let n = n / nn;
+    let n = unit_normal(n)?;
     let f = spec.flow_direction - n * spec.flow_direction.dot(&n);
     let fnorm = f.norm();
     if !(fnorm.is_finite() && fnorm > 1e-6 * spec.flow_direction.norm()) {

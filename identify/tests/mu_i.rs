@@ -125,10 +125,10 @@ fn seeded_bootstrap_is_reproducible_and_agrees_with_the_covariance() {
     }
 }
 
-#[test]
-fn i_range_far_below_i0_is_not_identifiable() {
-    // I ≤ 10⁻²: μ ≈ μ_s + (μ₂ − μ_s) I/I₀, only the slope is seen.
-    let i: Vec<f64> = (1..=20).map(|k| 5e-4 * k as f64).collect();
+/// The error of fitting μ(I) to exact points of [`TRUTH`] at `I = step, 2 step, …, 20 step`:
+/// a scale the data do not resolve, on `side`.
+fn unresolved_scale(step: f64, side: ScaleSide) -> (RheologySeries, IdentifyError) {
+    let i: Vec<f64> = (1..=20).map(|k| step * k as f64).collect();
     let s = RheologySeries {
         mu: Some(i.iter().map(|i| TRUTH.mu(*i)).collect()),
         inertial_number: i,
@@ -136,15 +136,16 @@ fn i_range_far_below_i0_is_not_identifiable() {
     };
     let err = fit_mu_i(&s, &FitOptions::default()).unwrap_err();
     assert!(
-        matches!(
-            err,
-            IdentifyError::ScaleNotResolved {
-                side: ScaleSide::AboveData,
-                ..
-            }
-        ),
+        matches!(&err, IdentifyError::ScaleNotResolved { side: sd, .. } if *sd == side),
         "{err}"
     );
+    (s, err)
+}
+
+#[test]
+fn i_range_far_below_i0_is_not_identifiable() {
+    // I ≤ 10⁻²: μ ≈ μ_s + (μ₂ − μ_s) I/I₀, only the slope is seen.
+    let (s, err) = unresolved_scale(5e-4, ScaleSide::AboveData);
     // The linear form is what these data support, and the refusal offers it.
     assert!(fit_mu_i_linear(&s, &FitOptions::default()).is_ok());
     assert_eq!(err.suggestion(), Some("use mu-i-linear"));
@@ -153,23 +154,7 @@ fn i_range_far_below_i0_is_not_identifiable() {
 
 #[test]
 fn i_range_far_above_i0_is_not_identifiable() {
-    let i: Vec<f64> = (1..=20).map(|k| 5.0 * k as f64).collect();
-    let s = RheologySeries {
-        mu: Some(i.iter().map(|i| TRUTH.mu(*i)).collect()),
-        inertial_number: i,
-        ..Default::default()
-    };
-    let err = fit_mu_i(&s, &FitOptions::default()).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            IdentifyError::ScaleNotResolved {
-                side: ScaleSide::BelowData,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    unresolved_scale(5.0, ScaleSide::BelowData);
 }
 
 #[test]

@@ -7,7 +7,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use grainlaw_core::continuum::dem_column::{group_profiles, read_rows, FrontRow, ProfileRow};
-use grainlaw_core::continuum::{column_collapse, inclined_plane, ColumnPlan, InclinedPlan};
+use grainlaw_core::continuum::{
+    column_collapse, inclined_plane, CaseInputs, ColumnPlan, InclinedPlan,
+};
 use grainlaw_core::verdict::{RunVerdict, Verdict};
 
 use crate::arrays::out1;
@@ -179,13 +181,22 @@ pub fn continuum<'py>(
             "solver `{solver}`: the only continuum solver is `gerris`"
         )));
     }
+    let dir =
+        out.unwrap_or_else(|| PathBuf::from("grainlaw-out").join(format!("continuum-{case}")));
+    // What both cases take, over the case's defaults of level and viscosity cap.
+    let shared = move |defaults: CaseInputs| CaseInputs {
+        dem,
+        packing_fraction,
+        level: level.unwrap_or(defaults.level),
+        viscosity_cap: viscosity_cap.unwrap_or(defaults.viscosity_cap),
+        gerris,
+        allow_suspect,
+        ..defaults
+    };
     let outcome = match case {
         "column-collapse" => {
-            let dir = out
-                .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-column-collapse"));
             let mut plan = ColumnPlan::new(law, dir.clone());
-            plan.dem = dem;
-            plan.packing_fraction = packing_fraction;
+            plan.inputs = shared(plan.inputs);
             plan.aspect_ratio = aspect_ratio;
             plan.half_width_m = half_width;
             plan.domain = domain;
@@ -193,14 +204,6 @@ pub fn continuum<'py>(
             plan.band = band;
             plan.jobs =
                 jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-            plan.gerris = gerris;
-            plan.allow_suspect = allow_suspect;
-            if let Some(l) = level {
-                plan.level = l;
-            }
-            if let Some(v) = viscosity_cap {
-                plan.viscosity_cap = v;
-            }
             if slope_deg.is_some() || depth.is_some() {
                 return Err(input(
                     "slope_deg and depth are options of the inclined-plane case",
@@ -210,21 +213,10 @@ pub fn continuum<'py>(
             (o.lines, o.warnings, o.verdict, dir)
         }
         "inclined-plane" => {
-            let dir = out
-                .unwrap_or_else(|| PathBuf::from("grainlaw-out").join("continuum-inclined-plane"));
             let mut plan = InclinedPlan::new(law, dir.clone());
-            plan.dem = dem;
-            plan.packing_fraction = packing_fraction;
+            plan.inputs = shared(plan.inputs);
             plan.slope_deg = slope_deg;
             plan.depth_m = depth;
-            plan.gerris = gerris;
-            plan.allow_suspect = allow_suspect;
-            if let Some(l) = level {
-                plan.level = l;
-            }
-            if let Some(v) = viscosity_cap {
-                plan.viscosity_cap = v;
-            }
             if aspect_ratio.is_some()
                 || half_width.is_some()
                 || domain.is_some()

@@ -52,29 +52,51 @@ pub fn grainlaw(args: &[&str], dir: Option<&Path>) -> Output {
     cmd.output().expect("grainlaw runs")
 }
 
+/// `grainlaw ARGS` run in `cwd`.
+pub fn grainlaw_in(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("the grainlaw binary runs")
+}
+
+/// `grainlaw ARGS` run in the test's directory.
+pub fn grainlaw_here(args: &[&str]) -> Output {
+    grainlaw_in(args, Path::new("."))
+}
+
 /// The standard error of a finished command, as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
 }
 
-/// Every file under `dir` (relative path → bytes).
-pub fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap().flatten() {
+/// Every file under `dir`, in its subdirectories too (directories that cannot be read are
+/// skipped).
+pub fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    if let Ok(rd) = std::fs::read_dir(dir) {
+        for e in rd.flatten() {
             let p = e.path();
             if p.is_dir() {
-                stack.push(p);
+                out.extend(walk(&p));
             } else {
-                out.insert(
-                    p.strip_prefix(dir).unwrap().to_path_buf(),
-                    std::fs::read(&p).unwrap(),
-                );
+                out.push(p);
             }
         }
     }
     out
+}
+
+/// Every file under `dir` (relative path → bytes).
+pub fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    walk(dir)
+        .into_iter()
+        .map(|p| {
+            let bytes = std::fs::read(&p).unwrap();
+            (p.strip_prefix(dir).unwrap().to_path_buf(), bytes)
+        })
+        .collect()
 }
 
 /// `a` and `b` hold the same files with the same bytes; `summary.json` the same keys and
@@ -116,4 +138,39 @@ pub fn run_stopped_and_resumed(args: &[&str], stop_after: &str, a: &Path, b: &Pa
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
     let o = grainlaw(&["run", "--resume", b.to_str().unwrap(), "-q"], None);
     assert_eq!(o.status.code(), code, "{}", stderr(&o));
+}
+
+/// The parameters of the law file `path` (a `grainlaw fit --out` or scenario law JSON) by name,
+/// in the file's order.
+pub fn law_parameters(path: &Path) -> Vec<(String, f64)> {
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    v["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            (
+                p["name"].as_str().unwrap().to_string(),
+                p["value"].as_f64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Σ_i of LAMMPS' per-atom `compute stress/atom NULL pair` columns (xx, yy, xy) of a dump.
+pub fn lammps_stress_sum(path: &Path) -> [f64; 3] {
+    let text = grainlaw::readers::read_text(path).unwrap();
+    let mut lines = text.lines().skip_while(|l| !l.starts_with("ITEM: ATOMS"));
+    let header: Vec<&str> = lines.next().unwrap().split_whitespace().skip(2).collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    let (xx, yy, xy) = (col("c_s[1]"), col("c_s[2]"), col("c_s[4]"));
+    let mut s = [0.0; 3];
+    for l in lines {
+        let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+        s[0] += v[xx];
+        s[1] += v[yy];
+        s[2] += v[xy];
+    }
+    s
 }

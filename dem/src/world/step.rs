@@ -212,13 +212,7 @@ impl World {
             self.work.vel.push([b.velocity.x, b.velocity.y, b.omega]);
         }
         let mut max_pen = 0.0f64;
-        for (row, geo) in self
-            .state
-            .contacts
-            .rows
-            .iter_mut()
-            .zip(&self.state.contacts.geometry)
-        {
+        for (row, geo) in self.state.contacts.rows_with_geometry_mut() {
             let open_gap = if geo.gap > geo.closed_gap {
                 geo.gap
             } else {
@@ -498,13 +492,7 @@ impl World {
             cell.advance_with(&(l + delta), h);
             // Gap change of each image contact from the cell's deformation, n·(Δh k).
             let dh = (cell.h - h_old) * cell_inverse(&h_old);
-            for (row, geo) in self
-                .state
-                .contacts
-                .rows
-                .iter()
-                .zip(&self.state.contacts.geometry)
-            {
+            for (row, geo) in self.state.contacts.rows_with_geometry() {
                 if geo.image != [0.0, 0.0] {
                     let u = dh * Vector::new(geo.image[0], geo.image[1]);
                     cell_gap_shift.push(row.n[0] * u.x + row.n[1] * u.y);

@@ -13,6 +13,7 @@ use super::band::{self, Band, ParameterSet};
 use super::dem_column::{self, DemColumn, FrontRow, Profile, ProfileRow};
 use super::gerris;
 use super::gfs::{ColumnCase, ReferenceInstant, SNAPSHOT_DIR};
+use super::inputs::CaseInputs;
 use super::rheology::{load_continuum_law, GerrisRheology, LightPhase};
 use super::snapshot::{self, InertialStatistics, Snapshot};
 use crate::error::{CliError, Result};
@@ -47,54 +48,34 @@ pub const VALIDITY_SUSPECT: f64 = 0.10;
 /// What `grainlaw continuum column-collapse` runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ColumnPlan {
-    /// The μ(I) law JSON.
-    pub law: PathBuf,
-    /// Output directory.
-    pub out: PathBuf,
-    /// A DEM column-collapse output directory to compare with (and take the set-up from).
-    pub dem: Option<PathBuf>,
+    /// Law, output, DEM run (a `column-collapse` output directory), `φ` (default: the DEM's
+    /// initial one), level, viscosity cap, Gerris command, suspect policy.
+    pub inputs: CaseInputs,
     /// Aspect ratio `a` (default: the DEM's, else [`DEFAULT_ASPECT_RATIO`]).
     pub aspect_ratio: Option<f64>,
     /// Initial half-width `R₀` (m) (default: the DEM's, else `d/0.04623`).
     pub half_width_m: Option<f64>,
-    /// Packing fraction `φ` of the continuum (default: the DEM's initial one; required without).
-    pub packing_fraction: Option<f64>,
-    /// Refinement level.
-    pub level: u32,
     /// Side of the square domain in units of `R₀` (default [`default_domain`]).
     pub domain: Option<f64>,
     /// End of the run in `t*` (default: the DEM's rest, else [`DEFAULT_END_T_STAR`]).
     pub end_t_star: Option<f64>,
-    /// Viscosity cap (Gerris units).
-    pub viscosity_cap: f64,
     /// Also run the law's uncertainty band.
     pub band: bool,
     /// Gerris runs at once for the band (≥ 1).
     pub jobs: usize,
-    /// The Gerris command (default `gerris2D`).
-    pub gerris: Option<PathBuf>,
-    /// A suspect run exits 0.
-    pub allow_suspect: bool,
 }
 
 impl ColumnPlan {
     /// The plan with the defaults for `law` and `out`.
     pub fn new(law: PathBuf, out: PathBuf) -> Self {
         ColumnPlan {
-            law,
-            out,
-            dem: None,
+            inputs: CaseInputs::new(law, out, DEFAULT_LEVEL, DEFAULT_VISCOSITY_CAP),
             aspect_ratio: None,
             half_width_m: None,
-            packing_fraction: None,
-            level: DEFAULT_LEVEL,
             domain: None,
             end_t_star: None,
-            viscosity_cap: DEFAULT_VISCOSITY_CAP,
             band: false,
             jobs: 1,
-            gerris: None,
-            allow_suspect: false,
         }
     }
 }
@@ -205,17 +186,17 @@ struct CentralMeasures {
 pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
     crate::plot::init_font();
     let mut cfg = resolve_config(plan)?;
-    check_column_out(plan)?;
+    plan.inputs.check_out("continuum-column-collapse")?;
     let started = std::time::Instant::now();
-    let mut out = OutputDir::create(&plan.out)?;
-    let gerris_cmd = gerris::command(plan.gerris.as_deref());
+    let mut out = OutputDir::create(&plan.inputs.out)?;
+    let gerris_cmd = gerris::command(plan.inputs.gerris.as_deref());
     let comments = run_comments(plan, &cfg);
     let central = run_case(
         &cfg.rheology,
         &cfg.setup,
-        plan.level,
+        plan.inputs.level,
         &comments,
-        &plan.out.join("gerris"),
+        &plan.inputs.out.join("gerris"),
         &gerris_cmd,
     )?;
     let (front_rows, cont_profiles) = write_central(&mut out, &central, &cfg)?;
@@ -252,7 +233,7 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
     let verdict = RunVerdict {
         run: checks,
         laws: Vec::new(),
-        allow_suspect: plan.allow_suspect,
+        allow_suspect: plan.inputs.allow_suspect,
     };
     let report = ColumnReport {
         plan,
@@ -274,7 +255,7 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
         warnings: cfg.warnings,
         verdict,
         summary: serde_json::from_str(&s.to_json()).unwrap_or(Value::Null),
-        dir: plan.out.clone(),
+        dir: plan.inputs.out.clone(),
     })
 }
 
@@ -282,14 +263,19 @@ pub fn column_collapse(plan: &ColumnPlan) -> Result<ColumnOutcome> {
 /// domain, end, reference instants) and the rheology. Errors: [`CliError::Usage`] for a bad
 /// setting, those of the readers for bad files.
 fn resolve_config(plan: &ColumnPlan) -> Result<ColumnConfig> {
-    let law_path = plan.law.display().to_string();
-    let law = load_continuum_law(&plan.law)?;
-    let dem = plan.dem.as_deref().map(DemColumn::read).transpose()?;
+    let law_path = plan.inputs.law.display().to_string();
+    let law = load_continuum_law(&plan.inputs.law)?;
+    let dem = plan
+        .inputs
+        .dem
+        .as_deref()
+        .map(DemColumn::read)
+        .transpose()?;
     let mut warnings = Vec::new();
-    if !(3..=12).contains(&plan.level) {
+    if !(3..=12).contains(&plan.inputs.level) {
         return Err(CliError::Usage(format!(
             "--level must lie in 3..=12, got {}",
-            plan.level
+            plan.inputs.level
         )));
     }
     if plan.jobs == 0 {
@@ -318,6 +304,7 @@ fn resolve_config(plan: &ColumnPlan) -> Result<ColumnConfig> {
     };
     positive("--half-width", r0)?;
     let phi = plan
+        .inputs
         .packing_fraction
         .or(ds.map(|s| s.initial_packing_fraction))
         .ok_or_else(|| {
@@ -345,8 +332,15 @@ fn resolve_config(plan: &ColumnPlan) -> Result<ColumnConfig> {
         .or(ds.and_then(|s| s.rest_t_star()))
         .unwrap_or(DEFAULT_END_T_STAR);
     positive("--t-end", end_t_star)?;
-    let rheology = GerrisRheology::new(law.clone(), &law_path, r0, g, phi, plan.viscosity_cap)?;
-    let cell = domain / f64::from(1u32 << plan.level);
+    let rheology = GerrisRheology::new(
+        law.clone(),
+        &law_path,
+        r0,
+        g,
+        phi,
+        plan.inputs.viscosity_cap,
+    )?;
+    let cell = domain / f64::from(1u32 << plan.inputs.level);
     let setup = Setup {
         aspect_ratio: a,
         half_width_m: r0,
@@ -405,20 +399,6 @@ fn dem_grain_warnings(
     }
 }
 
-/// Refuses an output directory that is the DEM run's (its files would be replaced) or that
-/// holds another scenario's run.
-fn check_column_out(plan: &ColumnPlan) -> Result<()> {
-    if let Some(d) = &plan.dem {
-        if same_dir(d, &plan.out) {
-            return Err(CliError::Usage(format!(
-                "--out {}: is the DEM run's directory (--dem): choose another",
-                plan.out.display()
-            )));
-        }
-    }
-    crate::output::dir::check_out_dir(&plan.out, "continuum-column-collapse")
-}
-
 /// The comment lines at the head of the Gerris case.
 fn run_comments(plan: &ColumnPlan, cfg: &ColumnConfig) -> Vec<String> {
     vec![
@@ -430,7 +410,11 @@ fn run_comments(plan: &ColumnPlan, cfg: &ColumnConfig) -> Vec<String> {
         ),
         format!(
             "column a = H0/R0 = {}, R0 = {} m, level {} in a domain of {} R0 (cells {} R0)",
-            cfg.setup.aspect_ratio, cfg.setup.half_width_m, plan.level, cfg.setup.domain, cfg.cell
+            cfg.setup.aspect_ratio,
+            cfg.setup.half_width_m,
+            plan.inputs.level,
+            cfg.setup.domain,
+            cfg.cell
         ),
     ]
 }
@@ -615,7 +599,7 @@ impl ColumnReport<'_> {
                 "gerris",
                 json!({
                     "case": "gerris/column.gfs",
-                    "level": self.plan.level,
+                    "level": self.plan.inputs.level,
                     "domain_R0": domain,
                     "cell_R0": cell,
                     "cell_over_d": cell / rheology.grain_diameter(),
@@ -660,7 +644,7 @@ impl ColumnReport<'_> {
         let (plan, cfg, central, m) = (self.plan, self.cfg, self.central, self.measures);
         let (law, rheology, setup) = (&cfg.law, &cfg.rheology, &cfg.setup);
         let (a, domain, cell) = (setup.aspect_ratio, setup.domain, cfg.cell);
-        let mut lines = vec![format!("report: {}/", plan.out.display())];
+        let mut lines = vec![format!("report: {}/", plan.inputs.out.display())];
         lines.push(format!(
             "law {} of {}: {}",
             law.law,
@@ -676,7 +660,7 @@ impl ColumnReport<'_> {
             setup.half_width_m,
             cfg.phi,
             rheology.grain_diameter(),
-            plan.level,
+            plan.inputs.level,
             cell / rheology.grain_diameter(),
             central.run.wall_seconds
         ));
@@ -710,14 +694,6 @@ impl ColumnReport<'_> {
         }
         lines.extend(self.verdict.lines());
         lines
-    }
-}
-
-/// Whether `a` and `b` name the same directory (both canonicalised when they exist).
-pub(crate) fn same_dir(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
     }
 }
 
@@ -1239,7 +1215,7 @@ fn run_band_cases(
                 sc.spawn(|| loop {
                     let next = queue.lock().map(|mut q| q.pop()).unwrap_or(None);
                     let Some((set, r)) = next else { break };
-                    let dir = plan.out.join("band").join(&set.label);
+                    let dir = plan.inputs.out.join("band").join(&set.label);
                     let mut c = comments.to_vec();
                     c.push(format!(
                         "band run {}: parameters {:?}",
@@ -1247,7 +1223,7 @@ fn run_band_cases(
                     ));
                     let res = std::fs::create_dir_all(&dir)
                         .map_err(|e| CliError::io(&dir, e))
-                        .and_then(|_| run_case(r, setup, plan.level, &c, &dir, gerris_cmd));
+                        .and_then(|_| run_case(r, setup, plan.inputs.level, &c, &dir, gerris_cmd));
                     if let Ok(mut d) = done.lock() {
                         d.push((set.label.clone(), res));
                     }

@@ -22,6 +22,7 @@ use super::column::interpolate;
 use super::dem_column::{read_rows, write_rows};
 use super::gerris;
 use super::gfs::{InclinedCase, SNAPSHOT_DIR};
+use super::inputs::CaseInputs;
 use super::rheology::{load_continuum_law, GerrisRheology};
 use super::snapshot::Snapshot;
 use crate::error::{CliError, Result};
@@ -47,42 +48,22 @@ pub const GRAVITY: f64 = 9.81;
 /// What `grainlaw continuum inclined-plane` runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InclinedPlan {
-    /// The μ(I) law JSON.
-    pub law: PathBuf,
-    /// Output directory.
-    pub out: PathBuf,
-    /// A DEM `inclined-flow` output directory.
-    pub dem: Option<PathBuf>,
+    /// Law, output, DEM run (an `inclined-flow` output directory), `φ` (default: the DEM
+    /// layer's mean), level, viscosity cap, Gerris command, suspect policy.
+    pub inputs: CaseInputs,
     /// Slope (degrees) (default: the DEM's).
     pub slope_deg: Option<f64>,
     /// Layer thickness `H` (m) (default: the DEM's flow height, else 20 d).
     pub depth_m: Option<f64>,
-    /// Packing fraction (default: the DEM layer's mean; required without).
-    pub packing_fraction: Option<f64>,
-    /// Refinement level.
-    pub level: u32,
-    /// Viscosity cap (Gerris units).
-    pub viscosity_cap: f64,
-    /// The Gerris command.
-    pub gerris: Option<PathBuf>,
-    /// A suspect run exits 0.
-    pub allow_suspect: bool,
 }
 
 impl InclinedPlan {
     /// The plan with the defaults for `law` and `out`.
     pub fn new(law: PathBuf, out: PathBuf) -> Self {
         InclinedPlan {
-            law,
-            out,
-            dem: None,
+            inputs: CaseInputs::new(law, out, DEFAULT_LEVEL, DEFAULT_VISCOSITY_CAP),
             slope_deg: None,
             depth_m: None,
-            packing_fraction: None,
-            level: DEFAULT_LEVEL,
-            viscosity_cap: DEFAULT_VISCOSITY_CAP,
-            gerris: None,
-            allow_suspect: false,
         }
     }
 }
@@ -250,16 +231,8 @@ impl InclinedRun {
 pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
     crate::plot::init_font();
     let mut cfg = resolve_inclined(plan)?;
-    if let Some(d) = &plan.dem {
-        if super::column::same_dir(d, &plan.out) {
-            return Err(CliError::Usage(format!(
-                "--out {}: is the DEM run's directory (--dem): choose another",
-                plan.out.display()
-            )));
-        }
-    }
-    crate::output::dir::check_out_dir(&plan.out, "continuum-inclined-plane")?;
-    let mut out = OutputDir::create(&plan.out)?;
+    plan.inputs.check_out("continuum-inclined-plane")?;
+    let mut out = OutputDir::create(&plan.inputs.out)?;
     let run = run_inclined_case(plan, &cfg)?;
     write_rows(
         &mut out,
@@ -281,7 +254,7 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
     let verdict = RunVerdict {
         run: checks,
         laws: Vec::new(),
-        allow_suspect: plan.allow_suspect,
+        allow_suspect: plan.inputs.allow_suspect,
     };
     let s = inclined_summary(plan, &cfg, &run, dem_json.as_ref(), &verdict);
     out.write("summary.json", s.to_json().as_bytes())?;
@@ -300,14 +273,14 @@ pub fn inclined_plane(plan: &InclinedPlan) -> Result<InclinedOutcome> {
 /// rheology and the law's steady flow on the slope. Errors: [`CliError::Usage`] for a bad
 /// setting, [`CliError::Input`] for a slope without steady flow.
 fn resolve_inclined(plan: &InclinedPlan) -> Result<InclinedConfig> {
-    let law_path = plan.law.display().to_string();
-    let law = load_continuum_law(&plan.law)?;
-    let dem = plan.dem.as_deref().map(read_dem).transpose()?;
+    let law_path = plan.inputs.law.display().to_string();
+    let law = load_continuum_law(&plan.inputs.law)?;
+    let dem = plan.inputs.dem.as_deref().map(read_dem).transpose()?;
     let mut warnings = Vec::new();
-    if !(3..=10).contains(&plan.level) {
+    if !(3..=10).contains(&plan.inputs.level) {
         return Err(CliError::Usage(format!(
             "--level must lie in 3..=10, got {}",
-            plan.level
+            plan.inputs.level
         )));
     }
     let d_m = law.constant("d").unwrap_or(f64::NAN);
@@ -325,6 +298,7 @@ fn resolve_inclined(plan: &InclinedPlan) -> Result<InclinedConfig> {
         .or(dem.as_ref().map(|d| d.depth_m))
         .unwrap_or(DEFAULT_DEPTH_DIAMETERS * d_m);
     let phi = plan
+        .inputs
         .packing_fraction
         .or(dem.as_ref().map(|d| d.packing_fraction))
         .ok_or_else(|| {
@@ -346,7 +320,7 @@ fn resolve_inclined(plan: &InclinedPlan) -> Result<InclinedConfig> {
         depth,
         GRAVITY,
         phi,
-        plan.viscosity_cap,
+        plan.inputs.viscosity_cap,
     )?;
     let theta = slope_deg.to_radians();
     let i_theta = rheology.inertial_number_for(theta.tan()).ok_or_else(|| CliError::Input {
@@ -386,11 +360,11 @@ fn resolve_inclined(plan: &InclinedPlan) -> Result<InclinedConfig> {
 /// Writes the case into `OUT/gerris` (stale snapshots removed), runs Gerris to steady flow,
 /// reads its end snapshot and sets its profile against the analytic one.
 fn run_inclined_case(plan: &InclinedPlan, cfg: &InclinedConfig) -> Result<InclinedRun> {
-    let case_dir = plan.out.join("gerris");
+    let case_dir = plan.inputs.out.join("gerris");
     let case = InclinedCase {
         rheology: cfg.rheology.clone(),
         slope_rad: cfg.theta,
-        level: plan.level,
+        level: plan.inputs.level,
         initial_surface_velocity: 2.0 * cfg.u_surface_g,
         steady_tolerance: STEADY_TOLERANCE * cfg.u_surface_g,
         max_steps: MAX_STEPS,
@@ -401,7 +375,7 @@ fn run_inclined_case(plan: &InclinedPlan, cfg: &InclinedConfig) -> Result<Inclin
             cfg.law_path,
             cfg.slope_deg,
             cfg.depth,
-            plan.level
+            plan.inputs.level
         )],
     };
     let snaps = case_dir.join(SNAPSHOT_DIR);
@@ -410,7 +384,7 @@ fn run_inclined_case(plan: &InclinedPlan, cfg: &InclinedConfig) -> Result<Inclin
     }
     std::fs::create_dir_all(&snaps).map_err(|e| CliError::io(&snaps, e))?;
     crate::output::dir::write_atomic(&case_dir.join("inclined.gfs"), case.to_gfs()?.as_bytes())?;
-    let gerris_cmd = gerris::command(plan.gerris.as_deref());
+    let gerris_cmd = gerris::command(plan.inputs.gerris.as_deref());
     let run = gerris::run(&gerris_cmd, &case_dir, "inclined.gfs")?;
     let endp = snaps.join("end.txt");
     if !endp.is_file() {
@@ -579,8 +553,8 @@ fn velocity_figure(
     plot.series.push(Series::new(
         &format!(
             "Gerris, level {} ({} cells across)",
-            plan.level,
-            1u32 << plan.level
+            plan.inputs.level,
+            1u32 << plan.inputs.level
         ),
         Style::Circles,
         PALETTE[0],
@@ -639,8 +613,8 @@ fn inclined_summary(
             "gerris",
             json!({
                 "case": "gerris/inclined.gfs",
-                "level": plan.level,
-                "cells_across": 1u32 << plan.level,
+                "level": plan.inputs.level,
+                "cells_across": 1u32 << plan.inputs.level,
                 "steps": run.steps,
                 "units": rheology.units,
                 "grain_diameter_over_H": rheology.grain_diameter(),
@@ -673,7 +647,7 @@ fn inclined_lines(
     verdict: &RunVerdict,
 ) -> Vec<String> {
     let mut lines = vec![
-        format!("report: {}/", plan.out.display()),
+        format!("report: {}/", plan.inputs.out.display()),
         format!(
             "{} on a {}° slope (tan θ = {:.4}): I = {:.4}; layer H = {:.2} mm = {:.1} d, φ = {:.3}",
             cfg.law.law,
@@ -686,8 +660,8 @@ fn inclined_lines(
         ),
         format!(
             "Gerris level {} ({} cells across), {} steps, {:.1} s: surface velocity {:.4} m/s, Bagnold {:.4} m/s; largest difference {:.2e} of it (RMS {:.2e})",
-            plan.level,
-            1u32 << plan.level,
+            plan.inputs.level,
+            1u32 << plan.inputs.level,
             run.steps.map_or("?".into(), |s| s.to_string()),
             run.run.wall_seconds,
             run.surface_velocity(cfg.uv),

@@ -10,7 +10,8 @@
 //! - [`dem_column`]: the DEM `column-collapse` run's `summary.json`, `front.csv`, `profiles.csv`;
 //! - [`column`](mod@column): the column collapse end to end, its comparison with DEM, its figures;
 //! - [`band`]: the law's covariance carried through the run;
-//! - [`inclined`]: steady flow down a slope against Bagnold's profile and DEM.
+//! - [`inclined`]: steady flow down a slope against Bagnold's profile and DEM;
+//! - [`inputs`]: what both cases take (law, output, DEM run, φ, Gerris resolution and command).
 
 pub mod band;
 pub mod column;
@@ -18,8 +19,10 @@ pub mod dem_column;
 pub mod gerris;
 pub mod gfs;
 pub mod inclined;
+pub mod inputs;
 pub mod rheology;
 pub mod snapshot;
 
 pub use column::{column_collapse, ColumnOutcome, ColumnPlan};
 pub use inclined::{inclined_plane, InclinedOutcome, InclinedPlan};
+pub use inputs::CaseInputs;

@@ -1,5 +1,6 @@
 //! The viridis colour map (perceptually uniform, readable in grey) and colour bars.
 
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -78,57 +79,70 @@ pub fn colorbar(
     let (lo, hi) = (scale.min, scale.max);
     let n = 200;
     if scale.log {
-        let mut chart = ChartBuilder::on(area)
-            .margin_top(40)
-            .margin_bottom(60)
-            .margin_left(25)
-            .margin_right(20)
-            .set_label_area_size(LabelAreaPosition::Right, 110)
-            .build_cartesian_2d(0.0..1.0, (lo..hi).log_scale())?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .disable_y_mesh()
-            .disable_x_axis()
-            .y_desc(label)
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .draw()?;
         let (a, b) = (lo.log10(), hi.log10());
-        chart.draw_series((0..n).map(|k| {
-            let v0 = 10f64.powf(a + (b - a) * k as f64 / n as f64);
-            let v1 = 10f64.powf(a + (b - a) * (k + 1) as f64 / n as f64);
-            Rectangle::new(
-                [(0.0, v0), (1.0, v1)],
-                scale.color(0.5 * (v0 + v1)).filled(),
-            )
-        }))?;
+        let exponent = |v: &f64| format!("{v:.0e}");
+        bar(
+            area,
+            (lo..hi).log_scale(),
+            scale,
+            label,
+            Some(&exponent),
+            |k| 10f64.powf(a + (b - a) * k as f64 / n as f64),
+            n,
+        )
     } else {
-        let mut chart = ChartBuilder::on(area)
-            .margin_top(40)
-            .margin_bottom(60)
-            .margin_left(25)
-            .margin_right(20)
-            .set_label_area_size(LabelAreaPosition::Right, 110)
-            .build_cartesian_2d(0.0..1.0, lo..hi)?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .disable_y_mesh()
-            .disable_x_axis()
-            .y_desc(label)
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .draw()?;
-        chart.draw_series((0..n).map(|k| {
-            let v0 = lo + (hi - lo) * k as f64 / n as f64;
-            let v1 = lo + (hi - lo) * (k + 1) as f64 / n as f64;
-            Rectangle::new(
-                [(0.0, v0), (1.0, v1)],
-                scale.color(0.5 * (v0 + v1)).filled(),
-            )
-        }))?;
+        bar(
+            area,
+            lo..hi,
+            scale,
+            label,
+            None,
+            |k| lo + (hi - lo) * k as f64 / n as f64,
+            n,
+        )
     }
+}
+
+/// The colour bar of [`colorbar`] on the value axis `y` (linear or logarithmic), its ticks
+/// written by `ticks` (the axis' own without), in `n` bands whose edges are `edge(k)`,
+/// `k = 0..=n`, each filled with the colour of its middle value.
+fn bar<Y>(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    y: Y,
+    scale: &Scale,
+    label: &str,
+    ticks: Option<&dyn Fn(&f64) -> String>,
+    edge: impl Fn(usize) -> f64,
+    n: usize,
+) -> DrawResult
+where
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(40)
+        .margin_bottom(60)
+        .margin_left(25)
+        .margin_right(20)
+        .set_label_area_size(LabelAreaPosition::Right, 110)
+        .build_cartesian_2d(0.0..1.0, y)?;
+    let mut mesh = chart.configure_mesh();
+    mesh.disable_x_mesh()
+        .disable_y_mesh()
+        .disable_x_axis()
+        .y_desc(label)
+        .label_style(font(15.0))
+        .axis_desc_style(font(17.0));
+    if let Some(f) = ticks {
+        mesh.y_label_formatter(f);
+    }
+    mesh.draw()?;
+    chart.draw_series((0..n).map(|k| {
+        let (v0, v1) = (edge(k), edge(k + 1));
+        Rectangle::new(
+            [(0.0, v0), (1.0, v1)],
+            scale.color(0.5 * (v0 + v1)).filled(),
+        )
+    }))?;
     Ok(())
 }

@@ -563,21 +563,7 @@ fn frame_bodies(f: &Frame, acc: &[(Vector, f64)]) -> Result<FrameBodies, ReadErr
     }
     let first_wall = bodies.len();
     for w in &f.walls {
-        bodies.push(BodyState {
-            kind: BodyKind::Wall,
-            name: w.name.clone(),
-            position: w.position,
-            angle: 0.0,
-            velocity: w.velocity,
-            omega: 0.0,
-            acceleration: Vector::zeros(),
-            angular_acceleration: 0.0,
-            mass: f64::INFINITY,
-            inertia: f64::INFINITY,
-            radius: 0.0,
-            density: 0.0,
-            thickness: 1.0,
-        });
+        bodies.push(BodyState::wall(&w.name, w.position, w.velocity));
     }
     Ok(FrameBodies {
         index,

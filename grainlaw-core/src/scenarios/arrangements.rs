@@ -12,12 +12,12 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_csv_table, table_row};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{OutputDir, Summary};
+use crate::output::Summary;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 
 /// One phase per arrangement (rectangular, triangular, cannonball), each settling its own
@@ -49,49 +49,28 @@ impl PhasedRun for Stacks<'_> {
         Arrangement::ALL.len()
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        _env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut StacksState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut StacksState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let (k, world) = (at.k, at.world);
         let c = self.c;
         let kind = Arrangement::ALL[k];
         *world = datasets::build::arrangement(c, kind)?;
         st.weight = grain_weight(world);
         st.vtk = VtkFrames::with_prefix(&format!("{}_", kind.name()), c.duration / 10.0, 11);
-        Ok(Some(PhasePlan {
-            name: kind.name().into(),
-            stop: Stop::UntilRest(RunUntilRest {
-                min_time: 0.2 * c.duration,
-                max_time: c.duration,
-                rest_energy: 1e-12,
-            }),
-        }))
+        let rest = RunUntilRest {
+            min_time: 0.2 * c.duration,
+            max_time: c.duration,
+            rest_energy: 1e-12,
+        };
+        Ok(Some(PhasePlan::new(kind.name(), Stop::UntilRest(rest))))
     }
 
-    fn step(
-        &self,
-        _k: usize,
-        st: &mut StacksState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        _r: &dem::StepReport,
-        _p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut StacksState, at: Step<'_>) -> Result<()> {
+        let (out, w) = (at.out, at.world);
         st.vtk.maybe(out, w)
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut StacksState,
-        out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut StacksState, at: Leave<'_>) -> Result<()> {
+        let (k, out, world, stats) = (at.k, at.out, at.world, at.stats);
         let name = Arrangement::ALL[k].name();
         st.all.merge(stats);
         std::mem::replace(&mut st.vtk, VtkFrames::new(f64::INFINITY, 1)).finish(out, world)?;
@@ -244,14 +223,7 @@ pub fn run(
     let mut table = rows::table(&table);
     table.comments.push("one row per arrangement; forces of the grains on the walls at rest (N per metre of thickness)".into());
     table.write(&mut ctx.out, "wall_loads.csv")?;
-    Ok(RunOutcome {
-        summary: s,
-        headline,
-        verdict: crate::verdict::RunVerdict {
-            run: checks,
-            ..Default::default()
-        },
-    })
+    Ok(RunOutcome::without_laws(s, headline, checks))
 }
 
 /// Relative imbalance between the loads on the walls and the weight of a stack at rest above

@@ -41,9 +41,9 @@ use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION,
 use super::common::{
     fit_keys, mean_diameter, parameter_lines, short_number, strain_bins, Stop, VtkFrames,
 };
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_rows, table_row};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
@@ -719,14 +719,8 @@ impl PhasedRun for Biaxial<'_> {
         self.per_pressure() * self.pressures.len()
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        _env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut State,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut State, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let (k, world) = (at.k, at.world);
         let c = self.c;
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];
@@ -755,10 +749,10 @@ impl PhasedRun for Biaxial<'_> {
                     steps: (c.compression_time / dt).ceil() as u64,
                     ..Default::default()
                 };
-                Ok(Some(PhasePlan {
-                    name: format!("compress p0={p0}"),
-                    stop: Stop::Steps(st.run.steps),
-                }))
+                Ok(Some(PhasePlan::new(
+                    format!("compress p0={p0}"),
+                    Stop::Steps(st.run.steps),
+                )))
             }
             Part::Axial(j) => {
                 let rate = c.axial_rate(p0);
@@ -789,23 +783,16 @@ impl PhasedRun for Biaxial<'_> {
                 if steps == 0 {
                     return Ok(None);
                 }
-                Ok(Some(PhasePlan {
-                    name: format!("axial p0={p0} ({}/{})", j + 1, self.segments()),
-                    stop: Stop::Steps(steps),
-                }))
+                Ok(Some(PhasePlan::new(
+                    format!("axial p0={p0} ({}/{})", j + 1, self.segments()),
+                    Stop::Steps(steps),
+                )))
             }
         }
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut State, at: Step<'_>) -> Result<()> {
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         let (i, part) = self.part(k);
         if i + 1 == self.pressures.len() && matches!(part, Part::Axial(_)) {
             st.cell.frames.maybe(out, w)?;
@@ -873,14 +860,8 @@ impl PhasedRun for Biaxial<'_> {
         st.cell.settle();
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut State, at: Leave<'_>) -> Result<()> {
+        let (k, out, world, stats) = (at.k, at.out, at.world, at.stats);
         st.cell.all.merge(stats);
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];

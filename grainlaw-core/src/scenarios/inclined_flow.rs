@@ -16,9 +16,9 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_csv_table, table_row};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{CsvTable, OutputDir, Summary};
@@ -26,7 +26,7 @@ use crate::plot::colormap::Scale;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::verdict::{max_solid_fraction, Checks, RunVerdict, WindowStats};
+use crate::verdict::{max_solid_fraction, Checks, WindowStats};
 
 /// Relative difference of the window halves of the mean velocity that matters for a steady
 /// flow (1; [`crate::verdict::halves_drift`]).
@@ -141,33 +141,12 @@ impl Flow<'_> {
 impl PhasedRun for Flow<'_> {
     type State = FlowState;
 
-    fn phase_count(&self) -> usize {
-        1
+    fn enter(&self, _st: &mut FlowState, _at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        Ok(Some(PhasePlan::new("flow", Stop::Steps(self.steps()))))
     }
 
-    fn enter(
-        &self,
-        _k: usize,
-        _env: &PhaseEnv,
-        _world: &mut dem::World,
-        _st: &mut FlowState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
-        Ok(Some(PhasePlan {
-            name: "flow".into(),
-            stop: Stop::Steps(self.steps()),
-        }))
-    }
-
-    fn step(
-        &self,
-        _k: usize,
-        st: &mut FlowState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut FlowState, at: Step<'_>) -> Result<()> {
+        let (out, w, r, p) = (at.out, at.world, at.report, at.progress);
         let c = self.c;
         let avg_from = ((c.duration - c.average) / c.dt).round() as u64;
         let sample_every = ((0.002 / c.dt).round() as u64).max(1);
@@ -191,14 +170,8 @@ impl PhasedRun for Flow<'_> {
         st.vtk.maybe(out, w)
     }
 
-    fn leave(
-        &self,
-        _k: usize,
-        st: &mut FlowState,
-        _out: &mut OutputDir,
-        _world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut FlowState, at: Leave<'_>) -> Result<()> {
+        let stats = at.stats;
         st.stats = *stats;
         Ok(())
     }
@@ -503,12 +476,5 @@ pub fn run(
             100.0 * fluid
         ),
     ];
-    Ok(RunOutcome {
-        summary: s,
-        headline,
-        verdict: RunVerdict {
-            run: checks,
-            ..Default::default()
-        },
-    })
+    Ok(RunOutcome::without_laws(s, headline, checks))
 }

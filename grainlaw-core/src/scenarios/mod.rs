@@ -78,3 +78,21 @@ pub struct RunOutcome {
     /// The verdict of the run and of its laws ([`crate::verdict`]).
     pub verdict: crate::verdict::RunVerdict,
 }
+
+impl RunOutcome {
+    /// The outcome of a run that exports no law: its summary, headline and own checks.
+    pub fn without_laws(
+        summary: Summary,
+        headline: Vec<String>,
+        checks: crate::verdict::Checks,
+    ) -> Self {
+        RunOutcome {
+            summary,
+            headline,
+            verdict: crate::verdict::RunVerdict {
+                run: checks,
+                ..Default::default()
+            },
+        }
+    }
+}

@@ -153,51 +153,67 @@ pub struct PhaseTime {
     pub wall_seconds: f64,
 }
 
+/// What [`PhasedRun::enter`] is given to start phase `k`.
+pub struct Enter<'a> {
+    /// The phase's index.
+    pub k: usize,
+    /// The run's environment (threads, progress, interruption flag).
+    pub env: &'a PhaseEnv,
+    /// The world, which the phase may replace.
+    pub world: &'a mut World,
+}
+
+/// What [`PhasedRun::step`] is given after one step of phase `k`.
+pub struct Step<'a> {
+    /// The phase's index.
+    pub k: usize,
+    /// The output directory (VTK frames).
+    pub out: &'a mut OutputDir,
+    /// The world after the step.
+    pub world: &'a World,
+    /// The step's report.
+    pub report: &'a StepReport,
+    /// The phase's statistics and counters after the step.
+    pub progress: &'a PhaseProgress,
+}
+
+/// What [`PhasedRun::leave`] is given to end phase `k`.
+pub struct Leave<'a> {
+    /// The phase's index.
+    pub k: usize,
+    /// The output directory.
+    pub out: &'a mut OutputDir,
+    /// The world at the end of the phase.
+    pub world: &'a mut World,
+    /// The phase's statistics.
+    pub stats: &'a PhaseStats,
+}
+
 /// A scenario's simulation as phases over one world with a serialisable state (module doc).
 pub trait PhasedRun {
     /// Everything collected step by step and between phases.
     type State: Serialize + DeserializeOwned;
 
-    /// Number of phases.
-    fn phase_count(&self) -> usize;
+    /// Number of phases (one unless the runner says otherwise).
+    fn phase_count(&self) -> usize {
+        1
+    }
 
-    /// Starts phase `k` (not called when a resume continues inside it): sets parameters, may
-    /// replace the world; `None` skips the phase.
-    fn enter(
-        &self,
-        k: usize,
-        env: &PhaseEnv,
-        world: &mut World,
-        state: &mut Self::State,
-        out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>>;
+    /// Starts phase `at.k` (not called when a resume continues inside it): sets parameters,
+    /// may replace the world; `None` skips the phase.
+    fn enter(&self, state: &mut Self::State, at: Enter<'_>) -> Result<Option<PhasePlan>>;
 
-    /// Records step `report` of phase `k` (the world after it; `progress`, the phase's
-    /// statistics and counters after it).
-    fn step(
-        &self,
-        k: usize,
-        state: &mut Self::State,
-        out: &mut OutputDir,
-        world: &World,
-        report: &StepReport,
-        progress: &PhaseProgress,
-    ) -> Result<()>;
+    /// Records one step of phase `at.k` (the world after it; the phase's statistics and
+    /// counters after it).
+    fn step(&self, state: &mut Self::State, at: Step<'_>) -> Result<()>;
 
     /// Finishes what the steps left running beside the run (re-solves of sampled steps,
     /// [`super::sensitivity::ResolveQueue`]) so that `state` is complete: called before a
     /// checkpoint is written and before [`PhasedRun::leave`]. Nothing to do by default.
     fn settle(&self, _state: &mut Self::State) {}
 
-    /// Ends phase `k` with its statistics.
-    fn leave(
-        &self,
-        k: usize,
-        state: &mut Self::State,
-        out: &mut OutputDir,
-        world: &mut World,
-        stats: &PhaseStats,
-    ) -> Result<()>;
+    /// Ends phase `at.k` with its statistics.
+    fn leave(&self, state: &mut Self::State, at: Leave<'_>) -> Result<()>;
 }
 
 /// The output directory as a user would type it in `--resume`.
@@ -259,7 +275,14 @@ pub fn drive<P: PhasedRun>(
     while k < run.phase_count() {
         let (plan, mut progress) = match cursor.take() {
             Some(c) => (c.plan, c.progress),
-            None => match run.enter(k, &env, &mut world, &mut state, &mut ctx.out)? {
+            None => match run.enter(
+                &mut state,
+                Enter {
+                    k,
+                    env: &env,
+                    world: &mut world,
+                },
+            )? {
                 Some(plan) => (plan, PhaseProgress::default()),
                 None => {
                     k += 1;
@@ -277,7 +300,14 @@ pub fn drive<P: PhasedRun>(
             plan.stop,
             &mut progress,
             |w, r, p| {
-                run.step(k, st, out, w, r, p)?;
+                let at = Step {
+                    k,
+                    out: &mut *out,
+                    world: w,
+                    report: r,
+                    progress: p,
+                };
+                run.step(st, at)?;
                 ctl.steps_this_run += 1;
                 ctl.steps_total += 1;
                 ctl.steps_since_checkpoint += 1;
@@ -317,7 +347,13 @@ pub fn drive<P: PhasedRun>(
             },
         )?;
         run.settle(&mut state);
-        run.leave(k, &mut state, &mut ctx.out, &mut world, &stats)?;
+        let at = Leave {
+            k,
+            out: &mut ctx.out,
+            world: &mut world,
+            stats: &stats,
+        };
+        run.leave(&mut state, at)?;
         ctl.phase_times.push(PhaseTime {
             name: plan.name.clone(),
             steps: ctl.steps_this_run - steps0,

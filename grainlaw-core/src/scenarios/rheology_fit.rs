@@ -188,7 +188,8 @@ pub(crate) fn rheology_plot(f: &RheologyFigure<'_>) -> XyPlot {
 
 /// How an accepted fit is shown: its summary-key prefix, the form recorded under
 /// `{key}_form` (with `{key}_r_squared`), the formula (legend), the printed title, whether the
-/// law is linear in `I`, and the name of its law JSON.
+/// law is linear in `I`, the name of its law JSON, and the law's value at `I` for parameters
+/// `p` (the curve and its band).
 struct Shown {
     key: &'static str,
     form: Option<&'static str>,
@@ -196,50 +197,7 @@ struct Shown {
     title: &'static str,
     linear: bool,
     file: &'static str,
-}
-
-impl Shown {
-    /// Exports `law` under `checks`, records the summary keys and the printed parameters
-    /// (after the line saying the law is rejected, when it is), and returns the fitted curve
-    /// with its 95 % band over `[lo, hi]`, the range of the fitted points.
-    #[allow(clippy::too_many_arguments)]
-    fn record(
-        &self,
-        out: &mut OutputDir,
-        verdict: &mut RunVerdict,
-        law: &CalibratedLaw,
-        checks: Checks,
-        (lo, hi): (f64, f64),
-        report: &identify::FitReport,
-        s: &mut Summary,
-        headline: &mut Vec<String>,
-        model: impl Fn(&[f64], f64) -> f64,
-    ) -> Result<FittedCurve> {
-        let exported = export_law(out, verdict, self.file, law, checks)?;
-        fit_keys(s, self.key, &report.parameters);
-        if let Some(form) = self.form {
-            s.text(&format!("{}_form", self.key), form)
-                .num(&format!("{}_r_squared", self.key), report.r_squared);
-        }
-        headline.extend(exported.heading(&law.law));
-        headline.extend(parameter_lines(
-            self.title,
-            report.r_squared,
-            &report.parameters,
-        ));
-        let band = delta_band(
-            &report.values(),
-            &report.covariance,
-            report.t_critical,
-            &curve_abscissae(lo, hi, !self.linear),
-            model,
-        );
-        Ok(FittedCurve {
-            label: self.formula.to_string(),
-            linear: self.linear,
-            band,
-        })
-    }
+    model: fn(&[f64], f64) -> f64,
 }
 
 /// The fits of μ(I) and φ(I) of one series ([`fit_mu_phi`]): their input and where they write.
@@ -270,44 +228,65 @@ fn refuse_fit(verdict: &mut RunVerdict, prefix: &str, law: &str, reason: String)
     );
 }
 
-/// The parts of [`LawFits`] a fit uses, borrowed apart.
-type Parts<'c, 'b> = (
-    &'c RheologySeries,
-    &'c RheologyFit<'b>,
-    &'c FitOptions,
-    (f64, f64),
-    &'c mut OutputDir,
-    &'c mut RunVerdict,
-    &'c mut Summary,
-    &'c mut Vec<String>,
-);
-
 impl<'b> LawFits<'_, 'b> {
-    /// Its parts: series, input, options, range, output directory, verdict, summary, headline.
-    fn parts(&mut self) -> Parts<'_, 'b> {
-        (
-            self.series,
-            self.inp,
-            &self.opts,
-            self.range,
-            self.out,
-            self.verdict,
-            self.s,
-            self.headline,
-        )
+    /// Exports `law` under `checks` as `shown` says, records the summary keys and the printed
+    /// parameters (after the line saying the law is rejected, when it is), and returns the
+    /// fitted curve with its 95 % band over the range of the fitted points.
+    fn record(
+        &mut self,
+        shown: &Shown,
+        law: &CalibratedLaw,
+        checks: Checks,
+        report: &identify::FitReport,
+    ) -> Result<FittedCurve> {
+        let exported = export_law(self.out, self.verdict, shown.file, law, checks)?;
+        fit_keys(self.s, shown.key, &report.parameters);
+        if let Some(form) = shown.form {
+            self.s
+                .text(&format!("{}_form", shown.key), form)
+                .num(&format!("{}_r_squared", shown.key), report.r_squared);
+        }
+        self.headline.extend(exported.heading(&law.law));
+        self.headline.extend(parameter_lines(
+            shown.title,
+            report.r_squared,
+            &report.parameters,
+        ));
+        let (lo, hi) = self.range;
+        let band = delta_band(
+            &report.values(),
+            &report.covariance,
+            report.t_critical,
+            &curve_abscissae(lo, hi, !shown.linear),
+            shown.model,
+        );
+        Ok(FittedCurve {
+            label: shown.formula.to_string(),
+            linear: shown.linear,
+            band,
+        })
+    }
+
+    /// A fit that failed with `error`: the error under `error_key` in the summary, the stale
+    /// law `file` (`mu_i`, `phi_i`) removed, its check refused with `reason`.
+    fn failed(&mut self, error_key: &str, error: &str, file: &str, reason: String) -> Result<()> {
+        self.s.text(error_key, error);
+        crate::verdict::remove_stale_law(self.out, file)?;
+        refuse_fit(self.verdict, self.inp.check_prefix, file, reason);
+        Ok(())
     }
 
     /// Stage "fit" of μ(I): the full law, or its linear form when the full one is refused or
     /// left out.
     fn mu(&mut self) -> Result<LawCurve> {
-        let (series, inp, opts, range, out, verdict, s, headline) = self.parts();
+        let (series, inp) = (self.series, self.inp);
         let mut mu_notes = Vec::new();
         let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
         // μ(I), or its linear form when μ(I) is refused or left out (`leave_out`)
         let full = if left("mu-i") {
             None
         } else {
-            Some(fit_mu_i(series, opts))
+            Some(fit_mu_i(series, &self.opts))
         };
         let mut mu_curve = None;
         let linear_reason = match full {
@@ -319,18 +298,7 @@ impl<'b> LawFits<'_, 'b> {
                     title: "μ(I) = μ_s + (μ₂ − μ_s)/(1 + I₀/I)",
                     linear: false,
                     file: "mu_i",
-                };
-                let law = CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone());
-                mu_curve = Some(shown.record(
-                    out,
-                    verdict,
-                    &law,
-                    inp.mu_checks.clone(),
-                    range,
-                    &f.report,
-                    s,
-                    headline,
-                    |p, i| {
+                    model: |p, i| {
                         identify::laws::mu_i::MuILaw {
                             mu_s: p[0],
                             mu_2: p[1],
@@ -338,11 +306,13 @@ impl<'b> LawFits<'_, 'b> {
                         }
                         .mu(i)
                     },
-                )?);
+                };
+                let law = CalibratedLaw::from_mu_i(&f, inp.grain, inp.provenance.clone());
+                mu_curve = Some(self.record(&shown, &law, inp.mu_checks.clone(), &f.report)?);
                 None
             }
             Some(Err(e)) => {
-                s.text("mu_i_fit_error", &e.to_string());
+                self.s.text("mu_i_fit_error", &e.to_string());
                 Some(e.to_string())
             }
             None => None,
@@ -350,14 +320,14 @@ impl<'b> LawFits<'_, 'b> {
         let try_linear = linear_reason.is_some() || left("mu-i");
         if try_linear && left("mu-i-linear") {
             // neither form is fitted: the plan said so at the start
-            crate::verdict::remove_stale_law(out, "mu_i")?;
+            crate::verdict::remove_stale_law(self.out, "mu_i")?;
             mu_notes.push("no μ(I) law fitted (left out by the plan)".into());
             if let Some(e) = linear_reason {
                 warn(&format!(
                     "μ(I) fit failed ({e}); its linear form is left out (leave_out)"
                 ));
                 refuse_fit(
-                    verdict,
+                    self.verdict,
                     inp.check_prefix,
                     "mu_i",
                     format!("no μ(I) law could be fitted: {e}"),
@@ -372,7 +342,7 @@ impl<'b> LawFits<'_, 'b> {
             } else {
                 "μ_s + b I (the full μ(I) left out)"
             };
-            match fit_mu_i_linear(series, opts) {
+            match fit_mu_i_linear(series, &self.opts) {
                 Ok(f) => {
                     let shown = Shown {
                         key: "mu_i",
@@ -381,31 +351,16 @@ impl<'b> LawFits<'_, 'b> {
                         title: "μ(I) = μ_s + b I (linear form)",
                         linear: true,
                         file: "mu_i",
+                        model: |p, i| p[0] + p[1] * i,
                     };
                     let law =
                         CalibratedLaw::from_mu_i_linear(&f, inp.grain, inp.provenance.clone());
-                    mu_curve = Some(shown.record(
-                        out,
-                        verdict,
-                        &law,
-                        inp.mu_checks.clone(),
-                        range,
-                        &f.report,
-                        s,
-                        headline,
-                        |p, i| p[0] + p[1] * i,
-                    )?);
+                    mu_curve = Some(self.record(&shown, &law, inp.mu_checks.clone(), &f.report)?);
                 }
                 Err(e2) => {
                     warn(&format!("linear μ(I) fit failed too: {e2}"));
-                    s.text("mu_i_linear_fit_error", &e2.to_string());
-                    crate::verdict::remove_stale_law(out, "mu_i")?;
-                    refuse_fit(
-                        verdict,
-                        inp.check_prefix,
-                        "mu_i",
-                        format!("no μ(I) law could be fitted: {e2}"),
-                    );
+                    let reason = format!("no μ(I) law could be fitted: {e2}");
+                    self.failed("mu_i_linear_fit_error", &e2.to_string(), "mu_i", reason)?;
                     mu_notes.push("no μ(I) law fitted (mu_i_linear_fit_error)".into());
                 }
             }
@@ -415,13 +370,13 @@ impl<'b> LawFits<'_, 'b> {
 
     /// Stage "fit" of φ(I).
     fn phi(&mut self) -> Result<LawCurve> {
-        let (series, inp, opts, range, out, verdict, s, headline) = self.parts();
+        let (series, inp) = (self.series, self.inp);
         let left = |law: &str| inp.leave_out.iter().any(|l| l == law);
         let mut phi_notes = Vec::new();
-        let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, opts)) {
+        let phi_curve = match (!left("phi-i")).then(|| fit_phi_i(series, &self.opts)) {
             // left out by the plan (said at the start)
             None => {
-                crate::verdict::remove_stale_law(out, "phi_i")?;
+                crate::verdict::remove_stale_law(self.out, "phi_i")?;
                 phi_notes.push("no φ(I) law fitted (left out by the plan)".into());
                 None
             }
@@ -433,30 +388,15 @@ impl<'b> LawFits<'_, 'b> {
                     title: "φ(I) = φ_max − a I",
                     linear: true,
                     file: "phi_i",
+                    model: |p, i| p[0] - p[1] * i,
                 };
                 let law = CalibratedLaw::from_phi_i(&f, inp.grain, inp.provenance.clone());
-                Some(shown.record(
-                    out,
-                    verdict,
-                    &law,
-                    inp.phi_checks.clone(),
-                    range,
-                    &f.report,
-                    s,
-                    headline,
-                    |p, i| p[0] - p[1] * i,
-                )?)
+                Some(self.record(&shown, &law, inp.phi_checks.clone(), &f.report)?)
             }
             Some(Err(e)) => {
                 warn(&format!("φ(I) fit failed: {e}"));
-                s.text("phi_i_fit_error", &e.to_string());
-                crate::verdict::remove_stale_law(out, "phi_i")?;
-                refuse_fit(
-                    verdict,
-                    inp.check_prefix,
-                    "phi_i",
-                    format!("the φ(I) fit failed: {e}"),
-                );
+                let reason = format!("the φ(I) fit failed: {e}");
+                self.failed("phi_i_fit_error", &e.to_string(), "phi_i", reason)?;
                 phi_notes.push("no φ(I) law fitted (phi_i_fit_error)".into());
                 None
             }

@@ -19,9 +19,9 @@ use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 
 use super::common::{solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_csv_table, table_row};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::{CliError, Result};
 use crate::output::{OutputDir, Summary};
@@ -132,34 +132,16 @@ impl RollStep {
 impl PhasedRun for Roll<'_> {
     type State = RollState;
 
-    fn phase_count(&self) -> usize {
-        1
-    }
-
-    fn enter(
-        &self,
-        _k: usize,
-        _env: &PhaseEnv,
-        _world: &mut dem::World,
-        _st: &mut RollState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, _st: &mut RollState, _at: Enter<'_>) -> Result<Option<PhasePlan>> {
         let c = self.c;
-        Ok(Some(PhasePlan {
-            name: "roll".into(),
-            stop: Stop::Steps((c.duration / c.dt).round().max(1.0) as u64),
-        }))
+        Ok(Some(PhasePlan::new(
+            "roll",
+            Stop::Steps((c.duration / c.dt).round().max(1.0) as u64),
+        )))
     }
 
-    fn step(
-        &self,
-        _k: usize,
-        st: &mut RollState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        _r: &dem::StepReport,
-        _p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut RollState, at: Step<'_>) -> Result<()> {
+        let (out, w) = (at.out, at.world);
         let snap = w.snapshot();
         let gs = homogenise::grain_stresses(&snap)?;
         let gr = gs
@@ -191,14 +173,8 @@ impl PhasedRun for Roll<'_> {
         st.vtk.maybe(out, w)
     }
 
-    fn leave(
-        &self,
-        _k: usize,
-        st: &mut RollState,
-        _out: &mut OutputDir,
-        _world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut RollState, at: Leave<'_>) -> Result<()> {
+        let stats = at.stats;
         st.stats = *stats;
         Ok(())
     }
@@ -501,14 +477,7 @@ pub fn run(c: &RollingConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
             |t| format!("{key} = {e:.2e} against the exact answer (limit {t:.0e})"),
         );
     }
-    Ok(RunOutcome {
-        summary: s,
-        headline,
-        verdict: crate::verdict::RunVerdict {
-            run: checks,
-            ..Default::default()
-        },
-    })
+    Ok(RunOutcome::without_laws(s, headline, checks))
 }
 
 /// Relative error of the acceleration, or of the mean stress, against the exact answer above

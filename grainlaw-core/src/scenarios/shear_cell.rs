@@ -28,10 +28,10 @@ use serde::{Deserialize, Serialize};
 use super::common::{
     add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, Stop, VtkFrames,
 };
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_rows, table_row, TableRow};
 use super::sensitivity::{record, Resolved};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{CsvTable, OutputDir, Summary};
@@ -517,21 +517,15 @@ impl PhasedRun for Shear<'_> {
         1 + self.targets.len() * (self.lead_stages() + 1)
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut ShearState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut ShearState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let (k, env, world) = (at.k, at.env, at.world);
         let c = self.c;
         if k == 0 {
             world.params.dt = c.dt_max;
-            return Ok(Some(PhasePlan {
-                name: "compress".into(),
-                stop: Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
-            }));
+            return Ok(Some(PhasePlan::new(
+                "compress",
+                Stop::Steps((c.compression_time / c.dt_max).ceil() as u64),
+            )));
         }
         let stage = self.stage(k);
         let i_target = self.targets[stage.target];
@@ -626,21 +620,11 @@ impl PhasedRun for Shear<'_> {
         st.lead = LeadAverages::default();
         st.lead_sensitivity = Sensitivity::default();
         st.window.reset();
-        Ok(Some(PhasePlan {
-            name,
-            stop: Stop::Steps(steps),
-        }))
+        Ok(Some(PhasePlan::new(name, Stop::Steps(steps))))
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut ShearState,
-        _out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut ShearState, at: Step<'_>) -> Result<()> {
+        let (k, w, r, p) = (at.k, at.world, at.report, at.progress);
         if k == 0 {
             return Ok(());
         }
@@ -682,14 +666,8 @@ impl PhasedRun for Shear<'_> {
         Ok(())
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut ShearState,
-        _out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut ShearState, at: Leave<'_>) -> Result<()> {
+        let (k, world, stats) = (at.k, at.world, at.stats);
         st.all.merge(stats);
         st.phase_cost = stats.mean_solve_cost();
         if k == 0 || self.stage(k).lead.is_some() {

@@ -12,7 +12,6 @@
 //! data cannot support).
 
 use datasets::config::SimpleShearConfig;
-use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed};
 use dem::math::Tensor as Mat;
 use homogenise::averaging::block_average;
@@ -24,13 +23,13 @@ use serde::{Deserialize, Serialize};
 
 use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
 use super::common::{mean_diameter, strain_bins, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, table_row};
 use super::shear_cell::{judge_runs, RunCheckData};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
-use crate::output::{OutputDir, Summary};
+use crate::output::Summary;
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 
@@ -346,14 +345,8 @@ impl PhasedRun for Shear<'_> {
         1 + self.targets.len()
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        _env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut State,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut State, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let (k, world) = (at.k, at.world);
         let c = self.c;
         let d = mean_diameter(world);
         if k == 0 {
@@ -361,10 +354,10 @@ impl PhasedRun for Shear<'_> {
             world.params.dt = dt;
             world.cell_control = Some(self.control(dt, d, None));
             world.validate(1e-9)?;
-            return Ok(Some(PhasePlan {
-                name: "compress".into(),
-                stop: Stop::Steps(c.compression_steps(d)),
-            }));
+            return Ok(Some(PhasePlan::new(
+                "compress",
+                Stop::Steps(c.compression_steps(d)),
+            )));
         }
         let i = self.targets[k - 1];
         let gamma_dot = i * (c.pressure / c.grain.density).sqrt() / d;
@@ -386,21 +379,11 @@ impl PhasedRun for Shear<'_> {
         };
         st.cell.history.clear();
         st.cell.window.reset();
-        Ok(Some(PhasePlan {
-            name: format!("I={i}"),
-            stop: Stop::Steps(steps),
-        }))
+        Ok(Some(PhasePlan::new(format!("I={i}"), Stop::Steps(steps))))
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut State, at: Step<'_>) -> Result<()> {
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         st.cell.frames.maybe(out, w)?;
         if k == 0 {
             return Ok(());
@@ -455,14 +438,8 @@ impl PhasedRun for Shear<'_> {
         st.cell.settle();
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut State,
-        out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut State, at: Leave<'_>) -> Result<()> {
+        let (k, out, world, stats) = (at.k, at.out, at.world, at.stats);
         st.cell.all.merge(stats);
         if k == 0 {
             return Ok(());

@@ -3,8 +3,6 @@
 //! are consistent with their forces (`m a = m g + Σ f`, `I ω̇ = Σ l × f`, as the engine's).
 #![allow(dead_code)]
 
-use std::f64::consts::PI;
-
 use dem::local::ContactStatus;
 use dem::math::{cross, Tensor, Vector};
 use dem::snapshot::{BodyKind, BodyState, ContactState, Snapshot, WallGeometry, WallState};
@@ -39,22 +37,9 @@ impl Builder {
     }
 
     pub fn grain(&mut self, position: Vector, radius: f64, density: f64, thickness: f64) -> u32 {
-        let mass = density * PI * radius * radius * thickness;
-        self.snap.bodies.push(BodyState {
-            kind: BodyKind::Grain,
-            name: String::new(),
-            position,
-            angle: 0.0,
-            velocity: Vector::zeros(),
-            omega: 0.0,
-            acceleration: Vector::zeros(),
-            angular_acceleration: 0.0,
-            mass,
-            inertia: 0.5 * mass * radius * radius,
-            radius,
-            density,
-            thickness,
-        });
+        self.snap
+            .bodies
+            .push(BodyState::disk(position, radius, density, thickness));
         (self.snap.bodies.len() - 1) as u32
     }
 
@@ -65,21 +50,9 @@ impl Builder {
     }
 
     fn wall_body(&mut self, name: &str, position: Vector, geometry: WallGeometry) -> u32 {
-        self.snap.bodies.push(BodyState {
-            kind: BodyKind::Wall,
-            name: name.to_string(),
-            position,
-            angle: 0.0,
-            velocity: Vector::zeros(),
-            omega: 0.0,
-            acceleration: Vector::zeros(),
-            angular_acceleration: 0.0,
-            mass: f64::INFINITY,
-            inertia: f64::INFINITY,
-            radius: 0.0,
-            density: 0.0,
-            thickness: 1.0,
-        });
+        self.snap
+            .bodies
+            .push(BodyState::wall(name, position, Vector::zeros()));
         let id = (self.snap.bodies.len() - 1) as u32;
         self.snap.walls.push(WallState {
             body: id,

@@ -17,13 +17,13 @@
 //! continuum comparison: `summary.json` (object `column`), `front.csv`, `profiles.csv`.
 
 use datasets::config::ColumnCollapseConfig;
-use datasets::phases::{PhaseProgress, PhaseStats};
+use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::{CliError, Result};
 use crate::output::{CsvTable, OutputDir, Summary};
@@ -193,20 +193,14 @@ impl PhasedRun for Collapse<'_> {
         2
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut CollapseState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut CollapseState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let (k, env, world) = (at.k, at.env, at.world);
         let c = self.c;
         Ok(match k {
-            DEPOSIT => Some(PhasePlan {
-                name: "deposit".into(),
-                stop: Stop::UntilRest(c.deposit.until_rest()),
-            }),
+            DEPOSIT => Some(PhasePlan::new(
+                "deposit",
+                Stop::UntilRest(c.deposit.until_rest()),
+            )),
             COLLAPSE => {
                 st.deposited = grain_count(world);
                 let released = datasets::build::column_collapse_release(c, world)?;
@@ -228,24 +222,17 @@ impl PhasedRun for Collapse<'_> {
                 );
                 self.record_profile(st, world, "t0".into(), 0.0);
                 self.sample_front(st, world);
-                Some(PhasePlan {
-                    name: "collapse".into(),
-                    stop: Stop::UntilRest(c.collapse.until_rest()),
-                })
+                Some(PhasePlan::new(
+                    "collapse",
+                    Stop::UntilRest(c.collapse.until_rest()),
+                ))
             }
             _ => None,
         })
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut CollapseState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut CollapseState, at: Step<'_>) -> Result<()> {
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         if k != COLLAPSE {
             return Ok(());
         }
@@ -275,14 +262,8 @@ impl PhasedRun for Collapse<'_> {
         st.vtk.maybe(out, w)
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut CollapseState,
-        _out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut CollapseState, at: Leave<'_>) -> Result<()> {
+        let (k, world, stats) = (at.k, at.world, at.stats);
         match k {
             DEPOSIT => st.deposit = *stats,
             _ => {

@@ -29,10 +29,10 @@ use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
-use super::phased::{drive, PhasedRun, RunControl};
+use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, serde_csv_table, table_row};
 use super::sensitivity::{resolve_last_step, Resolved};
-use super::{PhaseEnv, RunContext, RunOutcome};
+use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{CsvTable, OutputDir, Summary};
@@ -175,21 +175,10 @@ impl PhasedRun for Column<'_> {
         4
     }
 
-    fn enter(
-        &self,
-        k: usize,
-        env: &PhaseEnv,
-        world: &mut dem::World,
-        st: &mut ColumnState,
-        _out: &mut OutputDir,
-    ) -> Result<Option<PhasePlan>> {
+    fn enter(&self, st: &mut ColumnState, at: Enter<'_>) -> Result<Option<PhasePlan>> {
+        let (k, env, world) = (at.k, at.env, at.world);
         let c = self.c;
-        let plan = |name: &str, stop| {
-            Some(PhasePlan {
-                name: name.into(),
-                stop,
-            })
-        };
+        let plan = |name: &str, stop| Some(PhasePlan::new(name, stop));
         Ok(match k {
             DEPOSIT => {
                 c.deposit.solver.apply(&mut world.params);
@@ -241,15 +230,8 @@ impl PhasedRun for Column<'_> {
         })
     }
 
-    fn step(
-        &self,
-        k: usize,
-        st: &mut ColumnState,
-        out: &mut OutputDir,
-        w: &dem::World,
-        r: &dem::StepReport,
-        p: &datasets::phases::PhaseProgress,
-    ) -> Result<()> {
+    fn step(&self, st: &mut ColumnState, at: Step<'_>) -> Result<()> {
+        let (k, out, w, r, p) = (at.k, at.out, at.world, at.report, at.progress);
         let measured = k == MEASURE;
         st.measured.step(measured, w, r, &p.stats);
         if measured {
@@ -292,14 +274,8 @@ impl PhasedRun for Column<'_> {
         st.vtk.maybe(out, w)
     }
 
-    fn leave(
-        &self,
-        k: usize,
-        st: &mut ColumnState,
-        _out: &mut OutputDir,
-        world: &mut dem::World,
-        stats: &PhaseStats,
-    ) -> Result<()> {
+    fn leave(&self, st: &mut ColumnState, at: Leave<'_>) -> Result<()> {
+        let (k, world, stats) = (at.k, at.world, at.stats);
         match k {
             DEPOSIT => {
                 st.deposit = *stats;
