@@ -815,7 +815,7 @@ mod rve_option_tests {
 
     fn bench(args: &[&str]) -> Option<(f64, RveSide, Vec<String>)> {
         let all = ["grainlaw", "bench"].iter().chain(args).copied();
-        match Cli::try_parse_from(all).ok()?.command {
+        match Cli::try_parse_from(all).ok()?.command? {
             Command::Bench {
                 rve_restitution,
                 rve_only,
