@@ -75,6 +75,8 @@ pub struct RvePlan {
     /// Normal restitution of the LAMMPS peer between two grains of the mean mass (its dashpot,
     /// [`crate::lammps_peer::ContactModel::with_stiffness`]), in [0, 1).
     pub restitution: f64,
+    /// Stiffness number κ = k_n / (P · 1 m) of the LAMMPS peer.
+    pub kappa: f64,
     /// Which codes run.
     pub side: RveSide,
 }
@@ -864,6 +866,9 @@ struct OurRve {
     mu_se: f64,
     phi: f64,
     phi_se: f64,
+    /// The measured inertial number `γ̇ d / √(⟨−σ_yy⟩/ρ)` and normal stress `⟨−σ_yy⟩` (Pa).
+    inertial: f64,
+    pn: f64,
     overlap_ratio: f64,
     verdict: String,
     failure: Option<String>,
@@ -946,6 +951,8 @@ fn grainlaw_rve(n: usize, plan: &RvePlan) -> Result<OurRve> {
         mu_se: get("run1_mu_std_error"),
         phi: get("run1_phi"),
         phi_se: get("run1_phi_std_error"),
+        inertial: get("run1_I"),
+        pn: get("run1_P_Pa"),
         overlap_ratio: get("max_penetration_over_radius"),
         verdict: outcome
             .summary
@@ -1021,7 +1028,11 @@ fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) ->
         None => crate::scenarios::registry::load("simple-shear", &rve_sets(n, plan))?,
     };
     let c: datasets::config::SimpleShearConfig = crate::scenarios::registry::config_of(&loaded)?;
-    let peer = PeerRve::from_config(&c, plan.inertial, wall_limit, plan.restitution)?;
+    let contact = lr::PeerContact {
+        kappa: plan.kappa,
+        restitution: plan.restitution,
+    };
+    let peer = PeerRve::from_config(&c, plan.inertial, wall_limit, contact)?;
     let outcome = match lammps.filter(|_| plan.side.lammps()) {
         Some(lmp) => {
             let dir = std::env::temp_dir()
@@ -1054,6 +1065,10 @@ fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) ->
             100.0 * ours.overlap_ratio,
             ours.verdict
         );
+        println!(
+            "{:<18} grainlaw: ⟨−σ_yy⟩ = {:.1} Pa, I = {:.4}",
+            "", ours.pn, ours.inertial
+        );
     }
     let theirs = match &outcome {
         Some(RveOutcome::Ran(r)) => lammps_rve_row(r, plan),
@@ -1074,7 +1089,7 @@ fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) ->
     let m = &peer.model;
     let settings = format!(
         "κ = k_n/(P·1 m) = {:.0e} (k_n = {:.3e} N/m per m), dt = t_c/{} = {:.3} µs (t_c = {:.2} µs, two smallest grains), k_t/k_n = 2/7, e = {} (mean pair; grainlaw's e = {})",
-        lr::KAPPA,
+        peer.kappa,
         m.kn,
         lr::STEPS_PER_COLLISION,
         m.dt * 1e6,

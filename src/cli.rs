@@ -181,6 +181,10 @@ pub enum Command {
         /// `restitution` key of `simple-shear` (`--rve-set restitution=E`, default 0).
         #[arg(long, value_name = "E", default_value_t = crate::lammps_rve_peer::RESTITUTION, value_parser = parse_restitution)]
         rve_restitution: f64,
+        /// Stiffness number κ = k_n / (P · 1 m) of the LAMMPS peer (≥ 100; 10⁴ is the rigid
+        /// limit of da Cruz et al. 2005); its step stays t_c / 12.
+        #[arg(long, value_name = "K", default_value_t = crate::lammps_rve_peer::KAPPA)]
+        rve_kappa: f64,
         /// Run one code of the race only (`grainlaw` or `lammps`; default both).
         #[arg(long, value_enum, value_name = "CODE", default_value_t = crate::bench_cmd::RveSide::Both)]
         rve_only: crate::bench_cmd::RveSide,
@@ -617,6 +621,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             rve_inertial,
             rve_set,
             rve_restitution,
+            rve_kappa,
             rve_only,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
@@ -637,6 +642,7 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
                 inertial: rve_inertial,
                 sets: rve_set,
                 restitution: rve_restitution,
+                kappa: rve_kappa,
                 side: rve_only,
             },
         }),
@@ -855,5 +861,12 @@ mod rve_option_tests {
             assert!(bench(&["--rve-restitution", bad]).is_none(), "{bad}");
         }
         assert!(bench(&["--rve-only", "siconos"]).is_none());
+        match Cli::try_parse_from(["grainlaw", "bench", "--rve-kappa", "1e5"])
+            .unwrap()
+            .command
+        {
+            Some(Command::Bench { rve_kappa, .. }) => assert_eq!(rve_kappa, 1e5),
+            _ => panic!("not bench"),
+        }
     }
 }

@@ -24,7 +24,7 @@
 //! tangential history and Coulomb friction μ_p, the parameters of
 //! [`crate::lammps_peer::ContactModel::with_stiffness`]:
 //!
-//! - `k_n = κ P · (1 m)` with κ = [`KAPPA`] = 10⁴: the rigid limit of da Cruz et al. (Phys.
+//! - `k_n = κ P · (1 m)` with κ = [`KAPPA`] = 10⁴ (`grainlaw bench --rve-kappa K`): the rigid limit of da Cruz et al. (Phys.
 //!   Rev. E 72, 021309, 2005), whose 2D criterion is the stiffness number `κ = k_n / P ≥ 10⁴`
 //!   (with `k_n` in N/m per metre of thickness and `P` in Pa, `k_n / P` is a length: over 1 m,
 //!   the κ of a unit thickness); 10⁷ N/m per metre at P = 1 kPa. The mean overlap is then
@@ -90,6 +90,25 @@ pub const KAPPA: f64 = 1e4;
 /// Default normal restitution of the race's peer between two grains of the mean mass
 /// (`grainlaw bench --rve-restitution`): 0.2, the value soft-contact users commonly take.
 pub const RESTITUTION: f64 = 0.2;
+/// The race's settings of the peer's contacts (`grainlaw bench --rve-kappa`,
+/// `--rve-restitution`); [`Default`]: κ = [`KAPPA`], e = [`RESTITUTION`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PeerContact {
+    /// Stiffness number κ = k_n / (P · 1 m), ≥ 10² (the rigid limit from 10⁴ on).
+    pub kappa: f64,
+    /// Normal restitution of two grains of the mean mass, in [0, 1).
+    pub restitution: f64,
+}
+
+impl Default for PeerContact {
+    fn default() -> Self {
+        PeerContact {
+            kappa: KAPPA,
+            restitution: RESTITUTION,
+        }
+    }
+}
+
 /// Time steps per collision time of the two smallest grains (`h = t_c / 12`).
 pub const STEPS_PER_COLLISION: f64 = 12.0;
 /// Steps between two actions of the stress servo (`fix deform N`, `fix ave/time N`).
@@ -135,6 +154,8 @@ pub struct PeerRve {
     pub model: ContactModel,
     /// Normal restitution of two grains of the mean mass that the model's damping gives.
     pub restitution: f64,
+    /// Stiffness number κ = k_n / (P · 1 m).
+    pub kappa: f64,
     /// Wall-clock limit of the run (s).
     pub wall_limit: f64,
 }
@@ -153,15 +174,19 @@ impl PeerRve {
     /// number `inertial` (its `strain`, `average_strain`, `pressure`, `compression_duration`,
     /// `control_inertial_number`, friction and grains), the initial grains and cell those of
     /// `datasets::build_cell::simple_shear(c)`; `wall_limit` seconds of wall clock at most;
-    /// the dashpot for a normal restitution `restitution` ∈ [0, 1) between two grains of the
-    /// mean mass ([`ContactModel::with_stiffness`]; [`crate::lammps_peer::RESTITUTION`] = 0.2 is
-    /// the users' choice, grainlaw's model has `c.restitution`, 0 by default).
+    /// `k_n = κ P · 1 m` and the dashpot for a normal restitution `e` ∈ [0, 1) between two
+    /// grains of the mean mass, `contact` ([`ContactModel::with_stiffness`]; e = 0.2 is the
+    /// users' choice, grainlaw's model has `c.restitution`, 0 by default).
     pub fn from_config(
         c: &SimpleShearConfig,
         inertial: f64,
         wall_limit: f64,
-        restitution: f64,
+        contact: PeerContact,
     ) -> Result<Self> {
+        let PeerContact { kappa, restitution } = contact;
+        if !(kappa.is_finite() && kappa >= 1e2) {
+            return Err(bad(format!("the peer's κ must be ≥ 100, got {kappa}")));
+        }
         if !(inertial.is_finite() && inertial > 0.0) {
             return Err(bad(format!(
                 "the inertial number must be > 0, got {inertial}"
@@ -194,7 +219,7 @@ impl PeerRve {
         let d = crate::scenarios::common::mean_diameter(&w);
         let (p, rho) = (c.pressure, c.grain.density);
         let model = ContactModel::with_stiffness(
-            KAPPA * p * 1.0,
+            kappa * p * 1.0,
             &masses,
             STEPS_PER_COLLISION,
             restitution,
@@ -211,6 +236,7 @@ impl PeerRve {
                 .collect(),
             model,
             restitution,
+            kappa,
             radii,
             masses,
             density,
@@ -734,6 +760,53 @@ mod tests {
         crate::scenarios::registry::config_of(&loaded).unwrap()
     }
 
+    /// The race's contact settings reach the model: κ sets `k_n = κ P · 1 m` (the step falls
+    /// as `1/√κ` at fixed damping ratio), e sets the mean pair's restitution and the script's
+    /// `γ_n`; κ below 100 and e outside [0, 1) are refused with a message, not a panic.
+    #[test]
+    fn the_races_contact_settings_reach_the_model() {
+        let c = config(100, 0.5, 0.25);
+        let base = PeerRve::from_config(&c, 0.01, 600.0, PeerContact::default()).unwrap();
+        let stiff = PeerContact {
+            kappa: 1e5,
+            restitution: 0.01,
+        };
+        let p = PeerRve::from_config(&c, 0.01, 600.0, stiff).unwrap();
+        assert_eq!((p.kappa, p.restitution), (1e5, 0.01));
+        assert!((p.model.kn / (1e5 * c.pressure) - 1.0).abs() < 1e-15);
+        let n = p.masses.len() as f64;
+        let m_mean = p.masses.iter().sum::<f64>() / n;
+        assert!((p.model.restitution(0.5 * m_mean) - 0.01).abs() < 1e-12);
+        let script = p.input_script("rve.data", "rve.dump");
+        assert!(script.contains(&full(p.model.gamma_n)), "{script}");
+        // same e at 10× κ: the step shrinks by √10
+        let same_e = PeerContact {
+            kappa: 1e5,
+            restitution: base.restitution,
+        };
+        let q = PeerRve::from_config(&c, 0.01, 600.0, same_e).unwrap();
+        assert!((base.model.dt / q.model.dt / 10f64.sqrt() - 1.0).abs() < 1e-12);
+        for bad in [
+            PeerContact {
+                kappa: 10.0,
+                restitution: 0.2,
+            },
+            PeerContact {
+                kappa: 1e4,
+                restitution: 1.0,
+            },
+            PeerContact {
+                kappa: f64::NAN,
+                restitution: 0.2,
+            },
+        ] {
+            assert!(
+                PeerRve::from_config(&c, 0.01, 600.0, bad).is_err(),
+                "{bad:?}"
+            );
+        }
+    }
+
     /// Numbers of the data lines after `Atoms # sphere`.
     fn atoms(data: &str) -> Vec<Vec<f64>> {
         data.split("Atoms # sphere")
@@ -752,7 +825,7 @@ mod tests {
     #[test]
     fn the_input_holds_the_scenarios_grains_cell_and_settings() {
         let c = config(100, 0.5, 0.25);
-        let p = PeerRve::from_config(&c, 0.01, 600.0, RESTITUTION).unwrap();
+        let p = PeerRve::from_config(&c, 0.01, 600.0, PeerContact::default()).unwrap();
         let w = datasets::build_cell::simple_shear(&c).unwrap();
         let cell = w.cell().unwrap();
         let grains: Vec<_> = w
@@ -869,7 +942,7 @@ mod tests {
         assert!(l.rows.iter().any(|r| r.z > 0.0 && r.xy != 0.0));
         // the run's peer: its radii, step and shear rate from its own files
         let c = config(100, 0.5, 0.25);
-        let mut p = PeerRve::from_config(&c, 0.01, 600.0, RESTITUTION).unwrap();
+        let mut p = PeerRve::from_config(&c, 0.01, 600.0, PeerContact::default()).unwrap();
         p.radii = atoms(&data).iter().map(|a| a[2] / 2.0).collect();
         p.model.dt = script_number(&script, "timestep ");
         p.gamma_dot = script
@@ -942,7 +1015,7 @@ mod tests {
             return;
         };
         let c = config(100, 1.0, 0.5);
-        let p = PeerRve::from_config(&c, 0.01, 300.0, RESTITUTION).unwrap();
+        let p = PeerRve::from_config(&c, 0.01, 300.0, PeerContact::default()).unwrap();
         let dir = std::env::temp_dir().join(format!("grainlaw-test-rve-{}", std::process::id()));
         let r = match run(&lmp, &p, &dir).unwrap() {
             RveOutcome::Ran(r) => r,
