@@ -72,6 +72,37 @@ pub struct RvePlan {
     pub inertial: f64,
     /// Settings of grainlaw's run (`KEY=VALUE`, as `grainlaw run --set`), after the race's own.
     pub sets: Vec<String>,
+    /// Normal restitution of the LAMMPS peer between two grains of the mean mass (its dashpot,
+    /// [`crate::lammps_peer::ContactModel::with_stiffness`]), in [0, 1).
+    pub restitution: f64,
+    /// Stiffness number κ = k_n / (P · 1 m) of the LAMMPS peer.
+    pub kappa: f64,
+    /// Which codes run.
+    pub side: RveSide,
+}
+
+/// Which codes a race runs (`grainlaw bench --rve-only`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum RveSide {
+    /// grainlaw and LAMMPS (the race).
+    #[default]
+    Both,
+    /// grainlaw only (a measurement of μ and φ, no ratio).
+    Grainlaw,
+    /// LAMMPS only (the peer, on the grains grainlaw would start from).
+    Lammps,
+}
+
+impl RveSide {
+    /// Whether grainlaw runs.
+    pub fn grainlaw(self) -> bool {
+        self != RveSide::Lammps
+    }
+
+    /// Whether LAMMPS runs (when it is found).
+    pub fn lammps(self) -> bool {
+        self != RveSide::Grainlaw
+    }
 }
 
 /// The standard error of μ the race prices (issue 34's target: a μ point with SE ≤ 0.005).
@@ -835,9 +866,25 @@ struct OurRve {
     mu_se: f64,
     phi: f64,
     phi_se: f64,
+    /// The measured inertial number `γ̇ d / √(⟨−σ_yy⟩/ρ)` and normal stress `⟨−σ_yy⟩` (Pa).
+    inertial: f64,
+    pn: f64,
     overlap_ratio: f64,
     verdict: String,
     failure: Option<String>,
+}
+
+/// The settings of grainlaw's `simple-shear` run of `n` grains in the race: the plan's inertial
+/// number, strain and averaged strain, the laws left out, then the plan's own `--rve-set`s.
+fn rve_sets(n: usize, plan: &RvePlan) -> Vec<String> {
+    let sets = vec![
+        format!("grains={n}"),
+        format!("inertial_numbers=[{:e}]", plan.inertial),
+        format!("strain={:e}", plan.strain),
+        format!("average_strain={:e}", plan.average),
+        RVE_LEAVE_OUT.to_string(),
+    ];
+    sets.into_iter().chain(plan.sets.iter().cloned()).collect()
 }
 
 /// Runs the `simple-shear` scenario as `grainlaw run` does ([`crate::scenarios::run_controlled`]:
@@ -847,14 +894,7 @@ struct OurRve {
 fn grainlaw_rve(n: usize, plan: &RvePlan) -> Result<OurRve> {
     use std::sync::atomic::AtomicBool;
     use std::sync::Arc;
-    let sets = vec![
-        format!("grains={n}"),
-        format!("inertial_numbers=[{:e}]", plan.inertial),
-        format!("strain={:e}", plan.strain),
-        format!("average_strain={:e}", plan.average),
-        RVE_LEAVE_OUT.to_string(),
-    ];
-    let sets: Vec<String> = sets.into_iter().chain(plan.sets.iter().cloned()).collect();
+    let sets = rve_sets(n, plan);
     let loaded = crate::scenarios::registry::load("simple-shear", &sets)?;
     let dir = std::env::temp_dir().join(format!("grainlaw-bench-rve-{}-{n}", std::process::id()));
     let mut ctx = crate::scenarios::RunContext {
@@ -911,6 +951,8 @@ fn grainlaw_rve(n: usize, plan: &RvePlan) -> Result<OurRve> {
         mu_se: get("run1_mu_std_error"),
         phi: get("run1_phi"),
         phi_se: get("run1_phi_std_error"),
+        inertial: get("run1_I"),
+        pn: get("run1_P_Pa"),
         overlap_ratio: get("max_penetration_over_radius"),
         verdict: outcome
             .summary
@@ -971,16 +1013,27 @@ pub fn rve_rows(plan: &RvePlan) -> Result<()> {
 /// `QUOTED`.
 type TheirRve = (f64, f64, f64, &'static str);
 
-/// One grain count of the race: grainlaw's run → LAMMPS' (or the quoted figures) → the
-/// seconds to a μ point of the target precision → the ratio and the z-score → grainlaw's
-/// settings.
+/// One grain count of the race: grainlaw's run (unless `--rve-only lammps`) → LAMMPS' on the
+/// same initial grains (unless `--rve-only grainlaw`; else the quoted figures) → the seconds to
+/// a μ point of the target precision → the ratio and the z-scores → grainlaw's settings.
 fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) -> Result<()> {
     use crate::lammps_rve_peer::{self as lr, PeerRve, RveOutcome};
-    let ours = grainlaw_rve(n, plan)?;
-    let c: datasets::config::SimpleShearConfig =
-        crate::scenarios::registry::config_of(&ours.loaded)?;
-    let peer = PeerRve::from_config(&c, plan.inertial, wall_limit)?;
-    let outcome = match lammps {
+    let ours = if plan.side.grainlaw() {
+        Some(grainlaw_rve(n, plan)?)
+    } else {
+        None
+    };
+    let loaded = match &ours {
+        Some(o) => o.loaded.clone(),
+        None => crate::scenarios::registry::load("simple-shear", &rve_sets(n, plan))?,
+    };
+    let c: datasets::config::SimpleShearConfig = crate::scenarios::registry::config_of(&loaded)?;
+    let contact = lr::PeerContact {
+        kappa: plan.kappa,
+        restitution: plan.restitution,
+    };
+    let peer = PeerRve::from_config(&c, plan.inertial, wall_limit, contact)?;
+    let outcome = match lammps.filter(|_| plan.side.lammps()) {
         Some(lmp) => {
             let dir = std::env::temp_dir()
                 .join(format!("grainlaw-lammps-rve-{}-{n}", std::process::id()));
@@ -999,19 +1052,24 @@ fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) ->
         "φ ± SE",
         "overlap/R_min"
     );
-    let ours_per_strain = ours.shear_seconds / plan.strain;
-    println!(
-        "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
-        "grainlaw",
-        ours.shear_seconds,
-        ours.total_seconds,
-        ours_per_strain,
-        format!("{}/{}", ours.shear_steps, ours.total_steps),
-        pm(ours.mu, ours.mu_se),
-        pm(ours.phi, ours.phi_se),
-        100.0 * ours.overlap_ratio,
-        ours.verdict
-    );
+    if let Some(ours) = &ours {
+        println!(
+            "{:<18} {:>9.1} {:>9.1} {:>9.2} {:>15} {:>17} {:>17} {:>12.3}%  {}",
+            "grainlaw",
+            ours.shear_seconds,
+            ours.total_seconds,
+            ours.shear_seconds / plan.strain,
+            format!("{}/{}", ours.shear_steps, ours.total_steps),
+            pm(ours.mu, ours.mu_se),
+            pm(ours.phi, ours.phi_se),
+            100.0 * ours.overlap_ratio,
+            ours.verdict
+        );
+        println!(
+            "{:<18} grainlaw: ⟨−σ_yy⟩ = {:.1} Pa, I = {:.4}",
+            "", ours.pn, ours.inertial
+        );
+    }
     let theirs = match &outcome {
         Some(RveOutcome::Ran(r)) => lammps_rve_row(r, plan),
         Some(RveOutcome::Failed { reason, dir }) => {
@@ -1022,35 +1080,51 @@ fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) ->
             );
             None
         }
+        None if !plan.side.lammps() => {
+            println!("{:<18} not run (--rve-only grainlaw)", "LAMMPS");
+            None
+        }
         None => quoted_rve_row(n, plan),
     };
-    let theirs_to_se = match &outcome {
-        Some(RveOutcome::Ran(r)) if r.finished => seconds_to_precision(
-            r.log.compression_seconds,
-            r.log.shear_seconds,
-            plan.strain,
-            plan.average,
-            r.measure.mu_se,
-            TARGET_MU_SE,
-        ),
-        _ => f64::NAN,
-    };
-    print_precision(&ours, plan, theirs_to_se);
-    if let Some(t) = theirs {
-        let m = &peer.model;
-        let settings = format!(
-            "κ = k_n/(P·1 m) = {:.0e} (k_n = {:.3e} N/m per m), dt = t_c/{} = {:.3} µs (t_c = {:.2} µs, two smallest grains), k_t/k_n = 2/7, e = {} (mean pair)",
-            lr::KAPPA,
-            m.kn,
-            lr::STEPS_PER_COLLISION,
-            m.dt * 1e6,
-            m.collision_time * 1e6,
-            crate::lammps_peer::RESTITUTION
-        );
-        print_rve_ratio(t, &ours, ours_per_strain, &settings);
+    let m = &peer.model;
+    let settings = format!(
+        "κ = k_n/(P·1 m) = {:.0e} (k_n = {:.3e} N/m per m), dt = t_c/{} = {:.3} µs (t_c = {:.2} µs, two smallest grains), k_t/k_n = 2/7, e = {} (mean pair; grainlaw's e = {})",
+        peer.kappa,
+        m.kn,
+        lr::STEPS_PER_COLLISION,
+        m.dt * 1e6,
+        m.collision_time * 1e6,
+        peer.restitution,
+        c.restitution
+    );
+    if let Some(ours) = &ours {
+        let theirs_to_se = match &outcome {
+            Some(RveOutcome::Ran(r)) if r.finished => seconds_to_precision(
+                r.log.compression_seconds,
+                r.log.shear_seconds,
+                plan.strain,
+                plan.average,
+                r.measure.mu_se,
+                TARGET_MU_SE,
+            ),
+            _ => f64::NAN,
+        };
+        print_precision(ours, plan, theirs_to_se);
+        if let Some(t) = theirs {
+            print_rve_ratio(t, ours, ours.shear_seconds / plan.strain, &settings);
+        }
+        if let Some(RveOutcome::Ran(r)) = &outcome {
+            println!(
+                " φ: z = {:.2} (LAMMPS − grainlaw, {:+.4})",
+                z_score(r.measure.phi, r.measure.phi_se, ours.phi, ours.phi_se),
+                r.measure.phi - ours.phi
+            );
+        }
+    } else if theirs.is_some() {
+        println!(" LAMMPS gran/hooke/history at {settings}, σ_yy servo on the height");
     }
     println!(
-        " grainlaw: `simple-shear` {} (travel_per_step {}, solver {} to tolerance {:e}, at most {} sweeps, cell control {}), one thread, h = {:.3} ms in the shear; shear s is its shear phase, total s the whole run with its measurement",
+        " grainlaw: `simple-shear` {} (travel_per_step {}, solver {} to tolerance {:e}, at most {} sweeps, cell control {}, restitution {}), one thread, h = {:.3} ms in the shear; shear s is its shear phase, total s the whole run with its measurement",
         if plan.sets.is_empty() {
             "defaults".to_string()
         } else {
@@ -1061,9 +1135,10 @@ fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) ->
         c.solver.tolerance,
         c.solver.max_iterations,
         c.cell_control.as_str(),
+        c.restitution,
         1e3 * c.shear_dt(peer.gamma_dot, peer.mean_diameter),
     );
-    if let Some(f) = &ours.failure {
+    if let Some(f) = ours.as_ref().and_then(|o| o.failure.as_ref()) {
         println!(" grainlaw's verdict: {f}");
     }
     Ok(())

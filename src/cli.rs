@@ -172,9 +172,22 @@ pub enum Command {
         rve_inertial: f64,
         /// A setting of grainlaw's `simple-shear` run in the race, as `grainlaw run --set`
         /// takes it (repeatable), e.g. `--rve-set solver.max_iterations=300`; the LAMMPS side
-        /// follows the same grains, pressure and inertial number.
+        /// follows the same grains, pressure and inertial number (`seed=N`: both codes start
+        /// from the grains of seed N; `restitution=E`: grainlaw's Newton restitution).
         #[arg(long = "rve-set", value_name = "KEY=VALUE")]
         rve_set: Vec<String>,
+        /// Normal restitution of the LAMMPS peer between two grains of the mean mass, in
+        /// [0, 1): its dashpot γ_n from e = exp(−π ζ / √(1 − ζ²)). grainlaw's own is the
+        /// `restitution` key of `simple-shear` (`--rve-set restitution=E`, default 0).
+        #[arg(long, value_name = "E", default_value_t = crate::lammps_rve_peer::RESTITUTION, value_parser = parse_restitution)]
+        rve_restitution: f64,
+        /// Stiffness number κ = k_n / (P · 1 m) of the LAMMPS peer (≥ 100; 10⁴ is the rigid
+        /// limit of da Cruz et al. 2005); its step stays t_c / 12.
+        #[arg(long, value_name = "K", default_value_t = crate::lammps_rve_peer::KAPPA)]
+        rve_kappa: f64,
+        /// Run one code of the race only (`grainlaw` or `lammps`; default both).
+        #[arg(long, value_enum, value_name = "CODE", default_value_t = crate::bench_cmd::RveSide::Both)]
+        rve_only: crate::bench_cmd::RveSide,
     },
 }
 
@@ -357,6 +370,19 @@ fn continuum_cmd(cmd: ContinuumCommand) -> Result<()> {
             dir: dir.display().to_string(),
             reason: verdict.failure_line(),
         })
+    }
+}
+
+/// A restitution coefficient of `--rve-restitution`: a number in [0, 1).
+fn parse_restitution(s: &str) -> std::result::Result<f64, String> {
+    let e: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("a restitution must be a number in [0, 1), got '{s}'"))?;
+    if (0.0..1.0).contains(&e) {
+        Ok(e)
+    } else {
+        Err(format!("a restitution must lie in [0, 1), got {e}"))
     }
 }
 
@@ -594,6 +620,9 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
             rve_average,
             rve_inertial,
             rve_set,
+            rve_restitution,
+            rve_kappa,
+            rve_only,
         } => crate::bench_cmd::bench(&crate::bench_cmd::BenchPlan {
             fc_dir: dir.unwrap_or_else(crate::fc_cmd::default_dir),
             engine_grains,
@@ -612,6 +641,9 @@ fn dispatch(cmd: Option<Command>) -> Result<()> {
                 average: rve_average,
                 inertial: rve_inertial,
                 sets: rve_set,
+                restitution: rve_restitution,
+                kappa: rve_kappa,
+                side: rve_only,
             },
         }),
     }
@@ -779,4 +811,62 @@ fn scenarios_cmd(show: Option<&str>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod rve_option_tests {
+    use super::{Cli, Command};
+    use crate::bench_cmd::RveSide;
+    use clap::Parser;
+
+    fn bench(args: &[&str]) -> Option<(f64, RveSide, Vec<String>)> {
+        let all = ["grainlaw", "bench"].iter().chain(args).copied();
+        match Cli::try_parse_from(all).ok()?.command? {
+            Command::Bench {
+                rve_restitution,
+                rve_only,
+                rve_set,
+                ..
+            } => Some((rve_restitution, rve_only, rve_set)),
+            _ => None,
+        }
+    }
+
+    /// The race's peer restitution and side: defaults (e = the peer's constant, both codes),
+    /// set values, and values outside [0, 1) or unknown sides refused by the parser.
+    #[test]
+    fn the_race_options_parse() {
+        let (e, side, sets) = bench(&["--rve", "2000"]).unwrap();
+        assert_eq!(e, crate::lammps_rve_peer::RESTITUTION);
+        assert_eq!(side, RveSide::Both);
+        assert!(sets.is_empty());
+        let (e, side, sets) = bench(&[
+            "--rve",
+            "2000",
+            "--rve-restitution",
+            "0.05",
+            "--rve-only",
+            "lammps",
+            "--rve-set",
+            "seed=3",
+        ])
+        .unwrap();
+        assert_eq!((e, side), (0.05, RveSide::Lammps));
+        assert_eq!(sets, vec!["seed=3".to_string()]);
+        assert!(side.lammps() && !side.grainlaw());
+        let (_, side, _) = bench(&["--rve-only", "grainlaw"]).unwrap();
+        assert!(side.grainlaw() && !side.lammps());
+        assert_eq!(bench(&["--rve-restitution", "0"]).unwrap().0, 0.0);
+        for bad in ["1", "1.5", "-0.1", "NaN", "x"] {
+            assert!(bench(&["--rve-restitution", bad]).is_none(), "{bad}");
+        }
+        assert!(bench(&["--rve-only", "siconos"]).is_none());
+        match Cli::try_parse_from(["grainlaw", "bench", "--rve-kappa", "1e5"])
+            .unwrap()
+            .command
+        {
+            Some(Command::Bench { rve_kappa, .. }) => assert_eq!(rve_kappa, 1e5),
+            _ => panic!("not bench"),
+        }
+    }
 }

@@ -18,6 +18,7 @@ pub fn simple_shear(c: &SimpleShearConfig) -> Result<World> {
         grains: c.grains,
         grain: &c.grain,
         friction: c.friction.grain_grain,
+        restitution: c.restitution,
         solid_fraction: c.initial_solid_fraction,
         dt: c.compression_dt(2.0 * c.grain.radius_mean),
         solver: &c.solver,
@@ -32,6 +33,7 @@ pub fn biaxial(c: &BiaxialConfig) -> Result<World> {
         grains: c.grains,
         grain: &c.grain,
         friction: c.friction.grain_grain,
+        restitution: 0.0,
         solid_fraction: c.initial_solid_fraction,
         dt: c.dt_max,
         solver: &c.solver,
@@ -48,6 +50,8 @@ pub struct LooseCell<'a> {
     pub grain: &'a GrainSpec,
     /// Grain–grain friction coefficient.
     pub friction: f64,
+    /// Grain–grain normal restitution coefficient `e` (Newton's law on impacts; 0: none).
+    pub restitution: f64,
     /// Solid fraction aimed at (1).
     pub solid_fraction: f64,
     /// Time step (s).
@@ -75,7 +79,10 @@ pub fn loose_cell(c: &LooseCell) -> Result<World> {
         overlap_rate: c.solver.overlap_rate,
         ..Default::default()
     };
-    let laws = dem::ContactLaws::new(&["grain"], c.friction);
+    let mut laws = dem::ContactLaws::new(&["grain"], c.friction);
+    if c.restitution > 0.0 {
+        laws.set_restitution(0, 0, c.restitution);
+    }
     let mut w = World::new(params, laws);
     let slack = 0.5 * (spacing - 2.0 * r_max) * 0.9;
     for (k, &r) in radii.iter().enumerate() {

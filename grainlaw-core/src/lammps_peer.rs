@@ -91,22 +91,32 @@ impl ContactModel {
         let n = masses.len().max(1) as f64;
         let m_mean = masses.iter().sum::<f64>() / n;
         let d_mean = 2.0 * radii.iter().sum::<f64>() / n;
-        Self::with_stiffness(KN_FACTOR * m_mean * g / d_mean, masses, STEPS_PER_COLLISION)
+        Self::with_stiffness(
+            KN_FACTOR * m_mean * g / d_mean,
+            masses,
+            STEPS_PER_COLLISION,
+            RESTITUTION,
+        )
     }
 
     /// The model of normal stiffness `kn` (N/m per metre of thickness) for grains of masses
-    /// `masses` (kg per metre): `k_t = 2/7 k_n`, `γ_n` for restitution [`RESTITUTION`] between
+    /// `masses` (kg per metre): `k_t = 2/7 k_n`, `γ_n` for restitution `restitution` between
     /// two grains of the mean mass `m̄` (`e = exp(−π ζ / √(1 − ζ²))`,
-    /// `ζ = γ_n / (2 √(k_n / (m̄/2)))`), `γ_t = γ_n / 2`, and the time step
+    /// `ζ = γ_n / (2 √(k_n / (m̄/2)))`, [`damping_ratio`]), `γ_t = γ_n / 2`, and the time step
     /// `h = t_c / steps_per_collision` with `t_c = π / √(2 k_n / m_min − γ_n² / 4)` the collision
-    /// time of the two smallest grains.
-    pub fn with_stiffness(kn: f64, masses: &[f64], steps_per_collision: f64) -> Self {
+    /// time of the two smallest grains. The column takes [`RESTITUTION`]; `restitution` outside
+    /// [0, 1), or so low that the two smallest grains are overdamped (no `t_c`), gives a
+    /// non-finite `dt`: callers check it ([`ContactModel::is_usable`]).
+    pub fn with_stiffness(
+        kn: f64,
+        masses: &[f64],
+        steps_per_collision: f64,
+        restitution: f64,
+    ) -> Self {
         let n = masses.len().max(1) as f64;
         let m_mean = masses.iter().sum::<f64>() / n;
         let m_min = masses.iter().copied().fold(f64::INFINITY, f64::min);
-        // ζ from e: ln e = −π ζ / √(1 − ζ²)
-        let l = -RESTITUTION.ln();
-        let zeta = l / (std::f64::consts::PI.powi(2) + l * l).sqrt();
+        let zeta = damping_ratio(restitution);
         let gamma_n = 2.0 * zeta * (kn / (0.5 * m_mean)).sqrt();
         let collision_time =
             std::f64::consts::PI / (2.0 * kn / m_min - 0.25 * gamma_n * gamma_n).sqrt();
@@ -120,6 +130,17 @@ impl ContactModel {
         }
     }
 
+    /// Whether the model can be run: finite positive stiffness, damping, collision time and
+    /// step (false for a restitution outside [0, 1) or one that overdamps the two smallest
+    /// grains).
+    pub fn is_usable(&self) -> bool {
+        [self.kn, self.collision_time, self.dt]
+            .iter()
+            .all(|v| v.is_finite() && *v > 0.0)
+            && self.gamma_n.is_finite()
+            && self.gamma_n >= 0.0
+    }
+
     /// Normal restitution of a collision of effective mass `m_eff` (kg/m):
     /// `exp(−π ζ / √(1 − ζ²))`, `ζ = γ_n / (2 √(k_n / m_eff))`; 0 when overdamped (ζ ≥ 1).
     pub fn restitution(&self, m_eff: f64) -> f64 {
@@ -130,6 +151,21 @@ impl ContactModel {
             (-std::f64::consts::PI * zeta / (1.0 - zeta * zeta).sqrt()).exp()
         }
     }
+}
+
+/// The damping ratio `ζ` of a linear spring–dashpot whose collision has normal restitution `e`:
+/// the inverse of `e = exp(−π ζ / √(1 − ζ²))` (Schäfer, Dippel & Wolf, J. Phys. I France 6, 5,
+/// 1996), `ζ = −ln e / √(π² + ln² e)`; `ζ = 1` (critical damping) at `e = 0`, 0 at `e = 1`, NaN
+/// outside [0, 1].
+pub fn damping_ratio(e: f64) -> f64 {
+    if !(0.0..=1.0).contains(&e) {
+        return f64::NAN;
+    }
+    if e == 0.0 {
+        return 1.0;
+    }
+    let l = -e.ln();
+    l / (std::f64::consts::PI.powi(2) + l * l).sqrt()
 }
 
 /// The column handed to LAMMPS.
@@ -795,5 +831,42 @@ Total wall time: 0:00:13
         // 0.5 µm less 1.7 pm from the 0.1 µm vertical offset
         let o = largest_overlap(&grains[..2], -1.0, -1.0, 1.0);
         assert!((o - 5e-7).abs() < 1e-11, "{o}");
+    }
+
+    /// The damping of a restitution: `e = exp(−π ζ / √(1 − ζ²))` recovered from `ζ` over
+    /// e = 0.01 – 0.9, the mean pair of a model at `e` collides with restitution `e`, `e = 0` is
+    /// critical damping (ζ = 1) and a restitution outside [0, 1) is refused.
+    #[test]
+    fn the_damping_gives_the_asked_restitution() {
+        for &e in &[0.01, 0.05, 0.1, 0.2, 0.5, 0.9] {
+            let z = damping_ratio(e);
+            assert!(z > 0.0 && z < 1.0, "{e}: {z}");
+            let back = (-std::f64::consts::PI * z / (1.0 - z * z).sqrt()).exp();
+            assert!((back / e - 1.0).abs() < 1e-12, "{e}: {back}");
+        }
+        assert_eq!(damping_ratio(0.0), 1.0);
+        assert_eq!(damping_ratio(1.0), 0.0);
+        assert!(damping_ratio(-0.1).is_nan() && damping_ratio(1.5).is_nan());
+        // 2000 masses spread as the RVE's (radii 1.2–1.8 mm): the mean pair at e
+        let masses: Vec<f64> = (0..2000)
+            .map(|k| {
+                let r = 1.2e-3 + 0.6e-3 * k as f64 / 1999.0;
+                2500.0 * std::f64::consts::PI * r * r
+            })
+            .collect();
+        let m_mean = masses.iter().sum::<f64>() / masses.len() as f64;
+        for &e in &[0.0, 0.01, 0.05, 0.2] {
+            let m = ContactModel::with_stiffness(1e7, &masses, 12.0, e);
+            assert!(m.is_usable(), "{e}");
+            assert!((m.restitution(0.5 * m_mean) - e).abs() < 1e-12, "{e}");
+            assert!((m.gamma_t / m.gamma_n - 0.5).abs() < 1e-15);
+        }
+        // less bouncing: more damping, a longer damped collision, a longer step
+        let (a, b) = (
+            ContactModel::with_stiffness(1e7, &masses, 12.0, 0.2),
+            ContactModel::with_stiffness(1e7, &masses, 12.0, 0.01),
+        );
+        assert!(b.gamma_n > a.gamma_n && b.dt > a.dt);
+        assert!(!ContactModel::with_stiffness(1e7, &masses, 12.0, 1.5).is_usable());
     }
 }

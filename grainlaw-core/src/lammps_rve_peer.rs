@@ -24,13 +24,14 @@
 //! tangential history and Coulomb friction μ_p, the parameters of
 //! [`crate::lammps_peer::ContactModel::with_stiffness`]:
 //!
-//! - `k_n = κ P · (1 m)` with κ = [`KAPPA`] = 10⁴: the rigid limit of da Cruz et al. (Phys.
+//! - `k_n = κ P · (1 m)` with κ = [`KAPPA`] = 10⁴ (`grainlaw bench --rve-kappa K`): the rigid limit of da Cruz et al. (Phys.
 //!   Rev. E 72, 021309, 2005), whose 2D criterion is the stiffness number `κ = k_n / P ≥ 10⁴`
 //!   (with `k_n` in N/m per metre of thickness and `P` in Pa, `k_n / P` is a length: over 1 m,
 //!   the κ of a unit thickness); 10⁷ N/m per metre at P = 1 kPa. The mean overlap is then
 //!   about `d / κ` of a diameter, 0.01 %.
 //! - `k_t = 2/7 k_n`, `γ_t = γ_n / 2` (LAMMPS' `NULL` defaults), `γ_n` for a normal restitution
-//!   [`crate::lammps_peer::RESTITUTION`] = 0.2 between two grains of the mean mass.
+//!   `e` between two grains of the mean mass, a setting of the race (`grainlaw bench
+//!   --rve-restitution E`, default [`RESTITUTION`]).
 //! - Time step `h = t_c / 12` ([`STEPS_PER_COLLISION`]), `t_c = π / √(2 k_n / m_min − γ_n² / 4)`
 //!   the collision time of the two smallest grains: in the `t_c / 10` – `t_c / 20` that
 //!   soft-contact users take.
@@ -86,6 +87,28 @@ use crate::scenarios::simple_shear::{CellSamples, RheologyPoint};
 
 /// Stiffness number κ = k_n / (P · 1 m) of the peer: the rigid limit (da Cruz et al. 2005).
 pub const KAPPA: f64 = 1e4;
+/// Default normal restitution of the race's peer between two grains of the mean mass
+/// (`grainlaw bench --rve-restitution`): 0.2, the value soft-contact users commonly take.
+pub const RESTITUTION: f64 = 0.2;
+/// The race's settings of the peer's contacts (`grainlaw bench --rve-kappa`,
+/// `--rve-restitution`); [`Default`]: κ = [`KAPPA`], e = [`RESTITUTION`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PeerContact {
+    /// Stiffness number κ = k_n / (P · 1 m), ≥ 10² (the rigid limit from 10⁴ on).
+    pub kappa: f64,
+    /// Normal restitution of two grains of the mean mass, in [0, 1).
+    pub restitution: f64,
+}
+
+impl Default for PeerContact {
+    fn default() -> Self {
+        PeerContact {
+            kappa: KAPPA,
+            restitution: RESTITUTION,
+        }
+    }
+}
+
 /// Time steps per collision time of the two smallest grains (`h = t_c / 12`).
 pub const STEPS_PER_COLLISION: f64 = 12.0;
 /// Steps between two actions of the stress servo (`fix deform N`, `fix ave/time N`).
@@ -129,6 +152,10 @@ pub struct PeerRve {
     pub rate_cap: f64,
     /// Contact model and time step.
     pub model: ContactModel,
+    /// Normal restitution of two grains of the mean mass that the model's damping gives.
+    pub restitution: f64,
+    /// Stiffness number κ = k_n / (P · 1 m).
+    pub kappa: f64,
     /// Wall-clock limit of the run (s).
     pub wall_limit: f64,
 }
@@ -146,11 +173,28 @@ impl PeerRve {
     /// The representative volume of the `simple-shear` scenario `c` sheared at the inertial
     /// number `inertial` (its `strain`, `average_strain`, `pressure`, `compression_duration`,
     /// `control_inertial_number`, friction and grains), the initial grains and cell those of
-    /// `datasets::build_cell::simple_shear(c)`; `wall_limit` seconds of wall clock at most.
-    pub fn from_config(c: &SimpleShearConfig, inertial: f64, wall_limit: f64) -> Result<Self> {
+    /// `datasets::build_cell::simple_shear(c)`; `wall_limit` seconds of wall clock at most;
+    /// `k_n = κ P · 1 m` and the dashpot for a normal restitution `e` ∈ [0, 1) between two
+    /// grains of the mean mass, `contact` ([`ContactModel::with_stiffness`]; e = 0.2 is the
+    /// users' choice, grainlaw's model has `c.restitution`, 0 by default).
+    pub fn from_config(
+        c: &SimpleShearConfig,
+        inertial: f64,
+        wall_limit: f64,
+        contact: PeerContact,
+    ) -> Result<Self> {
+        let PeerContact { kappa, restitution } = contact;
+        if !(kappa.is_finite() && kappa >= 1e2) {
+            return Err(bad(format!("the peer's κ must be ≥ 100, got {kappa}")));
+        }
         if !(inertial.is_finite() && inertial > 0.0) {
             return Err(bad(format!(
                 "the inertial number must be > 0, got {inertial}"
+            )));
+        }
+        if !(0.0..1.0).contains(&restitution) {
+            return Err(bad(format!(
+                "the peer's restitution must lie in [0, 1), got {restitution}"
             )));
         }
         let w = datasets::build_cell::simple_shear(c)?;
@@ -174,12 +218,25 @@ impl PeerRve {
         let (density, radii, masses) = disk_masses(first, &grains).map_err(bad)?;
         let d = crate::scenarios::common::mean_diameter(&w);
         let (p, rho) = (c.pressure, c.grain.density);
+        let model = ContactModel::with_stiffness(
+            kappa * p * 1.0,
+            &masses,
+            STEPS_PER_COLLISION,
+            restitution,
+        );
+        if !model.is_usable() {
+            return Err(bad(format!(
+                "restitution {restitution} overdamps the two smallest grains (no collision time): take e > 0"
+            )));
+        }
         Ok(PeerRve {
             centres: grains
                 .iter()
                 .map(|b| [b.position.x, b.position.y])
                 .collect(),
-            model: ContactModel::with_stiffness(KAPPA * p * 1.0, &masses, STEPS_PER_COLLISION),
+            model,
+            restitution,
+            kappa,
             radii,
             masses,
             density,
@@ -703,6 +760,53 @@ mod tests {
         crate::scenarios::registry::config_of(&loaded).unwrap()
     }
 
+    /// The race's contact settings reach the model: κ sets `k_n = κ P · 1 m` (the step falls
+    /// as `1/√κ` at fixed damping ratio), e sets the mean pair's restitution and the script's
+    /// `γ_n`; κ below 100 and e outside [0, 1) are refused with a message, not a panic.
+    #[test]
+    fn the_races_contact_settings_reach_the_model() {
+        let c = config(100, 0.5, 0.25);
+        let base = PeerRve::from_config(&c, 0.01, 600.0, PeerContact::default()).unwrap();
+        let stiff = PeerContact {
+            kappa: 1e5,
+            restitution: 0.01,
+        };
+        let p = PeerRve::from_config(&c, 0.01, 600.0, stiff).unwrap();
+        assert_eq!((p.kappa, p.restitution), (1e5, 0.01));
+        assert!((p.model.kn / (1e5 * c.pressure) - 1.0).abs() < 1e-15);
+        let n = p.masses.len() as f64;
+        let m_mean = p.masses.iter().sum::<f64>() / n;
+        assert!((p.model.restitution(0.5 * m_mean) - 0.01).abs() < 1e-12);
+        let script = p.input_script("rve.data", "rve.dump");
+        assert!(script.contains(&full(p.model.gamma_n)), "{script}");
+        // same e at 10× κ: the step shrinks by √10
+        let same_e = PeerContact {
+            kappa: 1e5,
+            restitution: base.restitution,
+        };
+        let q = PeerRve::from_config(&c, 0.01, 600.0, same_e).unwrap();
+        assert!((base.model.dt / q.model.dt / 10f64.sqrt() - 1.0).abs() < 1e-12);
+        for bad in [
+            PeerContact {
+                kappa: 10.0,
+                restitution: 0.2,
+            },
+            PeerContact {
+                kappa: 1e4,
+                restitution: 1.0,
+            },
+            PeerContact {
+                kappa: f64::NAN,
+                restitution: 0.2,
+            },
+        ] {
+            assert!(
+                PeerRve::from_config(&c, 0.01, 600.0, bad).is_err(),
+                "{bad:?}"
+            );
+        }
+    }
+
     /// Numbers of the data lines after `Atoms # sphere`.
     fn atoms(data: &str) -> Vec<Vec<f64>> {
         data.split("Atoms # sphere")
@@ -721,7 +825,7 @@ mod tests {
     #[test]
     fn the_input_holds_the_scenarios_grains_cell_and_settings() {
         let c = config(100, 0.5, 0.25);
-        let p = PeerRve::from_config(&c, 0.01, 600.0).unwrap();
+        let p = PeerRve::from_config(&c, 0.01, 600.0, PeerContact::default()).unwrap();
         let w = datasets::build_cell::simple_shear(&c).unwrap();
         let cell = w.cell().unwrap();
         let grains: Vec<_> = w
@@ -838,7 +942,7 @@ mod tests {
         assert!(l.rows.iter().any(|r| r.z > 0.0 && r.xy != 0.0));
         // the run's peer: its radii, step and shear rate from its own files
         let c = config(100, 0.5, 0.25);
-        let mut p = PeerRve::from_config(&c, 0.01, 600.0).unwrap();
+        let mut p = PeerRve::from_config(&c, 0.01, 600.0, PeerContact::default()).unwrap();
         p.radii = atoms(&data).iter().map(|a| a[2] / 2.0).collect();
         p.model.dt = script_number(&script, "timestep ");
         p.gamma_dot = script
@@ -911,7 +1015,7 @@ mod tests {
             return;
         };
         let c = config(100, 1.0, 0.5);
-        let p = PeerRve::from_config(&c, 0.01, 300.0).unwrap();
+        let p = PeerRve::from_config(&c, 0.01, 300.0, PeerContact::default()).unwrap();
         let dir = std::env::temp_dir().join(format!("grainlaw-test-rve-{}", std::process::id()));
         let r = match run(&lmp, &p, &dir).unwrap() {
             RveOutcome::Ran(r) => r,

@@ -32,6 +32,12 @@ pub struct SimpleShearConfig {
     pub grain: GrainSpec,
     /// Friction coefficient between grains.
     pub friction: CellFriction,
+    /// Normal restitution coefficient `e` between grains (Newton's law on impacts,
+    /// `u_n⁺ ≥ −e u_n⁻`), in [0, 0.99]; default 0, the contact-dynamics choice (impacts
+    /// perfectly inelastic). Set it to compare with a soft-contact code run at the same `e`
+    /// (`grainlaw bench --rve … --rve-restitution E --rve-set restitution=E`).
+    #[serde(default)]
+    pub restitution: f64,
     /// Confining pressure P (Pa), > 0: σ_xx = σ_yy = −P in the compression, σ_yy = −P in shear.
     pub pressure: f64,
     /// Target inertial numbers `I = γ̇ d / √(P/ρ)`, one shear run each (lowest first).
@@ -187,6 +193,7 @@ impl SimpleShearConfig {
         limits::grains("grains", self.grains, 50)?;
         self.grain.validate("grain")?;
         non_negative("friction.grain_grain", self.friction.grain_grain)?;
+        in_range("restitution", self.restitution, 0.0, 0.99)?;
         if !(self.pressure.is_finite() && self.pressure > 0.0) {
             return Err(DatasetError::invalid(
                 "pressure",
@@ -329,5 +336,22 @@ mod tests {
         let mut more = sets.clone();
         more.push("max_steps=1e8".into());
         assert!(load(&more).is_ok());
+    }
+
+    /// `restitution`: 0 by default (no engine pair gets one), a set value reaches the world's
+    /// grain–grain law, and values outside [0, 0.99] are refused with the key named.
+    #[test]
+    fn the_restitution_key_reaches_the_world() {
+        let c = config(&["grains=50"]);
+        assert_eq!(c.restitution, 0.0);
+        let w = crate::build_cell::simple_shear(&c).unwrap();
+        assert_eq!(w.laws.restitution(0, 0), 0.0);
+        let c = config(&["grains=50", "restitution=0.2"]);
+        let w = crate::build_cell::simple_shear(&c).unwrap();
+        assert_eq!(w.laws.restitution(0, 0), 0.2);
+        for bad in ["restitution=-0.1", "restitution=1.0"] {
+            let e = load(&[bad.to_string()]).unwrap_err().to_string();
+            assert!(e.contains("restitution"), "{e}");
+        }
     }
 }
