@@ -49,6 +49,8 @@ fn bad_inputs_are_refused_with_one_line() {
         ("inertial_numbers=[0.05, 0.1, 0.2]", "inertial_numbers"),
         (r#"leave_out=["wall-law"]"#, "leave_out[0]"),
         ("sensitivity_samples=0", "sensitivity_samples"),
+        ("theta=0.4", "theta"),
+        ("theta=1.5", "theta"),
         ("sensitivity_samples=1001", "sensitivity_samples"),
     ] {
         let o = grainlaw(&["run", "simple-shear", "--set", set], None);

@@ -19,6 +19,7 @@ pub fn simple_shear(c: &SimpleShearConfig) -> Result<World> {
         grain: &c.grain,
         friction: c.friction.grain_grain,
         restitution: c.restitution,
+        theta: c.theta,
         solid_fraction: c.initial_solid_fraction,
         dt: c.compression_dt(2.0 * c.grain.radius_mean),
         solver: &c.solver,
@@ -34,6 +35,7 @@ pub fn biaxial(c: &BiaxialConfig) -> Result<World> {
         grain: &c.grain,
         friction: c.friction.grain_grain,
         restitution: 0.0,
+        theta: 1.0,
         solid_fraction: c.initial_solid_fraction,
         dt: c.dt_max,
         solver: &c.solver,
@@ -52,6 +54,8 @@ pub struct LooseCell<'a> {
     pub friction: f64,
     /// Grain–grain normal restitution coefficient `e` (Newton's law on impacts; 0: none).
     pub restitution: f64,
+    /// θ of the Moreau–Jean position update `q⁺ = q⁻ + h((1 − θ) v⁻ + θ v⁺)`, in [½, 1].
+    pub theta: f64,
     /// Solid fraction aimed at (1).
     pub solid_fraction: f64,
     /// Time step (s).
@@ -77,6 +81,7 @@ pub fn loose_cell(c: &LooseCell) -> Result<World> {
         detection_gap: 0.1 * c.grain.radius_min(),
         solver: c.solver.params(),
         overlap_rate: c.solver.overlap_rate,
+        theta: c.theta,
         ..Default::default()
     };
     let mut laws = dem::ContactLaws::new(&["grain"], c.friction);
