@@ -168,24 +168,32 @@ pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<([f64; 2], 
 /// [`resolved_pair`] takes it: a plain function, so that a re-solve can run on another thread.
 pub type PairOf = fn(&Snapshot) -> Option<[f64; 2]>;
 
+/// What a re-solve on the pool sends back: its outcome, or the payload of its panic.
+type Sent = std::thread::Result<ResolvedPair>;
+
 /// The outcome of a re-solve handed to rayon's pool. Called from a thread of the pool (a run
 /// inside a caller's pool), it runs the pool's pending work meanwhile (`rayon::yield_now`), its
 /// own re-solve included, so that runs waiting on all the pool's threads cannot wait for each
 /// other (test `runs_on_every_thread_of_a_pool_do_not_wait_for_each_other`: a blocking wait
 /// hangs there); once the pool has nothing to run (the re-solve runs elsewhere) or from outside
-/// the pool, it blocks until the outcome comes. A re-solve whose thread died is failed.
-fn wait_for(rx: &Receiver<ResolvedPair>) -> ResolvedPair {
-    loop {
+/// the pool, it blocks until the outcome comes. A re-solve that panicked panics here, on the
+/// run's thread, as it would have in line; one that never ran (its sender dropped) is failed.
+fn wait_for(rx: &Receiver<Sent>) -> ResolvedPair {
+    let sent = loop {
         match rx.try_recv() {
-            Ok(outcome) => return outcome,
+            Ok(sent) => break sent,
             Err(TryRecvError::Disconnected) => return Resolved::Failed,
             Err(TryRecvError::Empty) => {
                 if rayon::yield_now() != Some(rayon::Yield::Executed) {
-                    return rx.recv().unwrap_or(Resolved::Failed);
+                    match rx.recv() {
+                        Ok(sent) => break sent,
+                        Err(_) => return Resolved::Failed,
+                    }
                 }
             }
         }
-    }
+    };
+    sent.unwrap_or_else(|payload| std::panic::resume_unwind(payload))
 }
 
 /// A sample's re-solved stress pair with whether it reached the tolerance ([`resolved_pair`]).
@@ -195,17 +203,25 @@ pub type ResolvedPair = Resolved<([f64; 2], bool)>;
 ///
 /// A sample's re-solve ([`resolved_pair`]) reads only the world as the sampled step left it, so
 /// it can run on a copy of that world while the run goes on: with two or more threads in
-/// rayon's pool, [`ResolveQueue::submit`] hands the copy to the pool (`rayon::spawn`: the
-/// re-solve takes a thread the run's sweeps leave idle, and a parallel sweep that needs it
-/// runs its units on the calling thread) and [`ResolveQueue::settle`] records the outcomes in
-/// the order the samples were taken. Each outcome is a function of its copy alone, so the
-/// recorded sums are the same, bit for bit, as when every re-solve is made in line (one
-/// thread: [`ResolveQueue::submit`] records at once). Settle before reading the window's
-/// [`Sensitivity`] and before a checkpoint: pending re-solves are not saved.
+/// rayon's pool, [`ResolveQueue::submit`] hands the copy to the pool (`rayon::spawn`) and
+/// [`ResolveQueue::settle`] records the outcomes in the order the samples were taken. Each
+/// outcome is a function of its copy alone, so the recorded sums are the same, bit for bit, as
+/// when every re-solve is made in line (one thread: [`ResolveQueue::submit`] records at once).
+/// Settle before reading the window's [`Sensitivity`] and before a checkpoint: pending
+/// re-solves are not saved.
+///
+/// The re-solves share the pool with the run's own parallel work: where the run's steps do not
+/// fork (the default `solver.parallel = false` below 8192 contacts) they take a thread the run
+/// leaves idle; a step that forks may wait for a thread busy with a re-solve. At most as many
+/// re-solves as the pool has threads are pending at once: a sample beyond waits for the oldest
+/// and records it first, which bounds the copies held (and keeps the order). A queue dropped
+/// unsettled (a run that failed) cancels the re-solves that have not started.
 #[derive(Default)]
 pub struct ResolveQueue {
     /// The samples submitted and not yet recorded: the stress as run, the outcome's channel.
-    pending: VecDeque<([f64; 2], Receiver<ResolvedPair>)>,
+    pending: VecDeque<([f64; 2], Receiver<Sent>)>,
+    /// Set when the queue is dropped: re-solves not yet started do nothing.
+    cancelled: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
 impl std::fmt::Debug for ResolveQueue {
@@ -214,26 +230,45 @@ impl std::fmt::Debug for ResolveQueue {
     }
 }
 
+impl Drop for ResolveQueue {
+    fn drop(&mut self) {
+        self.cancelled
+            .store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
 impl ResolveQueue {
     /// Re-solves the sample the world `w` now holds (its stress as run: `run`) and records it
     /// into `s`: at once with one thread, else on a copy of `w` beside the run (recorded by
-    /// [`ResolveQueue::settle`]).
+    /// [`ResolveQueue::settle`], or here when as many as the pool's threads are pending).
     pub fn submit(&mut self, s: &mut Sensitivity, w: &World, run: [f64; 2], pair: PairOf) {
-        if self.pending.is_empty() && rayon::current_num_threads() < 2 {
+        let threads = rayon::current_num_threads();
+        if self.pending.is_empty() && threads < 2 {
             record(s, run, resolved_pair(w, pair));
             return;
         }
+        while self.pending.len() >= threads.max(1) {
+            if let Some((run, rx)) = self.pending.pop_front() {
+                record(s, run, wait_for(&rx));
+            }
+        }
         let world = w.clone();
+        let cancelled = self.cancelled.clone();
         let (tx, rx) = channel();
         rayon::spawn(move || {
-            // the receiver is gone only when the window was dropped unsettled: nothing to keep
-            let _ = tx.send(resolved_pair(&world, pair));
+            if cancelled.load(std::sync::atomic::Ordering::Relaxed) {
+                return;
+            }
+            let sent = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                resolved_pair(&world, pair)
+            }));
+            // the receiver is gone only when the queue was dropped unsettled: nothing to keep
+            let _ = tx.send(sent);
         });
         self.pending.push_back((run, rx));
     }
 
-    /// Waits for the pending re-solves and records them into `s` in the order submitted (a
-    /// re-solve whose thread died is recorded as failed).
+    /// Waits for the pending re-solves and records them into `s` in the order submitted.
     pub fn settle(&mut self, s: &mut Sensitivity) {
         while let Some((run, rx)) = self.pending.pop_front() {
             record(s, run, wait_for(&rx));
