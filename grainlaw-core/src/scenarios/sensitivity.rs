@@ -168,6 +168,13 @@ pub fn record(s: &mut Sensitivity, run: [f64; 2], resolved: Resolved<([f64; 2], 
 /// [`resolved_pair`] takes it: a plain function, so that a re-solve can run on another thread.
 pub type PairOf = fn(&Snapshot) -> Option<[f64; 2]>;
 
+/// Re-solves pending at most per thread of the pool ([`ResolveQueue::submit`]). On the
+/// 10⁴-grain cell with parallel sweeps (two threads, strain 0.3, 20 samples) the run took
+/// 83.3 s with one per thread, 80.2 s with four (283 MB at most) and 73.9 s unbounded (a
+/// forked step waits behind queued re-solves; unbounded, the backlog is left for both
+/// threads at the window's end), against 134.6 s on one thread.
+const PENDING_PER_THREAD: usize = 4;
+
 /// What a re-solve on the pool sends back: its outcome, or the payload of its panic.
 type Sent = std::thread::Result<ResolvedPair>;
 
@@ -212,9 +219,10 @@ pub type ResolvedPair = Resolved<([f64; 2], bool)>;
 ///
 /// The re-solves share the pool with the run's own parallel work: where the run's steps do not
 /// fork (the default `solver.parallel = false` below 8192 contacts) they take a thread the run
-/// leaves idle; a step that forks may wait for a thread busy with a re-solve. At most as many
-/// re-solves as the pool has threads are pending at once: a sample beyond waits for the oldest
-/// and records it first, which bounds the copies held (and keeps the order). A queue dropped
+/// leaves idle; a step that forks may wait for a thread busy with a re-solve. At most
+/// [`PENDING_PER_THREAD`] re-solves per thread of the pool are pending at once: a sample beyond
+/// waits for the oldest and records it first, which bounds the copies held (and keeps the
+/// order). A queue dropped
 /// unsettled (a run that failed) cancels the re-solves that have not started.
 #[derive(Default)]
 pub struct ResolveQueue {
@@ -240,14 +248,14 @@ impl Drop for ResolveQueue {
 impl ResolveQueue {
     /// Re-solves the sample the world `w` now holds (its stress as run: `run`) and records it
     /// into `s`: at once with one thread, else on a copy of `w` beside the run (recorded by
-    /// [`ResolveQueue::settle`], or here when as many as the pool's threads are pending).
+    /// [`ResolveQueue::settle`], or here when [`PENDING_PER_THREAD`] per thread are pending).
     pub fn submit(&mut self, s: &mut Sensitivity, w: &World, run: [f64; 2], pair: PairOf) {
         let threads = rayon::current_num_threads();
         if self.pending.is_empty() && threads < 2 {
             record(s, run, resolved_pair(w, pair));
             return;
         }
-        while self.pending.len() >= threads.max(1) {
+        while self.pending.len() >= PENDING_PER_THREAD * threads {
             if let Some((run, rx)) = self.pending.pop_front() {
                 record(s, run, wait_for(&rx));
             }
