@@ -30,6 +30,8 @@ const TINY: &[&str] = &[
     "travel_per_step=0.02",
     "--set",
     "cell_affine=false",
+    "--set",
+    "theta=1",
     "-q",
 ];
 
@@ -469,6 +471,8 @@ fn grains_following_the_cell_within_the_step_stop_the_ringing_of_its_stress() {
                 "--set",
                 "travel_per_step=0.02", // the step its figures were measured at
                 "--set",
+                "theta=1",
+                "--set",
                 affine,
                 "-q",
             ],
@@ -506,6 +510,8 @@ fn a_cell_control_that_runs_away_fails_its_run_at_the_step() {
                 "grain.radius_mean=2.5e-3",
                 "--set",
                 "travel_per_step=0.02", // the step its figures were measured at
+                "--set",
+                "theta=1",
                 "--set",
                 "grain.radius_spread=0.5e-3",
                 "--set",
