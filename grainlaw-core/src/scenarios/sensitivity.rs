@@ -173,7 +173,7 @@ pub type PairOf = fn(&Snapshot) -> Option<[f64; 2]>;
 /// 83.3 s with one per thread, 80.2 s with four (283 MB at most) and 73.9 s unbounded (a
 /// forked step waits behind queued re-solves; unbounded, the backlog is left for both
 /// threads at the window's end), against 134.6 s on one thread.
-const PENDING_PER_THREAD: usize = 4;
+pub const PENDING_PER_THREAD: usize = 4;
 
 /// What a re-solve on the pool sends back: its outcome, or the payload of its panic.
 type Sent = std::thread::Result<ResolvedPair>;
