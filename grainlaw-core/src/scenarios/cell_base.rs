@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::{implicit_cell_control, VtkFrames};
 use super::rows::{serde_rows, TableRow};
-use super::sensitivity::{PairOf, ResolveQueue};
+use super::sensitivity::{refuse_unsettled, PairOf, ResolveQueue};
 use crate::verdict::WindowStats;
 
 /// Gain of the explicit cell control as a fraction of its stability limit `Δt/(ρ d²)`
@@ -102,8 +102,13 @@ pub struct CellRecord<H: TableRow, R: TableRow> {
     #[serde(default)]
     pub window: WindowStats,
     /// The window's re-solves not yet recorded in `window.sensitivity` (never saved: the
-    /// phases settle them before a checkpoint, [`super::phased::PhasedRun::settle`]).
-    #[serde(skip)]
+    /// phases settle them before a checkpoint, [`super::phased::PhasedRun::settle`]; a
+    /// checkpoint of a state with re-solves pending fails, [`refuse_unsettled`]).
+    #[serde(
+        skip_deserializing,
+        skip_serializing_if = "ResolveQueue::is_settled",
+        serialize_with = "refuse_unsettled"
+    )]
     pub resolves: ResolveQueue,
 }
 

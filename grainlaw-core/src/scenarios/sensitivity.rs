@@ -287,11 +287,54 @@ impl ResolveQueue {
     pub fn pending(&self) -> usize {
         self.pending.len()
     }
+
+    /// Whether every re-solve submitted has been recorded.
+    pub fn is_settled(&self) -> bool {
+        self.pending.is_empty()
+    }
+}
+
+/// The serde form of a queue in a checkpointed state: a settled queue is not written
+/// (`skip_serializing_if = "ResolveQueue::is_settled"`), and one with re-solves pending refuses
+/// to be, so that a runner that does not settle before a checkpoint
+/// ([`super::phased::PhasedRun::settle`]) fails its checkpoint with this error instead of
+/// losing samples.
+pub fn refuse_unsettled<S: serde::Serializer>(q: &ResolveQueue, _: S) -> Result<S::Ok, S::Error> {
+    Err(serde::ser::Error::custom(format!(
+        "{} re-solves of the solver-sensitivity measure are pending: the runner did not settle them before the checkpoint (PhasedRun::settle)",
+        q.pending()
+    )))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// With two threads a sample is pending until settled, and a pending queue refuses to be
+    /// written into a checkpoint; once settled it is recorded (an empty world: its empty
+    /// problem has no solve, a sample counted as unresolved) and nothing is pending.
+    #[test]
+    fn a_pending_re_solve_is_recorded_when_settled_and_refuses_a_checkpoint() {
+        let w = World::new(
+            dem::WorldParams::default(),
+            dem::ContactLaws::new(&["grain"], 0.5),
+        );
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let mut s = Sensitivity::default();
+        let mut q = ResolveQueue::default();
+        pool.install(|| q.submit(&mut s, &w, [1.0, -2.0], |_| None));
+        assert_eq!(q.pending(), 1);
+        assert!(!q.is_settled());
+        let e = refuse_unsettled(&q, serde_json::value::Serializer).unwrap_err();
+        assert!(e.to_string().contains("1 re-solves"), "{e}");
+        assert_eq!(s.unresolved, 0);
+        pool.install(|| q.settle(&mut s));
+        assert!(q.is_settled());
+        assert_eq!((s.unresolved, s.samples, s.unavailable), (1, 0, 0), "{s:?}");
+    }
 
     /// Converged at 1e-8 always measures; short of it, a finite error at most a fifth of the
     /// run's own (seed 8's Janssen re-solves: 4.6·10⁻⁸ and 1.4·10⁻⁷ against a run at
