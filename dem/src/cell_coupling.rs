@@ -262,14 +262,21 @@ impl CellCoupling {
     pub fn refresh(&mut self, rows: &mut [ContactRow]) {
         let mut delta = self.delta0;
         for (s, &i) in self.rows.iter().enumerate() {
-            let r = rows[i as usize].r;
-            for (k, d) in delta.iter_mut().enumerate() {
-                let b = self.coef[s][k];
-                *d += self.compliance[k] * (b[0] * r[0] + b[1] * r[1]);
-            }
+            self.add_impulse(s, rows[i as usize].r, &mut delta);
         }
         self.delta = delta;
         self.sync(rows);
+    }
+
+    /// `δ_κ += m_κ B_sκ · x` for an impulse (or an impulse's change) `x` of the contact of slot
+    /// `s`: the one form of the cell's change by its contacts' impulses (`refresh`, and every
+    /// coupled update of a sweep).
+    #[inline(always)]
+    fn add_impulse(&self, s: usize, x: [f64; 2], delta: &mut ComponentValues) {
+        for (k, d) in delta.iter_mut().enumerate() {
+            let b = self.coef[s][k];
+            *d += self.compliance[k] * (b[0] * x[0] + b[1] * x[1]);
+        }
     }
 
     /// Every coupled row's affine velocity from the current `δ`.
@@ -346,11 +353,9 @@ impl CellCoupling {
         c.affine = self.affine_of(s, &self.delta);
         let before = c.r;
         if update(c, vel, inv, omega) {
-            let d = [c.r[0] - before[0], c.r[1] - before[1]];
-            for k in 0..3 {
-                let b = self.coef[s][k];
-                self.delta[k] += self.compliance[k] * (b[0] * d[0] + b[1] * d[1]);
-            }
+            let mut delta = self.delta;
+            self.add_impulse(s, [c.r[0] - before[0], c.r[1] - before[1]], &mut delta);
+            self.delta = delta;
         }
     }
 
@@ -442,11 +447,11 @@ impl CellCoupling {
                     };
                     if unsafe { update_shared(pr, i, pv, inv, mobile, omega) } {
                         let after = unsafe { (*row).r };
-                        let d = [after[0] - before[0], after[1] - before[1]];
-                        for ((x, b), m) in local.iter_mut().zip(&this.coef[s]).zip(&this.compliance)
-                        {
-                            *x += m * (b[0] * d[0] + b[1] * d[1]);
-                        }
+                        this.add_impulse(
+                            s,
+                            [after[0] - before[0], after[1] - before[1]],
+                            &mut local,
+                        );
                     }
                 }
                 std::array::from_fn(|k| local[k] - start[k])
