@@ -673,8 +673,10 @@ fn biaxial_rows(plan: &BenchPlan) -> Result<()> {
         return Ok(());
     }
     println!(
-        "\nbiaxial RVE (built-in `biaxial`, p0 = 1 kPa, dense: {} frictionless compression steps, then {} timed axial steps at I = 1e-3, μ = 0.5, tolerance 1e-4):",
-        plan.biaxial_compress_steps, plan.biaxial_steps
+        "\nbiaxial RVE (built-in `biaxial`, p0 = 1 kPa, dense: {} frictionless compression steps, then {} timed axial steps at I = 1e-3, μ = 0.5, tolerance 1e-4, the sweeps on {} thread(s), solver.parallel = true):",
+        plan.biaxial_compress_steps,
+        plan.biaxial_steps,
+        rayon::current_num_threads()
     );
     println!(
         "{:>7} {:>10} {:>9} {:>8} {:>8} {:>8} {:>8} {:>11} {:>10}",

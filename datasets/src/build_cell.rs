@@ -35,9 +35,9 @@ pub fn biaxial(c: &BiaxialConfig) -> Result<World> {
         grain: &c.grain,
         friction: c.friction.grain_grain,
         restitution: 0.0,
-        theta: 1.0,
+        theta: c.theta,
         solid_fraction: c.initial_solid_fraction,
-        dt: c.dt_max,
+        dt: c.compression_dt(),
         solver: &c.solver,
     })
 }

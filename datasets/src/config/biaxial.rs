@@ -58,8 +58,18 @@ pub struct BiaxialConfig {
     pub critical_strain: f64,
     /// Width of the axial-strain bins of the peak, dilatancy and stress–dilatancy analysis (1).
     pub bin_strain: f64,
-    /// Largest time step (s).
-    pub dt_max: f64,
+    /// Relative travel of neighbours a diameter apart per step over the mean radius (1), the
+    /// step-length rule of the axial compression: `Δt = travel_per_step · R̄ / (ε̇_a d)` with
+    /// `d = 2 R̄`, an axial strain of `travel_per_step / 2` per step at every pressure.
+    /// In [10⁻⁵, 0.1].
+    #[serde(default = "default_travel_per_step")]
+    pub travel_per_step: f64,
+    /// Largest time step (s), if given: caps the travel rule's step.
+    #[serde(default)]
+    pub dt_max: Option<f64>,
+    /// θ of the Moreau–Jean position update `q⁺ = q⁻ + h((1 − θ) v⁻ + θ v⁺)`, in [½, 1].
+    #[serde(default = "default_theta")]
+    pub theta: f64,
     /// Cap of the cell's strain rate under stress control, as an inertial number
     /// `I_cell = ε̇_max d / √(p₀/ρ)` (1), in (0, 0.1].
     pub control_inertial_number: f64,
@@ -68,6 +78,10 @@ pub struct BiaxialConfig {
     pub cell_control: CellControlMode,
     /// Duration of the isotropic compression (s).
     pub compression_time: f64,
+    /// Steps of the isotropic compression (its time step `compression_time / compression_steps`,
+    /// capped by `dt_max` if given: the compression only has to reach its target state).
+    #[serde(default = "default_compression_steps")]
+    pub compression_steps: u64,
     /// Solid fraction of the initial loose packing (1), in [0.2, 0.6].
     pub initial_solid_fraction: f64,
     /// Contact solver.
@@ -76,6 +90,22 @@ pub struct BiaxialConfig {
     /// ([`super::laws`]: checked at load, said at the start of the run).
     #[serde(default)]
     pub leave_out: Vec<String>,
+}
+
+/// The default [`BiaxialConfig::travel_per_step`]: an axial strain of 5·10⁻⁵ a step.
+fn default_travel_per_step() -> f64 {
+    1e-4
+}
+
+/// The default [`BiaxialConfig::compression_steps`]: 600 (steps of 0.25 ms at the default
+/// `compression_time`).
+fn default_compression_steps() -> u64 {
+    600
+}
+
+/// The default [`BiaxialConfig::theta`]: 1, the Moreau–Jean step that only dissipates.
+fn default_theta() -> f64 {
+    1.0
 }
 
 impl BiaxialConfig {
@@ -164,8 +194,19 @@ impl BiaxialConfig {
                 ),
             ));
         }
+        in_range("travel_per_step", self.travel_per_step, 1e-5, 0.1)?;
+        if let Some(dt) = self.dt_max {
+            positive("dt_max", dt)?;
+        }
+        in_range("theta", self.theta, 0.5, 1.0)?;
+        if self.compression_steps == 0 {
+            return Err(DatasetError::invalid(
+                "compression_steps",
+                "must be at least 1",
+            ));
+        }
         check_cell_compression(
-            self.dt_max,
+            self.compression_dt(),
             self.control_inertial_number,
             self.compression_time,
             self.initial_solid_fraction,
@@ -180,9 +221,9 @@ impl BiaxialConfig {
         let rate = self.inertial_number * (p_min / self.grain.density).sqrt() / d;
         limits::steps(
             "inertial_number",
-            &format!("max_axial_strain / (ε̇_a dt_max) at the lowest pressure ({p_min:e} Pa)"),
+            &format!("max_axial_strain / (ε̇_a Δt) at the lowest pressure ({p_min:e} Pa)"),
             self.max_axial_strain / rate,
-            self.dt_max,
+            self.axial_dt(p_min),
         )?;
         Ok(())
     }
@@ -191,5 +232,98 @@ impl BiaxialConfig {
     /// mean diameter `d = 2 R̄`.
     pub fn axial_rate(&self, p0: f64) -> f64 {
         self.inertial_number * (p0 / self.grain.density).sqrt() / (2.0 * self.grain.radius_mean)
+    }
+
+    /// `dt` capped by `dt_max` if given.
+    fn capped(&self, dt: f64) -> f64 {
+        self.dt_max.map_or(dt, |m| dt.min(m))
+    }
+
+    /// Time step of the axial compression at confining pressure `p0` (Pa): the travel rule
+    /// `Δt = travel_per_step · R̄ / (ε̇_a d)` with `d = 2 R̄`, i.e. `travel_per_step / (2 ε̇_a)`
+    /// at the axial rate [`Self::axial_rate`]: an axial strain of `travel_per_step / 2` a
+    /// step (less if `dt_max` caps it).
+    pub fn axial_dt(&self, p0: f64) -> f64 {
+        self.capped(self.travel_per_step / (2.0 * self.axial_rate(p0)))
+    }
+
+    /// Time step of the isotropic compression: `compression_time / compression_steps`, capped
+    /// by `dt_max` if given.
+    pub fn compression_dt(&self) -> f64 {
+        self.capped(self.compression_time / self.compression_steps as f64)
+    }
+
+    /// Steps of the isotropic compression: `compression_steps`, more if `dt_max` shortens
+    /// the step.
+    pub fn compression_step_count(&self) -> u64 {
+        (self.compression_time / self.compression_dt()).ceil() as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::overrides::{apply_override, parse_override};
+    use crate::scenario::{parse_table, typed, ScenarioConfig};
+
+    /// The built-in TOML with `sets` applied, typed and validated (what the loader does).
+    fn load(sets: &[&str]) -> Result<BiaxialConfig> {
+        let source = "builtin:biaxial";
+        let mut table = parse_table(include_str!("../../scenarios/biaxial.toml"), source)?;
+        for s in sets {
+            apply_override(&mut table, &parse_override(s)?, source)?;
+        }
+        let c: BiaxialConfig = typed(table, source)?;
+        c.check()?;
+        Ok(c)
+    }
+
+    /// The travel rule of the axial compression: an axial strain `ε̇_a Δt = travel_per_step / 2`
+    /// a step at every confining pressure (analytic), so the axial phase takes
+    /// `2 max_axial_strain / travel_per_step` steps whatever the pressure; grains 1000 times
+    /// larger (the axial rate 1000 times slower) take 1000 times longer steps and as many.
+    #[test]
+    fn the_axial_step_is_a_fixed_strain_at_every_pressure_and_scale() {
+        let mm = load(&[]).unwrap();
+        let m = load(&["grain.radius_mean=1.5", "grain.radius_spread=0.3"]).unwrap();
+        for &p0 in &mm.confining_pressures {
+            let strain = mm.axial_rate(p0) * mm.axial_dt(p0);
+            assert!(
+                (strain - mm.travel_per_step / 2.0).abs() < 1e-15,
+                "{p0}: {strain}"
+            );
+            let ratio = m.axial_dt(p0) / mm.axial_dt(p0);
+            assert!((ratio - 1000.0).abs() < 1e-9, "{p0}: {ratio}");
+        }
+        // the compression: compression_time in compression_steps steps
+        assert!((mm.compression_dt() - 0.15 / 600.0).abs() < 1e-18);
+        assert_eq!(mm.compression_step_count(), 600);
+    }
+
+    /// `dt_max` (not in the built-in file: a user's TOML may give it) caps both phases' steps.
+    #[test]
+    fn dt_max_caps_both_phases() {
+        let mut c = load(&[]).unwrap();
+        c.dt_max = Some(1e-4);
+        assert_eq!(c.axial_dt(1000.0), 1e-4);
+        assert_eq!(c.compression_dt(), 1e-4);
+        assert_eq!(c.compression_step_count(), 1500);
+        c.dt_max = Some(-1.0);
+        let e = c.check().unwrap_err().to_string();
+        assert!(e.contains("dt_max"), "{e}");
+    }
+
+    /// Out-of-range step keys are refused, naming the key.
+    #[test]
+    fn step_keys_out_of_range_are_refused() {
+        for (set, key) in [
+            ("travel_per_step=0", "travel_per_step"),
+            ("travel_per_step=0.2", "travel_per_step"),
+            ("compression_steps=0", "compression_steps"),
+            ("theta=0.4", "theta"),
+        ] {
+            let e = load(&[set]).unwrap_err().to_string();
+            assert!(e.contains(key), "{set}: {e}");
+        }
     }
 }

@@ -382,19 +382,17 @@ pub fn check_inertial_numbers(
     Ok(())
 }
 
-/// The keys of a biperiodic cell's isotropic compression, shared by `simple-shear` and
-/// `biaxial`: `dt_max` > 0, `control_inertial_number` in [10⁻⁶, 0.1] (the cap of the cell's
-/// strain rate under stress control), `compression_time` > 0 and at most
-/// [`limits`]-many steps of `dt_max`, `initial_solid_fraction` in [0.2, 0.6], and the solver
-/// table `solver`.
+/// The keys of a biperiodic cell's isotropic compression (`biaxial`): `control_inertial_number`
+/// in [10⁻⁶, 0.1] (the cap of the cell's strain rate under stress control),
+/// `compression_time` > 0 and at most [`limits`]-many steps of the compression's time step
+/// `dt`, `initial_solid_fraction` in [0.2, 0.6], and the solver table `solver`.
 pub fn check_cell_compression(
-    dt_max: f64,
+    dt: f64,
     control_inertial_number: f64,
     compression_time: f64,
     initial_solid_fraction: f64,
     solver: &SolverSpec,
 ) -> Result<()> {
-    positive("dt_max", dt_max)?;
     in_range(
         "control_inertial_number",
         control_inertial_number,
@@ -406,9 +404,9 @@ pub fn check_cell_compression(
     solver.validate("solver")?;
     limits::steps(
         "compression_time",
-        "compression_time / dt_max",
+        "compression_time / Δt (the step of the isotropic compression)",
         compression_time,
-        dt_max,
+        dt,
     )?;
     Ok(())
 }

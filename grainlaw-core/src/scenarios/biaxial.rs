@@ -725,7 +725,10 @@ impl PhasedRun for Biaxial<'_> {
         let (i, part) = self.part(k);
         let p0 = self.pressures[i];
         let d = mean_diameter(world);
-        let dt = c.dt_max;
+        let dt = match part {
+            Part::Compress => c.compression_dt(),
+            Part::Axial(_) => c.axial_dt(p0),
+        };
         let target = match part {
             Part::Compress | Part::Axial(0) => -p0,
             Part::Axial(_) => Self::corrected_target(st, p0),
@@ -746,7 +749,7 @@ impl PhasedRun for Biaxial<'_> {
                 world.validate(1e-9)?;
                 st.run = RunPlan {
                     dt,
-                    steps: (c.compression_time / dt).ceil() as u64,
+                    steps: c.compression_step_count(),
                     ..Default::default()
                 };
                 Ok(Some(PhasePlan::new(
@@ -1703,13 +1706,16 @@ pub struct BiaxialBench {
 }
 
 /// The overrides of the built-in `biaxial` scenario for a benchmark row of `grains` grains
-/// ([`bench_rve`]): p₀ = 1 kPa, nothing fitted.
+/// ([`bench_rve`]): p₀ = 1 kPa, nothing fitted, the sweeps on all of rayon's threads
+/// (`solver.parallel`).
 pub fn bench_sets(grains: usize) -> Vec<String> {
     vec![
         format!("grains={grains}"),
         "confining_pressures=[1000.0]".to_string(),
         // a benchmark of the engine: nothing is fitted
         r#"leave_out=["mohr-coulomb", "critical-state", "stress-dilatancy"]"#.to_string(),
+        // the sweeps on all of rayon's threads (the same numbers on any thread count)
+        "solver.parallel=true".to_string(),
     ]
 }
 
@@ -1733,7 +1739,7 @@ pub fn bench_rve(
         w.laws.set_friction(0, 0, 0.0);
     }
     let d = mean_diameter(&w);
-    let dt = c.dt_max;
+    let dt = c.compression_dt();
     w.params.dt = dt;
     w.cell_control = Some(bx.control(p0, -p0, dt, d, None));
     let t0 = std::time::Instant::now();
@@ -1743,6 +1749,8 @@ pub fn bench_rve(
     let compress_seconds = t0.elapsed().as_secs_f64();
     w.laws.set_friction(0, 0, c.friction.grain_grain);
     let rate = c.axial_rate(p0);
+    let dt = c.axial_dt(p0);
+    w.params.dt = dt;
     w.set_velocity_gradient(Mat::new(0.0, 0.0, 0.0, -rate));
     w.cell_control = Some(bx.control(p0, -p0, dt, d, Some(rate)));
     let (mut contacts, mut sweeps, mut corrections, mut unconverged) = (0usize, 0usize, 0u64, 0);
