@@ -2,7 +2,6 @@
 //! the front against `t*` with the contact-dynamics reference and the runout scalings, the
 //! profiles, the kinetic energy.
 
-use datasets::config::ColumnCollapseConfig;
 use dem::snapshot::WallGeometry;
 use plotters::style::RGBColor;
 
@@ -11,6 +10,7 @@ use crate::error::Result;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_xy, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
+use crate::scenarios::column_collapse::config::ColumnCollapseConfig;
 use crate::scenarios::RunContext;
 
 /// What the figures show.
