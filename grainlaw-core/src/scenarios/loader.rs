@@ -13,7 +13,7 @@ use datasets::overrides::{apply_override, parse_override};
 
 /// A typed, validated scenario configuration: what every scenario kind's config struct
 /// (`janssen::config::JanssenConfig`, …) tells the loader and the runners, whatever its keys.
-/// Each kind implements it in its own `config.rs` (`scenarios/NAME/config.rs`); the list of
+/// Each kind implements it beside its runner (`scenarios/NAME/mod.rs`); the list of
 /// kinds, with their built-in TOML and their runners, is the registry
 /// ([`crate::scenarios::registry`]), which the loader reads through [`Catalogue`].
 pub trait ScenarioConfig: std::fmt::Debug + Send + Sync + Any {
@@ -53,7 +53,7 @@ pub trait ScenarioConfig: std::fmt::Debug + Send + Sync + Any {
 }
 
 /// The methods every kind writes the same way: `seed`, `check` (the struct's `validate`),
-/// `as_any`; used in each kind's `config.rs`.
+/// `as_any`; used by each kind's implementation (`scenarios/NAME/mod.rs`).
 macro_rules! common_methods {
     () => {
         fn seed(&self) -> u64 {

@@ -7,9 +7,10 @@
 //!
 //! One folder per scenario (`janssen/`, `rolling/`, `arrangements/`, `stick_slip/`,
 //! `inclined_flow/`, `shear_cell/`, `simple_shear/`, `biaxial/`, `column_collapse/`): `mod.rs`
-//! the runner, `config.rs` its typed configuration (`deny_unknown_fields`, `validate`, its
-//! [`loader::ScenarioConfig`]), `build.rs` its world, and its measure, fit and figure files
-//! where it has them. What several share is in [`common`] (config pieces, laws, deposits, world
+//! the runner and its kind's [`loader::ScenarioConfig`], `config.rs` its typed configuration
+//! (`deny_unknown_fields`, `validate`), `build.rs` its world (`janssen` and `stick-slip` build
+//! the shared rained column of `common::build`), and its measure, fit and figure files where it
+//! has them. What several share is in [`common`] (config pieces, laws, deposits, world
 //! pieces, the runner's phase helpers), [`cell_base`], [`rows`], [`rheology_fit`] and
 //! [`sensitivity`].
 

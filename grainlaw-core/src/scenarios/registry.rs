@@ -6,7 +6,7 @@
 //! nowhere else; [`run_controlled`] runs a loaded one through its entry.
 //!
 //! A new scenario is one more [`Runner`] in [`SCENARIOS`] (its config struct implements
-//! [`ScenarioConfig`] in its folder's `config.rs`).
+//! [`ScenarioConfig`] in its folder's `mod.rs`).
 
 use std::sync::Arc;
 

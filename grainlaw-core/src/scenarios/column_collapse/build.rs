@@ -60,7 +60,7 @@ fn collapse_walls(w: &mut World, c: &ColumnCollapseConfig) -> (usize, usize, usi
 }
 
 /// The column of `column-collapse` before its release: [`ColumnCollapseConfig::poured_grains`]
-/// seeded polydisperse grains deposited by drop and roll ([`crate::generators::deposition`])
+/// seeded polydisperse grains deposited by drop and roll ([`datasets::generators::deposition`])
 /// between the symmetry wall x = 0 and the gate x = R₀, on the rough floor (the deposition's
 /// floor y = 0 is the floor disks' tops). Time step `dt / deposit.substeps`, gravity −g ŷ.
 pub fn column_collapse_deposit(c: &ColumnCollapseConfig) -> Result<CollapseWorld> {
