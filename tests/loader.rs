@@ -2,10 +2,10 @@
 //! arbitrary input (property tests), reproducible generation.
 
 use datasets::DatasetError;
+use grainlaw::scenarios::common::build::{column, column_width};
+use grainlaw::scenarios::janssen::config::JanssenConfig;
 use grainlaw::scenarios::registry::{config_of, from_text, load, SCENARIOS};
-use grainlaw_core::scenarios::common::build::{column, column_width};
-use grainlaw_core::scenarios::janssen::config::JanssenConfig;
-use grainlaw_core::scenarios::stick_slip::config::StickSlipConfig;
+use grainlaw::scenarios::stick_slip::config::StickSlipConfig;
 use proptest::prelude::*;
 
 #[test]
@@ -133,7 +133,7 @@ fn janssen_geometry_and_reproducible_generation() {
     let a = column(&c.grain, c.grains, w, &c.friction, 7, 1e-3).unwrap();
     let b = column(&c.grain, c.grains, w, &c.friction, 7, 1e-3).unwrap();
     let d = column(&c.grain, c.grains, w, &c.friction, 8, 1e-3).unwrap();
-    let pos = |x: &grainlaw_core::scenarios::common::build::ColumnWorld| -> Vec<u64> {
+    let pos = |x: &grainlaw::scenarios::common::build::ColumnWorld| -> Vec<u64> {
         x.world
             .bodies
             .iter()
@@ -165,9 +165,9 @@ fn janssen_geometry_and_reproducible_generation() {
 fn run_until_rest_stops_at_rest() {
     let c: StickSlipConfig = config_of(&load("stick-slip", &["grains=3".into()]).unwrap()).unwrap();
     let mut col = column(&c.grain, 3, 0.02, &c.cases.walls_and_grains, 1, 1e-3).unwrap();
-    let stats = grainlaw_core::scenarios::phases::run_until_rest(
+    let stats = grainlaw::scenarios::phases::run_until_rest(
         &mut col.world,
-        &grainlaw_core::scenarios::phases::RunUntilRest {
+        &grainlaw::scenarios::phases::RunUntilRest {
             min_time: 0.0,
             max_time: 2.0,
             rest_energy: 1e-8,
@@ -176,12 +176,10 @@ fn run_until_rest_stops_at_rest() {
     )
     .unwrap();
     assert!(stats.at_rest);
+    assert!(stats.steps < 2000 && stats.steps >= grainlaw::scenarios::phases::REST_STEPS as u64);
     assert!(
-        stats.steps < 2000 && stats.steps >= grainlaw_core::scenarios::phases::REST_STEPS as u64
-    );
-    assert!(
-        grainlaw_core::scenarios::phases::translational_energy(&col.world)
-            < 1e-8 * grainlaw_core::scenarios::phases::energy_scale(&col.world)
+        grainlaw::scenarios::phases::translational_energy(&col.world)
+            < 1e-8 * grainlaw::scenarios::phases::energy_scale(&col.world)
     );
 }
 

@@ -6,22 +6,22 @@
 
 pub mod build;
 pub mod config;
-use datasets::generators::Arrangement;
 
+use datasets::generators::Arrangement;
 use serde::{Deserialize, Serialize};
 
 use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::{PhaseStats, RunUntilRest};
 use super::rows::{self, serde_csv_table, table_row};
 use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::Summary;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
-use crate::scenarios::arrangements::config::ArrangementsConfig;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::{PhaseStats, RunUntilRest};
 use build::arrangement;
+use config::ArrangementsConfig;
 
 /// One phase per arrangement (rectangular, triangular, cannonball), each settling its own
 /// stack to rest.
@@ -56,7 +56,7 @@ impl PhasedRun for Stacks<'_> {
         let (k, world) = (at.k, at.world);
         let c = self.c;
         let kind = Arrangement::ALL[k];
-        *world = crate::scenarios::arrangements::build::arrangement(c, kind)?;
+        *world = build::arrangement(c, kind)?;
         st.weight = grain_weight(world);
         st.vtk = VtkFrames::with_prefix(&format!("{}_", kind.name()), c.duration / 10.0, 11);
         let rest = RunUntilRest {

@@ -25,6 +25,7 @@
 
 pub mod build;
 pub mod config;
+
 use dem::cell::{CellControl, Imposed};
 use dem::math::Tensor as Mat;
 use homogenise::averaging::block_average;
@@ -38,10 +39,13 @@ use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
 use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
+use super::common::laws::LawNeed;
 use super::common::{
     fit_keys, mean_diameter, parameter_lines, short_number, strain_bins, Stop, VtkFrames,
 };
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::rows::{self, serde_rows, table_row};
 use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -50,13 +54,10 @@ use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::warn;
-use crate::scenarios::biaxial::config::{BiaxialConfig, Preparation};
-use crate::scenarios::common::laws::LawNeed;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::PhaseStats;
 use crate::verdict::{
     export_law, max_solid_fraction, remove_stale_law, Checks, RunVerdict, Verdict, WindowStats,
 };
+use config::{BiaxialConfig, Preparation};
 
 cell_history_row! {
     /// One step of the axial compression: a row of `history_p{k}.csv`.
@@ -739,7 +740,7 @@ impl PhasedRun for Biaxial<'_> {
         match part {
             Part::Compress => {
                 // the same initial packing for every pressure
-                *world = crate::scenarios::biaxial::build::biaxial(c)?;
+                *world = build::biaxial(c)?;
                 if c.preparation == Preparation::Dense {
                     world.laws.set_friction(0, 0, 0.0);
                 }
@@ -923,7 +924,7 @@ pub fn run(c: &BiaxialConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Res
     pressures.sort_by(f64::total_cmp);
     let bx = Biaxial { c, pressures };
     let fresh = || -> Result<(dem::World, State)> {
-        let world = crate::scenarios::biaxial::build::biaxial(c)?;
+        let world = build::biaxial(c)?;
         let p_last = *bx.pressures.last().unwrap_or(&1.0);
         let t_last = c.compression_time + c.max_axial_strain / c.axial_rate(p_last);
         Ok((
@@ -1732,7 +1733,7 @@ pub fn bench_rve(
         pressures: vec![1000.0],
     };
     let p0 = 1000.0;
-    let mut w = crate::scenarios::biaxial::build::biaxial(c)?;
+    let mut w = build::biaxial(c)?;
     if c.preparation == Preparation::Dense {
         w.laws.set_friction(0, 0, 0.0);
     }

@@ -5,12 +5,12 @@
 use dem::snapshot::WallGeometry;
 use plotters::style::RGBColor;
 
+use super::config::ColumnCollapseConfig;
 use super::{scaling, FrontSample, HistoryRow, LabelledProfile};
 use crate::error::Result;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_xy, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::scenarios::column_collapse::config::ColumnCollapseConfig;
 use crate::scenarios::RunContext;
 
 /// What the figures show.

@@ -20,16 +20,16 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::{CliError, Result};
 use crate::output::{CsvTable, OutputDir, Summary};
 use crate::progress::{info, warn};
-use crate::scenarios::column_collapse::config::ColumnCollapseConfig;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::PhaseStats;
 use crate::verdict::{Checks, RunVerdict, Verdict, WindowStats};
+use config::ColumnCollapseConfig;
 
 pub mod build;
 pub mod config;
@@ -206,8 +206,7 @@ impl PhasedRun for Collapse<'_> {
             )),
             COLLAPSE => {
                 st.deposited = grain_count(world);
-                let released =
-                    crate::scenarios::column_collapse::build::column_collapse_release(c, world)?;
+                let released = build::column_collapse_release(c, world)?;
                 *world = released.world;
                 c.collapse.solver.apply(&mut world.params);
                 st.d = mean_diameter(world);
@@ -367,7 +366,7 @@ fn simulate(
     let ts = c.time_scale();
     let run = Collapse { c };
     let fresh = || -> Result<(dem::World, CollapseState)> {
-        let col = crate::scenarios::column_collapse::build::column_collapse_deposit(c)?;
+        let col = build::column_collapse_deposit(c)?;
         let state = CollapseState {
             deposit: PhaseStats::default(),
             collapse: PhaseStats::default(),

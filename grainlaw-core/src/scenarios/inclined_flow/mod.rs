@@ -9,6 +9,7 @@
 
 pub mod build;
 pub mod config;
+
 use dem::snapshot::Snapshot;
 use dem::BodyKind;
 use homogenise::inertia_ratio::{fluid_fraction, inertia_ratios};
@@ -16,7 +17,9 @@ use homogenise::inertia_ratio::{fluid_fraction, inertia_ratios};
 use serde::{Deserialize, Serialize};
 
 use super::common::{mean_diameter, solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::rows::{self, serde_csv_table, table_row};
 use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -26,11 +29,9 @@ use crate::plot::colormap::Scale;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, draw_xy, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::scenarios::inclined_flow::config::InclinedFlowConfig;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::PhaseStats;
 use crate::verdict::{max_solid_fraction, Checks, WindowStats};
 use build::inclined_flow;
+use config::InclinedFlowConfig;
 
 /// Relative difference of the window halves of the mean velocity that matters for a steady
 /// flow (1; [`crate::verdict::halves_drift`]).
@@ -203,12 +204,12 @@ fn simulate(
         1.6 * crate::scenarios::common::build::grain_area(world) / (0.75 * length)
     };
     let bins = {
-        let world = crate::scenarios::inclined_flow::build::inclined_flow(c)?;
+        let world = build::inclined_flow(c)?;
         let fit = (layer_height(&world) / (2.0 * c.grain.radius_mean)).floor() as usize;
         c.profile_bins.min(fit.max(1))
     };
     let fresh = || -> Result<(dem::World, FlowState)> {
-        let world = crate::scenarios::inclined_flow::build::inclined_flow(c)?;
+        let world = build::inclined_flow(c)?;
         let h_est = layer_height(&world) / 1.6;
         let state = FlowState {
             base: c.grain.radius_mean, // top of the rough base (disks centred on y = 0)

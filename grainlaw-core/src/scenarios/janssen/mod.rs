@@ -26,8 +26,12 @@ use identify::janssen::JanssenSetup;
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
+use super::common::build::{column, column_width};
+use super::common::laws::LawNeed;
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::rows::{self, serde_csv_table, table_row};
 use super::sensitivity::{resolve_last_step, Resolved};
 use super::{RunContext, RunOutcome};
@@ -35,12 +39,8 @@ use crate::checkpoint::PhasePlan;
 use crate::error::Result;
 use crate::output::{CsvTable, OutputDir, Summary};
 use crate::progress::{info, warn};
-use crate::scenarios::common::build::{column, column_width};
-use crate::scenarios::common::laws::LawNeed;
-use crate::scenarios::janssen::config::JanssenConfig;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::PhaseStats;
 use crate::verdict::{export_law, max_solid_fraction, Checks, RunVerdict, Verdict, WindowStats};
+use config::JanssenConfig;
 
 pub mod config;
 mod figures;

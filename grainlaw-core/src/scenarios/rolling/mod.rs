@@ -13,13 +13,15 @@
 
 pub mod build;
 pub mod config;
+
 use dem::math::Vector;
 use homogenise::tensor::{frobenius, in_frame, skew_ratio, Tensor2};
-
 use serde::{Deserialize, Serialize};
 
 use super::common::{solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::rows::{self, serde_csv_table, table_row};
 use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -27,10 +29,8 @@ use crate::error::{CliError, Result};
 use crate::output::{OutputDir, Summary};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::PhaseStats;
-use crate::scenarios::rolling::config::RollingConfig;
 use build::rolling;
+use config::RollingConfig;
 
 /// Exact acceleration along the slope (m/s²), friction force over m g (up the slope), and
 /// whether the disk rolls without slipping.
@@ -191,7 +191,7 @@ fn simulate(
     ctl: &mut RunControl,
 ) -> Result<(dem::World, RollState)> {
     let fresh = || -> Result<(dem::World, RollState)> {
-        let (world, e1, e2) = crate::scenarios::rolling::build::rolling(c)?;
+        let (world, e1, e2) = build::rolling(c)?;
         let c0 = world.bodies[1].position;
         let state = RollState {
             e1,

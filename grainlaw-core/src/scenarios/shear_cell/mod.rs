@@ -12,6 +12,7 @@
 
 pub mod build;
 pub mod config;
+
 use dem::math::{Tensor, Vector};
 use dem::snapshot::Snapshot;
 use homogenise::kinematics::{velocity_gradient, VelocityWeight};
@@ -25,10 +26,13 @@ use identify::{CalibratedLaw, FitOptions};
 
 use serde::{Deserialize, Serialize};
 
+use super::common::laws::LawNeed;
 use super::common::{
     add_fitted_curve, delta_band, fit_keys, mean_diameter, parameter_lines, Stop, VtkFrames,
 };
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::rows::{self, serde_rows, table_row, TableRow};
 use super::sensitivity::{record, Resolved};
 use super::{RunContext, RunOutcome};
@@ -39,15 +43,12 @@ use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
 use crate::progress::{info, warn};
-use crate::scenarios::common::laws::LawNeed;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::PhaseStats;
-use crate::scenarios::shear_cell::config::ShearCellConfig;
 use crate::verdict::{
     export_law, max_solid_fraction, Checks, RunVerdict, Sensitivity, Verdict, WindowStats,
     SENSITIVITY_MU_SUSPECT, SENSITIVITY_PRESSURE_SUSPECT, SENSITIVITY_TOLERANCE,
 };
 use build::shear_cell;
+use config::ShearCellConfig;
 
 /// Averages of one run (sums of finite samples).
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -415,7 +416,7 @@ struct ShearState {
     #[serde(default)]
     lead_sensitivity: Sensitivity,
     /// Decades by which the lead stages have tightened the solver tolerance so far
-    /// ([`crate::scenarios::shear_cell::config::ShearCellConfig::solver_tightenings`]).
+    /// ([`config::ShearCellConfig::solver_tightenings`]).
     #[serde(default)]
     tightenings: u32,
     /// Mean cost per step of the last phase's solves, in sweeps
@@ -752,7 +753,7 @@ fn simulate(
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
     let fresh = || -> Result<(dem::World, ShearState)> {
-        let (world, _) = crate::scenarios::shear_cell::build::shear_cell(c)?;
+        let (world, _) = build::shear_cell(c)?;
         let state = ShearState {
             all: PhaseStats::default(),
             rows: Vec::new(),

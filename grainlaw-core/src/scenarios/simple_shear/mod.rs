@@ -13,6 +13,7 @@
 
 pub mod build;
 pub mod config;
+
 use dem::cell::{CellControl, Imposed};
 use dem::math::Tensor as Mat;
 use homogenise::averaging::block_average;
@@ -23,7 +24,9 @@ use identify::mu_i::RheologySeries;
 use serde::{Deserialize, Serialize};
 
 use super::cell_base::{cell_history_row, CellRecord, ControlPlan, GAIN_FRACTION, MIN_BLOCKS};
+use super::common::laws::LawNeed;
 use super::common::{mean_diameter, strain_bins, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
 use super::rows::{self, table_row};
 use super::shear_cell::{judge_runs, RunCheckData};
@@ -33,9 +36,7 @@ use crate::error::Result;
 use crate::output::Summary;
 use crate::plot::xy::{draw_row, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::scenarios::common::laws::LawNeed;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::simple_shear::config::SimpleShearConfig;
+use config::SimpleShearConfig;
 
 /// Whether window step `j` (0-based) of a window of `len` steps is re-solved: `samples`
 /// (`sensitivity_samples`, 20 by default) spread evenly over the window, the last step of each
@@ -366,12 +367,8 @@ impl PhasedRun for Shear<'_> {
         let i = self.targets[k - 1];
         let gamma_dot = i * (c.pressure / c.grain.density).sqrt() / d;
         let dt = c.shear_dt(gamma_dot, d);
-        let steps =
-            crate::scenarios::simple_shear::config::whole_steps(c.strain / (gamma_dot * dt));
-        let avg_steps = crate::scenarios::simple_shear::config::whole_steps(
-            c.average_strain / (gamma_dot * dt),
-        )
-        .min(steps);
+        let steps = config::whole_steps(c.strain / (gamma_dot * dt));
+        let avg_steps = config::whole_steps(c.average_strain / (gamma_dot * dt)).min(steps);
         world.params.dt = dt;
         let l = world.cell().map_or_else(Mat::zeros, |cell| cell.l);
         world.set_velocity_gradient(Mat::new(0.0, gamma_dot, 0.0, l[(1, 1)]));
@@ -512,7 +509,7 @@ fn simulate(
     targets.sort_by(f64::total_cmp);
     let shear = Shear { c, targets };
     let fresh = || -> Result<(dem::World, State)> {
-        let world = crate::scenarios::simple_shear::build::simple_shear(c)?;
+        let world = build::simple_shear(c)?;
         let t_total = c.compression_duration * c.grain_time()
             + shear
                 .targets

@@ -5,12 +5,15 @@
 //! then regular), friction at the walls and between grains (load–unload cycles).
 
 pub mod config;
-use dem::math::Vector;
 
+use dem::math::Vector;
 use serde::{Deserialize, Serialize};
 
+use super::common::build::column;
 use super::common::{grain_weight, solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::rows::{self, serde_csv_table, table_row};
 use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
@@ -19,11 +22,8 @@ use crate::output::Summary;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};
 use crate::plot::xy::{draw_column, Axis, LegendAt, Series, Style, XyPlot};
 use crate::plot::PALETTE;
-use crate::scenarios::common::build::column;
-use crate::scenarios::loader::{common_methods, ScenarioConfig};
-use crate::scenarios::phases::PhaseStats;
-use crate::scenarios::stick_slip::config::StickSlipConfig;
 use crate::verdict::WindowStats;
+use config::StickSlipConfig;
 
 /// Mean and standard deviation of a series.
 pub fn mean_std(v: &[f64]) -> (f64, f64) {
