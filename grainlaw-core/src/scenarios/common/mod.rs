@@ -1,6 +1,9 @@
-//! Pieces every scenario runner uses: phases with progress and honest solver and numerics
-//! accounting, VTK frames at a fixed simulated-time interval, the solver keys of
-//! `summary.json`.
+//! What several scenarios share. Here: the pieces every scenario runner uses (phases with
+//! progress and honest solver and numerics accounting, VTK frames at a fixed simulated-time
+//! interval, the solver keys of `summary.json`); in the submodules, the shared pieces of the
+//! configurations ([`config`]: grains, friction, solver, cell control; [`deposit`]; [`laws`],
+//! the laws a plan fits and the data each needs) and of the worlds ([`build`]: walls, the
+//! rained column of `janssen` and `stick-slip`, rough beds, the loose biperiodic cell).
 
 pub mod build;
 pub mod config;
