@@ -8,11 +8,11 @@
 use std::io::{BufWriter, Write};
 use std::time::Instant;
 
-use datasets::phases::PhaseProgress;
 use dem::{ContactLaws, SolverParams, World, WorldParams};
 use grainlaw::checkpoint::{self, Cursor, PhasePlan, RunCheckpoint, ScenarioRecord};
 use grainlaw::provenance::RunOrigin;
 use grainlaw::scenarios::common::Stop;
+use grainlaw::scenarios::phases::PhaseProgress;
 use nalgebra::Vector2;
 
 /// A triangular lattice of `n` disks of radius about `r` (1 mm, scaled down by up to 1 %), rows

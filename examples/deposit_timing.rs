@@ -1,6 +1,6 @@
 //! Times the janssen deposition and relaxation phases for a few sub-step counts.
 //! `cargo run --release --example deposit_timing -- [grains] [substeps...]`
-use datasets::phases::{run_until_rest, RunUntilRest};
+use grainlaw::scenarios::phases::{run_until_rest, RunUntilRest};
 use std::time::Instant;
 
 fn main() {
@@ -13,11 +13,12 @@ fn main() {
     };
     let loaded =
         grainlaw::scenarios::registry::load("janssen", &[format!("grains={grains}")]).unwrap();
-    let c: datasets::config::JanssenConfig =
+    let c: grainlaw::scenarios::janssen::config::JanssenConfig =
         grainlaw::scenarios::registry::config_of(&loaded).unwrap();
     for s in subs {
-        let width = datasets::build::column_width(&c.grain, c.grains, c.column_aspect);
-        let mut col = datasets::build::column(
+        let width =
+            grainlaw::scenarios::common::build::column_width(&c.grain, c.grains, c.column_aspect);
+        let mut col = grainlaw::scenarios::common::build::column(
             &c.grain,
             c.grains,
             width,

@@ -14,7 +14,7 @@
 //! numbers differ compare best on the cost of the same stretch of simulated time.
 //!
 //! `cargo run --release --example pour_fingerprint -- [grains (2000)] [seed (1)] [steps]`
-use datasets::benchmarks::{janssen_column, ColumnRun, Preparation};
+use grainlaw::benchmarks::{janssen_column, ColumnRun, Preparation};
 use std::time::Instant;
 
 fn fnv(h: &mut u64, x: u64) {

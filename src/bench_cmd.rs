@@ -6,10 +6,10 @@
 //!    else its quoted figures, labelled as quoted.
 //! 2. Bare Gauss–Seidel sweep throughput (contact updates per second, one core).
 //! 3. Engine time per step of a settled deposit about 25 grains deep in a box that widens with
-//!    N ([`datasets::benchmarks::scaling_deposit`]), on 1 and 2 threads (colour-ordered parallel
-//!    solve, the same numbers on both), with the fitted exponent of `t ∝ Nᵃ`.
+//!    N ([`crate::benchmarks::scaling_deposit`]), on 1 and 2 threads (colour-ordered
+//!    parallel solve, the same numbers on both), with the fitted exponent of `t ∝ Nᵃ`.
 //! 4. Janssen columns settled to kinetic / potential energy < 10⁻⁸
-//!    ([`datasets::benchmarks::settle_column`]) against a soft-contact code, LAMMPS (Hookean
+//!    ([`crate::benchmarks::settle_column`]) against a soft-contact code, LAMMPS (Hookean
 //!    with history, one core), run in the same bench on the same initial column
 //!    ([`crate::lammps_peer`]) when `lmp` is found; otherwise against its quoted times,
 //!    labelled as quoted.
@@ -22,7 +22,7 @@
 
 use std::path::Path;
 
-use datasets::benchmarks::{
+use crate::benchmarks::{
     scaling_deposit, scaling_exponent, settle_column, time_steps, ColumnRun, Preparation,
     ScalingRow,
 };
@@ -312,7 +312,7 @@ fn columns(plan: &BenchPlan) -> Result<()> {
 fn print_columns_header(lammps: Option<&Path>, wall_limit: f64) {
     println!(
         "\nJanssen column settled to KE/PE < 1e-8 (radius 1–2 mm, μ = 0.5, box 40 mean diameters; one thread below {} grains, else all):",
-        datasets::benchmarks::PARALLEL_FROM_GRAINS
+        crate::benchmarks::PARALLEL_FROM_GRAINS
     );
     match lammps {
         Some(lmp) => println!(
@@ -379,7 +379,7 @@ fn column_seeds(
         let total = r.total_seconds();
         let peer = match lammps {
             Some(lmp) => {
-                let w = datasets::benchmarks::janssen_column(n, prep, &run, seed)?;
+                let w = crate::benchmarks::janssen_column(n, prep, &run, seed)?;
                 let column =
                     crate::lammps_peer::PeerColumn::from_world(&w, 1e-8, run.max_time, wall_limit)?;
                 let dir = std::env::temp_dir().join(format!(
@@ -692,7 +692,7 @@ fn biaxial_rows(plan: &BenchPlan) -> Result<()> {
     );
     for &n in &plan.biaxial_grains {
         let loaded = registry::load("biaxial", &biaxial::bench_sets(n))?;
-        let c: datasets::config::BiaxialConfig = registry::config_of(&loaded)?;
+        let c: crate::scenarios::biaxial::config::BiaxialConfig = registry::config_of(&loaded)?;
         let r = biaxial::bench_rve(&c, plan.biaxial_compress_steps, plan.biaxial_steps)?;
         println!(
             "{:>7} {:>10.1} {:>9.0} {:>8.1} {:>8.2} {:>8} {:>8.3} {:>11.2e} {:>10.0}",
@@ -858,7 +858,7 @@ const QUOTED_RVE: QuotedRve = QuotedRve {
 
 /// grainlaw's side of one race.
 struct OurRve {
-    loaded: datasets::LoadedScenario,
+    loaded: crate::scenarios::loader::LoadedScenario,
     total_seconds: f64,
     prep_seconds: f64,
     shear_seconds: f64,
@@ -1029,7 +1029,8 @@ fn rve_race(n: usize, plan: &RvePlan, lammps: Option<&Path>, wall_limit: f64) ->
         Some(o) => o.loaded.clone(),
         None => crate::scenarios::registry::load("simple-shear", &rve_sets(n, plan))?,
     };
-    let c: datasets::config::SimpleShearConfig = crate::scenarios::registry::config_of(&loaded)?;
+    let c: crate::scenarios::simple_shear::config::SimpleShearConfig =
+        crate::scenarios::registry::config_of(&loaded)?;
     let contact = lr::PeerContact {
         kappa: plan.kappa,
         restitution: plan.restitution,

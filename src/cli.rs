@@ -748,7 +748,7 @@ fn resumed_scenario(
     dir: &Path,
     scenario: Option<&str>,
     set: &[String],
-) -> Result<(datasets::LoadedScenario, Vec<String>, bool)> {
+) -> Result<(crate::scenarios::loader::LoadedScenario, Vec<String>, bool)> {
     let cp: RunCheckpoint<serde::de::IgnoredAny> = checkpoint::read(dir)?;
     let rec = cp.scenario;
     let refuse = |given: String| CliError::Checkpoint {
@@ -798,7 +798,7 @@ fn scenarios_cmd(show: Option<&str>) -> Result<()> {
             print!("{}", s.builtin_toml());
             // the laws it fits and the data each needs, from the same table the load checks
             let loaded = registry::load(name, &[])?;
-            let needs = datasets::config::laws::describe(&loaded.config.law_needs());
+            let needs = crate::scenarios::common::laws::describe(&loaded.config.law_needs());
             if !needs.is_empty() {
                 println!("\n{}", needs.join("\n"));
             }

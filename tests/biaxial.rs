@@ -8,8 +8,8 @@ mod common;
 use common::{assert_same_outputs, grainlaw, run_stopped_and_resumed, stderr};
 use std::path::Path;
 
-/// The laws one pressure cannot identify (Mohr–Coulomb needs 3, the critical state 2 as
-/// replicas: `datasets::config::laws`), left out so that a one-pressure plan runs; the
+/// The laws one pressure cannot identify (Mohr–Coulomb needs 3, the critical state 2 as replicas:
+/// `grainlaw::scenarios::common::laws`), left out so that a one-pressure plan runs; the
 /// stress–dilatancy relation is still tried.
 const ONE_PRESSURE: &str = r#"leave_out=["mohr-coulomb", "critical-state"]"#;
 

@@ -1,10 +1,11 @@
 //! The scenario loader: built-ins, overrides, typed errors naming the key or line, no panic on
 //! arbitrary input (property tests), reproducible generation.
 
-use datasets::build::{column, column_width};
-use datasets::config::{JanssenConfig, StickSlipConfig};
 use datasets::DatasetError;
+use grainlaw::scenarios::common::build::{column, column_width};
+use grainlaw::scenarios::janssen::config::JanssenConfig;
 use grainlaw::scenarios::registry::{config_of, from_text, load, SCENARIOS};
+use grainlaw::scenarios::stick_slip::config::StickSlipConfig;
 use proptest::prelude::*;
 
 #[test]
@@ -132,7 +133,7 @@ fn janssen_geometry_and_reproducible_generation() {
     let a = column(&c.grain, c.grains, w, &c.friction, 7, 1e-3).unwrap();
     let b = column(&c.grain, c.grains, w, &c.friction, 7, 1e-3).unwrap();
     let d = column(&c.grain, c.grains, w, &c.friction, 8, 1e-3).unwrap();
-    let pos = |x: &datasets::build::ColumnWorld| -> Vec<u64> {
+    let pos = |x: &grainlaw::scenarios::common::build::ColumnWorld| -> Vec<u64> {
         x.world
             .bodies
             .iter()
@@ -164,9 +165,9 @@ fn janssen_geometry_and_reproducible_generation() {
 fn run_until_rest_stops_at_rest() {
     let c: StickSlipConfig = config_of(&load("stick-slip", &["grains=3".into()]).unwrap()).unwrap();
     let mut col = column(&c.grain, 3, 0.02, &c.cases.walls_and_grains, 1, 1e-3).unwrap();
-    let stats = datasets::phases::run_until_rest(
+    let stats = grainlaw::scenarios::phases::run_until_rest(
         &mut col.world,
-        &datasets::phases::RunUntilRest {
+        &grainlaw::scenarios::phases::RunUntilRest {
             min_time: 0.0,
             max_time: 2.0,
             rest_energy: 1e-8,
@@ -175,10 +176,10 @@ fn run_until_rest_stops_at_rest() {
     )
     .unwrap();
     assert!(stats.at_rest);
-    assert!(stats.steps < 2000 && stats.steps >= datasets::phases::REST_STEPS as u64);
+    assert!(stats.steps < 2000 && stats.steps >= grainlaw::scenarios::phases::REST_STEPS as u64);
     assert!(
-        datasets::phases::translational_energy(&col.world)
-            < 1e-8 * datasets::phases::energy_scale(&col.world)
+        grainlaw::scenarios::phases::translational_energy(&col.world)
+            < 1e-8 * grainlaw::scenarios::phases::energy_scale(&col.world)
     );
 }
 

@@ -49,8 +49,9 @@ fn output_dir_writes_atomically_and_removes_a_stale_summary() {
 #[test]
 fn vtk_polydata_counts() {
     let l = grainlaw::scenarios::registry::load("rolling", &[]).unwrap();
-    let c: datasets::config::RollingConfig = grainlaw::scenarios::registry::config_of(&l).unwrap();
-    let (mut w, _, _) = datasets::build::rolling(&c).unwrap();
+    let c: grainlaw::scenarios::rolling::config::RollingConfig =
+        grainlaw::scenarios::registry::config_of(&l).unwrap();
+    let (mut w, _, _) = grainlaw::scenarios::rolling::build::rolling(&c).unwrap();
     for _ in 0..5 {
         w.step().unwrap();
     }

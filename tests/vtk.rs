@@ -157,7 +157,7 @@ fn id_of(s: &Snapshot, body: u32) -> f64 {
 /// several compressed blocks.
 #[test]
 fn frames_decode_to_the_snapshot() {
-    let mut w = datasets::benchmarks::grid_world(600, 0.08, 0.3, 3);
+    let mut w = grainlaw::benchmarks::grid_world(600, 0.08, 0.3, 3);
     for _ in 0..300 {
         w.step().unwrap();
     }
@@ -303,7 +303,7 @@ fn frames_decode_to_the_snapshot() {
 /// An empty frame (no contact) is a valid file with empty arrays (no block).
 #[test]
 fn an_empty_contact_frame_decodes() {
-    let w = datasets::benchmarks::grid_world(10, 0.05, 0.3, 1);
+    let w = grainlaw::benchmarks::grid_world(10, 0.05, 0.3, 1);
     let s = w.snapshot();
     assert!(s.contacts.is_empty());
     let c = parse(&contacts_vtp(&s));

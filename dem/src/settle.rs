@@ -1,7 +1,7 @@
 //! Settling a world to rest: [`settle`] steps it (with an optional adaptive step,
 //! [`StepControl`], or the subdivision of unconverged steps, [`step_subdivided`]) until the
 //! kinetic over potential energy [`energy_ratio`] falls below a target after a converged step,
-//! and reports the run ([`SettleReport`]). The benchmark columns of `datasets::benchmarks`
+//! and reports the run ([`SettleReport`]). The benchmark columns of `grainlaw_core::benchmarks`
 //! (`grainlaw bench`) settle through it.
 
 use std::time::Instant;

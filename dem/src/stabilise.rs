@@ -37,11 +37,12 @@
 //! swept in their stored order (sorted by collider pair) on one thread, so the result does not
 //! depend on the thread count.
 //!
-//! Energy: the projection does no kinetic work, but it moves bodies under gravity and applied
-//! loads `f`; their work over the projection, `W_corr = Σ f·Δq_corr` over free degrees of freedom
-//! ([`CorrectionReport::load_work`]), is the opposite of the potential-energy change it causes.
-//! It is reported separately; the energy balance of the step ([`crate::world`],
-//! `datasets::phases`) counts the work of the loads along the velocities and is left unchanged.
+//! Energy: the projection does no kinetic work, but it moves bodies under gravity and applied loads
+//! `f`; their work over the projection, `W_corr = Σ f·Δq_corr` over free degrees of freedom
+//! ([`CorrectionReport::load_work`]), is the opposite of the potential-energy change it causes. It
+//! is reported separately; the energy balance of the step ([`crate::world`],
+//! `grainlaw_core::scenarios::phases`) counts the work of the loads along the velocities and is
+//! left unchanged.
 //!
 //! References: M. B. Cline, D. K. Pai, *Post-stabilization for rigid body simulation with contact
 //! and constraints*, IEEE ICRA 2003 (the projection `Δq = M⁻¹ Hᵀ P` after the velocity step);

@@ -14,8 +14,8 @@ const G: f64 = 9.81;
 /// Smallest grain radius of the sheared strip (m).
 const R_MIN: f64 = 1e-3;
 
-/// The energy-growth tolerance of `datasets::phases` (`ENERGY_GROWTH_TOLERANCE`): a step whose
-/// residual δ exceeds this fraction of the load energy scale counts as an energy growth.
+/// The energy-growth tolerance of `grainlaw_core::scenarios::phases` (`ENERGY_GROWTH_TOLERANCE`): a
+/// step whose residual δ exceeds this fraction of the load energy scale counts as an energy growth.
 const ENERGY_GROWTH_TOLERANCE: f64 = 1e-5;
 
 /// Largest geometric overlap over the smallest grain radius after the last step: every pair of
@@ -261,14 +261,14 @@ fn a_disk_inside_a_fixed_floor_is_lifted_and_the_work_reported() {
     assert!(w.kinetic_energy() <= 1e-12 * m * G * r);
 }
 
-/// Issue 12's sheared dense packing: 300 disks (radius 1–1.5 mm, μ = 0.5) in a periodic strip
-/// under gravity, settled for 200 steps, loaded by a rough top wall at 1 kPa (free along y, 0.2
-/// times the grains' mass) for 150 steps, then sheared by it at 0.1 m/s for 500 steps (h = 0.5
-/// ms, about 0.05 R_min per step; Gauss–Seidel to 10⁻⁵ with at most 300 sweeps, so many steps
-/// end at the cap and leave approaching contacts behind). At every step: the largest overlap
-/// after the step, computed from the positions, stays ≤ 0.1 % of R_min, and the energy residual
-/// `δ = ΔK − W_ext − W_drive` (the check of `datasets::phases`) stays ≤ 10⁻⁵ E_load. The same
-/// loading and shear without the correction, from the same settled state, goes beyond 0.1 %.
+/// Issue 12's sheared dense packing: 300 disks (radius 1–1.5 mm, μ = 0.5) in a periodic strip under
+/// gravity, settled for 200 steps, loaded by a rough top wall at 1 kPa (free along y, 0.2 times the
+/// grains' mass) for 150 steps, then sheared by it at 0.1 m/s for 500 steps (h = 0.5 ms, about 0.05
+/// R_min per step; Gauss–Seidel to 10⁻⁵ with at most 300 sweeps, so many steps end at the cap and
+/// leave approaching contacts behind). At every step: the largest overlap after the step, computed
+/// from the positions, stays ≤ 0.1 % of R_min, and the energy residual `δ = ΔK − W_ext − W_drive`
+/// (the check of `grainlaw_core::scenarios::phases`) stays ≤ 10⁻⁵ E_load. The same loading and
+/// shear without the correction, from the same settled state, goes beyond 0.1 %.
 #[test]
 fn a_sheared_dense_packing_keeps_its_overlaps_below_a_thousandth_of_the_radius() {
     let solver = SolverParams {

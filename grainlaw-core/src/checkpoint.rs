@@ -22,7 +22,6 @@ use std::fs::File;
 use std::io::{self, BufReader, Write};
 use std::path::{Path, PathBuf};
 
-use datasets::phases::{PhaseProgress, RunUntilRest};
 use dem::checkpoint::WorldState;
 use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
@@ -32,6 +31,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CliError, Result};
+use crate::scenarios::phases::{PhaseProgress, RunUntilRest};
 
 /// Format tag of run checkpoints. v2: a biperiodic cell may be under the implicit control
 /// (`dem::cell::CellControl::implicit`), the default of `simple-shear` and `biaxial`, whose

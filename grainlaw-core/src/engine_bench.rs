@@ -1,5 +1,5 @@
 //! Measurements of the engine behind `grainlaw bench` (`grainlaw::bench_cmd`; the benchmark
-//! worlds are built in `datasets::benchmarks`, settled by `dem::settle`): the bare sweep rate
+//! worlds are built in `crate::benchmarks`, settled by `dem::settle`): the bare sweep rate
 //! of a world's contacts ([`sweep_rate`]) and the memory footprint of the engine's data layout
 //! ([`MemoryFootprint`]).
 

@@ -3,7 +3,7 @@
 //!
 //! [`PeerColumn::from_world`] takes the grains (centres, radii, density), the box (floor and the
 //! two vertical walls, from the world's line walls), gravity and friction from the [`World`]
-//! that `datasets::benchmarks::janssen_column` returns before settling.
+//! that `crate::benchmarks::janssen_column` returns before settling.
 //! [`PeerColumn::write_input`] writes a LAMMPS data file and input script; [`run`] runs
 //! `lmp -in` serially (`OMP_NUM_THREADS=1`, no MPI launcher), wall-clock timed, and reads back
 //! its log ([`parse_log`]) and final state ([`parse_dump`], [`largest_overlap`]).
@@ -714,7 +714,7 @@ pub fn run(lmp: &Path, column: &PeerColumn, dir: &Path) -> Result<PeerOutcome> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use datasets::benchmarks::{janssen_column, ColumnRun, Preparation, COLUMN_WIDTH};
+    use crate::benchmarks::{janssen_column, ColumnRun, Preparation, COLUMN_WIDTH};
 
     fn column(n: usize, prep: Preparation) -> (World, PeerColumn) {
         let run = ColumnRun::for_column(prep, n);

@@ -2,8 +2,8 @@
 //! grainlaw's `simple-shear` scenario, from the same initial grains, in the same run, one core.
 //!
 //! [`PeerRve::from_config`] builds the scenario's initial loose packing
-//! (`datasets::build_cell::simple_shear`, the same seed, radii and cell as `grainlaw run
-//! simple-shear`) and takes the grains' centres and radii and the cell from it.
+//! (`crate::scenarios::simple_shear::build::simple_shear`, the same seed, radii and cell as
+//! `grainlaw run simple-shear`) and takes the grains' centres and radii and the cell from it.
 //! [`PeerRve::write_input`] writes a LAMMPS data file and input script; [`run`] runs `lmp -in`
 //! serially (`OMP_NUM_THREADS=1`, no MPI launcher), wall-clock timed, and reads back its log
 //! ([`parse_log`]: typed thermo rows, [`ThermoRow`]) and its snapshots (largest overlap,
@@ -75,7 +75,6 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use datasets::config::SimpleShearConfig;
 use dem::cell::Cell;
 use dem::math::Vector as Vect;
 use dem::BodyKind;
@@ -83,6 +82,7 @@ use dem::BodyKind;
 use crate::error::{CliError, Result};
 use crate::lammps_peer::{disk_masses, run_and_read, write_input_files, ContactModel, Outcome};
 use crate::readers::{read_lammps, ReadOptions};
+use crate::scenarios::simple_shear::config::SimpleShearConfig;
 use crate::scenarios::simple_shear::{CellSamples, RheologyPoint};
 
 /// Stiffness number κ = k_n / (P · 1 m) of the peer: the rigid limit (da Cruz et al. 2005).
@@ -170,13 +170,13 @@ fn full(x: f64) -> String {
 }
 
 impl PeerRve {
-    /// The representative volume of the `simple-shear` scenario `c` sheared at the inertial
-    /// number `inertial` (its `strain`, `average_strain`, `pressure`, `compression_duration`,
+    /// The representative volume of the `simple-shear` scenario `c` sheared at the inertial number
+    /// `inertial` (its `strain`, `average_strain`, `pressure`, `compression_duration`,
     /// `control_inertial_number`, friction and grains), the initial grains and cell those of
-    /// `datasets::build_cell::simple_shear(c)`; `wall_limit` seconds of wall clock at most;
-    /// `k_n = κ P · 1 m` and the dashpot for a normal restitution `e` ∈ [0, 1) between two
-    /// grains of the mean mass, `contact` ([`ContactModel::with_stiffness`]; e = 0.2 is the
-    /// users' choice, grainlaw's model has `c.restitution`, 0 by default).
+    /// `crate::scenarios::simple_shear::build::simple_shear(c)`; `wall_limit` seconds of wall clock
+    /// at most; `k_n = κ P · 1 m` and the dashpot for a normal restitution `e` ∈ [0, 1) between two
+    /// grains of the mean mass, `contact` ([`ContactModel::with_stiffness`]; e = 0.2 is the users'
+    /// choice, grainlaw's model has `c.restitution`, 0 by default).
     pub fn from_config(
         c: &SimpleShearConfig,
         inertial: f64,
@@ -197,7 +197,7 @@ impl PeerRve {
                 "the peer's restitution must lie in [0, 1), got {restitution}"
             )));
         }
-        let w = datasets::build_cell::simple_shear(c)?;
+        let w = crate::scenarios::simple_shear::build::simple_shear(c)?;
         let cell = w
             .cell()
             .ok_or_else(|| bad("the scenario's world has no biperiodic cell"))?;
@@ -826,7 +826,7 @@ mod tests {
     fn the_input_holds_the_scenarios_grains_cell_and_settings() {
         let c = config(100, 0.5, 0.25);
         let p = PeerRve::from_config(&c, 0.01, 600.0, PeerContact::default()).unwrap();
-        let w = datasets::build_cell::simple_shear(&c).unwrap();
+        let w = crate::scenarios::simple_shear::build::simple_shear(&c).unwrap();
         let cell = w.cell().unwrap();
         let grains: Vec<_> = w
             .bodies

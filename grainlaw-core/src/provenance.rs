@@ -10,9 +10,10 @@
 //! were made. The provenance of a law is made from it by
 //! [`RunControl::law_provenance`](crate::scenarios::RunControl::law_provenance).
 
-use datasets::LoadedScenario;
 use identify::law::{epoch_seconds, sha256_hex, utc_date, InputFile};
 use serde::{Deserialize, Serialize};
+
+use crate::scenarios::loader::LoadedScenario;
 
 /// What a run records about its start: the date and the input files with their SHA-256.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]

@@ -61,7 +61,7 @@
 //! `grainlaw fit` or a Python fit, which return only laws that passed every check
 //! (`identify::user_fit::FIT_VERDICT`). What a plan cannot identify is not left to a verdict
 //! at the end: a plan short of the data a law needs is refused before the run
-//! (`datasets::config::laws`), unless it leaves that law out.
+//! (`crate::scenarios::common::laws`), unless it leaves that law out.
 //!
 //! An interval says which kind it is: the block averages of one sample's window
 //! (`homogenise::averaging`) measure that sample's noise and understate the scatter between
@@ -71,13 +71,13 @@
 
 use std::fmt;
 
-use datasets::phases::PhaseStats;
 use dem::solver::worst;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 use crate::error::Result;
 use crate::output::{OutputDir, Summary};
+use crate::scenarios::phases::PhaseStats;
 
 /// Fraction of unconverged steps in a window above which the result is suspect (1).
 pub const SOLVER_UNCONVERGED_SUSPECT: f64 = 0.01;
@@ -161,12 +161,12 @@ pub const ENERGY_GROWTH_SUSPECT: f64 = 0.01;
 /// Fraction of window steps whose energy grew above which the result is refused (1).
 pub const ENERGY_GROWTH_REFUSED: f64 = 0.25;
 /// Energy gained by one step of the window over the load energy `E_load` (`δ / E_load`,
-/// `dem::energy::load_energy_scale`: the work of every load over one mean diameter) above which
-/// the result is suspect, however few such steps there are (1): a thousand times the growth
-/// that counts a step (`datasets::phases::ENERGY_GROWTH_TOLERANCE`), the energy of the loads
-/// moving by a hundredth of a diameter created in one step. The fraction check cannot see it: one
-/// step in a hundred is not above its 1 % (an I = 0.25 window of simple shear: one step gained
-/// 22 % of E_load and the fraction check passed).
+/// `dem::energy::load_energy_scale`: the work of every load over one mean diameter) above which the
+/// result is suspect, however few such steps there are (1): a thousand times the growth that counts
+/// a step (`crate::scenarios::phases::ENERGY_GROWTH_TOLERANCE`), the energy of the loads moving by
+/// a hundredth of a diameter created in one step. The fraction check cannot see it: one step in a
+/// hundred is not above its 1 % (an I = 0.25 window of simple shear: one step gained 22 % of E_load
+/// and the fraction check passed).
 pub const ENERGY_STEP_SUSPECT: f64 = 0.01;
 /// The same, above which the result is refused (1): one step created more energy than the work
 /// of every load over a whole diameter.
@@ -814,7 +814,7 @@ impl WindowStats {
             self.worst_energy_growth = phase.last_energy_growth;
             self.worst_energy_growth_step = Some(r.step);
         }
-        let rmin = datasets::phases::min_grain_radius(world);
+        let rmin = crate::scenarios::phases::min_grain_radius(world);
         if rmin > 0.0 {
             self.max_overlap_ratio = self.max_overlap_ratio.max(r.max_penetration / rmin);
         }

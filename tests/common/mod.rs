@@ -26,7 +26,7 @@ pub const SMALL_SHEAR_CELL: &[&str] = &[
 ];
 
 /// The laws a rheology of three inertial numbers cannot identify (μ(I) needs 5, its linear
-/// form and φ(I) 4: `datasets::config::laws`), left out so that such a plan runs.
+/// form and φ(I) 4: `grainlaw::scenarios::common::laws`), left out so that such a plan runs.
 pub const LEAVE_OUT_RHEOLOGY: &str = r#"leave_out=["mu-i", "mu-i-linear", "phi-i"]"#;
 
 /// [`SMALL_SHEAR_CELL`] at the three inertial numbers `list` (a TOML array) with the laws they

@@ -1,5 +1,5 @@
-//! Packing generators: seeded polydisperse radii, grains rained without overlap above a floor
-//! (then settled by gravity in the engine, see [`crate::phases`]), regular stacks, and dense
+//! Packing generators: seeded polydisperse radii, grains rained without overlap above a floor (then
+//! settled by gravity in the engine, by the phases of `grainlaw-core`), regular stacks, and dense
 //! packings by sequential geometric deposition.
 
 pub mod deposition;

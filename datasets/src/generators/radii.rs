@@ -3,16 +3,15 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::config::GrainSpec;
-
-/// `n` radii uniform in `[mean − spread, mean + spread]` (m), drawn from `rng`.
-pub fn uniform_radii(rng: &mut ChaCha8Rng, n: usize, spec: &GrainSpec) -> Vec<f64> {
+/// `n` radii uniform in `[mean − spread, mean + spread]` (m), drawn from `rng`; all `mean` when
+/// `spread` is not positive (a scenario's `grain` table: `radius_mean`, `radius_spread`).
+pub fn uniform_radii(rng: &mut ChaCha8Rng, n: usize, mean: f64, spread: f64) -> Vec<f64> {
     (0..n)
         .map(|_| {
-            if spec.radius_spread > 0.0 {
-                rng.random_range(spec.radius_min()..=spec.radius_max())
+            if spread > 0.0 {
+                rng.random_range((mean - spread)..=(mean + spread))
             } else {
-                spec.radius_mean
+                mean
             }
         })
         .collect()

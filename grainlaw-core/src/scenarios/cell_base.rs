@@ -5,14 +5,14 @@
 //! phase collects in a [`CellRecord`], and take block-averaged standard errors over at least
 //! [`MIN_BLOCKS`] blocks.
 
-use datasets::config::CellControlMode;
-use datasets::phases::PhaseStats;
 use dem::cell::{CellControl, Imposed};
 use serde::{Deserialize, Serialize};
 
 use super::common::{implicit_cell_control, VtkFrames};
 use super::rows::{serde_rows, TableRow};
 use super::sensitivity::{refuse_unsettled, PairOf, ResolveQueue};
+use crate::scenarios::common::config::CellControlMode;
+use crate::scenarios::phases::PhaseStats;
 use crate::verdict::WindowStats;
 
 /// Gain of the explicit cell control as a fraction of its stability limit `Δt/(ρ d²)`

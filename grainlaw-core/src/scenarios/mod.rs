@@ -1,8 +1,18 @@
 //! Running a scenario end to end: simulation phases with progress, homogenisation, fits,
 //! figures, CSV, VTK and `summary.json` (written last). The scenarios are listed once, in
-//! [`registry`] ([`registry::SCENARIOS`]), which loads them and runs them ([`run_controlled`]).
-//! Every runner is a [`phased::PhasedRun`]: its simulation can be checkpointed, stopped and
-//! resumed.
+//! [`registry`] ([`registry::SCENARIOS`]), which loads them ([`loader`]) and runs them
+//! ([`run_controlled`]). Every runner is a [`phased::PhasedRun`]: its simulation can be
+//! checkpointed, stopped and resumed; its phases run the world to rest or for a number of steps
+//! ([`phases`]).
+//!
+//! One folder per scenario (`janssen/`, `rolling/`, `arrangements/`, `stick_slip/`,
+//! `inclined_flow/`, `shear_cell/`, `simple_shear/`, `biaxial/`, `column_collapse/`): `mod.rs`
+//! the runner and its kind's [`loader::ScenarioConfig`], `config.rs` its typed configuration
+//! (`deny_unknown_fields`, `validate`), `build.rs` its world (`janssen` and `stick-slip` build
+//! the shared rained column of `common::build`), and its measure, fit and figure files where it
+//! has them. What several share is in [`common`] (config pieces, laws, deposits, world
+//! pieces, the runner's phase helpers), [`cell_base`], [`rows`], [`rheology_fit`] and
+//! [`sensitivity`].
 
 pub mod arrangements;
 pub mod biaxial;
@@ -12,7 +22,9 @@ pub mod common;
 pub mod dump;
 pub mod inclined_flow;
 pub mod janssen;
+pub mod loader;
 pub mod phased;
+pub mod phases;
 pub mod registry;
 pub mod rheology_fit;
 pub mod rolling;
@@ -25,7 +37,7 @@ pub mod stick_slip;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-use datasets::LoadedScenario;
+use crate::scenarios::loader::LoadedScenario;
 
 use crate::output::{OutputDir, Summary};
 use crate::progress::Verbosity;

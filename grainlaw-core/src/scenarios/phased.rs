@@ -19,7 +19,6 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use datasets::phases::{PhaseProgress, PhaseStats};
 use dem::{StepReport, World};
 use identify::law::Provenance;
 use serde::de::DeserializeOwned;
@@ -30,6 +29,7 @@ use super::{PhaseEnv, RunContext};
 use crate::checkpoint::{self, Cursor, PhasePlan, RunCheckpoint, ScenarioRecord};
 use crate::error::{CliError, Result};
 use crate::output::OutputDir;
+use crate::scenarios::phases::{PhaseProgress, PhaseStats};
 
 /// When periodic checkpoints are written (a checkpoint is also written when the run is
 /// stopped by the user, whatever this says).

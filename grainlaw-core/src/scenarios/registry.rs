@@ -1,21 +1,16 @@
 //! The one list of scenarios. Each entry is a [`Scenario`]: its name and one-line description,
 //! its built-in TOML (`datasets/scenarios/NAME.toml`, embedded), its typed configuration
-//! (`datasets::config`, loaded with `--set` overrides through [`load`]) and its runner
-//! (`grainlaw-core/src/scenarios/NAME.rs`). The command line (`run`, `scenarios`, `campaign`, `bench`), the
+//! (`scenarios/NAME/config.rs`, loaded with `--set` overrides through [`load`]) and its runner
+//! (`scenarios/NAME/mod.rs`). The command line (`run`, `scenarios`, `campaign`, `bench`), the
 //! library API ([`crate::api`]), the Python bindings and the tests find scenarios here and
 //! nowhere else; [`run_controlled`] runs a loaded one through its entry.
 //!
 //! A new scenario is one more [`Runner`] in [`SCENARIOS`] (its config struct implements
-//! `datasets::ScenarioConfig` in `datasets/src/kinds.rs`).
+//! [`ScenarioConfig`] in its folder's `mod.rs`).
 
 use std::sync::Arc;
 
-use datasets::config::{
-    ArrangementsConfig, BiaxialConfig, ColumnCollapseConfig, InclinedFlowConfig, JanssenConfig,
-    RollingConfig, ShearCellConfig, SimpleShearConfig, StickSlipConfig,
-};
-use datasets::scenario::{typed_config, Catalogue};
-use datasets::{DatasetError, LoadedScenario, ScenarioConfig};
+use datasets::DatasetError;
 use serde::de::DeserializeOwned;
 use toml::Table;
 
@@ -26,6 +21,16 @@ use super::{
 };
 use crate::error::{CliError, Result};
 use crate::output::Summary;
+use crate::scenarios::arrangements::config::ArrangementsConfig;
+use crate::scenarios::biaxial::config::BiaxialConfig;
+use crate::scenarios::column_collapse::config::ColumnCollapseConfig;
+use crate::scenarios::inclined_flow::config::InclinedFlowConfig;
+use crate::scenarios::janssen::config::JanssenConfig;
+use crate::scenarios::loader::{typed_config, Catalogue, LoadedScenario, ScenarioConfig};
+use crate::scenarios::rolling::config::RollingConfig;
+use crate::scenarios::shear_cell::config::ShearCellConfig;
+use crate::scenarios::simple_shear::config::SimpleShearConfig;
+use crate::scenarios::stick_slip::config::StickSlipConfig;
 
 /// A scenario: what the registry knows of one kind.
 pub trait Scenario: Sync {
@@ -203,9 +208,9 @@ impl Catalogue for Registry {
 }
 
 /// Loads `spec` (a scenario name or a TOML file path) with the overrides `sets` (`KEY=VALUE`),
-/// typed and validated ([`datasets::scenario::load`] over the registry).
+/// typed and validated ([`crate::scenarios::loader::load`] over the registry).
 pub fn load(spec: &str, sets: &[String]) -> datasets::Result<LoadedScenario> {
-    datasets::scenario::load(&Registry, spec, sets)
+    crate::scenarios::loader::load(&Registry, spec, sets)
 }
 
 /// Like [`load`] from TOML text already read; `name` and `source` name it.
@@ -215,7 +220,7 @@ pub fn from_text(
     text: &str,
     sets: &[String],
 ) -> datasets::Result<LoadedScenario> {
-    datasets::scenario::from_text(&Registry, name, source, text, sets)
+    crate::scenarios::loader::from_text(&Registry, name, source, text, sets)
 }
 
 /// The configuration of `loaded` as the type `C` of its kind, or a [`DatasetError::Type`] on
@@ -235,7 +240,7 @@ pub fn config_of<C: ScenarioConfig + Clone>(loaded: &LoadedScenario) -> datasets
         })
 }
 
-/// One line per law the plan leaves out (`leave_out`, `datasets::config::laws`): its name,
+/// One line per law the plan leaves out (`leave_out`, `crate::scenarios::common::laws`): its name,
 /// and the data the plan has against what it needs.
 pub fn left_out_lines(config: &dyn ScenarioConfig) -> Vec<String> {
     let needs = config.law_needs();

@@ -2,10 +2,10 @@
 //! the front against `t*` with the contact-dynamics reference and the runout scalings, the
 //! profiles, the kinetic energy.
 
-use datasets::config::ColumnCollapseConfig;
 use dem::snapshot::WallGeometry;
 use plotters::style::RGBColor;
 
+use super::config::ColumnCollapseConfig;
 use super::{scaling, FrontSample, HistoryRow, LabelledProfile};
 use crate::error::Result;
 use crate::plot::particles::{draw_particles, GrainFill, ParticleView};

@@ -5,9 +5,9 @@
 //!
 //! 1. *Deposit*: polydisperse disks poured by drop and roll between the frictionless symmetry
 //!    wall x = 0 and a gate at x = R₀, on a rough floor (glued disks whose tops are y = 0),
-//!    settle under gravity until at rest ([`datasets::build::column_collapse_deposit`]).
+//!    settle under gravity until at rest ([`build::column_collapse_deposit`]).
 //! 2. *Collapse*: the column is trimmed to `H₀ = a R₀` (grains whose top is above `H₀`
-//!    removed), the gate removed, and the time set to 0 ([`datasets::build::column_collapse_release`]);
+//!    removed), the gate removed, and the time set to 0 ([`build::column_collapse_release`]);
 //!    the grains collapse and spread until at rest (`collapse.rest_energy`) or
 //!    `collapse.max_time`.
 //!
@@ -16,20 +16,23 @@
 //! `r_∞ = x_f`, the final height `h(0)` and the rest time. Outputs per the contract of the
 //! continuum comparison: `summary.json` (object `column`), `front.csv`, `profiles.csv`.
 
-use datasets::config::ColumnCollapseConfig;
-use datasets::phases::PhaseStats;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::{RunContext, RunOutcome};
 use crate::checkpoint::PhasePlan;
 use crate::error::{CliError, Result};
 use crate::output::{CsvTable, OutputDir, Summary};
 use crate::progress::{info, warn};
 use crate::verdict::{Checks, RunVerdict, Verdict, WindowStats};
+use config::ColumnCollapseConfig;
 
+pub mod build;
+pub mod config;
 mod figures;
 pub mod profile;
 
@@ -48,7 +51,7 @@ pub const REST_LABEL: &str = "rest";
 
 /// Energy gained over the collapse, `E_end − E_start − E_correction` over the load energy
 /// `E_load = Σ m g d`, above which the run is suspect (1): the scheme only dissipates
-/// (`datasets::phases`), so a gain is accumulated solver inexactness.
+/// (`crate::scenarios::phases`), so a gain is accumulated solver inexactness.
 pub const ENERGY_GAIN_SUSPECT: f64 = 0.01;
 /// The same, above which the run is refused (1).
 pub const ENERGY_GAIN_REFUSED: f64 = 0.1;
@@ -203,7 +206,7 @@ impl PhasedRun for Collapse<'_> {
             )),
             COLLAPSE => {
                 st.deposited = grain_count(world);
-                let released = datasets::build::column_collapse_release(c, world)?;
+                let released = build::column_collapse_release(c, world)?;
                 *world = released.world;
                 c.collapse.solver.apply(&mut world.params);
                 st.d = mean_diameter(world);
@@ -211,8 +214,9 @@ impl PhasedRun for Collapse<'_> {
                 st.mass = grain_weight(world) / world.params.gravity.norm();
                 st.e_pot_start = world.potential_energy();
                 st.e_start = world.kinetic_energy() + st.e_pot_start;
-                st.e_load = datasets::phases::load_energy_scale(world);
-                st.phi = datasets::build::grain_area(world) / (c.half_width() * c.height());
+                st.e_load = crate::scenarios::phases::load_energy_scale(world);
+                st.phi = crate::scenarios::common::build::grain_area(world)
+                    / (c.half_width() * c.height());
                 info(
                     env.verbosity,
                     &format!(
@@ -362,7 +366,7 @@ fn simulate(
     let ts = c.time_scale();
     let run = Collapse { c };
     let fresh = || -> Result<(dem::World, CollapseState)> {
-        let col = datasets::build::column_collapse_deposit(c)?;
+        let col = build::column_collapse_deposit(c)?;
         let state = CollapseState {
             deposit: PhaseStats::default(),
             collapse: PhaseStats::default(),
@@ -466,7 +470,7 @@ fn measure(c: &ColumnCollapseConfig, world: &dem::World, st: &CollapseState) -> 
         .map(|b| b.position.x + b.radius)
         .fold(0.0, f64::max);
 
-    // Energy balance over the collapse (datasets::phases): with fixed walls the mechanical
+    // Energy balance over the collapse (crate::scenarios::phases): with fixed walls the mechanical
     // energy changes by the residuals δ ≤ 0 and the position corrections' potential energy.
     let e_end = world.kinetic_energy() + world.potential_energy();
     let dissipated = st.e_start - e_end + st.collapse.position_correction_energy;
@@ -934,4 +938,21 @@ pub fn write_runout(out: &mut OutputDir, runs: &[CampaignRun]) -> Result<()> {
     })?;
     out.write("runout.csv", &bytes)?;
     figures::runout_figure(out, &ok, &other)
+}
+
+/// What the loader and the registry ask of every kind ([`ScenarioConfig`]).
+impl ScenarioConfig for ColumnCollapseConfig {
+    common_methods!();
+
+    fn kind(&self) -> &'static str {
+        "column-collapse"
+    }
+
+    fn grains(&self) -> usize {
+        self.poured_grains()
+    }
+
+    fn build_first(&self) -> datasets::Result<()> {
+        build::column_collapse_deposit(self).map(drop)
+    }
 }

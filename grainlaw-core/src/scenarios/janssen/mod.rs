@@ -19,8 +19,6 @@
 //!    ends at that bound, the fit with μ_w = μ_wall (full mobilisation, Janssen's assumption)
 //!    is reported instead and flagged.
 
-use datasets::config::JanssenConfig;
-use datasets::phases::PhaseStats;
 use dem::math::Vector;
 use homogenise::state::solid_fraction;
 use homogenise::Region;
@@ -28,8 +26,12 @@ use identify::janssen::JanssenSetup;
 use identify::CalibratedLaw;
 use serde::{Deserialize, Serialize};
 
+use super::common::build::{column, column_width};
+use super::common::laws::LawNeed;
 use super::common::{grain_weight, mean_diameter, solver_keys, Stop, VtkFrames};
+use super::loader::{common_methods, ScenarioConfig};
 use super::phased::{drive, Enter, Leave, PhasedRun, RunControl, Step};
+use super::phases::PhaseStats;
 use super::rows::{self, serde_csv_table, table_row};
 use super::sensitivity::{resolve_last_step, Resolved};
 use super::{RunContext, RunOutcome};
@@ -38,7 +40,9 @@ use crate::error::Result;
 use crate::output::{CsvTable, OutputDir, Summary};
 use crate::progress::{info, warn};
 use crate::verdict::{export_law, max_solid_fraction, Checks, RunVerdict, Verdict, WindowStats};
+use config::JanssenConfig;
 
+pub mod config;
 mod figures;
 mod solver_sensitivity;
 use solver_sensitivity::JanssenSensitivity;
@@ -321,7 +325,7 @@ fn simulate(
     width: f64,
 ) -> Result<(dem::World, ColumnState)> {
     let fresh = || -> Result<(dem::World, ColumnState)> {
-        let col = datasets::build::column(
+        let col = crate::scenarios::common::build::column(
             &c.grain,
             c.grains,
             width,
@@ -697,7 +701,7 @@ fn write_profile(
 /// Runs the scenario: config, build and run (`simulate`), measure (`homogenise`), fit,
 /// verdict (`judge`), report.
 pub fn run(c: &JanssenConfig, ctx: &mut RunContext, ctl: &mut RunControl) -> Result<RunOutcome> {
-    let width = datasets::build::column_width(&c.grain, c.grains, c.column_aspect);
+    let width = crate::scenarios::common::build::column_width(&c.grain, c.grains, c.column_aspect);
     announce(c, ctx.verbosity, width);
     let (world, st) = simulate(c, ctx, ctl, width)?;
     let world = &world;
@@ -851,4 +855,35 @@ fn fit_data_line(profile: &ColumnProfile, window: (f64, f64), uses_tau_w: bool) 
         },
         named.join(", ")
     )
+}
+
+/// What the loader and the registry ask of every kind ([`ScenarioConfig`]).
+impl ScenarioConfig for JanssenConfig {
+    common_methods!();
+
+    fn kind(&self) -> &'static str {
+        "janssen"
+    }
+
+    fn law_needs(&self) -> Vec<LawNeed> {
+        vec![LawNeed {
+            law: "janssen",
+            formula: "σ_v(z) of Janssen 1895, K and μ_w jointly",
+            key: "",
+            needs: 4,
+            have: None,
+            why: "depth bins of the wall profile in the fit window",
+            instead_of: None,
+        }]
+    }
+
+    fn grains(&self) -> usize {
+        self.grains
+    }
+
+    fn build_first(&self) -> datasets::Result<()> {
+        let w = column_width(&self.grain, self.grains, self.column_aspect);
+        let dt = self.dt / self.deposit.substeps as f64;
+        column(&self.grain, self.grains, w, &self.friction, self.seed, dt).map(drop)
+    }
 }
