@@ -16,8 +16,8 @@ pub fn sweep_rate(w: &World, sweeps: usize) -> f64 {
     if rows.is_empty() || sweeps == 0 {
         return 0.0;
     }
-    let inv: Vec<[f64; 3]> = w.bodies.iter().map(dem::Body::inverse_mass).collect();
-    let mut vel: Vec<[f64; 3]> = w
+    let inv: Vec<dem::math::Spatial> = w.bodies.iter().map(dem::Body::inverse_mass).collect();
+    let mut vel: Vec<dem::math::Spatial> = w
         .bodies
         .iter()
         .map(|b| [b.velocity.x, b.velocity.y, b.omega])
@@ -50,8 +50,8 @@ impl MemoryFootprint {
         use std::mem::size_of;
         let per_grain = size_of::<dem::Body>()
             + size_of::<dem::collider::Collider>()
-            + 3 * size_of::<[f64; 3]>() // velocities, inverse masses, free velocities
-            + 3 * size_of::<[f64; 3]>() // body forces
+            + 3 * size_of::<dem::math::Spatial>() // velocities, inverse masses, free velocities
+            + 3 * size_of::<dem::math::Spatial>() // body forces
             + 4 + 16 + 8 + 8 + 4 + 4 + 4 // detector: collider, centre, radius, margin, cells
             + 4 + 8 + 16 + 8 + 4 // candidate list: collider, radius, centre, reach, start
             + 4; // wavefront schedule: depth
@@ -76,7 +76,7 @@ impl MemoryFootprint {
     /// the colouring with its body → contact adjacency.
     pub fn parallel_extra() -> Self {
         use std::mem::size_of;
-        let per_grain = 3 * size_of::<[f64; 3]>() // velocities, free velocities, inverse masses
+        let per_grain = 3 * size_of::<dem::math::Spatial>() // velocities, free velocities, inverse masses
             + 2 * 16 // centres (world and copy)
             + 2 // mobility flags
             + 4 + 4 // permutation both ways
