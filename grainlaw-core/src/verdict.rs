@@ -450,6 +450,24 @@ impl Checks {
         }
     }
 
+    /// [`Checks::at_most`] for a solver error over the tolerance: refused above
+    /// [`SOLVER_ERROR_REFUSED`]; suspect above [`SOLVER_ERROR_SUSPECT`] unless the solver's
+    /// effect on the result was `measured` (and passed), which stands in for the suspect limit.
+    fn solver_error(
+        &mut self,
+        check: &str,
+        ratio: f64,
+        measured: bool,
+        what: impl Fn(f64) -> String,
+    ) {
+        let suspect = if measured {
+            SOLVER_ERROR_REFUSED
+        } else {
+            SOLVER_ERROR_SUSPECT
+        };
+        self.at_most(check, ratio, suspect, Some(SOLVER_ERROR_REFUSED), what);
+    }
+
     /// The numerics of the steps that feed a result: unconverged steps and worst error over the
     /// tolerance, energy growth, largest overlap ([module documentation](self)).
     pub fn window(&mut self, label: &str, w: &WindowStats) {
@@ -496,15 +514,10 @@ impl Checks {
             );
         }
         let e = w.worst_error / w.tolerance;
-        self.at_most(
+        self.solver_error(
             "solver.worst_error_over_tolerance",
             e,
-            if measured {
-                SOLVER_ERROR_REFUSED
-            } else {
-                SOLVER_ERROR_SUSPECT
-            },
-            Some(SOLVER_ERROR_REFUSED),
+            measured,
             |t| {
                 format!(
                     "{label}: worst solver error {:.2e} is {e:.0} times the tolerance {:.0e} (limit {t:.0}×)",
@@ -519,18 +532,13 @@ impl Checks {
         let loaded = w.worst_error_without_gap_shifts;
         if loaded > w.worst_error || loaded.is_nan() {
             let e0 = loaded / w.tolerance;
-            self.at_most(
+            self.solver_error(
                 "solver.loaded_error_over_tolerance",
                 e0,
                 // A measured sensitivity that passed stands in for the suspect limit, where
                 // every re-solve reached the tolerance (one short of it was judged on the
                 // problem's scale only).
-                if measured_loaded {
-                    SOLVER_ERROR_REFUSED
-                } else {
-                    SOLVER_ERROR_SUSPECT
-                },
-                Some(SOLVER_ERROR_REFUSED),
+                measured_loaded,
                 |t| {
                     format!(
                         "{label}: worst solver error over the loaded contacts' scale (without the gap-closing shifts of open pairs) {loaded:.2e} is {e0:.0} times the tolerance {:.0e} (limit {t:.0}×)",
