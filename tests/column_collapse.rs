@@ -27,11 +27,10 @@ fn grainlaw(args: &[&str]) -> Output {
     common::grainlaw(args, None)
 }
 
-/// Runs `column-collapse` with `sets` into `dir` (suspect results allowed: the verdicts are
-/// checked one by one below) and returns its summary.
-fn run(dir: &Path, sets: &[&str]) -> Value {
-    let out = dir.to_str().unwrap();
-    let mut args = vec![
+/// The arguments of a quiet `column-collapse` run into `out` with suspect results allowed (the
+/// verdicts are checked one by one below), then `extra`.
+fn run_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let head = [
         "run",
         "column-collapse",
         "--out",
@@ -39,7 +38,12 @@ fn run(dir: &Path, sets: &[&str]) -> Value {
         "-q",
         "--allow-suspect",
     ];
-    args.extend_from_slice(sets);
+    head.iter().chain(extra).copied().collect()
+}
+
+/// Runs `column-collapse` with `sets` into `dir` ([`run_args`]) and returns its summary.
+fn run(dir: &Path, sets: &[&str]) -> Value {
+    let args = run_args(dir.to_str().unwrap(), sets);
     let o = grainlaw(&args);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
@@ -246,18 +250,8 @@ fn a_resumed_collapse_is_bit_identical() {
     ];
     run(whole.path(), &small);
     let out = cut.path().to_str().unwrap();
-    let mut args = vec![
-        "run",
-        "column-collapse",
-        "--out",
-        out,
-        "-q",
-        "--allow-suspect",
-        // the deposit takes about 490 steps: stopped in the middle of the collapse
-        "--stop-after-steps",
-        "1200",
-    ];
-    args.extend_from_slice(&small);
+    // the deposit takes about 490 steps: stopped in the middle of the collapse
+    let args = run_args(out, &[&["--stop-after-steps", "1200"], &small[..]].concat());
     let o = grainlaw(&args);
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
     assert!(text(&o).contains("of phase `collapse`"), "{}", text(&o));

@@ -1011,16 +1011,19 @@ impl RunVerdict {
             .unwrap_or(Verdict::Ok)
     }
 
+    /// The run's reasons, then every law's in the laws' order.
+    fn reasons(&self) -> impl Iterator<Item = &Reason> {
+        self.run
+            .reasons
+            .iter()
+            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
+    }
+
     /// Summary keys: `verdict`, `verdict_reasons` (the run's and every law's reasons, each once)
     /// and `law_verdicts` (per law: `law`, `file`, `verdict`, `reasons`).
     pub fn keys(&self, s: &mut Summary) {
         let mut all: Vec<Value> = Vec::new();
-        for r in self
-            .run
-            .reasons
-            .iter()
-            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
-        {
+        for r in self.reasons() {
             let v = r.to_json();
             if !all.contains(&v) {
                 all.push(v);
@@ -1050,12 +1053,7 @@ impl RunVerdict {
     pub fn lines(&self) -> Vec<String> {
         let mut out = vec![format!("verdict: {}", self.verdict())];
         let mut seen: Vec<(&str, &str)> = Vec::new();
-        for r in self
-            .run
-            .reasons
-            .iter()
-            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
-        {
+        for r in self.reasons() {
             let key = (r.check.as_str(), r.message.as_str());
             if !seen.contains(&key) {
                 seen.push(key);
@@ -1090,12 +1088,7 @@ impl RunVerdict {
     /// One line saying what failed (for the exit-status message).
     pub fn failure_line(&self) -> String {
         let mut first: Vec<String> = Vec::new();
-        for r in self
-            .run
-            .reasons
-            .iter()
-            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
-        {
+        for r in self.reasons() {
             let t = format!("{} ({})", r.check, r.verdict);
             if !first.contains(&t) {
                 first.push(t);
