@@ -251,3 +251,15 @@ pub fn assert_no_failures(failures: &[String], rows: usize) {
         failures.join("\n")
     );
 }
+
+/// `grainlaw homogenise` of LAMMPS dumps at μ = 0.5, quietly; the output directory and the
+/// files follow.
+pub const HOMOGENISE_LAMMPS: &[&str] = &[
+    "homogenise",
+    "--from",
+    "lammps",
+    "--mu",
+    "0.5",
+    "-q",
+    "--out",
+];
