@@ -35,14 +35,7 @@ fn lattice(n: usize, cols: usize) -> World {
     };
     let mut w = World::new(params, ContactLaws::new(&["grain"], 0.3));
     let width = 2.0 * r * (cols as f64 + 0.5);
-    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        0,
-    );
+    w.add_box_walls(width, 0);
     let mut s: u64 = 0x9E37_79B9_7F4A_7C15;
     for i in 0..n {
         let (ix, iy) = (i % cols, i / cols);

@@ -113,13 +113,7 @@ fn failure(r: &Row, cwd: &Path) -> Option<String> {
 
 fn run_table(rows: &[Row], cwd: &Path) {
     let failures: Vec<String> = rows.iter().filter_map(|r| failure(r, cwd)).collect();
-    assert!(
-        failures.is_empty(),
-        "{} of {} rows failed:\n{}",
-        failures.len(),
-        rows.len(),
-        failures.join("\n")
-    );
+    common::assert_no_failures(&failures, rows.len());
 }
 
 fn builtin(name: &str) -> &'static str {
@@ -613,22 +607,17 @@ fn bad_scenarios_in_files_and_overrides() {
 }
 
 /// Dotted keys of the float leaves of `t` (`inertial_numbers[0]` for an array of floats).
-fn float_keys(t: &Table, prefix: &str, out: &mut Vec<String>) {
-    for (k, v) in t {
-        let key = if prefix.is_empty() {
-            k.clone()
-        } else {
-            format!("{prefix}.{k}")
-        };
-        match v {
-            Value::Float(_) => out.push(key),
+fn float_keys(t: &Table) -> Vec<String> {
+    common::toml_leaves(t)
+        .into_iter()
+        .filter_map(|(key, v)| match v {
+            Value::Float(_) => Some(key),
             Value::Array(a) if a.iter().all(Value::is_float) && !a.is_empty() => {
-                out.push(format!("{key}[0]"))
+                Some(format!("{key}[0]"))
             }
-            Value::Table(sub) => float_keys(sub, &key, out),
-            _ => {}
-        }
-    }
+            _ => None,
+        })
+        .collect()
 }
 
 /// `t` with the float at `key` (dotted, `name[0]` for an array's first element) set to `v`.
@@ -656,8 +645,7 @@ fn non_finite_values_in_every_float_key() {
     let mut count = 0;
     for b in grainlaw::scenarios::registry::SCENARIOS.iter() {
         let table: Table = b.builtin_toml().parse().unwrap();
-        let mut keys = Vec::new();
-        float_keys(&table, "", &mut keys);
+        let keys = float_keys(&table);
         assert!(keys.len() >= 5, "{}: {keys:?}", b.name());
         for key in &keys {
             for (word, v) in [

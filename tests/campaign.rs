@@ -1,45 +1,26 @@
 //! `grainlaw campaign`: the runs of a plan (Cartesian product), shares that partition them,
 //! resumability (finished runs are not redone), collection and merged fits, bad plans.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn campaign(cwd: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .current_dir(cwd)
-        .arg("campaign")
-        .args(args)
-        .output()
-        .expect("grainlaw runs")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use common::{campaign, plan_dir, text, Table};
 
 /// A rolling disk sweep (2 frictions × 2 seeds): four runs in the product's order, each an
 /// ordinary run whose summary matches the analytic acceleration (rolling: (2/3) g sin θ;
 /// sliding: g (sin θ − μ cos θ)) to 1e-9 relative; a second call redoes nothing.
 #[test]
 fn sweep_runs_the_product_and_is_resumable() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("plan.toml"),
+    let dir = plan_dir(
         "scenario = \"rolling\"\n[set]\nduration = 0.1\n[sweep]\nseed = [1, 2]\nfriction = [0.05, 0.5]\n",
-    )
-    .unwrap();
+    );
     let o = campaign(dir.path(), &["plan.toml", "--out", "c"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let c = dir.path().join("c");
     let table = std::fs::read_to_string(c.join("campaign.csv")).unwrap();
-    let mut rows = csv::Reader::from_reader(table.as_bytes());
-    let head = rows.headers().unwrap().clone();
-    let col = |n: &str| head.iter().position(|h| h == n).unwrap();
-    let rows: Vec<csv::StringRecord> = rows.records().map(|r| r.unwrap()).collect();
+    let table = Table::parse(&table);
+    let (col, rows) = (|n: &str| table.col(n), &table.rows);
     assert_eq!(rows.len(), 4);
     let g = 9.81f64;
     let th = 20f64.to_radians();
@@ -85,12 +66,9 @@ fn sweep_runs_the_product_and_is_resumable() {
 /// campaign (exit 2, naming the missing runs), then merges once every share is done.
 #[test]
 fn shares_partition_the_runs_and_collect_waits_for_all() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("plan.toml"),
+    let dir = plan_dir(
         "scenario = \"rolling\"\n[set]\nduration = 0.05\n[sweep]\nslope_deg = [10.0, 15.0, 20.0, 25.0, 30.0]\n",
-    )
-    .unwrap();
+    );
     let o = campaign(
         dir.path(),
         &["plan.toml", "--out", "c", "--task", "2", "--of", "2"],
@@ -191,12 +169,9 @@ fn bad_plans_are_refused_before_any_run() {
 /// of the merged table the mean of the runs' (to 1e-12).
 #[test]
 fn shear_cell_seeds_are_merged_and_fitted() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("plan.toml"),
+    let dir = plan_dir(
         "scenario = \"shear-cell\"\n[set]\ngrains = 80\ncell_length_diameters = 10\ninertial_numbers = [0.02, 0.08, 0.3]\nleave_out = [\"mu-i\", \"mu-i-linear\", \"phi-i\"]\nstrain = 1.0\naverage_strain = 0.5\n[sweep]\nseed = [1, 2]\n",
-    )
-    .unwrap();
+    );
     let o = campaign(dir.path(), &["plan.toml", "--out", "c", "--jobs", "2"]);
     let t = text(&o);
     // 0: both laws fitted (perhaps in their linear forms); 3: one refused, with its reason.
@@ -258,12 +233,7 @@ fn shear_cell_seeds_are_merged_and_fitted() {
 /// point per run failed its own checks), so that only the collection runs.
 #[test]
 fn collect_writes_the_campaign_figure() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("plan.toml"),
-        "scenario = \"simple-shear\"\n[sweep]\nseed = [1, 2, 3]\n",
-    )
-    .unwrap();
+    let dir = plan_dir("scenario = \"simple-shear\"\n[sweep]\nseed = [1, 2, 3]\n");
     let c = dir.path().join("c");
     for k in 0..3usize {
         let run = c.join(format!("runs/{k:04}"));

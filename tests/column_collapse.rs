@@ -4,9 +4,12 @@
 //! values refused naming the key, and the runout table of a campaign over the aspect ratio.
 
 use std::collections::BTreeSet;
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
+use std::path::Path;
+use std::process::Output;
+
+use common::{campaign, plan_dir, text, Table};
 use serde_json::Value;
 
 /// A column 10 mean diameters wide (R₀ = 5 cm), a = 2: about 190 grains, 2 s.
@@ -19,27 +22,15 @@ const SMALL: &[&str] = &[
     "floor_length=8",
 ];
 
+/// `grainlaw ARGS` at the fixed date of [`common::grainlaw`].
 fn grainlaw(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .env("SOURCE_DATE_EPOCH", "1767225600")
-        .args(args)
-        .output()
-        .expect("grainlaw runs")
+    common::grainlaw(args, None)
 }
 
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
-/// Runs `column-collapse` with `sets` into `dir` (suspect results allowed: the verdicts are
-/// checked one by one below) and returns its summary.
-fn run(dir: &Path, sets: &[&str]) -> Value {
-    let out = dir.to_str().unwrap();
-    let mut args = vec![
+/// The arguments of a quiet `column-collapse` run into `out` with suspect results allowed (the
+/// verdicts are checked one by one below), then `extra`.
+fn run_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let head = [
         "run",
         "column-collapse",
         "--out",
@@ -47,7 +38,12 @@ fn run(dir: &Path, sets: &[&str]) -> Value {
         "-q",
         "--allow-suspect",
     ];
-    args.extend_from_slice(sets);
+    head.iter().chain(extra).copied().collect()
+}
+
+/// Runs `column-collapse` with `sets` into `dir` ([`run_args`]) and returns its summary.
+fn run(dir: &Path, sets: &[&str]) -> Value {
+    let args = run_args(dir.to_str().unwrap(), sets);
     let o = grainlaw(&args);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
@@ -254,18 +250,8 @@ fn a_resumed_collapse_is_bit_identical() {
     ];
     run(whole.path(), &small);
     let out = cut.path().to_str().unwrap();
-    let mut args = vec![
-        "run",
-        "column-collapse",
-        "--out",
-        out,
-        "-q",
-        "--allow-suspect",
-        // the deposit takes about 490 steps: stopped in the middle of the collapse
-        "--stop-after-steps",
-        "1200",
-    ];
-    args.extend_from_slice(&small);
+    // the deposit takes about 490 steps: stopped in the middle of the collapse
+    let args = run_args(out, &[&["--stop-after-steps", "1200"], &small[..]].concat());
     let o = grainlaw(&args);
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
     assert!(text(&o).contains("of phase `collapse`"), "{}", text(&o));
@@ -352,17 +338,10 @@ fn bad_values_are_refused_naming_the_key() {
 /// with the runout of each run's summary) and `runout.png`.
 #[test]
 fn a_campaign_over_the_aspect_ratio_gives_the_runout() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("plan.toml"),
+    let dir = plan_dir(
         "scenario = \"column-collapse\"\n[set]\nhalf_width_diameters = 6.0\nfloor_length = 10.0\n[sweep]\naspect_ratio = [2.0, 0.5]\n",
-    )
-    .unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .current_dir(dir.path())
-        .args(["campaign", "plan.toml", "--out", "c", "--jobs", "2"])
-        .output()
-        .unwrap();
+    );
+    let o = campaign(dir.path(), &["plan.toml", "--out", "c", "--jobs", "2"]);
     // a run whose verdict is suspect exits 3: the campaign still collects it
     assert!(
         matches!(o.status.code(), Some(0) | Some(2) | Some(3)),
@@ -373,14 +352,12 @@ fn a_campaign_over_the_aspect_ratio_gives_the_runout() {
     let table = std::fs::read_to_string(c.join("runout.csv")).unwrap_or_else(|e| {
         panic!("{e}: {}", text(&o));
     });
-    let mut rows = csv::Reader::from_reader(table.as_bytes());
-    let head = rows.headers().unwrap().clone();
-    let col = |n: &str| head.iter().position(|h| h == n).unwrap();
-    let rows: Vec<csv::StringRecord> = rows.records().map(|r| r.unwrap()).collect();
+    let table = Table::parse(&table);
+    let (col, rows) = (|n: &str| table.col(n), &table.rows);
     assert_eq!(rows.len(), 2);
     let a: Vec<f64> = rows.iter().map(|r| r[col("a")].parse().unwrap()).collect();
     assert_eq!(a, vec![0.5, 2.0]);
-    for r in &rows {
+    for r in rows {
         let run = &r[col("run")];
         let s: Value = serde_json::from_slice(
             &std::fs::read(c.join("runs").join(run).join("summary.json")).unwrap(),

@@ -70,12 +70,7 @@ fn solve_fc_one_contact() {
     let out = String::from_utf8(o.stdout).unwrap();
     assert!(out.contains("iterations") && out.contains("error"), "{out}");
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&sol).unwrap()).unwrap();
-    let r: Vec<f64> = v["r"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
+    let r: Vec<f64> = serde_json::from_value(v["r"].clone()).unwrap();
     assert!(
         (r[0] - 1.0).abs() < 1e-9 && (r[1] + 1.0 / 6.0).abs() < 1e-9,
         "r = {r:?}"

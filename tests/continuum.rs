@@ -44,6 +44,35 @@ fn number_after(text: &str, prefix: &str) -> f64 {
     rest[..end].parse().unwrap()
 }
 
+/// The C program `src` compiled (`-O0`, with the maths library) in a temporary directory and
+/// run: what it prints; `None`, saying that `what` is skipped, without a C compiler.
+fn compile_and_run(what: &str, src: &str) -> Option<String> {
+    let Some(cc) = ["cc", "gcc", "clang"]
+        .into_iter()
+        .find(|c| Command::new(c).arg("--version").output().is_ok())
+    else {
+        eprintln!("{what}: SKIPPED: no C compiler");
+        return None;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (c, exe) = (dir.path().join("prog.c"), dir.path().join("prog"));
+    std::fs::write(&c, src).unwrap();
+    let out = Command::new(cc)
+        .arg(&c)
+        .arg("-O0")
+        .arg("-o")
+        .arg(&exe)
+        .arg("-lm")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(String::from_utf8(Command::new(&exe).output().unwrap().stdout).unwrap())
+}
+
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
 }
@@ -108,15 +137,6 @@ fn gfs_writer_converts_the_law_and_the_geometry() {
     assert!(gfs.contains("return 1./(T/gl_eta + (1. - T)/0.0001);"));
 
     // the viscosity function itself, compiled
-    let Some(cc) = ["cc", "gcc", "clang"]
-        .into_iter()
-        .find(|c| Command::new(c).arg("--version").output().is_ok())
-    else {
-        eprintln!(
-            "gfs_writer_converts_the_law_and_the_geometry: compiled check SKIPPED: no C compiler"
-        );
-        return;
-    };
     let body = r.source_viscosity_c(Some(&LightPhase::default())).unwrap();
     let points: [(f64, f64, f64); 7] = [
         (1.0, 0.5, 1.0),  // inside the bounds
@@ -127,7 +147,6 @@ fn gfs_writer_converts_the_law_and_the_geometry() {
         (1.0, 0.5, 0.0),  // light phase
         (1.0, 0.5, 0.3),  // mixed cell
     ];
-    let dir = tempfile::tempdir().unwrap();
     let src = format!(
         "#include <math.h>\n#include <stdio.h>\n#define MIN(a,b) ((a) < (b) ? (a) : (b))\n#define MAX(a,b) ((a) > (b) ? (a) : (b))\nstatic double visc(double P, double D2, double T) {body}\nint main(void) {{\n{}  return 0;\n}}\n",
         points
@@ -135,22 +154,12 @@ fn gfs_writer_converts_the_law_and_the_geometry() {
             .map(|(p, d2, t)| format!("  printf(\"%.17g\\n\", visc({p:?}, {d2:?}, {t:?}));\n"))
             .collect::<String>()
     );
-    std::fs::write(dir.path().join("v.c"), src).unwrap();
-    let exe = dir.path().join("v");
-    let out = Command::new(cc)
-        .arg(dir.path().join("v.c"))
-        .arg("-O0")
-        .arg("-o")
-        .arg(&exe)
-        .arg("-lm")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let printed = String::from_utf8(Command::new(&exe).output().unwrap().stdout).unwrap();
+    let Some(printed) = compile_and_run(
+        "gfs_writer_converts_the_law_and_the_geometry: compiled check",
+        &src,
+    ) else {
+        return;
+    };
     let (lo, hi) = (r.regularisation.eta_min, r.regularisation.eta_max);
     for ((p, d2, t), line) in points.iter().zip(printed.lines()) {
         let eta = if *p <= 0.0 {
@@ -642,37 +651,18 @@ fn worked_reading_in_c() {
         block.contains(&format!("return {expr};")),
         "the doc's block is not `{expr}`:\n{block}"
     );
-    let Some(cc) = ["cc", "gcc", "clang"]
-        .into_iter()
-        .find(|c| Command::new(c).arg("--version").output().is_ok())
-    else {
-        eprintln!("worked_reading_in_c: SKIPPED: no C compiler");
-        return;
-    };
     let is: Vec<f64> = (0..=12)
         .map(|k| 1e-3 * 2000f64.powf(k as f64 / 12.0))
         .collect();
-    let dir = tempfile::tempdir().unwrap();
     let src = format!(
         "#include <stdio.h>\n{block}\nint main(void) {{\n{}  return 0;\n}}\n",
         is.iter()
             .map(|i| format!("  printf(\"%.17g\\n\", mu_of_I({i:?}));\n"))
             .collect::<String>()
     );
-    std::fs::write(dir.path().join("w.c"), src).unwrap();
-    let exe = dir.path().join("w");
-    let out = Command::new(cc)
-        .arg(dir.path().join("w.c"))
-        .arg("-o")
-        .arg(&exe)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let printed = String::from_utf8(Command::new(&exe).output().unwrap().stdout).unwrap();
+    let Some(printed) = compile_and_run("worked_reading_in_c", &src) else {
+        return;
+    };
     let want = law.evaluate(&is).unwrap();
     for ((i, line), w) in is.iter().zip(printed.lines()).zip(want) {
         let got: f64 = line.parse().unwrap();

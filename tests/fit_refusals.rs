@@ -12,6 +12,8 @@
 //! implies `se > |θ|` or a scale outside the data, which are reported first; it is tested on
 //! the check itself in `identify::accept`.
 
+mod common;
+
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
@@ -433,11 +435,5 @@ fn each_case_is_accepted_or_refused_with_its_reason_and_exit_status() {
         .enumerate()
         .filter_map(|(k, r)| check(r, k, dir.path()))
         .collect();
-    assert!(
-        failures.is_empty(),
-        "{} of {} rows failed:\n{}",
-        failures.len(),
-        rows.len(),
-        failures.join("\n")
-    );
+    common::assert_no_failures(&failures, rows.len());
 }

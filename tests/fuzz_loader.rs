@@ -10,11 +10,13 @@
 //! once broke one of these rules live in `tests/corpus/` and are replayed by
 //! `corpus_inputs_are_refused_with_their_message`.
 
+mod common;
+
 use std::path::Path;
 
 use grainlaw::scenarios::registry::{from_text, SCENARIOS};
 use proptest::prelude::*;
-use toml::{Table, Value};
+use toml::Table;
 
 /// Longest accepted error message (characters).
 const MAX_MESSAGE: usize = 600;
@@ -103,26 +105,14 @@ const TOKENS: &[&str] = &[
     "5.",
 ];
 
-/// Dotted paths of every leaf value of a table (inline tables included).
-fn leaf_keys(t: &Table, prefix: &str, out: &mut Vec<String>) {
-    for (k, v) in t {
-        let key = if prefix.is_empty() {
-            k.clone()
-        } else {
-            format!("{prefix}.{k}")
-        };
-        match v {
-            Value::Table(sub) => leaf_keys(sub, &key, out),
-            _ => out.push(key),
-        }
-    }
-}
-
+/// Dotted paths of every leaf value of scenario `which`'s built-in configuration (inline
+/// tables included).
 fn builtin_leaf_keys(which: usize) -> Vec<String> {
     let t: Table = SCENARIOS[which].builtin_toml().parse().unwrap();
-    let mut keys = Vec::new();
-    leaf_keys(&t, "", &mut keys);
-    keys
+    common::toml_leaves(&t)
+        .into_iter()
+        .map(|(key, _)| key)
+        .collect()
 }
 
 /// One mutation of a TOML text, given as line operations.

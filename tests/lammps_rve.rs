@@ -256,18 +256,8 @@ fn rve_points_of_every_i_merge_into_the_laws() {
     for i in TARGETS {
         let out = dir.path().join(format!("I{i}"));
         let files = series_files(i);
-        let o = grainlaw(&[
-            "homogenise",
-            "--from",
-            "lammps",
-            "--mu",
-            "0.5",
-            "-q",
-            "--out",
-            out.to_str().unwrap(),
-            files[0].to_str().unwrap(),
-            files[1].to_str().unwrap(),
-        ]);
+        let paths = [&out, &files[0], &files[1]].map(|p| p.to_str().unwrap());
+        let o = grainlaw(&[common::HOMOGENISE_LAMMPS, &paths].concat());
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let table = out.join("rheology.csv");
         let text = std::fs::read_to_string(&table).unwrap();

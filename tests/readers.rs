@@ -467,19 +467,10 @@ fn errors_name_the_file_and_line() {
 fn homogenise_command_writes_the_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let mut args: Vec<String> = [
-        "grainlaw",
-        "homogenise",
-        "--from",
-        "lammps",
-        "--mu",
-        "0.5",
-        "-q",
-        "--out",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
+    let mut args: Vec<String> = std::iter::once(&"grainlaw")
+        .chain(common::HOMOGENISE_LAMMPS)
+        .map(|s| s.to_string())
+        .collect();
     args.push(out.display().to_string());
     args.extend(lammps_files().iter().map(|p| p.display().to_string()));
     assert_eq!(grainlaw::cli::main_with_args(args), 0);

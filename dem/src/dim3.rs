@@ -150,13 +150,7 @@ impl FrictionCone for Coulomb3 {
 mod tests {
     use super::*;
     use crate::local::{Coulomb2, Delassus2};
-
-    fn lcg(state: &mut u64) -> Real {
-        *state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        ((*state >> 11) as Real) / ((1u64 << 53) as Real)
-    }
+    use crate::test_support::lcg;
 
     /// The frame is orthonormal and right-handed for normals all over the sphere (10⁻¹⁴), and
     /// local components go and come back.

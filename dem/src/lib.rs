@@ -59,6 +59,8 @@ pub mod solver;
 pub mod stabilise;
 pub mod step_control;
 pub mod sweep;
+#[cfg(test)]
+mod test_support;
 pub mod wavefront;
 pub mod world;
 

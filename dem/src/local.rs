@@ -249,19 +249,13 @@ impl FrictionCone for Coulomb2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::lcg;
 
     fn law_error(w: &Delassus2, q: [f64; 2], mu: f64, r: [f64; 2]) -> f64 {
         let wr = w.mul(r);
         let u = [wr[0] + q[0], wr[1] + q[1]];
         let e = natural_map_residual(r, u, mu);
         (e[0] * e[0] + e[1] * e[1]).sqrt()
-    }
-
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*state >> 11) as f64) / ((1u64 << 53) as f64)
     }
 
     #[test]

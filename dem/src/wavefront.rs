@@ -114,13 +114,8 @@ mod tests {
     /// fourth disk on a wall (body `n`).
     fn rows(n: usize) -> Vec<ContactRow> {
         let mut rows = Vec::new();
-        let mut lcg = 12345u64;
-        let mut next = || {
-            lcg = lcg
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((lcg >> 11) as f64) / ((1u64 << 53) as f64)
-        };
+        let mut state = 12345u64;
+        let mut next = || crate::test_support::lcg(&mut state);
         for i in 0..n {
             let pairs = [(i, (i + 1) % n), (i, n)];
             for (a, b) in pairs {

@@ -631,6 +631,22 @@ impl World {
         b
     }
 
+    /// Add the fixed line walls of an open box of `material`, in this order: `bottom` (y = 0),
+    /// `left` (x = 0) and `right` (x = `width`, m), each facing the inside; returns their body
+    /// indices.
+    pub fn add_box_walls(&mut self, width: f64, material: u16) -> [u32; 3] {
+        [
+            self.add_line_wall("bottom", Vector::zeros(), Vector::new(0.0, 1.0), material),
+            self.add_line_wall("left", Vector::zeros(), Vector::new(1.0, 0.0), material),
+            self.add_line_wall(
+                "right",
+                Vector::new(width, 0.0),
+                Vector::new(-1.0, 0.0),
+                material,
+            ),
+        ]
+    }
+
     /// Add a fixed segment wall from `a` to `b`; returns its body index (centre at the middle).
     pub fn add_segment_wall(&mut self, name: &str, a: Vector, b: Vector, material: u16) -> u32 {
         let id = self.state.bodies.len() as u32;

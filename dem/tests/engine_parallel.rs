@@ -25,14 +25,7 @@ fn crystal(nx: usize, ny: usize, parallel: bool) -> World {
     };
     let mut w = World::new(params, ContactLaws::new(&["grain"], 0.3));
     let width = 2.0 * R * nx as f64 + R;
-    w.add_line_wall("bottom", Vector2::zeros(), Vector2::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector2::zeros(), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        0,
-    );
+    w.add_box_walls(width, 0);
     for j in 0..ny {
         for i in 0..nx {
             let shift = if j % 2 == 1 { R } else { 0.0 };

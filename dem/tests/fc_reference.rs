@@ -556,12 +556,7 @@ fn gzip_and_plain_files_read_the_same_and_solutions_are_written_atomically() {
     assert!(solution.converged && solution.error <= 1e-8);
     dem::fc::write_solution(&out, &solution).unwrap();
     let v: Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
-    let r: Vec<f64> = v["r"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
+    let r: Vec<f64> = serde_json::from_value(v["r"].clone()).unwrap();
     // serde_json writes the shortest representation that round-trips; its default (fast) parser
     // may be one unit in the last place off.
     for (a, b) in r.iter().zip(&solution.r) {

@@ -444,9 +444,7 @@ pub fn grid_world(n: usize, width: f64, mu: f64, seed: u64) -> World {
         },
     };
     let mut w = World::new(params, ContactLaws::new(&["grain"], mu));
-    w.add_line_wall("bottom", Vector::new(0.0, 0.0), Vector::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector::new(0.0, 0.0), Vector::new(1.0, 0.0), 0);
-    w.add_line_wall("right", Vector::new(width, 0.0), Vector::new(-1.0, 0.0), 0);
+    w.add_box_walls(width, 0);
     let pitch = 2.0 * r_max * 1.02;
     let per_row = ((width / pitch).floor() as usize).max(1);
     let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;

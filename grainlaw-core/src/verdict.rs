@@ -450,6 +450,24 @@ impl Checks {
         }
     }
 
+    /// [`Checks::at_most`] for a solver error over the tolerance: refused above
+    /// [`SOLVER_ERROR_REFUSED`]; suspect above [`SOLVER_ERROR_SUSPECT`] unless the solver's
+    /// effect on the result was `measured` (and passed), which stands in for the suspect limit.
+    fn solver_error(
+        &mut self,
+        check: &str,
+        ratio: f64,
+        measured: bool,
+        what: impl Fn(f64) -> String,
+    ) {
+        let suspect = if measured {
+            SOLVER_ERROR_REFUSED
+        } else {
+            SOLVER_ERROR_SUSPECT
+        };
+        self.at_most(check, ratio, suspect, Some(SOLVER_ERROR_REFUSED), what);
+    }
+
     /// The numerics of the steps that feed a result: unconverged steps and worst error over the
     /// tolerance, energy growth, largest overlap ([module documentation](self)).
     pub fn window(&mut self, label: &str, w: &WindowStats) {
@@ -496,15 +514,10 @@ impl Checks {
             );
         }
         let e = w.worst_error / w.tolerance;
-        self.at_most(
+        self.solver_error(
             "solver.worst_error_over_tolerance",
             e,
-            if measured {
-                SOLVER_ERROR_REFUSED
-            } else {
-                SOLVER_ERROR_SUSPECT
-            },
-            Some(SOLVER_ERROR_REFUSED),
+            measured,
             |t| {
                 format!(
                     "{label}: worst solver error {:.2e} is {e:.0} times the tolerance {:.0e} (limit {t:.0}×)",
@@ -519,18 +532,13 @@ impl Checks {
         let loaded = w.worst_error_without_gap_shifts;
         if loaded > w.worst_error || loaded.is_nan() {
             let e0 = loaded / w.tolerance;
-            self.at_most(
+            self.solver_error(
                 "solver.loaded_error_over_tolerance",
                 e0,
                 // A measured sensitivity that passed stands in for the suspect limit, where
                 // every re-solve reached the tolerance (one short of it was judged on the
                 // problem's scale only).
-                if measured_loaded {
-                    SOLVER_ERROR_REFUSED
-                } else {
-                    SOLVER_ERROR_SUSPECT
-                },
-                Some(SOLVER_ERROR_REFUSED),
+                measured_loaded,
                 |t| {
                     format!(
                         "{label}: worst solver error over the loaded contacts' scale (without the gap-closing shifts of open pairs) {loaded:.2e} is {e0:.0} times the tolerance {:.0e} (limit {t:.0}×)",
@@ -1003,16 +1011,19 @@ impl RunVerdict {
             .unwrap_or(Verdict::Ok)
     }
 
+    /// The run's reasons, then every law's in the laws' order.
+    fn reasons(&self) -> impl Iterator<Item = &Reason> {
+        self.run
+            .reasons
+            .iter()
+            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
+    }
+
     /// Summary keys: `verdict`, `verdict_reasons` (the run's and every law's reasons, each once)
     /// and `law_verdicts` (per law: `law`, `file`, `verdict`, `reasons`).
     pub fn keys(&self, s: &mut Summary) {
         let mut all: Vec<Value> = Vec::new();
-        for r in self
-            .run
-            .reasons
-            .iter()
-            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
-        {
+        for r in self.reasons() {
             let v = r.to_json();
             if !all.contains(&v) {
                 all.push(v);
@@ -1042,12 +1053,7 @@ impl RunVerdict {
     pub fn lines(&self) -> Vec<String> {
         let mut out = vec![format!("verdict: {}", self.verdict())];
         let mut seen: Vec<(&str, &str)> = Vec::new();
-        for r in self
-            .run
-            .reasons
-            .iter()
-            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
-        {
+        for r in self.reasons() {
             let key = (r.check.as_str(), r.message.as_str());
             if !seen.contains(&key) {
                 seen.push(key);
@@ -1082,12 +1088,7 @@ impl RunVerdict {
     /// One line saying what failed (for the exit-status message).
     pub fn failure_line(&self) -> String {
         let mut first: Vec<String> = Vec::new();
-        for r in self
-            .run
-            .reasons
-            .iter()
-            .chain(self.laws.iter().flat_map(|l| l.checks.reasons.iter()))
-        {
+        for r in self.reasons() {
             let t = format!("{} ({})", r.check, r.verdict);
             if !first.contains(&t) {
                 first.push(t);

@@ -86,9 +86,7 @@ fn deposit(n: usize, seed: u64) -> World {
     };
     let mut w = World::new(params, ContactLaws::new(&["grain"], 0.4));
     let width = 0.06;
-    w.add_line_wall("bottom", Vector::zeros(), Vector::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector::zeros(), Vector::new(1.0, 0.0), 0);
-    w.add_line_wall("right", Vector::new(width, 0.0), Vector::new(-1.0, 0.0), 0);
+    w.add_box_walls(width, 0);
     let mut s = seed;
     let mut u = move || {
         s = s

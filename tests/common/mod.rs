@@ -174,3 +174,92 @@ pub fn lammps_stress_sum(path: &Path) -> [f64; 3] {
     }
     s
 }
+
+/// The standard output then the standard error of a finished command, as text.
+pub fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// A temporary directory holding the campaign plan `plan` as `plan.toml`.
+pub fn plan_dir(plan: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("plan.toml"), plan).unwrap();
+    dir
+}
+
+/// `grainlaw campaign ARGS` run in `cwd`.
+pub fn campaign(cwd: &Path, args: &[&str]) -> Output {
+    grainlaw_in(&[&["campaign"], args].concat(), cwd)
+}
+
+/// A CSV table read whole: its header and its rows.
+pub struct Table {
+    /// The header row.
+    pub head: csv::StringRecord,
+    /// The rows below it.
+    pub rows: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    /// The table in `text` (panics on a malformed one).
+    pub fn parse(text: &str) -> Table {
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let head = r.headers().unwrap().clone();
+        let rows = r.records().map(|r| r.unwrap()).collect();
+        Table { head, rows }
+    }
+
+    /// The index of the column `name` (panics without it).
+    pub fn col(&self, name: &str) -> usize {
+        self.head.iter().position(|h| h == name).unwrap()
+    }
+}
+
+/// Every leaf of the TOML table `t` that is not a table, under its dotted key (`a.b.c`),
+/// depth first in the table's order (inline tables included).
+pub fn toml_leaves(t: &toml::Table) -> Vec<(String, &toml::Value)> {
+    fn walk<'a>(t: &'a toml::Table, prefix: &str, out: &mut Vec<(String, &'a toml::Value)>) {
+        for (k, v) in t {
+            let key = if prefix.is_empty() {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            };
+            match v {
+                toml::Value::Table(sub) => walk(sub, &key, out),
+                _ => out.push((key, v)),
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(t, "", &mut out);
+    out
+}
+
+/// Asserts that a table test's `failures` (one message per failed row, of `rows` rows) is
+/// empty, listing them all when not.
+pub fn assert_no_failures(failures: &[String], rows: usize) {
+    assert!(
+        failures.is_empty(),
+        "{} of {} rows failed:\n{}",
+        failures.len(),
+        rows,
+        failures.join("\n")
+    );
+}
+
+/// `grainlaw homogenise` of LAMMPS dumps at μ = 0.5, quietly; the output directory and the
+/// files follow.
+pub const HOMOGENISE_LAMMPS: &[&str] = &[
+    "homogenise",
+    "--from",
+    "lammps",
+    "--mu",
+    "0.5",
+    "-q",
+    "--out",
+];

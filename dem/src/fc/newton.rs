@@ -767,12 +767,7 @@ mod tests {
     /// grains follow the cell within the step.
     fn chain_with_cell(n: usize) -> FcProblem {
         let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = || crate::test_support::lcg(&mut seed);
         let (mut ri, mut ci, mut v) = (Vec::new(), Vec::new(), Vec::new());
         let mut push = |i: usize, j: usize, b: [f64; 4]| {
             for (k, x) in b.into_iter().enumerate() {

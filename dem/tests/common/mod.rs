@@ -36,14 +36,7 @@ pub fn random_box(
         },
     };
     let mut w = World::new(params, ContactLaws::new(&["grain"], mu));
-    w.add_line_wall("bottom", Vector2::new(0.0, 0.0), Vector2::new(0.0, 1.0), 0);
-    w.add_line_wall("left", Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0), 0);
-    w.add_line_wall(
-        "right",
-        Vector2::new(width, 0.0),
-        Vector2::new(-1.0, 0.0),
-        0,
-    );
+    w.add_box_walls(width, 0);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let pitch = 2.0 * r_max * 1.05;
     let per_row = ((width / pitch).floor() as usize).max(1);

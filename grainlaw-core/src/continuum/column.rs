@@ -627,15 +627,7 @@ impl ColumnReport<'_> {
             s.set("band", b.json.clone());
         }
         self.verdict.keys(&mut s);
-        s.set(
-            "warnings",
-            Value::Array(
-                cfg.warnings
-                    .iter()
-                    .map(|w| Value::from(w.as_str()))
-                    .collect(),
-            ),
-        );
+        s.set("warnings", Value::from(cfg.warnings.clone()));
         s
     }
 

@@ -625,15 +625,7 @@ fn inclined_summary(
         s.set("dem", j.clone());
     }
     verdict.keys(&mut s);
-    s.set(
-        "warnings",
-        Value::Array(
-            cfg.warnings
-                .iter()
-                .map(|w| Value::from(w.as_str()))
-                .collect(),
-        ),
-    );
+    s.set("warnings", Value::from(cfg.warnings.clone()));
     s.text("grainlaw_version", identify::law::GRAINLAW_VERSION);
     s
 }

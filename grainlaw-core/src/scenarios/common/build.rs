@@ -62,17 +62,7 @@ pub(crate) fn world_with_laws(
 /// Adds the line walls `bottom` (y = 0), `left` (x = 0) and `right` (x = `width`, m) of a box,
 /// material [`WALL`], and returns their body indices.
 pub fn box_walls(w: &mut World, width: f64) -> [usize; 3] {
-    [
-        w.add_line_wall("bottom", Vector::zeros(), Vector::new(0.0, 1.0), WALL),
-        w.add_line_wall("left", Vector::zeros(), Vector::new(1.0, 0.0), WALL),
-        w.add_line_wall(
-            "right",
-            Vector::new(width, 0.0),
-            Vector::new(-1.0, 0.0),
-            WALL,
-        ),
-    ]
-    .map(|b| b as usize)
+    w.add_box_walls(width, WALL).map(|b| b as usize)
 }
 
 /// A box of two vertical walls and a floor filled with rained grains.
