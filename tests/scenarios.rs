@@ -68,18 +68,40 @@ fn refit(dir: &Path, law: &str, file: &str) -> (i32, Vec<(String, f64)>) {
 
 /// The data rows of a CSV file the runs write (comment lines and the header skipped), empty
 /// cells as NaN.
-fn csv_rows(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
+/// A CSV table's numeric rows under its header (comment lines skipped; a cell that is not a
+/// number reads as NaN): its columns are read by name ([`Csv::col`]), never by position.
+struct Csv {
+    head: Vec<String>,
+    rows: Vec<Vec<f64>>,
+}
+
+impl Csv {
+    /// The index of the column `name` (panics without it).
+    fn col(&self, name: &str) -> usize {
+        self.head
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.head))
+    }
+}
+
+fn csv_table(path: &Path) -> Csv {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let head = lines
+        .next()
         .unwrap()
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .skip(1)
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
         .map(|l| {
             l.split(',')
                 .map(|c| c.parse().unwrap_or(f64::NAN))
                 .collect()
         })
-        .collect()
+        .collect();
+    Csv { head, rows }
 }
 
 fn num(s: &Value, key: &str) -> f64 {
@@ -464,17 +486,12 @@ fn inclined_flow_short() {
     assert!((0.0..=1.0).contains(&f));
     assert!(num(&s, "flow_height_diameters") > 2.0);
     // Layers at least a mean diameter (3 mm) thick, and solid fractions that are area fractions.
-    let text = std::fs::read_to_string(out.join("profiles.csv")).unwrap();
-    let heights: Vec<(f64, f64)> = text
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.starts_with("height"))
-        .map(|l| {
-            let c: Vec<f64> = l
-                .split(',')
-                .map(|x| x.parse().unwrap_or(f64::NAN))
-                .collect();
-            (c[0], c[2])
-        })
+    let profiles = csv_table(&out.join("profiles.csv"));
+    let (height, solid) = (profiles.col("height_m"), profiles.col("solid_fraction"));
+    let heights: Vec<(f64, f64)> = profiles
+        .rows
+        .iter()
+        .map(|c| (c[height], c[solid]))
         .collect();
     assert!(heights.len() >= 2);
     assert!(
@@ -583,11 +600,20 @@ fn shear_cell_short() {
             }
         }
     }
-    let rows = csv_rows(&out.join("rheology.csv"));
+    let rheology = csv_table(&out.join("rheology.csv"));
+    let [i_target, mu, phi, samples, over_uniform] = [
+        "I_target",
+        "mu",
+        "phi",
+        "samples",
+        "wall_velocity_over_uniform",
+    ]
+    .map(|c| rheology.col(c));
+    let rows = &rheology.rows;
     assert_eq!(rows.len(), 5);
     // Every sample of every averaging window is re-solved to 1e-8 for the solver-sensitivity
     // checks (docs/outputs.md §2.1): the counts add up exactly, and at most 10 % fail.
-    let samples: f64 = rows.iter().map(|r| r[13]).sum();
+    let samples: f64 = rows.iter().map(|r| r[samples]).sum();
     let (resolved, unresolved) = (
         num(&s, "window_resolved_samples"),
         num(&s, "window_unresolved_samples"),
@@ -595,38 +621,51 @@ fn shear_cell_short() {
     assert_eq!(resolved + unresolved, samples);
     assert!(unresolved <= 0.1 * samples, "{unresolved} of {samples}");
     assert!(num(&s, "window_resolved_mu_change").is_finite());
-    for r in &rows {
-        assert!(r[2] > 0.1 && r[2] < 0.9, "mu = {}", r[2]);
-        assert!(r[3] > 0.5 && r[3] < 0.9, "phi = {}", r[3]);
+    for r in rows {
+        assert!(r[mu] > 0.1 && r[mu] < 0.9, "mu = {}", r[mu]);
+        assert!(r[phi] > 0.5 && r[phi] < 0.9, "phi = {}", r[phi]);
     }
-    assert!(rows[4][2] > rows[0][2], "μ should grow with I");
-    assert!(rows[4][3] < rows[0][3], "φ should fall with I");
+    assert!(rows[4][mu] > rows[0][mu], "μ should grow with I");
+    assert!(rows[4][phi] < rows[0][phi], "φ should fall with I");
     assert!(num(&s, "runs") == 5.0);
     // The wall velocity of each run (2 corrections by default): each factor follows the
     // control law from the bulk I its stage measured (1 within a factor 1.5 of the target,
     // else √(I_target/I) bounded to [1/2, 2]), and the run's V over the uniform-shear estimate
     // (rheology.csv) is their product (1e-12 relative).
-    let lead = csv_rows(&out.join("lead_stages.csv"));
-    assert_eq!(lead.len(), 10, "two corrections for each of 5 runs");
-    let over_uniform = 14; // rheology.csv column wall_velocity_over_uniform
-    for r in &rows {
-        let mine: Vec<&Vec<f64>> = lead.iter().filter(|l| l[0] == r[0]).collect();
+    let lead = csv_table(&out.join("lead_stages.csv"));
+    let [l_target, l_measured, l_factor, l_over] = [
+        "I_target",
+        "I_measured",
+        "velocity_factor",
+        "wall_velocity_over_uniform",
+    ]
+    .map(|c| lead.col(c));
+    assert_eq!(lead.rows.len(), 10, "two corrections for each of 5 runs");
+    for r in rows {
+        let mine: Vec<&Vec<f64>> = lead
+            .rows
+            .iter()
+            .filter(|l| l[l_target] == r[i_target])
+            .collect();
         assert_eq!(mine.len(), 2);
         let mut product = 1.0;
         for l in mine {
-            let miss = l[0] / l[2];
-            let expect = if l[2].is_nan() || l[2] <= 0.0 || (1.0 / 1.5..=1.5).contains(&miss) {
+            let miss = l[l_target] / l[l_measured];
+            let expect = if l[l_measured].is_nan()
+                || l[l_measured] <= 0.0
+                || (1.0 / 1.5..=1.5).contains(&miss)
+            {
                 1.0
             } else {
                 miss.sqrt().clamp(0.5, 2.0)
             };
             assert!(
-                (l[3] - expect).abs() <= 1e-12,
+                (l[l_factor] - expect).abs() <= 1e-12,
                 "factor {} vs {expect}",
-                l[3]
+                l[l_factor]
             );
-            product *= l[3];
-            assert!((l[4] - product).abs() <= 1e-12 * product);
+            product *= l[l_factor];
+            assert!((l[l_over] - product).abs() <= 1e-12 * product);
         }
         assert!(
             (r[over_uniform] - product).abs() <= 1e-12 * product,

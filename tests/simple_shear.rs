@@ -274,14 +274,24 @@ fn tiny_summary(extra: &[&str], dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
 }
 
-/// The first time of the shear run's history (s).
+/// The first time of the shear run's history (s): its column `t_s`, found by name.
 fn first_history_time(dir: &Path) -> f64 {
     let h = std::fs::read_to_string(dir.join("history_I1.csv")).unwrap();
-    let row = h
-        .lines()
-        .find(|l| l.starts_with(|c: char| c.is_ascii_digit()))
-        .unwrap();
-    row.split(',').next().unwrap().parse().unwrap()
+    let mut lines = h.lines().filter(|l| !l.starts_with('#'));
+    let t = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|c| c == "t_s")
+        .expect("a column t_s");
+    lines
+        .next()
+        .unwrap()
+        .split(',')
+        .nth(t)
+        .unwrap()
+        .parse()
+        .unwrap()
 }
 
 /// A consistent change of units gives the same dimensionless run. Rigid grains have no

@@ -25,7 +25,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
-use dem::math::Vector;
+use dem::math::{Spatial, Vector};
 use dem::snapshot::WallGeometry;
 
 use super::frame::{ContactRecord, Frame, GrainRecord, Other, WallRecord};
@@ -178,7 +178,9 @@ fn steps_header(path: &Path, ln: usize, line: &str) -> Result<(u64, f64), ReadEr
     Ok((step, labeled_number(path, ln, line, "time=")?))
 }
 
-type Dof = HashMap<u64, ([f64; 3], [f64; 3])>;
+/// A body's degrees of freedom in a DOF file: its displacement `(x, y, θ)` and velocity
+/// `(v_x, v_y, ω)`, packed per body (`dem::math::Spatial`).
+type Dof = HashMap<u64, (Spatial, Spatial)>;
 
 fn parse_dof(path: &Path, text: &str) -> Result<Vec<(u64, f64, Dof)>, ReadError> {
     let mut out: Vec<(u64, f64, Dof)> = Vec::new();

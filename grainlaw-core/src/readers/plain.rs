@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use dem::math::Vector;
+use dem::math::{Spatial, Vector};
 use dem::snapshot::WallGeometry;
 use serde::{Deserialize, Serialize};
 
@@ -64,7 +64,7 @@ pub struct PlainGrain {
     /// Acceleration `[a_x, a_y, ω̇]` (m/s², rad/s²); when absent in any grain, finite
     /// differences of the velocities are used.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub acceleration: Option<[f64; 3]>,
+    pub acceleration: Option<Spatial>,
 }
 
 /// A wall: a line (`point`, `normal` towards the grains) or a segment (`a`, `b`).
