@@ -14,18 +14,13 @@ mod common;
 
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
+use common::stderr;
+
+/// `grainlaw ARGS` run in `dir` ([`common::grainlaw_in`]).
 fn grainlaw(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_grainlaw"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("grainlaw runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
+    common::grainlaw_in(args, dir)
 }
 
 /// Runs `grainlaw fit LAW FILE --out law.json` in `dir`: exit code, stdout + stderr, and the

@@ -149,14 +149,9 @@ fn a_shear_cell_resumed_across_its_solver_tightening_gives_the_same_files() {
     let cell = &common::small_shear_cell("inertial_numbers=[0.04, 0.08, 0.15]", &[])[..];
     assert_finished(&grainlaw(&[cell, &["--out"]].concat(), &[&a]));
     let table = std::fs::read_to_string(a.join("rheology.csv")).unwrap();
-    let mut lines = table.lines().filter(|l| !l.starts_with('#'));
-    let col = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .position(|c| c == "solver_tolerance")
-        .expect("a column solver_tolerance");
-    let tolerances: Vec<&str> = lines.map(|l| l.split(',').nth(col).unwrap()).collect();
+    let t = common::Table::parse(&table);
+    let col = t.col("solver_tolerance");
+    let tolerances: Vec<&str> = t.rows.iter().map(|r| &r[col]).collect();
     assert_eq!(tolerances, ["1e-4", "1e-5", "1e-5"], "{table}");
     let o = grainlaw(
         &[cell, &["--stop-after-steps", "240", "--out"]].concat(),

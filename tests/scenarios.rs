@@ -66,44 +66,6 @@ fn refit(dir: &Path, law: &str, file: &str) -> (i32, Vec<(String, f64)>) {
     (code, params)
 }
 
-/// The data rows of a CSV file the runs write (comment lines and the header skipped), empty
-/// cells as NaN.
-/// A CSV table's numeric rows under its header (comment lines skipped; a cell that is not a
-/// number reads as NaN): its columns are read by name ([`Csv::col`]), never by position.
-struct Csv {
-    head: Vec<String>,
-    rows: Vec<Vec<f64>>,
-}
-
-impl Csv {
-    /// The index of the column `name` (panics without it).
-    fn col(&self, name: &str) -> usize {
-        self.head
-            .iter()
-            .position(|h| h == name)
-            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.head))
-    }
-}
-
-fn csv_table(path: &Path) -> Csv {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let head = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|c| c.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
-    Csv { head, rows }
-}
-
 fn num(s: &Value, key: &str) -> f64 {
     s.get(key)
         .and_then(Value::as_f64)
@@ -486,10 +448,10 @@ fn inclined_flow_short() {
     assert!((0.0..=1.0).contains(&f));
     assert!(num(&s, "flow_height_diameters") > 2.0);
     // Layers at least a mean diameter (3 mm) thick, and solid fractions that are area fractions.
-    let profiles = csv_table(&out.join("profiles.csv"));
+    let profiles = common::Table::read(&out.join("profiles.csv"));
     let (height, solid) = (profiles.col("height_m"), profiles.col("solid_fraction"));
     let heights: Vec<(f64, f64)> = profiles
-        .rows
+        .numbers()
         .iter()
         .map(|c| (c[height], c[solid]))
         .collect();
@@ -600,7 +562,7 @@ fn shear_cell_short() {
             }
         }
     }
-    let rheology = csv_table(&out.join("rheology.csv"));
+    let rheology = common::Table::read(&out.join("rheology.csv"));
     let [i_target, mu, phi, samples, over_uniform] = [
         "I_target",
         "mu",
@@ -609,7 +571,7 @@ fn shear_cell_short() {
         "wall_velocity_over_uniform",
     ]
     .map(|c| rheology.col(c));
-    let rows = &rheology.rows;
+    let rows = &rheology.numbers();
     assert_eq!(rows.len(), 5);
     // Every sample of every averaging window is re-solved to 1e-8 for the solver-sensitivity
     // checks (docs/outputs.md §2.1): the counts add up exactly, and at most 10 % fail.
@@ -632,7 +594,7 @@ fn shear_cell_short() {
     // control law from the bulk I its stage measured (1 within a factor 1.5 of the target,
     // else √(I_target/I) bounded to [1/2, 2]), and the run's V over the uniform-shear estimate
     // (rheology.csv) is their product (1e-12 relative).
-    let lead = csv_table(&out.join("lead_stages.csv"));
+    let lead = common::Table::read(&out.join("lead_stages.csv"));
     let [l_target, l_measured, l_factor, l_over] = [
         "I_target",
         "I_measured",
@@ -640,10 +602,10 @@ fn shear_cell_short() {
         "wall_velocity_over_uniform",
     ]
     .map(|c| lead.col(c));
-    assert_eq!(lead.rows.len(), 10, "two corrections for each of 5 runs");
+    let lead_rows = lead.numbers();
+    assert_eq!(lead_rows.len(), 10, "two corrections for each of 5 runs");
     for r in rows {
-        let mine: Vec<&Vec<f64>> = lead
-            .rows
+        let mine: Vec<&Vec<f64>> = lead_rows
             .iter()
             .filter(|l| l[l_target] == r[i_target])
             .collect();

@@ -794,7 +794,7 @@ impl World {
         self.refresh_inverse_mass();
         let mut set = ContactSet::default();
         self.detect_into(0.0, 0.0, 0.0, 0.0, &mut set)?;
-        for (row, g) in set.rows.iter().zip(&set.geometry) {
+        for (row, g) in set.rows_with_geometry() {
             if g.gap < -tolerance {
                 let (a, b) = (row.a as usize, row.b as usize);
                 if self.state.bodies[a].kind == BodyKind::Wall {

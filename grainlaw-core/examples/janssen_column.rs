@@ -1,4 +1,4 @@
-//! Settle the benchmark Janssen column: `cargo run --release -p datasets --example
+//! Settle the benchmark Janssen column: `cargo run --release -p grainlaw-core --example
 //! janssen_column -- N [pour|deposit] [serial]`.
 use grainlaw_core::benchmarks::{settle_column, ColumnRun, Preparation};
 

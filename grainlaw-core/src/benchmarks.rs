@@ -211,7 +211,7 @@ pub fn janssen_column(
         Preparation::Deposit => deposit(&mut rng, &radii, COLUMN_WIDTH, 1e-6 * R_MIN)?.centres,
     };
     let mut w = box_world(COLUMN_WIDTH, run, &centres, &radii, grain.density);
-    w.validate(1e-12)?;
+    w.validate(crate::scenarios::common::build::BUILD_TOLERANCE)?;
     Ok(w)
 }
 

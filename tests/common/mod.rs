@@ -205,17 +205,35 @@ pub struct Table {
 }
 
 impl Table {
-    /// The table in `text` (panics on a malformed one).
+    /// The table in `text`, its `#` comment lines skipped (panics on a malformed one).
     pub fn parse(text: &str) -> Table {
-        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let mut r = csv::ReaderBuilder::new()
+            .comment(Some(b'#'))
+            .from_reader(text.as_bytes());
         let head = r.headers().unwrap().clone();
         let rows = r.records().map(|r| r.unwrap()).collect();
         Table { head, rows }
     }
 
+    /// The table in the file at `path` ([`Table::parse`]).
+    pub fn read(path: &Path) -> Table {
+        Table::parse(&std::fs::read_to_string(path).unwrap())
+    }
+
     /// The index of the column `name` (panics without it).
     pub fn col(&self, name: &str) -> usize {
-        self.head.iter().position(|h| h == name).unwrap()
+        self.head
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.head))
+    }
+
+    /// The rows as numbers (a cell that is not one reads as NaN).
+    pub fn numbers(&self) -> Vec<Vec<f64>> {
+        self.rows
+            .iter()
+            .map(|r| r.iter().map(|c| c.parse().unwrap_or(f64::NAN)).collect())
+            .collect()
     }
 }
 

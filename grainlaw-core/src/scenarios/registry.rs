@@ -64,7 +64,7 @@ pub struct Runner<C> {
     pub description: &'static str,
     /// [`Scenario::builtin_toml`].
     pub toml: &'static str,
-    /// The runner (`grainlaw-core/src/scenarios/NAME.rs`'s `run`).
+    /// The runner (`grainlaw-core/src/scenarios/NAME/mod.rs`'s `run`).
     pub run: fn(&C, &mut RunContext, &mut RunControl) -> Result<RunOutcome>,
 }
 

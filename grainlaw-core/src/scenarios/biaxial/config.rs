@@ -7,9 +7,7 @@ use serde::{Deserialize, Serialize};
 use datasets::error::{in_range, num, positive, DatasetError, Result};
 use datasets::limits;
 
-use crate::scenarios::common::config::{
-    check_cell_compression, CellControlMode, GrainSpec, SolverSpec,
-};
+use crate::scenarios::common::config::{CellControlMode, GrainSpec, SolverSpec};
 use crate::scenarios::common::laws::LawNeed;
 use crate::scenarios::simple_shear::config::CellFriction;
 
@@ -209,12 +207,27 @@ impl BiaxialConfig {
                 "must be at least 1",
             ));
         }
-        check_cell_compression(
-            self.compression_dt(),
+        // the isotropic compression: the cap of the cell's strain rate under stress control,
+        // its duration in at most limits-many steps, the loose packing, the solver table
+        in_range(
+            "control_inertial_number",
             self.control_inertial_number,
-            self.compression_time,
+            1e-6,
+            0.1,
+        )?;
+        positive("compression_time", self.compression_time)?;
+        in_range(
+            "initial_solid_fraction",
             self.initial_solid_fraction,
-            &self.solver,
+            0.2,
+            0.6,
+        )?;
+        self.solver.validate("solver")?;
+        limits::steps(
+            "compression_time",
+            "compression_time / Δt (the step of the isotropic compression)",
+            self.compression_time,
+            self.compression_dt(),
         )?;
         let d = 2.0 * self.grain.radius_mean;
         let p_min = self

@@ -131,8 +131,8 @@ pub fn column(
     })
 }
 
-/// Centres of a rough wall: disks of radius `r` evenly spaced along `[0, length)` at height `y`,
-/// `gap_fraction · 2r` apart (surface to surface).
+/// Centres of a rough wall: `m = ⌊length / 2r⌋` disks of radius `r` evenly spaced along
+/// `[0, length)` at height `y`, at the pitch `length / m ≥ 2r` (touching, or a little apart).
 pub(crate) fn rough_row(length: f64, r: f64, y: f64) -> (Vec<Vector>, Vec<f64>) {
     let m = ((length / (2.0 * r)).floor() as usize).max(1);
     let pitch = length / m as f64;
@@ -235,7 +235,7 @@ pub fn loose_cell(c: &LooseCell) -> Result<World> {
         c.grain.radius_mean,
         c.grain.radius_spread,
     );
-    let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
+    let area = total_area(&radii);
     let n_side = (c.grains as f64).sqrt().ceil() as usize;
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
     let spacing = ((area / c.solid_fraction).sqrt() / n_side as f64).max(2.04 * r_max);
@@ -263,6 +263,6 @@ pub fn loose_cell(c: &LooseCell) -> Result<World> {
     }
     let cell = Cell::rectangle(side, side)?;
     w.set_cell(Some(cell))?;
-    w.validate(1e-12)?;
+    w.validate(BUILD_TOLERANCE)?;
     Ok(w)
 }

@@ -382,35 +382,6 @@ pub fn check_inertial_numbers(
     Ok(())
 }
 
-/// The keys of a biperiodic cell's isotropic compression (`biaxial`): `control_inertial_number`
-/// in [10⁻⁶, 0.1] (the cap of the cell's strain rate under stress control),
-/// `compression_time` > 0 and at most [`limits`]-many steps of the compression's time step
-/// `dt`, `initial_solid_fraction` in [0.2, 0.6], and the solver table `solver`.
-pub fn check_cell_compression(
-    dt: f64,
-    control_inertial_number: f64,
-    compression_time: f64,
-    initial_solid_fraction: f64,
-    solver: &SolverSpec,
-) -> Result<()> {
-    in_range(
-        "control_inertial_number",
-        control_inertial_number,
-        1e-6,
-        0.1,
-    )?;
-    positive("compression_time", compression_time)?;
-    in_range("initial_solid_fraction", initial_solid_fraction, 0.2, 0.6)?;
-    solver.validate("solver")?;
-    limits::steps(
-        "compression_time",
-        "compression_time / Δt (the step of the isotropic compression)",
-        compression_time,
-        dt,
-    )?;
-    Ok(())
-}
-
 /// How the cell's stress-controlled components follow their targets (`dem::cell::CellControl`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
